@@ -1,0 +1,95 @@
+// The scene after loading: validated, triangulated, in world space (scene-format.md).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace abcube {
+
+enum class Method { abuffer, zbuffer, envmap, raytrace, gpu };
+const char* method_name(Method m);
+// Parses a method name; returns false for an unknown one.
+bool parse_method(const std::string& s, Method* out);
+
+struct Camera {
+  glm::dvec3 position{0, 1, -4};
+  glm::dvec3 look_at{0, 0.5, 0};
+  glm::dvec3 up{0, 1, 0};
+  double fov_y_deg = 60;
+  int width = 512;
+  int height = 512;
+};
+
+struct PointLight {
+  glm::dvec3 position{0};
+  glm::dvec3 color{1};  // intensity per channel, no distance attenuation
+  bool cast_shadows = true;
+};
+
+// Phong material (thesis ch. 6; scene-format.md "materials").
+struct Material {
+  std::string name;
+  glm::dvec3 color{0.8};  // Od, diffuse colour
+  double ambient = 1.0;   // ka, times the scene ambient
+  double diffuse = 1.0;   // kd
+  double specular = 0.0;  // ks
+  double shininess = 32;  // n
+  double reflect = 0.0;   // kr, mirror weight
+  double transmit = 0.0;  // kt, refractive weight
+  double ior = 1.0;
+  double opacity = 1.0;   // coverage transparency, blended by the A-buffer resolve
+};
+
+struct SceneObject {
+  std::string type;              // triangle, quad, box, sphere, mesh
+  std::string path;              // "objects[3]" (for messages)
+  uint32_t material = 0;         // index into Scene::materials (per-triangle ids may differ for meshes)
+  bool closed = false;           // has an inside (box, sphere, closed mesh)
+  uint32_t first_triangle = 0;   // range in TriangleSoup
+  uint32_t triangle_count = 0;
+};
+
+// Every object's triangles, unindexed, world space. Triangle i owns entries 3i..3i+2
+// of positions and normals; normals are unit (flat ones repeated when the surface has
+// no smooth normals). The winding gives the geometric normal cross(b-a, c-a).
+struct TriangleSoup {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;
+  std::vector<uint32_t> object_id;    // per triangle, index into Scene::objects
+  std::vector<uint32_t> material_id;  // per triangle, index into Scene::materials
+  size_t triangle_count() const { return object_id.size(); }
+};
+
+struct RenderSettings {
+  Method method = Method::abuffer;
+  int cube_resolution = 512;
+  int max_depth = 4;
+};
+
+struct Bounds {
+  glm::dvec3 lo{1e300}, hi{-1e300};
+  bool empty() const { return lo.x > hi.x; }
+  void extend(const glm::dvec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+};
+
+struct Scene {
+  std::string file;  // path as given, for messages
+  Camera camera;
+  glm::dvec3 background{0};
+  glm::dvec3 ambient{0.1};
+  std::vector<PointLight> lights;
+  std::vector<Material> materials;
+  std::vector<SceneObject> objects;
+  TriangleSoup triangles;
+  RenderSettings render;
+  size_t dropped_triangles = 0;  // zero-area or non-finite triangles dropped at load
+
+  Bounds bounds() const;
+};
+
+// Largest Euclidean distance from p to any scene vertex (0 for an empty scene).
+double max_distance_from(const Scene& scene, const glm::dvec3& p);
+
+}  // namespace abcube

@@ -1,0 +1,142 @@
+// abcube render: load a scene, run the passes its method needs, write the image and stats.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_common.hpp"
+#include "error.hpp"
+#include "gl_context.hpp"
+#include "gl_passes.hpp"
+#include "image_io.hpp"
+#include "memory.hpp"
+#include "scene_load.hpp"
+
+namespace abcube {
+
+namespace {
+
+using nlohmann::json;
+
+struct RenderRequest {
+  std::string scene_path, output, stats_path;
+  GlChoice gl = GlChoice::automatic;
+  int gl_device = -1;
+  int threads = 0;
+  bool reference = false;
+};
+
+// Parses the command line and applies its overrides to the scene (cli.md).
+RenderRequest parse_request(const std::vector<std::string>& words, Scene* scene) {
+  const Args args(words,
+                  {"-o", "--output", "--method", "--cube-res", "--max-depth", "--threads", "--gl",
+                   "--gl-device", "--stats"},
+                  {"--reference"});
+  args.expect_positional(1, "SCENE.json");
+  RenderRequest r;
+  r.scene_path = args.positional()[0];
+  r.output = args.has("-o") ? args.get("-o") : args.get("--output");
+  if (r.output.empty()) throw InputError("-o OUT: an output image is required");
+  if (!image_format_supported(r.output)) {
+    throw InputError(r.output + ": no image writer for this file extension");
+  }
+  r.stats_path = args.get("--stats");
+  if (args.has("--gl") && !parse_gl_choice(args.get("--gl"), &r.gl)) {
+    throw InputError("--gl: unknown path '" + args.get("--gl") +
+                     "' (auto, egl, egl-device, egl-surfaceless, osmesa, none)");
+  }
+  r.gl_device = args.get_int("--gl-device", -1, 0, 1024);
+  r.threads = args.get_int("--threads", 0, 0, 4096);
+  r.reference = args.has("--reference");
+  Method method{};
+  if (args.has("--method") && !parse_method(args.get("--method"), &method)) {
+    throw InputError("--method: unknown method '" + args.get("--method") +
+                     "' (abuffer, zbuffer, envmap, raytrace, gpu)");
+  }
+
+  *scene = load_scene(r.scene_path);
+  if (args.has("--method")) scene->render.method = method;
+  scene->render.cube_resolution = args.get_int("--cube-res", scene->render.cube_resolution, 1, 16384);
+  scene->render.max_depth = args.get_int("--max-depth", scene->render.max_depth, 0, 64);
+  check_render_size(*scene, available_memory_bytes());
+  return r;
+}
+
+json gl_json(const GlContext* ctx) {
+  if (!ctx) return {{"path", "none"}, {"renderer", describe_gl(nullptr)}};
+  const GlInfo& i = ctx->info();
+  json j = {{"path", i.api}, {"renderer", i.gl_renderer}, {"gl_version", i.gl_version},
+            {"gl_vendor", i.gl_vendor}};
+  if (!i.egl_vendor.empty()) j["egl_vendor"] = i.egl_vendor;
+  if (i.device_index >= 0) j["egl_device"] = i.device_index;
+  return j;
+}
+
+// The Z-buffer raster on the GPU: camera view only, Phong, aliased (--method gpu).
+Image render_gpu(const Scene& scene, const RenderRequest& r, json* stats) {
+  std::string log;
+  Clock::time_point t0 = Clock::now();
+  std::unique_ptr<GlContext> ctx = open_gl_context(r.gl, r.gl_device, &log);
+  if (!ctx) {
+    if (r.gl == GlChoice::none) throw InputError("--method gpu needs OpenGL, but --gl none was given");
+    for (char& c : log) c = c == '\n' ? ';' : c;
+    throw RuntimeFailure("--method gpu needs OpenGL and no GL path works here: " + log);
+  }
+  (*stats)["gl"] = gl_json(ctx.get());
+  (*stats)["timings_ms"]["gl_init"] = ms_since(t0);
+  GlScene gl(scene);
+  Image image = gl.camera_color(scene.camera);
+  const GpuTimings& t = gl.timings();
+  (*stats)["timings_ms"]["upload"] = t.upload_ms;
+  (*stats)["timings_ms"]["camera_raster"] = t.camera_ms;
+  (*stats)["timings_ms"]["readback"] = t.readback_ms;
+  (*stats)["plan"]["passes"] = {"camera_raster"};
+  (*stats)["plan"]["skipped"] = {
+      {{"pass", "cube_distance"}, {"why", "method gpu is the plain Z-buffer raster: no map search"}},
+      {{"pass", "cube_color"}, {"why", "method gpu looks up no environment map"}}};
+  return image;
+}
+
+}  // namespace
+
+int cmd_render(const std::vector<std::string>& words) {
+  const Clock::time_point start = Clock::now();
+  Scene scene;
+  const RenderRequest r = parse_request(words, &scene);
+  json stats;
+  stats["scene"] = r.scene_path;
+  stats["method"] = method_name(scene.render.method);
+  stats["timings_ms"]["load"] = ms_since(start);
+  stats["counts"] = {{"triangles", scene.triangles.triangle_count()},
+                     {"dropped_triangles", scene.dropped_triangles},
+                     {"objects", scene.objects.size()},
+                     {"lights", scene.lights.size()}};
+  stats["size"] = {{"width", scene.camera.width}, {"height", scene.camera.height},
+                   {"cube_resolution", scene.render.cube_resolution},
+                   {"max_depth", scene.render.max_depth}};
+  stats["threads"] = resolve_threads(r.threads);
+
+  Image image;
+  switch (scene.render.method) {
+    case Method::gpu:
+      image = render_gpu(scene, r, &stats);
+      break;
+    default:
+      throw RuntimeFailure(std::string("method '") + method_name(scene.render.method) +
+                           "' is not in this build yet; use --method gpu");
+  }
+  if (r.reference) {
+    throw RuntimeFailure("--reference needs the exact tracer, which is not in this build yet");
+  }
+
+  Clock::time_point t0 = Clock::now();
+  write_image(r.output, image);
+  stats["timings_ms"]["write"] = ms_since(t0);
+  stats["timings_ms"]["total"] = ms_since(start);
+  stats["memory"] = {{"peak_rss_bytes", peak_rss_bytes()}};
+  if (!r.stats_path.empty()) write_text_atomic(r.stats_path, stats.dump(2) + "\n");
+  return 0;
+}
+
+}  // namespace abcube

@@ -1,0 +1,79 @@
+#include "gl_context.hpp"
+
+#include <cstdlib>
+
+#include "error.hpp"
+
+namespace abcube {
+
+bool parse_gl_choice(const std::string& s, GlChoice* out) {
+  static const std::pair<const char*, GlChoice> names[] = {
+      {"auto", GlChoice::automatic},        {"egl", GlChoice::egl},
+      {"egl-device", GlChoice::egl_device}, {"egl-surfaceless", GlChoice::egl_surfaceless},
+      {"osmesa", GlChoice::osmesa},         {"none", GlChoice::none}};
+  for (const auto& [name, value] : names) {
+    if (s == name) {
+      *out = value;
+      return true;
+    }
+  }
+  return false;
+}
+
+namespace {
+int device_from_environment(int device_index) {
+  if (device_index >= 0) return device_index;
+  const char* env = std::getenv("ABCUBE_EGL_DEVICE");
+  if (!env || !*env) return -1;
+  char* end = nullptr;
+  const long v = std::strtol(env, &end, 10);
+  if (*end != '\0' || v < 0) throw InputError(std::string("ABCUBE_EGL_DEVICE: not a device index: ") + env);
+  return static_cast<int>(v);
+}
+}  // namespace
+
+std::unique_ptr<GlContext> open_gl_context(GlChoice choice, int device_index, std::string* log) {
+  device_index = device_from_environment(device_index);
+  std::string why;
+  std::unique_ptr<GlContext> ctx;
+  auto note = [&](const char* api) {
+    if (log) *log += std::string(api) + ": " + why + "\n";
+  };
+  switch (choice) {
+    case GlChoice::none:
+      return nullptr;
+    case GlChoice::egl_device:
+      if ((ctx = create_egl_device_context(device_index, &why))) return ctx;
+      throw RuntimeFailure("--gl egl-device failed: " + why);
+    case GlChoice::egl_surfaceless:
+      if ((ctx = create_egl_surfaceless_context(&why))) return ctx;
+      throw RuntimeFailure("--gl egl-surfaceless failed: " + why);
+    case GlChoice::osmesa:
+      if ((ctx = create_osmesa_context(&why))) return ctx;
+      throw RuntimeFailure("--gl osmesa failed: " + why);
+    case GlChoice::egl: {
+      // EGL in whichever form works: a (hardware, or the chosen) device, else surfaceless.
+      if ((ctx = create_egl_device_context(device_index, &why))) return ctx;
+      if (device_index >= 0) throw RuntimeFailure("--gl egl failed: " + why);
+      const std::string device_why = why;
+      if ((ctx = create_egl_surfaceless_context(&why))) return ctx;
+      throw RuntimeFailure("--gl egl failed: device: " + device_why + "; surfaceless: " + why);
+    }
+    case GlChoice::automatic:
+      if ((ctx = create_egl_device_context(device_index, &why))) return ctx;
+      note("egl-device");
+      if ((ctx = create_egl_surfaceless_context(&why))) return ctx;
+      note("egl-surfaceless");
+      if ((ctx = create_osmesa_context(&why))) return ctx;
+      note("osmesa");
+      return nullptr;
+  }
+  return nullptr;
+}
+
+std::string describe_gl(const GlContext* ctx) {
+  if (!ctx) return "none (CPU only)";
+  return ctx->info().gl_renderer + " (" + ctx->info().api + ")";
+}
+
+}  // namespace abcube

@@ -1,0 +1,276 @@
+#include "gl_passes.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "cube_map.hpp"
+#include "error.hpp"
+
+namespace abcube {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+struct Vertex {
+  float position[3];
+  float normal[3];
+  uint32_t object;
+  uint32_t material;
+};
+
+struct MaterialGpu {
+  float color_ambient[4];
+  float coefficients[4];
+};
+
+struct LightGpu {
+  float position[4];
+  float color[4];
+};
+
+}  // namespace
+
+// One framebuffer: distance (R32F) + object id (R32UI), or colour (RGBA32F); depth 32F.
+struct GlScene::Target {
+  int width = 0, height = 0;
+  bool distance_pass = false;
+  GLuint fbo = 0, color0 = 0, color1 = 0, depth = 0;
+
+  Target(int w, int h, bool distance) : width(w), height(h), distance_pass(distance) {
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    auto make = [&](GLenum format, GLenum attachment) {
+      GLuint tex = 0;
+      glGenTextures(1, &tex);
+      glBindTexture(GL_TEXTURE_2D, tex);
+      glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
+      glFramebufferTexture2D(GL_FRAMEBUFFER, attachment, GL_TEXTURE_2D, tex, 0);
+      return tex;
+    };
+    color0 = make(distance ? GL_R32F : GL_RGBA32F, GL_COLOR_ATTACHMENT0);
+    if (distance) color1 = make(GL_R32UI, GL_COLOR_ATTACHMENT1);
+    depth = make(GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT);
+    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(distance ? 2 : 1, buffers);
+    const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+      throw RuntimeFailure("framebuffer " + std::to_string(w) + "x" + std::to_string(h) +
+                           " incomplete (status " + std::to_string(status) + ")");
+    }
+  }
+  ~Target() {
+    const GLuint textures[] = {color0, color1, depth};
+    glDeleteTextures(3, textures);
+    glDeleteFramebuffers(1, &fbo);
+  }
+
+  void clear(const glm::dvec3& background) const {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glViewport(0, 0, width, height);
+    const float zero_depth = 0.f;  // reversed Z: 0 is infinitely far
+    glClearBufferfv(GL_DEPTH, 0, &zero_depth);
+    if (distance_pass) {
+      const float far[4] = {NO_DISTANCE, 0, 0, 0};
+      const GLuint none[4] = {NO_OBJECT, 0, 0, 0};
+      glClearBufferfv(GL_COLOR, 0, far);
+      glClearBufferuiv(GL_COLOR, 1, none);
+    } else {
+      const float bg[4] = {float(background.x), float(background.y), float(background.z), 1.f};
+      glClearBufferfv(GL_COLOR, 0, bg);
+    }
+  }
+
+  // Reads attachment `index` into `out` (`components` values per texel, GL row order).
+  void read(int index, GLenum format, GLenum type, void* out) const {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(index));
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, width, height, format, type, out);
+  }
+};
+
+GlScene::GlScene(const Scene& scene) : scene_(scene) {
+  const Clock::time_point t0 = Clock::now();
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size_);
+  const double radius = max_distance_from(scene, scene.camera.position);
+  near_ = default_near_distance(radius);
+
+  const TriangleSoup& t = scene.triangles;
+  std::vector<Vertex> vertices(t.positions.size());
+  for (size_t v = 0; v < vertices.size(); ++v) {
+    Vertex& o = vertices[v];
+    std::memcpy(o.position, &t.positions[v].x, sizeof o.position);
+    std::memcpy(o.normal, &t.normals[v].x, sizeof o.normal);
+    o.object = t.object_id[v / 3];
+    o.material = t.material_id[v / 3];
+  }
+  vertex_count_ = static_cast<GLsizei>(vertices.size());
+  glGenVertexArrays(1, &vao_);
+  glBindVertexArray(vao_);
+  glGenBuffers(1, &vbo_);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo_);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)),
+               vertices.data(), GL_STATIC_DRAW);
+  const auto offset = [](size_t bytes) { return reinterpret_cast<const void*>(bytes); };
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), offset(offsetof(Vertex, position)));
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), offset(offsetof(Vertex, normal)));
+  glVertexAttribIPointer(2, 1, GL_UNSIGNED_INT, sizeof(Vertex), offset(offsetof(Vertex, object)));
+  glVertexAttribIPointer(3, 1, GL_UNSIGNED_INT, sizeof(Vertex), offset(offsetof(Vertex, material)));
+  for (GLuint a = 0; a < 4; ++a) glEnableVertexAttribArray(a);
+
+  std::vector<MaterialGpu> materials;
+  for (const Material& m : scene.materials) {
+    materials.push_back({{float(m.color.r), float(m.color.g), float(m.color.b), float(m.ambient)},
+                         {float(m.diffuse), float(m.specular), float(m.shininess), 0.f}});
+  }
+  if (materials.empty()) materials.push_back({});
+  glGenBuffers(1, &materials_);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, materials_);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(materials.size() * sizeof(MaterialGpu)),
+               materials.data(), GL_STATIC_DRAW);
+  glGenBuffers(1, &lights_);
+
+  distance_program_ = std::make_unique<GlProgram>(std::vector<const char*>{"scene.vert"},
+                                                  std::vector<const char*>{"cube_distance.frag"});
+  phong_program_ = std::make_unique<GlProgram>(
+      std::vector<const char*>{"scene.vert"},
+      std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "phong.frag"});
+
+  // Infinite reversed-Z (cube_map.hpp): depth in [0, 1], 1 at the near plane.
+  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glDisable(GL_CULL_FACE);  // back faces too: the map holds every surface
+  glFinish();
+  check_gl("scene upload");
+  timings_.upload_ms = ms_since(t0);
+}
+
+GlScene::~GlScene() {
+  target_.reset();
+  glDeleteBuffers(1, &vbo_);
+  glDeleteBuffers(1, &materials_);
+  glDeleteBuffers(1, &lights_);
+  glDeleteVertexArrays(1, &vao_);
+}
+
+GlScene::Target& GlScene::target(int width, int height, bool distance_pass) {
+  if (width < 1 || height < 1 || width > max_size_ || height > max_size_) {
+    throw RuntimeFailure("GL target " + std::to_string(width) + "x" + std::to_string(height) +
+                         " exceeds GL_MAX_TEXTURE_SIZE " + std::to_string(max_size_));
+  }
+  if (!target_ || target_->width != width || target_->height != height ||
+      target_->distance_pass != distance_pass) {
+    target_.reset();
+    target_ = std::make_unique<Target>(width, height, distance_pass);
+  }
+  return *target_;
+}
+
+void GlScene::upload_lights(const glm::dvec3& center) {
+  std::vector<LightGpu> lights;
+  for (const PointLight& l : scene_.lights) {
+    const glm::dvec3 p = l.position - center;
+    lights.push_back({{float(p.x), float(p.y), float(p.z), 1.f},
+                      {float(l.color.r), float(l.color.g), float(l.color.b), 0.f}});
+  }
+  if (lights.empty()) lights.push_back({});
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, lights_);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(lights.size() * sizeof(LightGpu)),
+               lights.data(), GL_DYNAMIC_DRAW);
+}
+
+void GlScene::draw(const GlProgram& program, const glm::mat4& clip, const glm::dvec3& center) {
+  program.use();
+  glUniformMatrix4fv(program.uniform("u_clip"), 1, GL_FALSE, &clip[0][0]);
+  glUniform3f(program.uniform("u_center"), float(center.x), float(center.y), float(center.z));
+  glUniform3f(program.uniform("u_ambient"), float(scene_.ambient.r), float(scene_.ambient.g),
+              float(scene_.ambient.b));
+  glUniform1i(program.uniform("u_light_count"), static_cast<GLint>(scene_.lights.size()));
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, materials_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, lights_);
+  glBindVertexArray(vao_);
+  if (vertex_count_ > 0) glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
+}
+
+void GlScene::cube_distance(const glm::dvec3& center, int n, CubeImage* distance, CubeIds* ids, int n_t) {
+  const int h = n_t > 0 ? n_t : n;
+  Target& t = target(n, h, true);
+  *distance = CubeImage(n, 1);
+  if (ids) ids->n = n;
+  for (int face = 0; face < CUBE_FACES; ++face) {
+    Clock::time_point t0 = Clock::now();
+    t.clear(scene_.background);
+    draw(*distance_program_, face_clip_matrix(face, center, near_), center);
+    glFinish();
+    timings_.cube_distance_ms += ms_since(t0);
+    t0 = Clock::now();
+    Image& img = distance->faces[static_cast<size_t>(face)];
+    img = Image(n, h, 1);
+    t.read(0, GL_RED, GL_FLOAT, img.data.data());
+    if (ids) {
+      auto& f = ids->faces[static_cast<size_t>(face)];
+      f.assign(static_cast<size_t>(n) * h, NO_OBJECT);
+      t.read(1, GL_RED_INTEGER, GL_UNSIGNED_INT, f.data());
+    }
+    timings_.readback_ms += ms_since(t0);
+  }
+  check_gl("cube distance prepass");
+}
+
+CubeImage GlScene::cube_color(const glm::dvec3& center, int n) {
+  Target& t = target(n, n, false);
+  CubeImage out(n, 3);
+  upload_lights(center);
+  std::vector<float> rgba(static_cast<size_t>(n) * n * 4);
+  for (int face = 0; face < CUBE_FACES; ++face) {
+    Clock::time_point t0 = Clock::now();
+    t.clear(scene_.background);
+    draw(*phong_program_, face_clip_matrix(face, center, near_), center);
+    glFinish();
+    timings_.cube_color_ms += ms_since(t0);
+    t0 = Clock::now();
+    t.read(0, GL_RGBA, GL_FLOAT, rgba.data());
+    Image& img = out.faces[static_cast<size_t>(face)];
+    for (size_t p = 0; p < static_cast<size_t>(n) * n; ++p) {
+      for (int c = 0; c < 3; ++c) img.data[p * 3 + c] = rgba[p * 4 + c];
+    }
+    timings_.readback_ms += ms_since(t0);
+  }
+  check_gl("cube colour pass");
+  return out;
+}
+
+Image GlScene::camera_color(const Camera& camera) {
+  Target& t = target(camera.width, camera.height, false);
+  upload_lights(camera.position);
+  Clock::time_point t0 = Clock::now();
+  t.clear(scene_.background);
+  const double aspect = static_cast<double>(camera.width) / camera.height;
+  draw(*phong_program_,
+       camera_clip_matrix(camera.position, camera.look_at, camera.up, glm::radians(camera.fov_y_deg),
+                          aspect, near_),
+       camera.position);
+  glFinish();
+  timings_.camera_ms += ms_since(t0);
+  t0 = Clock::now();
+  std::vector<float> rgba(static_cast<size_t>(camera.width) * camera.height * 4);
+  t.read(0, GL_RGBA, GL_FLOAT, rgba.data());
+  // GL's row 0 is the bottom; the image's row 0 is the top.
+  Image out(camera.width, camera.height, 3);
+  for (int y = 0; y < camera.height; ++y) {
+    const float* src = &rgba[static_cast<size_t>(camera.height - 1 - y) * camera.width * 4];
+    for (int x = 0; x < camera.width; ++x) out.set_rgb(x, y, {src[4 * x], src[4 * x + 1], src[4 * x + 2]});
+  }
+  timings_.readback_ms += ms_since(t0);
+  check_gl("camera pass");
+  return out;
+}
+
+}  // namespace abcube

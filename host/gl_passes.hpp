@@ -1,0 +1,68 @@
+// The GL passes: the six cube faces around the camera (distance prepass, Z-buffer colour)
+// and the camera view (Z-buffer Phong). All read back into cpu_core image types.
+#pragma once
+#include <glad/gl.h>
+
+#include <memory>
+
+#include "gl_program.hpp"
+#include "image.hpp"
+#include "scene.hpp"
+
+namespace abcube {
+
+// Wall milliseconds of GL work (glFinish-bracketed) and of reading it back.
+struct GpuTimings {
+  double upload_ms = 0;
+  double cube_distance_ms = 0;
+  double cube_color_ms = 0;
+  double camera_ms = 0;
+  double readback_ms = 0;
+};
+
+// Value of a prepass texel that no surface covers.
+constexpr float NO_DISTANCE = INFINITY;
+constexpr uint32_t NO_OBJECT = 0xffffffffu;
+
+// The scene uploaded to the current GL context. Needs a current GL 4.5 context for its
+// whole life (gl_context.hpp).
+class GlScene {
+ public:
+  explicit GlScene(const Scene& scene);
+  ~GlScene();
+  GlScene(const GlScene&) = delete;
+  GlScene& operator=(const GlScene&) = delete;
+
+  // Distance prepass over the six faces around `center`: per texel the Euclidean distance
+  // to the nearest surface (NO_DISTANCE where none) and its object id (NO_OBJECT), faces
+  // as cube_map.hpp defines them. `ids` may be null. Faces of n_s x n_t texels; n_t = 0
+  // means square (a 8x, 4x supersampled face checks the 4x8 sample positions).
+  void cube_distance(const glm::dvec3& center, int n, CubeImage* distance, CubeIds* ids, int n_t = 0);
+
+  // Z-buffer Phong colour of the six faces seen from `center` (no shadows).
+  CubeImage cube_color(const glm::dvec3& center, int n);
+
+  // Z-buffer Phong image of the camera view (aliased: one sample per pixel centre).
+  Image camera_color(const Camera& camera);
+
+  const GpuTimings& timings() const { return timings_; }
+  double near_distance() const { return near_; }
+  int max_size() const { return max_size_; }
+
+ private:
+  struct Target;
+  void draw(const GlProgram& program, const glm::mat4& clip, const glm::dvec3& center);
+  void upload_lights(const glm::dvec3& center);
+  Target& target(int width, int height, bool distance_pass);
+
+  const Scene& scene_;
+  GLuint vao_ = 0, vbo_ = 0, materials_ = 0, lights_ = 0;
+  GLsizei vertex_count_ = 0;
+  double near_ = 1e-4;
+  int max_size_ = 0;
+  std::unique_ptr<GlProgram> distance_program_, phong_program_;
+  std::unique_ptr<Target> target_;
+  GpuTimings timings_;
+};
+
+}  // namespace abcube

@@ -1,0 +1,22 @@
+// Every pass draws the scene's triangles with this stage. u_clip is cube_map.hpp's
+// face_clip_matrix or camera_clip_matrix (infinite reversed-Z); u_center is the eye.
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in uint a_object;
+layout(location = 3) in uint a_material;
+
+uniform mat4 u_clip;
+uniform vec3 u_center;
+
+out vec3 v_relative;  // position relative to the eye, interpolated perspective-correctly
+out vec3 v_normal;
+flat out uint v_object;
+flat out uint v_material;
+
+void main() {
+  gl_Position = u_clip * vec4(a_position, 1.0);
+  v_relative = a_position - u_center;
+  v_normal = a_normal;
+  v_object = a_object;
+  v_material = a_material;
+}
