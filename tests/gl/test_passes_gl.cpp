@@ -1,0 +1,156 @@
+// The GL passes against known answers: prepass distances inside a box, a Z-buffer image
+// of a quad, and the GLSL Phong mirror against cpu_core/shading.hpp.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "camera.hpp"
+#include "cube_map.hpp"
+#include "gl_passes.hpp"
+#include "gl_test_support.hpp"
+#include "shading.hpp"
+
+namespace abcube {
+namespace {
+
+// Distance from c along unit u to the inside of the box [lo, hi] that contains c.
+double box_exit_distance(glm::dvec3 c, glm::dvec3 u, glm::dvec3 lo, glm::dvec3 hi) {
+  double t = INFINITY;
+  for (int a = 0; a < 3; ++a) {
+    if (u[a] > 0) t = std::min(t, (hi[a] - c[a]) / u[a]);
+    if (u[a] < 0) t = std::min(t, (lo[a] - c[a]) / u[a]);
+  }
+  return t;
+}
+
+void expect_box_distances(glm::dvec3 center, glm::dvec3 lo, glm::dvec3 hi, int n) {
+  Scene s;
+  test::add_box(s, lo, hi);
+  GlScene gl(s);
+  CubeImage dist;
+  gl.cube_distance(center, n, &dist, nullptr);
+  double worst = 0;
+  for (int face = 0; face < CUBE_FACES; ++face) {
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const glm::dvec3 u = glm::normalize(texel_center_direction(face, i, j, n));
+        const double expected = box_exit_distance(center, u, lo, hi);
+        const double got = dist.faces[face].at(i, j)[0];
+        worst = std::max(worst, std::abs(got - expected) / expected);
+      }
+    }
+  }
+  EXPECT_LT(worst, 1e-5) << "worst relative distance error over " << 6 * n * n << " texels";
+}
+
+// Centred in a box of half-size 1: texel distance = 1 / max(|x|,|y|,|z|) of the unit
+// texel-centre direction (design.md).
+TEST(PrepassGl, DistanceInsideUnitBox) {
+  test::test_context();
+  expect_box_distances(glm::dvec3(0), glm::dvec3(-1), glm::dvec3(1), 64);
+}
+
+// Off-centre, so a flipped face or axis would put the wrong wall in a texel.
+TEST(PrepassGl, DistanceOffCentre) {
+  test::test_context();
+  expect_box_distances(glm::dvec3(0.3, -0.2, 0.45), glm::dvec3(-1, -0.7, -1.2), glm::dvec3(1.5, 1, 0.8), 32);
+}
+
+// Nothing beyond the near plane is clipped, however far: a wall 1e6 away is in the map.
+TEST(PrepassGl, NoFarClipping) {
+  test::test_context();
+  Scene s;
+  test::add_box(s, glm::dvec3(-1e6), glm::dvec3(1e6));
+  GlScene gl(s);
+  CubeImage dist;
+  gl.cube_distance(glm::dvec3(0), 8, &dist, nullptr);
+  for (int face = 0; face < CUBE_FACES; ++face) {
+    for (float d : dist.faces[face].data) EXPECT_GE(d, 1e6f * 0.999f);
+  }
+}
+
+// A quad covering a known rectangle of the view: pixels whose centre is inside get the
+// material colour (ambient only), the rest the background; exact but for the edge rows.
+TEST(ZbufferGl, QuadCoversKnownRectangle) {
+  test::test_context();
+  Scene s;
+  s.ambient = glm::dvec3(1);
+  s.background = glm::dvec3(0.0, 0.0, 1.0);
+  s.camera.position = glm::dvec3(0);
+  s.camera.look_at = glm::dvec3(0, 0, -1);
+  s.camera.up = glm::dvec3(0, 1, 0);
+  s.camera.fov_y_deg = 90;
+  s.camera.width = 80;
+  s.camera.height = 60;
+  const uint32_t red = test::add_material(s, glm::dvec3(1, 0, 0));
+  // At z = -1 the view spans x in [-4/3, 4/3], y in [-1, 1].
+  const double x0 = -0.5, x1 = 0.7, y0 = -0.3, y1 = 0.55;
+  test::add_quad(s, {x0, y0, -1}, {x1, y0, -1}, {x1, y1, -1}, {x0, y1, -1}, red);
+  GlScene gl(s);
+  const Image img = gl.camera_color(s.camera);
+  const CameraFrame f = make_camera_frame(s.camera);
+  int mismatches = 0, edge = 0;
+  for (int y = 0; y < s.camera.height; ++y) {
+    for (int x = 0; x < s.camera.width; ++x) {
+      const glm::dvec3 d = f.direction(x + 0.5, y + 0.5);
+      const double px = d.x / -d.z, py = d.y / -d.z;
+      const bool inside = px > x0 && px < x1 && py > y0 && py < y1;
+      // Within one pixel of an edge either answer is allowed.
+      const double pix = 2.0 * f.tan_half_fov_y / s.camera.height;
+      const bool near_edge = std::min({std::abs(px - x0), std::abs(px - x1), std::abs(py - y0),
+                                       std::abs(py - y1)}) < pix;
+      const glm::vec3 c = img.rgb(x, y);
+      const bool red_here = c.r > 0.99f && c.b < 0.01f;
+      const bool bg_here = c.b > 0.99f && c.r < 0.01f;
+      if (near_edge) {
+        edge += red_here || bg_here ? 0 : 1;
+      } else if (inside ? !red_here : !bg_here) {
+        ++mismatches;
+      }
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_EQ(edge, 0) << "edge pixels must be one colour or the other";
+}
+
+// The GLSL Phong (common_shading.glsl) equals cpu_core phong_local at pixel centres.
+TEST(ZbufferGl, PhongMatchesCpuShading) {
+  test::test_context();
+  Scene s;
+  s.ambient = glm::dvec3(0.1, 0.15, 0.2);
+  s.background = glm::dvec3(0);
+  s.camera.position = glm::dvec3(0, 1, 3);
+  s.camera.look_at = glm::dvec3(0, 0, 0);
+  s.camera.width = 64;
+  s.camera.height = 48;
+  s.lights.push_back({glm::dvec3(2, 3, 1), glm::dvec3(0.9, 0.8, 0.7), true});
+  s.lights.push_back({glm::dvec3(-3, 1, -1), glm::dvec3(0.3, 0.3, 0.5), true});
+  const uint32_t m = test::add_material(s, glm::dvec3(0.7, 0.5, 0.3), 0.8);
+  s.materials[m].specular = 0.6;
+  s.materials[m].shininess = 20;
+  test::add_quad(s, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, m);  // floor y = 0
+  GlScene gl(s);
+  const Image img = gl.camera_color(s.camera);
+  const CameraFrame f = make_camera_frame(s.camera);
+  double worst = 0;
+  int checked = 0;
+  for (int y = 0; y < s.camera.height; ++y) {
+    for (int x = 0; x < s.camera.width; ++x) {
+      const glm::dvec3 d = f.direction(x + 0.5, y + 0.5);
+      if (d.y >= -1e-3) continue;
+      const double t = -f.eye.y / d.y;
+      const glm::dvec3 p = f.eye + t * d;
+      if (std::abs(p.x) > 2.9 || std::abs(p.z) > 2.9) continue;
+      const glm::dvec3 expected =
+          phong_local(s.materials[m], p, glm::dvec3(0, 1, 0), f.eye, s.ambient, s.lights);
+      const glm::vec3 got = img.rgb(x, y);
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(got[c] - expected[c]));
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 500);
+  EXPECT_LT(worst, 2e-3);
+}
+
+}  // namespace
+}  // namespace abcube
