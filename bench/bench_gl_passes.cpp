@@ -1,0 +1,127 @@
+// GL passes benchmark: the six-face distance prepass and the camera-view raster at several
+// cube resolutions, median of R runs, with the renderer string, and the prepass's error
+// against the exact tracer (relative distance at texel centres), so no speed is quoted
+// without its error.
+//
+//   bench_gl_passes SCENE.json [--sizes 256,512,1024] [--runs 5] [--gl auto|egl|osmesa]
+//                   [--error-samples 20000]
+#include <algorithm>
+#include <cstdio>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_common.hpp"
+#include "cube_map.hpp"
+#include "error.hpp"
+#include "gl_context.hpp"
+#include "gl_passes.hpp"
+#include "raytrace.hpp"
+#include "scene_load.hpp"
+
+namespace abcube {
+namespace {
+
+struct Spread {
+  double median, lo, hi;
+};
+
+Spread spread(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return {v[v.size() / 2], v.front(), v.back()};
+}
+
+struct PrepassError {
+  double median_rel = 0, p99_rel = 0, max_rel = 0, same_object = 0;
+  size_t texels = 0;
+};
+
+// Exact first hit along random texel-centre directions against what the prepass stored.
+PrepassError prepass_error(const Scene& scene, const RayTracer& rt, const CubeImage& dist,
+                           const CubeIds& ids, int samples) {
+  const int n = dist.n;
+  std::mt19937 rng(1234);
+  std::uniform_int_distribution<int> pick(0, n - 1), pick_face(0, 5);
+  std::vector<double> rel;
+  size_t same = 0;
+  for (int k = 0; k < samples; ++k) {
+    const int face = pick_face(rng), i = pick(rng), j = pick(rng);
+    const glm::dvec3 d = glm::normalize(texel_center_direction(face, i, j, n));
+    Hit hit;
+    const float g = dist.faces[face].at(i, j)[0];
+    if (!rt.intersect(scene.camera.position, d, &hit) || !std::isfinite(g)) continue;
+    rel.push_back(std::abs(g - hit.t) / hit.t);
+    same += ids.faces[face][static_cast<size_t>(j) * n + i] == hit.object_id;
+  }
+  PrepassError e;
+  e.texels = rel.size();
+  if (rel.empty()) return e;
+  std::sort(rel.begin(), rel.end());
+  e.median_rel = rel[rel.size() / 2];
+  e.p99_rel = rel[std::min(rel.size() - 1, rel.size() * 99 / 100)];
+  e.max_rel = rel.back();
+  e.same_object = static_cast<double>(same) / rel.size();
+  return e;
+}
+
+int run(const std::vector<std::string>& words) {
+  const Args args(words, {"--sizes", "--runs", "--gl", "--error-samples"}, {});
+  args.expect_positional(1, "SCENE.json");
+  const Scene scene = load_scene(args.positional()[0]);
+  const int runs = args.get_int("--runs", 5, 1, 1000);
+  const int samples = args.get_int("--error-samples", 20000, 0, 100000000);
+  GlChoice choice = GlChoice::automatic;
+  if (args.has("--gl") && !parse_gl_choice(args.get("--gl"), &choice)) throw InputError("--gl: unknown path");
+  std::vector<int> sizes;
+  std::stringstream ss(args.get("--sizes", "256,512,1024"));
+  for (std::string item; std::getline(ss, item, ',');) sizes.push_back(std::stoi(item));
+
+  std::string log;
+  auto ctx = open_gl_context(choice, -1, &log);
+  if (!ctx) throw RuntimeFailure("no GL context: " + log);
+  const RayTracer rt(scene);
+  GlScene gl(scene);
+  std::printf("scene: %s (%zu triangles)\nrenderer: %s\nruns: %d (median [min, max] ms)\n\n",
+              args.positional()[0].c_str(), scene.triangles.triangle_count(), describe_gl(ctx.get()).c_str(),
+              runs);
+  std::printf("| N | prepass 6 faces ms | readback ms | camera %dx%d raster ms | prepass rel. distance error "
+              "vs exact: median / p99 / max | same object | texels checked |\n|---|---|---|---|---|---|---|\n",
+              scene.camera.width, scene.camera.height);
+  for (int n : sizes) {
+    std::vector<double> prepass, readback, camera;
+    CubeImage dist;
+    CubeIds ids;
+    for (int r = 0; r < runs; ++r) {
+      const GpuTimings before = gl.timings();
+      gl.cube_distance(scene.camera.position, n, &dist, &ids);
+      prepass.push_back(gl.timings().cube_distance_ms - before.cube_distance_ms);
+      readback.push_back(gl.timings().readback_ms - before.readback_ms);
+      const double cam0 = gl.timings().camera_ms;
+      gl.camera_color(scene.camera);
+      camera.push_back(gl.timings().camera_ms - cam0);
+    }
+    const Spread p = spread(prepass), rb = spread(readback), c = spread(camera);
+    const PrepassError e = prepass_error(scene, rt, dist, ids, samples);
+    std::printf("| %d | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1e / %.1e / %.1e | %.4f | %zu |\n",
+                n, p.median, p.lo, p.hi, rb.median, rb.lo, rb.hi, c.median, c.lo, c.hi, e.median_rel, e.p99_rel,
+                e.max_rel, e.same_object, e.texels);
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace abcube
+
+int main(int argc, char** argv) {
+  try {
+    return abcube::run(std::vector<std::string>(argv + 1, argv + argc));
+  } catch (const abcube::InputError& e) {
+    std::fprintf(stderr, "bench_gl_passes: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_gl_passes: error: %s\n", e.what());
+    return 1;
+  }
+}
