@@ -83,7 +83,8 @@ bool is_closed_surface(const TriangleSoup& soup, size_t first, size_t count);
 // (o, a, b, c)); positive when a closed surface's normals point outward.
 double signed_volume(const TriangleSoup& soup, size_t first, size_t count);
 
-// Reverses the winding of the triangles (swaps corners b and c with their normals).
+// Reverses the winding of the triangles (swaps corners b and c with their normals) and
+// turns every normal that then points against the new geometric normal (all flat ones).
 void flip_winding(TriangleSoup* soup, size_t first, size_t count);
 
 }  // namespace abcube

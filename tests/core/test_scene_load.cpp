@@ -1,0 +1,770 @@
+// Scene loading (cpu_core/scene_load.cpp, tessellate.cpp) against scene-format.md:
+// the format's own example, one test per class of bad input (each message must name
+// its place), and known answers for the tessellated primitives and the transform.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <tuple>
+
+#include "error.hpp"
+#include "scene_load.hpp"
+#include "tessellate.hpp"
+
+namespace abcube {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A fresh folder under the system temp dir, removed with its contents afterwards.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "abcube_scene_XXXXXX").string();
+    path_ = ::mkdtemp(pattern.data()) ? fs::path(pattern) : fs::path();
+    EXPECT_FALSE(path_.empty()) << "mkdtemp failed";
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+  std::string write(const std::string& relative, const std::string& text) const {
+    const fs::path p = path_ / relative;
+    fs::create_directories(p.parent_path());
+    std::ofstream(p, std::ios::binary) << text;
+    return p.string();
+  }
+
+ private:
+  fs::path path_;
+};
+
+// The example of scene-format.md, verbatim.
+const char* FORMAT_EXAMPLE = R"({
+  "version": 1,
+  "camera": {
+    "position": [0, 1, -4], "look_at": [0, 0.5, 0], "up": [0, 1, 0],
+    "fov_y": 60, "width": 512, "height": 512
+  },
+  "background": [0, 0, 0],
+  "ambient": [0.1, 0.1, 0.1],
+  "lights": [
+    { "type": "point", "position": [3, 5, -3], "color": [1, 1, 1], "cast_shadows": true }
+  ],
+  "materials": {
+    "white":  { "color": [0.8, 0.8, 0.8] },
+    "mirror": { "color": [0.1, 0.1, 0.1], "specular": 0.5, "shininess": 64, "reflect": 0.9 },
+    "glass":  { "color": [1, 1, 1], "diffuse": 0.0, "transmit": 0.9, "ior": 1.5 },
+    "veil":   { "color": [0.2, 0.4, 1.0], "opacity": 0.5 }
+  },
+  "objects": [
+    { "type": "triangle", "vertices": [[-1,0,0],[1,0,0],[0,1,0]], "material": "white" },
+    { "type": "quad", "vertices": [[-5,0,-5],[5,0,-5],[5,0,5],[-5,0,5]], "material": "white" },
+    { "type": "box", "min": [-0.5,0,-0.5], "max": [0.5,1,0.5], "material": "mirror" },
+    { "type": "sphere", "center": [0,1,0], "radius": 1, "segments": 64, "material": "glass" },
+    { "type": "mesh", "file": "meshes/knot.obj", "material": "white",
+      "transform": { "translate": [0,0,2], "rotate_deg": [0,45,0], "scale": 0.5 } }
+  ],
+  "render": {
+    "method": "abuffer",
+    "cube_resolution": 512,
+    "max_depth": 4
+  }
+})";
+
+// A unit cube written with quad faces, wound outward: closed, 12 triangles.
+const char* CUBE_OBJ = R"(v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+v 0 0 1
+v 1 0 1
+v 1 1 1
+v 0 1 1
+f 1 4 3 2
+f 5 6 7 8
+f 1 5 8 4
+f 2 3 7 6
+f 1 2 6 5
+f 4 8 7 3
+)";
+
+// A small valid scene whose parts a test replaces one at a time.
+struct SceneText {
+  std::string version = "1";
+  std::string camera =
+      R"({"position": [0, 1, 5], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 60, "width": 64, "height": 48})";
+  std::string lights = R"([{"type": "point", "position": [2, 4, 3], "color": [1, 1, 1]}])";
+  std::string materials = R"({"white": {"color": [0.8, 0.8, 0.8]}, "m": {"reflect": 0.5}})";
+  std::string objects = R"([{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "white"}])";
+  std::string render = R"({"method": "abuffer", "cube_resolution": 64, "max_depth": 2})";
+  std::string extra;  // more top-level members, with a leading comma
+
+  std::string str() const {
+    return "{\n\"version\": " + version + ",\n\"camera\": " + camera + ",\n\"lights\": " + lights +
+           ",\n\"materials\": " + materials + ",\n\"objects\": " + objects + ",\n\"render\": " + render +
+           extra + "\n}\n";
+  }
+};
+
+SceneText with_objects(const std::string& objects) {
+  SceneText s;
+  s.objects = objects;
+  return s;
+}
+
+Scene load_text(const std::string& text, const std::string& dir = ".") {
+  return load_scene_text(text, "scene.json", dir);
+}
+
+// The message of the InputError that loading raises (a test failure if none, or if the
+// message is not exactly one line).
+std::string load_error(const std::string& text, const std::string& dir = ".") {
+  try {
+    load_text(text, dir);
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    return m;
+  }
+  ADD_FAILURE() << "no error for:\n" << text;
+  return "";
+}
+
+#define EXPECT_ERROR(text, place)                                     \
+  do {                                                                \
+    const std::string message_ = load_error(text);                    \
+    EXPECT_NE(message_.find(place), std::string::npos) << message_;   \
+  } while (0)
+
+glm::dvec3 corner(const Scene& s, size_t triangle, int k) {
+  return glm::dvec3(s.triangles.positions[3 * triangle + static_cast<size_t>(k)]);
+}
+
+glm::dvec3 geometric_normal(const Scene& s, size_t t) {
+  return glm::normalize(glm::cross(corner(s, t, 1) - corner(s, t, 0), corner(s, t, 2) - corner(s, t, 0)));
+}
+
+// Every edge of the object used exactly twice, once in each direction (checked here
+// independently of is_closed_surface, with an ordered map of corner positions).
+bool edges_shared_twice(const Scene& s, const SceneObject& o) {
+  using Point = std::tuple<float, float, float>;
+  std::map<std::pair<Point, Point>, int> directed;
+  for (uint32_t t = o.first_triangle; t < o.first_triangle + o.triangle_count; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3 a = s.triangles.positions[3 * t + static_cast<size_t>(k)];
+      const glm::vec3 b = s.triangles.positions[3 * t + static_cast<size_t>((k + 1) % 3)];
+      ++directed[{Point(a.x, a.y, a.z), Point(b.x, b.y, b.z)}];
+    }
+  }
+  for (const auto& [edge, count] : directed) {
+    const auto reverse = directed.find({edge.second, edge.first});
+    if (count != 1 || reverse == directed.end() || reverse->second != 1) return false;
+  }
+  return !directed.empty();
+}
+
+double object_volume(const Scene& s, const SceneObject& o) {
+  return signed_volume(s.triangles, o.first_triangle, o.triangle_count);
+}
+
+// ---- The format's example ---------------------------------------------------------------
+
+TEST(SceneLoad, FormatExampleLoads) {
+  TempDir dir;
+  dir.write("meshes/knot.obj", CUBE_OBJ);
+  const std::string path = dir.write("scene.json", FORMAT_EXAMPLE);
+  const Scene s = load_scene(path);
+
+  EXPECT_EQ(s.file, path);
+  EXPECT_EQ(s.camera.width, 512);
+  EXPECT_DOUBLE_EQ(s.camera.fov_y_deg, 60);
+  ASSERT_EQ(s.lights.size(), 1u);
+  EXPECT_TRUE(s.lights[0].cast_shadows);
+  ASSERT_EQ(s.materials.size(), 4u);  // in file order
+  const Material& white = s.materials[0];
+  EXPECT_EQ(white.name, "white");
+  EXPECT_DOUBLE_EQ(white.ambient, 1.0);
+  EXPECT_DOUBLE_EQ(white.diffuse, 1.0);
+  EXPECT_DOUBLE_EQ(white.specular, 0.0);
+  EXPECT_DOUBLE_EQ(white.shininess, 32);
+  EXPECT_DOUBLE_EQ(white.ior, 1.0);
+  EXPECT_DOUBLE_EQ(white.opacity, 1.0);
+  EXPECT_DOUBLE_EQ(s.materials[1].reflect, 0.9);
+  EXPECT_DOUBLE_EQ(s.materials[2].transmit, 0.9);
+  EXPECT_DOUBLE_EQ(s.materials[2].ior, 1.5);
+  EXPECT_DOUBLE_EQ(s.materials[3].opacity, 0.5);
+  EXPECT_EQ(s.render.method, Method::abuffer);
+  EXPECT_EQ(s.render.cube_resolution, 512);
+  EXPECT_EQ(s.render.max_depth, 4);
+
+  ASSERT_EQ(s.objects.size(), 5u);
+  const uint32_t expected_triangles[5] = {1, 2, 12, 2 * 64 * 31, 12};
+  const bool expected_closed[5] = {false, false, true, true, true};
+  uint32_t first = 0;
+  for (size_t i = 0; i < 5; ++i) {
+    const SceneObject& o = s.objects[i];
+    EXPECT_EQ(o.path, "objects[" + std::to_string(i) + "]");
+    EXPECT_EQ(o.first_triangle, first);
+    EXPECT_EQ(o.triangle_count, expected_triangles[i]) << o.type;
+    EXPECT_EQ(o.closed, expected_closed[i]) << o.type;
+    for (uint32_t t = o.first_triangle; t < o.first_triangle + o.triangle_count; ++t) {
+      EXPECT_EQ(s.triangles.object_id[t], i);
+      EXPECT_EQ(s.triangles.material_id[t], o.material);
+    }
+    first += o.triangle_count;
+  }
+  EXPECT_EQ(s.triangles.triangle_count(), first);
+  EXPECT_EQ(s.triangles.positions.size(), 3 * first);
+  EXPECT_EQ(s.triangles.normals.size(), 3 * first);
+  EXPECT_EQ(s.dropped_triangles, 0u);
+  EXPECT_EQ(s.objects[2].material, 1u);  // the box is the mirror
+  // The knot stand-in: a unit cube scaled by 0.5 has volume 1/8, wherever it is turned.
+  EXPECT_NEAR(object_volume(s, s.objects[4]), 0.125, 1e-6);
+}
+
+// ---- Syntax errors: FILE:LINE:COL ------------------------------------------------------
+
+TEST(SceneLoadErrors, SyntaxErrorsGiveLineAndColumn) {
+  // Line 3, `  "camera": {,`: the comma is column 14.
+  const std::string text = "{\n  \"version\": 1,\n  \"camera\": {,\n}";
+  const std::string m = load_error(text);
+  EXPECT_EQ(m.rfind("scene.json:3:14: ", 0), 0u) << m;
+  // Columns count characters, not bytes: "é" is two bytes, one column.
+  const std::string m2 = load_error("{\n\"é\": 1 2}");
+  EXPECT_EQ(m2.rfind("scene.json:2:8: ", 0), 0u) << m2;
+  // Trailing comma, and a file cut short.
+  EXPECT_EQ(load_error("{\"a\": [1, 2,]}").rfind("scene.json:1:13: ", 0), 0u);
+  EXPECT_EQ(load_error("{\"version\": 1").rfind("scene.json:1:14: ", 0), 0u);
+  EXPECT_EQ(load_error("").rfind("scene.json:1:1: ", 0), 0u);
+  // A misplaced string is pointed at where it starts.
+  EXPECT_EQ(load_error("{\n  \"version\": 1\n  \"camera\": {}\n}").rfind("scene.json:3:3: ", 0), 0u);
+}
+
+TEST(SceneLoadErrors, InfiniteNumbersAreRejectedWithTheirPlace) {
+  SceneText s;
+  s.camera = "{\"position\": [0, 1, 5], \"look_at\": [0, 0, 0], \"fov_y\": 1e999}";
+  const std::string m = load_error(s.str());
+  EXPECT_EQ(m.rfind("scene.json:3:66: ", 0), 0u) << m;  // where 1e999 starts on the camera line
+  EXPECT_NE(m.find("1e999"), std::string::npos) << m;
+  // Finite in double but not in the float the renderer stores.
+  EXPECT_ERROR(with_objects(R"([{"type": "triangle", "vertices": [[0,0,0],[1,0,0],[0,1,1e300]]}])").str(),
+               "scene.json: objects[0].vertices[2][2]: out of range");
+  EXPECT_ERROR(with_objects(R"([{"type": "sphere", "center": [0,0,0], "radius": -1e39}])").str(),
+               "objects[0].radius: out of range");
+}
+
+// ---- Value errors: FILE: path: ... ------------------------------------------------------
+
+TEST(SceneLoadErrors, UnknownFieldsAnywhere) {
+  SceneText s;
+  s.extra = ",\n\"colour\": [1, 1, 1]";
+  EXPECT_ERROR(s.str(), "scene.json: colour: unknown field");
+  s = SceneText();
+  s.camera = R"({"position": [0, 1, 5], "look_at": [0, 0, 0], "fov": 60})";
+  EXPECT_ERROR(s.str(), "scene.json: camera.fov: unknown field");
+  s = SceneText();
+  s.materials = R"({"m": {"reflection": 0.5}})";
+  EXPECT_ERROR(s.str(), "scene.json: materials.m.reflection: unknown field");
+  s = SceneText();
+  s.lights = R"([{"type": "point", "position": [0, 1, 0], "intensity": 2}])";
+  EXPECT_ERROR(s.str(), "scene.json: lights[0].intensity: unknown field");
+  s = SceneText();
+  s.render = R"({"samples": 4})";
+  EXPECT_ERROR(s.str(), "scene.json: render.samples: unknown field");
+  EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1]},
+                                {"type": "sphere", "center": [0,0,0], "radus": 1}])").str(),
+               "scene.json: objects[1].radus: unknown field");
+  // A field of another object type is unknown here too.
+  EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1], "radius": 1}])").str(),
+               "objects[0].radius: unknown field");
+  EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1], "transform": {"rotate": [0,1,0]}}])").str(),
+               "objects[0].transform.rotate: unknown field");
+  EXPECT_ERROR(with_objects(R"([{"type": "cone"}])").str(), "objects[0].type: must be one of");
+}
+
+TEST(SceneLoadErrors, RepeatedFieldsAreNotSilentlyReplaced) {
+  SceneText s;
+  s.camera = R"({"position": [0, 1, 5], "look_at": [0, 0, 0], "fov_y": 60, "fov_y": 30})";
+  EXPECT_ERROR(s.str(), "scene.json: camera.fov_y: field appears twice");
+  EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1]},
+                                {"type": "sphere", "center": [0,0,0], "radius": 1, "radius": 2}])").str(),
+               "scene.json: objects[1].radius: field appears twice");
+}
+
+TEST(SceneLoadErrors, DegenerateCamera) {
+  SceneText s;
+  s.camera = R"({"position": [0, 5, 0], "look_at": [0, 0, 0], "up": [0, 1, 0]})";
+  EXPECT_ERROR(s.str(), "scene.json: camera.up: must not be parallel to the view direction");
+  s.camera = R"({"position": [0, 5, 0], "look_at": [0, 0, 0], "up": [0, 0, 0]})";
+  EXPECT_ERROR(s.str(), "camera.up: must be nonzero");
+  s.camera = R"({"position": [1, 2, 3], "look_at": [1, 2, 3]})";
+  EXPECT_ERROR(s.str(), "scene.json: camera.look_at: must differ from camera.position");
+  s.camera = R"({"position": [0, 1, 5], "look_at": [0, 0, 0], "fov_y": 0})";
+  EXPECT_ERROR(s.str(), "scene.json: camera.fov_y: must be > 0 and < 180 (degrees), got 0");
+  s.camera = R"({"position": [0, 1, 5], "look_at": [0, 0, 0], "fov_y": 180})";
+  EXPECT_ERROR(s.str(), "camera.fov_y: must be > 0 and < 180 (degrees), got 180");
+  s.camera = R"({"position": [0, 1, 5], "look_at": [0, 0, 0], "width": 0})";
+  EXPECT_ERROR(s.str(), "scene.json: camera.width: must be >= 1, got 0");
+  s.camera = R"({"position": [0, 1, 5], "look_at": [0, 0, 0], "height": 2.5})";
+  EXPECT_ERROR(s.str(), "camera.height: must be an integer, got 2.5");
+  s.camera = R"({"position": [0, 1, 5], "look_at": [0, 0, 0], "width": 40000})";
+  EXPECT_ERROR(s.str(), "camera.width: must be <= 32768, got 40000");
+  s.camera = R"({"look_at": [0, 0, 0]})";
+  EXPECT_ERROR(s.str(), "scene.json: camera.position: missing required field");
+}
+
+TEST(SceneLoadErrors, MissingMeshFileNamesFieldAndResolvedPath) {
+  TempDir dir;
+  const std::string m =
+      load_error(with_objects(R"([{"type": "mesh", "file": "meshes/missing.obj"}])").str(), dir.path().string());
+  EXPECT_NE(m.find("scene.json: objects[0].file: "), std::string::npos) << m;
+  EXPECT_NE(m.find((dir.path() / "meshes/missing.obj").string()), std::string::npos) << m;
+}
+
+TEST(SceneLoadErrors, UnknownMaterialNamesTheObject) {
+  EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1], "material": "white"},
+                                {"type": "box", "min": [0,0,0], "max": [1,1,1], "material": "nope"}])").str(),
+               "scene.json: objects[1].material: no material of that name");
+}
+
+TEST(SceneLoadErrors, MaterialWeightsAndIor) {
+  SceneText s;
+  s.materials = R"({"m": {"reflect": 1.5}})";
+  EXPECT_ERROR(s.str(), "scene.json: materials.m.reflect: must be in [0, 1], got 1.5");
+  s.materials = R"({"m": {"opacity": -0.25}})";
+  EXPECT_ERROR(s.str(), "materials.m.opacity: must be in [0, 1], got -0.25");
+  s.materials = R"({"m": {"transmit": 2}})";
+  EXPECT_ERROR(s.str(), "materials.m.transmit: must be in [0, 1], got 2");
+  s.materials = R"({"m": {"ior": 0.9}})";
+  EXPECT_ERROR(s.str(), "scene.json: materials.m.ior: must be >= 1, got 0.9");
+  s.materials = R"({"m": {"shininess": -1}})";
+  EXPECT_ERROR(s.str(), "materials.m.shininess: must be >= 0, got -1");
+  s.materials = R"({"m": {"color": [0.5, -0.1, 0.5]}})";
+  EXPECT_ERROR(s.str(), "materials.m.color[1]: must be >= 0, got -0.1");
+  s.materials = R"({"my glass": {"ior": 0.5}})";
+  EXPECT_ERROR(s.str(), "materials[\"my glass\"].ior: must be >= 1");
+}
+
+TEST(SceneLoadErrors, WrongTypes) {
+  EXPECT_ERROR(with_objects(R"([{"type": "sphere", "center": [0,0,0], "radius": "1"}])").str(),
+               "scene.json: objects[0].radius: must be a number, got \"1\"");
+  EXPECT_ERROR(with_objects(R"([{"type": "triangle", "vertices": [[0,0,0],[1,0,0]]}])").str(),
+               "objects[0].vertices: must be an array of 3 points");
+  EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0], "max": [1,1,1]}])").str(),
+               "objects[0].min: must be an array of 3 numbers, got [0,0]");
+  EXPECT_ERROR(with_objects(R"({"type": "box"})").str(), "scene.json: objects: must be an array");
+  EXPECT_ERROR(with_objects(R"([42])").str(), "scene.json: objects[0]: must be an object, got 42");
+  SceneText s;
+  s.lights = R"([{"type": "point", "position": [0, 1, 0], "cast_shadows": 1}])";
+  EXPECT_ERROR(s.str(), "lights[0].cast_shadows: must be true or false, got 1");
+  s = SceneText();
+  s.materials = R"([{"color": [1, 1, 1]}])";
+  EXPECT_ERROR(s.str(), "scene.json: materials: must be an object");
+  s = SceneText();
+  s.render = R"({"method": 3})";
+  EXPECT_ERROR(s.str(), "render.method: must be a string, got 3");
+  EXPECT_ERROR("[1, 2]", "scene.json: must be an object");
+}
+
+TEST(SceneLoadErrors, Version) {
+  SceneText s;
+  s.version = "2";
+  EXPECT_ERROR(s.str(), "scene.json: version: must be 1");
+  s.version = "\"1\"";
+  EXPECT_ERROR(s.str(), "scene.json: version: must be 1");
+  EXPECT_ERROR(R"({"camera": {"position": [0,1,5], "look_at": [0,0,0]}, "objects": []})",
+               "scene.json: version: missing required field");
+}
+
+TEST(SceneLoadErrors, QuadMustBeCoplanarAndSimple) {
+  EXPECT_ERROR(with_objects(R"([{"type": "quad", "vertices": [[0,0,0],[1,0,0],[1,1,0],[0,1,0.1]]}])").str(),
+               "scene.json: objects[0].vertices: the 4 vertices must be coplanar");
+  EXPECT_ERROR(with_objects(R"([{"type": "quad", "vertices": [[0,0,0],[1,1,0],[1,0,0],[0,1,0]]}])").str(),
+               "objects[0].vertices: the quad crosses itself");
+  // Within the relative tolerance: a large quad with a tiny wobble is fine.
+  EXPECT_NO_THROW(load_text(with_objects(R"([{"type": "quad", "vertices": [[0,0,0],[1000,0,0],[1000,1000,0],[0,1000,1e-7]]}])").str()));
+}
+
+TEST(SceneLoadErrors, BoxMinBelowMax) {
+  EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,1,0], "max": [1,1,1]}])").str(),
+               "scene.json: objects[0].max[1]: must be > min[1] = 1, got 1");
+  EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,5], "max": [1,1,1]}])").str(), "objects[0].max[2]");
+}
+
+TEST(SceneLoadErrors, SphereRadiusAndSegments) {
+  // The very message scene-format.md gives as its example.
+  const std::string objects = R"([{"type": "box", "min": [0,0,0], "max": [1,1,1]},
+      {"type": "box", "min": [0,0,0], "max": [1,1,1]}, {"type": "box", "min": [0,0,0], "max": [1,1,1]},
+      {"type": "sphere", "center": [0,0,0], "radius": -1}])";
+  EXPECT_EQ(load_error(with_objects(objects).str()), "scene.json: objects[3].radius: must be > 0, got -1");
+  EXPECT_ERROR(with_objects(R"([{"type": "sphere", "center": [0,0,0], "radius": 0}])").str(),
+               "objects[0].radius: must be > 0, got 0");
+  EXPECT_ERROR(with_objects(R"([{"type": "sphere", "center": [0,0,0], "radius": 1, "segments": 2}])").str(),
+               "objects[0].segments: must be >= 3, got 2");
+  EXPECT_ERROR(with_objects(R"([{"type": "sphere", "center": [0,0,0], "radius": 1, "segments": 5000}])").str(),
+               "objects[0].segments: must be <= 4096, got 5000");
+}
+
+TEST(SceneLoadErrors, TransformScaleNonzero) {
+  EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1], "transform": {"scale": 0}}])").str(),
+               "objects[0].transform.scale: must be nonzero, got 0");
+  EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1], "transform": {"scale": [1,0,1]}}])").str(),
+               "objects[0].transform.scale[1]: must be nonzero");
+}
+
+TEST(SceneLoadErrors, LightsAndRender) {
+  SceneText s;
+  s.lights = R"([{"type": "spot", "position": [0, 1, 0]}])";
+  EXPECT_ERROR(s.str(), "scene.json: lights[0].type: must be \"point\", got \"spot\"");
+  s.lights = R"([{"type": "point", "position": [0, 1, 0], "color": [1, -1, 1]}])";
+  EXPECT_ERROR(s.str(), "lights[0].color[1]: must be >= 0, got -1");
+  s = SceneText();
+  s.render = R"({"method": "photon"})";
+  EXPECT_ERROR(s.str(), "scene.json: render.method: must be one of abuffer, zbuffer, envmap, raytrace, gpu, got \"photon\"");
+  s.render = R"({"cube_resolution": 0})";
+  EXPECT_ERROR(s.str(), "render.cube_resolution: must be >= 1, got 0");
+  s.render = R"({"cube_resolution": 20000})";
+  EXPECT_ERROR(s.str(), "render.cube_resolution: must be <= 16384, got 20000");
+  s.render = R"({"max_depth": -1})";
+  EXPECT_ERROR(s.str(), "render.max_depth: must be >= 0, got -1");
+}
+
+TEST(SceneLoadErrors, MissingSceneFileNamesIt) {
+  try {
+    load_scene("/nonexistent/dir/scene.json");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("/nonexistent/dir/scene.json: cannot read scene", 0), 0u) << e.what();
+  }
+}
+
+// ---- Geometry --------------------------------------------------------------------------
+
+TEST(SceneLoadGeometry, ZeroAreaTrianglesAreDroppedAndCounted) {
+  const Scene s = load_text(with_objects(R"([
+      {"type": "triangle", "vertices": [[0,0,0],[1,1,1],[2,2,2]]},
+      {"type": "triangle", "vertices": [[0,0,0],[0,0,0],[1,0,0]]},
+      {"type": "quad", "vertices": [[0,0,0],[1,0,0],[2,0,0],[0,1,0]]},
+      {"type": "triangle", "vertices": [[1e30,0,0],[0,1e30,0],[0,0,1e30]], "transform": {"scale": 1e30}},
+      {"type": "triangle", "vertices": [[0,0,0],[1e-6,0,0],[0,1e-6,0]]},
+      {"type": "triangle", "vertices": [[0,0,0],[1e6,0,0],[0,1e6,0]]}])").str());
+  ASSERT_EQ(s.objects.size(), 6u);
+  EXPECT_EQ(s.dropped_triangles, 4u);  // collinear, repeated vertex, half the quad, overflow
+  const uint32_t expected[6] = {0, 0, 1, 0, 1, 1};
+  for (size_t i = 0; i < 6; ++i) EXPECT_EQ(s.objects[i].triangle_count, expected[i]) << i;
+  EXPECT_EQ(s.triangles.triangle_count(), 3u);
+  EXPECT_FALSE(s.objects[0].closed);
+}
+
+TEST(SceneLoadGeometry, BoxIsClosedWithOutwardFlatNormals) {
+  const Scene s = load_text(with_objects(R"([{"type": "box", "min": [-1,0,2], "max": [0,2,5]}])").str());
+  const SceneObject& box = s.objects[0];
+  EXPECT_EQ(box.triangle_count, 12u);
+  EXPECT_TRUE(box.closed);
+  EXPECT_TRUE(edges_shared_twice(s, box));
+  EXPECT_NEAR(object_volume(s, box), 1.0 * 2.0 * 3.0, 1e-9);
+  const glm::dvec3 center(-0.5, 1, 3.5);
+  for (size_t t = 0; t < 12; ++t) {
+    const glm::dvec3 n = geometric_normal(s, t);
+    const glm::dvec3 mid = (corner(s, t, 0) + corner(s, t, 1) + corner(s, t, 2)) / 3.0;
+    EXPECT_GT(glm::dot(n, mid - center), 0.0) << t;                               // outward
+    EXPECT_NEAR(std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z), 1.0, 1e-12);    // axis-aligned
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(glm::length(glm::dvec3(s.triangles.normals[3 * t + static_cast<size_t>(k)]) - n), 0.0, 1e-6);
+    }
+  }
+}
+
+TEST(SceneLoadGeometry, SphereIsClosedWithOutwardSmoothNormals) {
+  for (int segments : {3, 7, 32, 65}) {
+    const std::string objects = R"([{"type": "sphere", "center": [1,2,3], "radius": 2, "segments": )" +
+                                std::to_string(segments) + "}]";
+    const Scene s = load_text(with_objects(objects).str());
+    const SceneObject& o = s.objects[0];
+    const int rings = std::max(2, segments / 2);
+    EXPECT_EQ(o.triangle_count, static_cast<uint32_t>(2 * segments * (rings - 1))) << segments;
+    EXPECT_TRUE(o.closed) << segments;
+    EXPECT_TRUE(edges_shared_twice(s, o)) << segments;
+    const double v = object_volume(s, o), ball = 4.0 / 3.0 * M_PI * 8.0;
+    EXPECT_GT(v, 0.0);
+    EXPECT_LT(v, ball);  // inscribed polyhedron
+    if (segments >= 32) EXPECT_GT(v, 0.97 * ball) << segments;
+    const glm::dvec3 c(1, 2, 3);
+    for (size_t t = 0; t < o.triangle_count; ++t) {
+      const glm::dvec3 g = geometric_normal(s, t);
+      for (int k = 0; k < 3; ++k) {
+        const glm::dvec3 p = corner(s, t, k);
+        const glm::dvec3 n(s.triangles.normals[3 * t + static_cast<size_t>(k)]);
+        EXPECT_NEAR(glm::length(p - c), 2.0, 1e-5);
+        EXPECT_NEAR(glm::length(n - glm::normalize(p - c)), 0.0, 1e-5);
+        EXPECT_GT(glm::dot(n, g), 0.0);  // smooth and geometric normals agree on outside
+      }
+    }
+  }
+  // The default is 32 segments.
+  EXPECT_EQ(load_text(SceneText().str()).objects[0].triangle_count, 2u * 32 * 15);
+}
+
+TEST(SceneLoadGeometry, TransformScalesThenRotatesXYZThenTranslates) {
+  // (1,2,3) scaled by (2,3,4) is (2,6,12); 90 degrees about x: (2,-12,6); about y: (6,-12,-2);
+  // about z: (12,6,-2); translated by (10,20,30): (22,26,28).
+  const Scene s = load_text(with_objects(R"([{"type": "triangle", "vertices": [[1,2,3],[2,2,3],[1,3,3]],
+      "transform": {"scale": [2,3,4], "rotate_deg": [90,90,90], "translate": [10,20,30]}}])").str());
+  ASSERT_EQ(s.triangles.triangle_count(), 1u);
+  const glm::dvec3 p = corner(s, 0, 0);
+  EXPECT_NEAR(p.x, 22, 1e-5);
+  EXPECT_NEAR(p.y, 26, 1e-5);
+  EXPECT_NEAR(p.z, 28, 1e-5);
+  // The triangle's normal +z goes through the same rotations: z -> -y -> -y -> +x.
+  const glm::dvec3 n(s.triangles.normals[0]);
+  EXPECT_NEAR(glm::length(n - glm::dvec3(1, 0, 0)), 0.0, 1e-6);
+  EXPECT_NEAR(glm::length(geometric_normal(s, 0) - glm::dvec3(1, 0, 0)), 0.0, 1e-6);
+}
+
+TEST(SceneLoadGeometry, MirroringTransformKeepsNormalsOutward) {
+  const Scene s = load_text(with_objects(R"([
+      {"type": "box", "min": [0,0,0], "max": [1,2,3], "transform": {"scale": [-1,1,1]}},
+      {"type": "triangle", "vertices": [[0,0,0],[1,0,0],[0,1,0]], "transform": {"scale": [1,1,-2]}},
+      {"type": "sphere", "center": [0,0,0], "radius": 1, "transform": {"scale": [2,-1,1]}}])").str());
+  EXPECT_TRUE(s.objects[0].closed);
+  EXPECT_NEAR(object_volume(s, s.objects[0]), 6.0, 1e-9);
+  // The triangle faced +z; mirrored in z, the surface it becomes still faces the side its
+  // normal maps to: the inverse transpose of diag(1,1,-2) takes +z to -z.
+  EXPECT_NEAR(glm::length(geometric_normal(s, s.objects[1].first_triangle) - glm::dvec3(0, 0, -1)), 0.0, 1e-6);
+  // Ellipsoid x/2, -y, z: normals by the inverse transpose, n ~ (p.x/4, p.y, p.z).
+  const SceneObject& e = s.objects[2];
+  EXPECT_TRUE(e.closed);
+  EXPECT_GT(object_volume(s, e), 0.0);
+  for (size_t t = e.first_triangle; t < e.first_triangle + e.triangle_count; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3 p = corner(s, t, k);
+      const glm::dvec3 n(s.triangles.normals[3 * t + static_cast<size_t>(k)]);
+      EXPECT_NEAR(glm::length(n - glm::normalize(glm::dvec3(p.x / 4, p.y, p.z))), 0.0, 1e-5);
+    }
+  }
+}
+
+TEST(SceneLoadGeometry, QuarterTurnsKeepBoxesAxisAligned) {
+  const Scene s = load_text(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,2,3],
+      "transform": {"rotate_deg": [0,90,0]}}])").str());
+  const Bounds b = s.bounds();
+  EXPECT_EQ(b.lo, glm::dvec3(0, 0, -1));
+  EXPECT_EQ(b.hi, glm::dvec3(3, 2, 0));
+}
+
+// ---- Meshes ----------------------------------------------------------------------------
+
+TEST(SceneLoadMesh, MtlMaterialsAreUsedWithoutObjectMaterial) {
+  const std::string dir = std::string(ABCUBE_SOURCE_DIR) + "/scenes";
+  const Scene s = load_text(with_objects(R"([{"type": "mesh", "file": "meshes/octahedron.obj"}])").str(), dir);
+  const SceneObject& o = s.objects[0];
+  EXPECT_EQ(o.triangle_count, 8u);
+  EXPECT_TRUE(o.closed);
+  EXPECT_NEAR(object_volume(s, o), 4.0 / 3.0, 1e-6);  // octahedron with unit "radius"
+  std::map<std::string, const Material*> by_name;
+  for (const Material& m : s.materials) by_name[m.name] = &m;
+  ASSERT_TRUE(by_name.count("meshes/octahedron.obj:red"));
+  ASSERT_TRUE(by_name.count("meshes/octahedron.obj:blue"));
+  const Material& red = *by_name["meshes/octahedron.obj:red"];
+  EXPECT_NEAR(red.color.r, 0.8, 1e-6);
+  EXPECT_NEAR(red.color.g, 0.1, 1e-6);
+  EXPECT_NEAR(red.specular, 0.5, 1e-6);
+  EXPECT_NEAR(red.shininess, 64, 1e-6);
+  const Material& blue = *by_name["meshes/octahedron.obj:blue"];
+  EXPECT_NEAR(blue.specular, 0.3, 1e-6);  // mean of Ks 0.2 0.3 0.4
+  EXPECT_NEAR(blue.opacity, 0.5, 1e-6);
+  EXPECT_NEAR(blue.ior, 1.33, 1e-6);
+  // Upper faces red, lower faces blue.
+  for (uint32_t t = o.first_triangle; t < o.first_triangle + o.triangle_count; ++t) {
+    const glm::dvec3 mid = (corner(s, t, 0) + corner(s, t, 1) + corner(s, t, 2)) / 3.0;
+    EXPECT_EQ(s.materials[s.triangles.material_id[t]].name,
+              mid.y > 0 ? "meshes/octahedron.obj:red" : "meshes/octahedron.obj:blue");
+  }
+  // An object material overrides the MTL, which then adds no materials.
+  const Scene named = load_text(
+      with_objects(R"([{"type": "mesh", "file": "meshes/octahedron.obj", "material": "m"}])").str(), dir);
+  EXPECT_EQ(named.materials.size(), 2u);
+  for (uint32_t id : named.triangles.material_id) EXPECT_EQ(named.materials[id].name, "m");
+}
+
+TEST(SceneLoadMesh, MeshWithoutMaterialsGetsTheDefault) {
+  TempDir dir;
+  dir.write("cube.obj", CUBE_OBJ);
+  const Scene s = load_text(with_objects(R"([{"type": "mesh", "file": "cube.obj"}])").str(), dir.path().string());
+  const Material& m = s.materials[s.objects[0].material];
+  EXPECT_EQ(m.name, "(default)");
+  EXPECT_DOUBLE_EQ(m.color.r, 0.8);
+  EXPECT_TRUE(s.objects[0].closed);
+  EXPECT_NEAR(object_volume(s, s.objects[0]), 1.0, 1e-9);
+}
+
+TEST(SceneLoadMesh, ObjNormalsPolygonsAndWinding) {
+  TempDir dir;
+  // A square pyramid whose base is one quad and whose faces all wind inward, with
+  // vertex normals: the loader keeps the normals and turns the closed mesh outward.
+  dir.write("pyramid.obj", R"(v 0 0 0
+v 1 0 0
+v 1 0 1
+v 0 0 1
+v 0.5 1 0.5
+vn 0 1 0
+f 1//1 4//1 3//1 2//1
+f 1//1 2//1 5//1
+f 2//1 3//1 5//1
+f 3//1 4//1 5//1
+f 4//1 1//1 5//1
+)");
+  // An L-shaped hexagon (concave): ear clipping must cover exactly its area, 3 units.
+  dir.write("ell.obj", "v 0 0 0\nv 2 0 0\nv 2 0 1\nv 1 0 1\nv 1 0 2\nv 0 0 2\nf 6 5 4 3 2 1\n");
+  const Scene s = load_text(with_objects(R"([{"type": "mesh", "file": "pyramid.obj"},
+      {"type": "mesh", "file": "ell.obj", "transform": {"translate": [5, 0, 0]}}])").str(), dir.path().string());
+  const SceneObject& pyramid = s.objects[0];
+  EXPECT_EQ(pyramid.triangle_count, 6u);
+  EXPECT_TRUE(pyramid.closed);
+  EXPECT_NEAR(object_volume(s, pyramid), 1.0 / 3.0, 1e-6);  // flipped to outward
+  // The vn (0,1,0) is kept where it lies on the outer side (the slopes) and turned with
+  // the base, which now faces down.
+  for (uint32_t t = pyramid.first_triangle; t < pyramid.first_triangle + pyramid.triangle_count; ++t) {
+    const glm::dvec3 g = geometric_normal(s, t);
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3 n = s.triangles.normals[3 * t + static_cast<size_t>(k)];
+      EXPECT_EQ(n, glm::vec3(0, g.y > 0 ? 1 : -1, 0)) << t;
+    }
+  }
+  const SceneObject& ell = s.objects[1];
+  EXPECT_EQ(ell.triangle_count, 4u);
+  EXPECT_FALSE(ell.closed);
+  double area = 0;
+  for (uint32_t t = ell.first_triangle; t < ell.first_triangle + ell.triangle_count; ++t) {
+    const glm::dvec3 g = glm::cross(corner(s, t, 1) - corner(s, t, 0), corner(s, t, 2) - corner(s, t, 0));
+    EXPECT_GT(g.y, 0.0);  // every piece keeps the polygon's winding (6 5 4 ... faces +y)
+    area += 0.5 * glm::length(g);
+  }
+  EXPECT_NEAR(area, 3.0, 1e-9);
+}
+
+TEST(SceneLoadMesh, MissingMtlIsAnErrorOnlyWhenItsMaterialsAreNeeded) {
+  TempDir dir;
+  dir.write("lost.obj", "mtllib lost.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl paint\nf 1 2 3\n");
+  const std::string m = load_error(with_objects(R"([{"type": "mesh", "file": "lost.obj"}])").str(), dir.path().string());
+  EXPECT_NE(m.find("scene.json: objects[0].file: "), std::string::npos) << m;
+  EXPECT_NO_THROW(load_text(with_objects(R"([{"type": "mesh", "file": "lost.obj", "material": "white"}])").str(),
+                            dir.path().string()));
+}
+
+TEST(SceneLoadMesh, BadObjIndicesAreErrors) {
+  TempDir dir;
+  dir.write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n");
+  const std::string m = load_error(with_objects(R"([{"type": "mesh", "file": "bad.obj", "material": "white"}])").str(),
+                                   dir.path().string());
+  EXPECT_NE(m.find("scene.json: objects[0].file: "), std::string::npos) << m;
+}
+
+// ---- Tessellation helpers --------------------------------------------------------------
+
+TEST(Tessellate, ClosedSurfaceNeedsConsistentOrientation) {
+  Scene s = load_text(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1]}])").str());
+  EXPECT_TRUE(is_closed_surface(s.triangles, 0, 12));
+  EXPECT_FALSE(is_closed_surface(s.triangles, 0, 11));  // a hole
+  std::swap(s.triangles.positions[1], s.triangles.positions[2]);  // one face turned over
+  EXPECT_FALSE(is_closed_surface(s.triangles, 0, 12));
+}
+
+// ---- Memory estimate -------------------------------------------------------------------
+
+TEST(SceneLoadMemory, EstimateAndBudget) {
+  SceneText text;
+  text.render = R"({"cube_resolution": 100})";
+  const Scene s = load_text(text.str());
+  const uint64_t bytes = estimate_render_bytes(s);
+  // 64x48 pixels, 6 faces of 100x100 texels, 960 triangles, each with some headroom.
+  EXPECT_GT(bytes, 64u * 48 * 12 + 6u * 100 * 100 * 4 + 960u * 80);
+  EXPECT_LT(bytes, uint64_t{64} << 20);
+  EXPECT_NO_THROW(check_render_size(s, bytes));
+  try {
+    check_render_size(s, bytes - 1);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("scene.json: render: estimated ", 0), 0u) << m;
+    EXPECT_NE(m.find("for 64x48 and cube 100 exceeds available memory"), std::string::npos) << m;
+  }
+  // A huge cube map is refused by its estimate, not by an allocation failure.
+  text.render = R"({"cube_resolution": 16384})";
+  EXPECT_GT(estimate_render_bytes(load_text(text.str())), uint64_t{6} * 16384 * 16384 * 32);
+}
+
+// ---- The repository's scenes -----------------------------------------------------------
+
+TEST(RepositoryScenes, AllLoad) {
+  const fs::path root = fs::path(ABCUBE_SOURCE_DIR) / "scenes";
+  int count = 0;
+  for (const fs::path& dir : {root, root / "bench"}) {
+    for (const auto& entry : fs::directory_iterator(dir)) {
+      if (entry.path().extension() != ".json") continue;
+      SCOPED_TRACE(entry.path().string());
+      Scene s;
+      EXPECT_NO_THROW(s = load_scene(entry.path().string()));
+      EXPECT_GT(s.triangles.triangle_count(), 0u);
+      EXPECT_FALSE(s.lights.empty());
+      EXPECT_EQ(s.dropped_triangles, 0u);
+      ++count;
+    }
+  }
+  EXPECT_GE(count, 5);
+  const Scene bench = load_scene((root / "bench/spheres_terrain.json").string());
+  EXPECT_GE(bench.triangles.triangle_count(), 100000u);
+}
+
+// Exact ray-triangle intersection (Moller-Trumbore 1997); returns the distance or -1.
+double hit_triangle(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& a, const glm::dvec3& b,
+                    const glm::dvec3& c) {
+  const glm::dvec3 e1 = b - a, e2 = c - a, p = glm::cross(d, e2);
+  const double det = glm::dot(e1, p);
+  if (std::fabs(det) < 1e-12) return -1;
+  const glm::dvec3 s = o - a, q = glm::cross(s, e1);
+  const double u = glm::dot(s, p) / det, v = glm::dot(d, q) / det;
+  if (u < 0 || v < 0 || u + v > 1) return -1;
+  const double t = glm::dot(e2, q) / det;
+  return t > 1e-9 ? t : -1;
+}
+
+// hidden_point.json (thesis fig. 11.3) does what scenes/README.md says: some points of the
+// green triangle are hidden from the camera by the red one, yet seen in the mirror.
+TEST(RepositoryScenes, HiddenPointSeenOnlyInTheMirror) {
+  const Scene s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/hidden_point.json");
+  ASSERT_EQ(s.objects.size(), 3u);  // mirror, red, green: one triangle each
+  auto tri = [&](size_t i, int k) { return corner(s, i, k); };
+  const glm::dvec3 eye = s.camera.position;
+  int seen_in_mirror = 0, hidden_but_reflected = 0;
+  const int n = 60;
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; i + j <= n; ++j) {
+      // A point on the mirror, and the camera ray reflected there.
+      const glm::dvec3 m = tri(0, 0) + (tri(0, 1) - tri(0, 0)) * (i / double(n)) + (tri(0, 2) - tri(0, 0)) * (j / double(n));
+      const glm::dvec3 d = glm::normalize(m - eye);
+      const glm::dvec3 normal = geometric_normal(s, 0);
+      const glm::dvec3 r = d - 2.0 * glm::dot(d, normal) * normal;
+      const double to_red = hit_triangle(m, r, tri(1, 0), tri(1, 1), tri(1, 2));
+      const double to_green = hit_triangle(m, r, tri(2, 0), tri(2, 1), tri(2, 2));
+      if (to_green < 0 || (to_red > 0 && to_red < to_green)) continue;
+      ++seen_in_mirror;
+      const glm::dvec3 g = m + to_green * r;
+      const double along = glm::length(g - eye);
+      const double blocked = hit_triangle(eye, (g - eye) / along, tri(1, 0), tri(1, 1), tri(1, 2));
+      if (blocked > 0 && blocked < along) ++hidden_but_reflected;
+    }
+  }
+  EXPECT_GT(seen_in_mirror, 50);
+  EXPECT_GT(hidden_but_reflected, seen_in_mirror / 5) << seen_in_mirror;
+}
+
+}  // namespace
+}  // namespace abcube
