@@ -76,4 +76,75 @@ inline bool refract_dir(const glm::dvec3& i, const glm::dvec3& n, double eta, gl
   return true;
 }
 
+// ---------------------------------------------------------------------------------------
+// The secondary-ray rules, written once for every method (raytrace.hpp shows how the exact
+// tracer composes them; the A-buffer searches follow the same rules).
+// ---------------------------------------------------------------------------------------
+
+// Self-intersection (rule "offset"): a secondary ray leaving surface point p starts at p
+// moved by eps along the unit geometric normal, to the side the new ray travels into, with
+//   eps = SELF_INTERSECTION_REL * (max(|p.x|, |p.y|, |p.z|) + scene_scale).
+// The offset scales with the magnitude of the coordinates, so it stays many orders above
+// the rounding of a double-precision hit point (about 1e-16 of that magnitude) whatever
+// the angle of the ray: a ray that leaves a plane cannot hit that plane again, grazing or
+// not. scene_scale is the largest absolute coordinate of the scene's vertices plus the
+// diagonal of their bounds (RayTracer::scene_scale).
+constexpr double SELF_INTERSECTION_REL = 1e-9;
+
+inline double self_intersection_offset(const glm::dvec3& p, double scene_scale) {
+  const double m = std::fmax(std::fabs(p.x), std::fmax(std::fabs(p.y), std::fabs(p.z)));
+  return SELF_INTERSECTION_REL * (m + scene_scale);
+}
+
+inline glm::dvec3 offset_origin(const glm::dvec3& p, const glm::dvec3& geometric_normal,
+                                const glm::dvec3& dir, double eps) {
+  return glm::dot(geometric_normal, dir) >= 0.0 ? p + eps * geometric_normal
+                                                : p - eps * geometric_normal;
+}
+
+// Refraction at an interface (rule "refraction", Whitted 1980 with Snell's law):
+// - entering iff the ray runs against the unit geometric normal cross(b-a, c-a) (outward
+//   for closed objects): dot(N_g, d) < 0. Entering uses eta = 1/ior, leaving eta = ior
+//   (air on the other side of every interface: no stack of nested media).
+// - the ray bends about the shading normal flipped to the incoming ray's side of the
+//   geometric normal; if that normal still faces along the ray (interpolated normals can),
+//   the geometric normal is used instead.
+// - total internal reflection (negative radicand in refract_dir) sends the transmitted
+//   weight along the mirror direction about the same normal.
+struct Transmission {
+  glm::dvec3 dir{0.0};  // unit when d is unit
+  double eta = 1.0;     // n1 / n2
+  bool entering = true;
+  bool total_internal_reflection = false;
+};
+
+inline Transmission transmission(const glm::dvec3& d, const glm::dvec3& geometric_normal,
+                                 const glm::dvec3& shading_normal, double ior) {
+  Transmission r;
+  r.entering = glm::dot(geometric_normal, d) < 0.0;
+  r.eta = r.entering ? 1.0 / ior : ior;
+  const glm::dvec3 n_against = r.entering ? geometric_normal : -geometric_normal;
+  glm::dvec3 n = glm::dot(shading_normal, n_against) >= 0.0 ? shading_normal : -shading_normal;
+  if (glm::dot(n, d) >= 0.0) n = n_against;
+  r.total_internal_reflection = !refract_dir(d, n, r.eta, &r.dir);
+  if (r.total_internal_reflection) r.dir = reflect_dir(d, n);
+  return r;
+}
+
+// Light let through by one surface crossing the shadow segment P..L (rule "shadows";
+// shadow rays are not refracted):  (1 - op) + op * kt * Od, component-wise.
+// An opaque blocker (kt = 0, op = 1) gives 0; a refractive one (op = 1) gives kt * Od;
+// a coverage-transparent one (kt = 0) gives 1 - op. S_l is the product over every
+// crossing, so a closed glass object between P and L counts twice (entry and exit).
+inline glm::dvec3 blocker_transmittance(const Material& m) {
+  return glm::dvec3(1.0 - m.opacity) + (m.opacity * m.transmit) * m.color;
+}
+
+// Coverage transparency (rule "opacity"; thesis 5.2.1, Pack_Under_Mask blend):
+// C = op * C_surface + (1 - op) * C_behind, C_behind from the ray continued straight on.
+inline glm::dvec3 blend_coverage(double opacity, const glm::dvec3& c_surface,
+                                 const glm::dvec3& c_behind) {
+  return opacity * c_surface + (1.0 - opacity) * c_behind;
+}
+
 }  // namespace abcube
