@@ -604,10 +604,12 @@ std::string resolve_mesh_path(const Source& src, const std::string& file) {
 LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
   const std::string path = f.at("file");
   const std::string file = read_string(st.src, f.need("file"), path);
+  if (file.empty()) fail(st.src, path, "must name an OBJ file, got \"\"");
   const std::string resolved = resolve_mesh_path(st.src, file);
   std::error_code ec;
   if (!std::filesystem::is_regular_file(resolved, ec)) {
-    fail(st.src, path, "cannot read mesh \"" + resolved + "\": no such file");
+    const bool exists = std::filesystem::exists(resolved, ec);
+    fail(st.src, path, "cannot read mesh \"" + resolved + "\": " + (exists ? "not a regular file" : "no such file"));
   }
   tinyobj::ObjReaderConfig config;
   config.triangulate = false;  // polygons are ear-clipped here, keeping their winding

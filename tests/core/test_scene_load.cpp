@@ -326,6 +326,13 @@ TEST(SceneLoadErrors, MissingMeshFileNamesFieldAndResolvedPath) {
       load_error(with_objects(R"([{"type": "mesh", "file": "meshes/missing.obj"}])").str(), dir.path().string());
   EXPECT_NE(m.find("scene.json: objects[0].file: "), std::string::npos) << m;
   EXPECT_NE(m.find((dir.path() / "meshes/missing.obj").string()), std::string::npos) << m;
+  EXPECT_NE(m.find("no such file"), std::string::npos) << m;
+  dir.write("meshes/folder.obj/x", "");
+  const std::string d =
+      load_error(with_objects(R"([{"type": "mesh", "file": "meshes/folder.obj"}])").str(), dir.path().string());
+  EXPECT_NE(d.find("objects[0].file: cannot read mesh"), std::string::npos) << d;
+  EXPECT_NE(d.find("not a regular file"), std::string::npos) << d;
+  EXPECT_ERROR(with_objects(R"([{"type": "mesh", "file": ""}])").str(), "objects[0].file: must name an OBJ file");
 }
 
 TEST(SceneLoadErrors, UnknownMaterialNamesTheObject) {
