@@ -51,23 +51,87 @@ RayQuery::RayQuery(const glm::dvec3& o, const glm::dvec3& d) : origin(o), dir(d)
   inv_dir = glm::dvec3(1.0) / d;
 }
 
-struct Bvh::BuildItem {
-  Box box;
-  glm::dvec3 centroid{0.0};
+// A triangle during construction: its bounds and centroid.
+struct BvhBuildItem {
+  glm::dvec3 lo{0.0}, hi{0.0}, centroid{0.0};
   uint32_t triangle = 0;
 };
+
+namespace {
+
+struct SahSplit {
+  int axis = -1;  // -1: no usable split
+  int bin = 0;    // items in bins < bin go left
+  double cost = DBL_MAX;
+};
+
+int sah_bin(const BvhBuildItem& it, int axis, const Box& centroids) {
+  const double scale = SAH_BINS / (centroids.hi[axis] - centroids.lo[axis]);
+  return std::min(static_cast<int>((it.centroid[axis] - centroids.lo[axis]) * scale), SAH_BINS - 1);
+}
+
+// The cheapest binned-SAH split of items[begin, end) over the three axes (Wald 2007):
+// cost = TRAVERSAL_COST + (A_left N_left + A_right N_right) / A, in triangle tests.
+SahSplit best_sah_split(const std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t end, const Box& box,
+                        const Box& centroids) {
+  SahSplit best;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!(centroids.hi[axis] - centroids.lo[axis] > 0.0)) continue;
+    std::array<Box, SAH_BINS> bins;
+    std::array<uint32_t, SAH_BINS> counts{};
+    for (uint32_t i = begin; i < end; ++i) {
+      const int b = sah_bin(items[i], axis, centroids);
+      bins[b].extend(items[i].lo);
+      bins[b].extend(items[i].hi);
+      ++counts[b];
+    }
+    // Sweep from the right for the right-hand areas, then from the left.
+    std::array<double, SAH_BINS> right_area{};
+    std::array<uint32_t, SAH_BINS> right_count{};
+    Box acc;
+    uint32_t acc_n = 0;
+    for (int b = SAH_BINS - 1; b > 0; --b) {
+      acc.extend(bins[b]);
+      acc_n += counts[b];
+      right_area[b] = acc.area();
+      right_count[b] = acc_n;
+    }
+    Box left;
+    uint32_t left_n = 0;
+    for (int b = 1; b < SAH_BINS; ++b) {
+      left.extend(bins[b - 1]);
+      left_n += counts[b - 1];
+      if (left_n == 0 || right_count[b] == 0) continue;
+      const double cost = TRAVERSAL_COST + (left.area() * left_n + right_area[b] * right_count[b]) / box.area();
+      if (cost < best.cost) best = {axis, b, cost};
+    }
+  }
+  return best;
+}
+
+// Splits items[begin, end) at their median along `axis` (ties broken by triangle index).
+uint32_t median_split(std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t end, int axis) {
+  const uint32_t mid = begin + (end - begin) / 2;
+  std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
+                   [axis](const BvhBuildItem& a, const BvhBuildItem& b) {
+                     if (a.centroid[axis] != b.centroid[axis]) return a.centroid[axis] < b.centroid[axis];
+                     return a.triangle < b.triangle;
+                   });
+  return mid;
+}
+
+}  // namespace
 
 Bvh::Bvh(const TriangleSoup& soup) {
   const size_t n = soup.triangle_count();
   ABCUBE_CHECK(soup.positions.size() == 3 * n, "positions must hold 3 vertices per triangle");
   ABCUBE_CHECK(n < UINT32_MAX / 3, "too many triangles for 32-bit indices");
   if (n == 0) return;
-  std::vector<BuildItem> items(n);
+  std::vector<BvhBuildItem> items(n);
   for (size_t i = 0; i < n; ++i) {
-    BuildItem& it = items[i];
-    for (int k = 0; k < 3; ++k) it.box.extend(glm::dvec3(soup.positions[3 * i + k]));
-    it.centroid = 0.5 * (it.box.lo + it.box.hi);
-    it.triangle = static_cast<uint32_t>(i);
+    Box b;
+    for (int k = 0; k < 3; ++k) b.extend(glm::dvec3(soup.positions[3 * i + k]));
+    items[i] = {b.lo, b.hi, 0.5 * (b.lo + b.hi), static_cast<uint32_t>(i)};
   }
   nodes_.reserve(2 * n);
   order_.reserve(n);
@@ -81,94 +145,39 @@ Bvh::Bvh(const TriangleSoup& soup) {
 }
 
 // Builds the subtree over items[begin, end) and returns its node index (depth first).
-uint32_t Bvh::build(std::vector<BuildItem>& items, uint32_t begin, uint32_t end, int depth) {
+uint32_t Bvh::build(std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t end, int depth) {
   const uint32_t index = static_cast<uint32_t>(nodes_.size());
   nodes_.emplace_back();
   depth_ = std::max(depth_, depth + 1);
   Box box, centroids;
   for (uint32_t i = begin; i < end; ++i) {
-    box.extend(items[i].box);
+    box.extend(items[i].lo);
+    box.extend(items[i].hi);
     centroids.extend(items[i].centroid);
   }
   nodes_[index].lo = box.lo;
   nodes_[index].hi = box.hi;
   const uint32_t count = end - begin;
   const glm::dvec3 extent = centroids.hi - centroids.lo;
-  const int axis_max = extent.x > extent.y ? (extent.x > extent.z ? 0 : 2) : (extent.y > extent.z ? 1 : 2);
-  auto make_leaf = [&]() {
+  const int widest = extent.x > extent.y ? (extent.x > extent.z ? 0 : 2) : (extent.y > extent.z ? 1 : 2);
+  const SahSplit split = depth < SAH_DEPTH_LIMIT && count > 2 ? best_sah_split(items, begin, end, box, centroids)
+                                                              : SahSplit{};
+  const bool leaf_is_cheaper = split.axis >= 0 && split.cost >= static_cast<double>(count);
+  const bool cannot_split = !(extent[widest] > 0.0);  // coincident centroids
+  if (count <= 2 || (count <= MAX_LEAF && (leaf_is_cheaper || cannot_split))) {
     nodes_[index].offset = static_cast<uint32_t>(order_.size());
     nodes_[index].count = count;
     for (uint32_t i = begin; i < end; ++i) order_.push_back(items[i].triangle);
     return index;
-  };
-  if (count <= 2) return make_leaf();
-
-  // Binned SAH over the three axes (Wald 2007).
-  double best_cost = DBL_MAX;
-  int best_axis = -1, best_split = 0;
-  for (int axis = 0; axis < 3 && depth < SAH_DEPTH_LIMIT; ++axis) {
-    if (!(extent[axis] > 0.0)) continue;
-    std::array<Box, SAH_BINS> bins;
-    std::array<uint32_t, SAH_BINS> counts{};
-    const double scale = SAH_BINS / extent[axis];
-    auto bin_of = [&](const BuildItem& it) {
-      const int b = static_cast<int>((it.centroid[axis] - centroids.lo[axis]) * scale);
-      return std::min(b, SAH_BINS - 1);
-    };
-    for (uint32_t i = begin; i < end; ++i) {
-      const int b = bin_of(items[i]);
-      bins[b].extend(items[i].box);
-      ++counts[b];
-    }
-    // Sweep from the right to get the right-hand areas, then from the left.
-    std::array<double, SAH_BINS> right_area{};
-    std::array<uint32_t, SAH_BINS> right_count{};
-    Box acc;
-    uint32_t acc_n = 0;
-    for (int b = SAH_BINS - 1; b > 0; --b) {
-      acc.extend(bins[b]);
-      acc_n += counts[b];
-      right_area[b] = acc.area();
-      right_count[b] = acc_n;
-    }
-    Box left;
-    uint32_t left_n = 0;
-    for (int b = 1; b < SAH_BINS; ++b) {  // split between bins b-1 and b
-      left.extend(bins[b - 1]);
-      left_n += counts[b - 1];
-      if (left_n == 0 || right_count[b] == 0) continue;
-      const double cost = TRAVERSAL_COST + (left.area() * left_n + right_area[b] * right_count[b]) / box.area();
-      if (cost < best_cost) {
-        best_cost = cost;
-        best_axis = axis;
-        best_split = b;
-      }
-    }
   }
-  if (best_axis >= 0 && best_cost >= static_cast<double>(count) && count <= MAX_LEAF) return make_leaf();
-
   uint32_t mid = begin;
-  if (best_axis >= 0) {
-    const double lo = centroids.lo[best_axis];
-    const double scale = SAH_BINS / extent[best_axis];
-    auto goes_left = [&](const BuildItem& it) {
-      return std::min(static_cast<int>((it.centroid[best_axis] - lo) * scale), SAH_BINS - 1) < best_split;
-    };
-    mid = static_cast<uint32_t>(
-        std::stable_partition(items.begin() + begin, items.begin() + end, goes_left) - items.begin());
+  if (split.axis >= 0) {
+    auto goes_left = [&](const BvhBuildItem& it) { return sah_bin(it, split.axis, centroids) < split.bin; };
+    mid = static_cast<uint32_t>(std::stable_partition(items.begin() + begin, items.begin() + end, goes_left) -
+                                items.begin());
   }
-  if (mid == begin || mid == end) {
-    // No usable SAH split (coincident centroids, or too deep): split at the median.
-    if (!(extent[axis_max] > 0.0) && count <= MAX_LEAF) return make_leaf();
-    mid = begin + count / 2;
-    std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
-                     [&](const BuildItem& a, const BuildItem& b) {
-                       if (a.centroid[axis_max] != b.centroid[axis_max])
-                         return a.centroid[axis_max] < b.centroid[axis_max];
-                       return a.triangle < b.triangle;
-                     });
-  }
-  nodes_[index].axis = static_cast<uint32_t>(best_axis >= 0 ? best_axis : axis_max);
+  if (mid == begin || mid == end) mid = median_split(items, begin, end, widest);  // no SAH split, or too deep
+  nodes_[index].axis = static_cast<uint32_t>(split.axis >= 0 ? split.axis : widest);
   build(items, begin, mid, depth + 1);
   const uint32_t second = build(items, mid, end, depth + 1);
   nodes_[index].offset = second;

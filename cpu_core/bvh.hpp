@@ -19,6 +19,8 @@
 
 namespace abcube {
 
+struct BvhBuildItem;  // bvh.cpp
+
 // A ray prepared for the watertight test: the axis kz of the largest direction component,
 // kx, ky the other two (swapped to keep the winding), and the shear (sx, sy, sz).
 struct RayQuery {
@@ -64,8 +66,7 @@ class Bvh {
                           TriangleHit* hit) const;
 
  private:
-  struct BuildItem;
-  uint32_t build(std::vector<BuildItem>& items, uint32_t begin, uint32_t end, int depth);
+  uint32_t build(std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t end, int depth);
   bool intersect_slot(const RayQuery& ray, uint32_t slot, double tmax, TriangleHit* hit) const;
   static bool hits_box(const RayQuery& ray, const BvhNode& node, double tmax);
 

@@ -8,9 +8,11 @@
 // L = unit vector to the light, V = unit vector to the viewer, R = reflect(-L, N).
 // N is the shading normal turned to face the viewer (two-sided lighting), so a surface
 // seen from behind is lit like its front. S_l in [0, 1] is the light's visibility: 1 when
-// unshadowed, 0 behind an opaque blocker, the product of (kt * Od) of transparent blockers
-// otherwise (shadow rays are not refracted). shaders/common_shading.glsl mirrors
-// phong_local for the GPU passes.
+// unshadowed, 0 behind an opaque blocker, otherwise the product over the blockers of
+// blocker_transmittance = (1 - op) + op * kt * Od (kt * Od for glass, 1 - op for a veil;
+// shadow rays are not refracted). shaders/common_shading.glsl mirrors phong_local for the
+// GPU passes. The secondary-ray rules are at the end of this file; raytrace.hpp composes
+// all of them.
 #pragma once
 #include <cmath>
 #include <vector>
