@@ -98,7 +98,8 @@ Image error_heatmap(const Image& a, const Image& b) {
 
 double error_cp(const glm::dvec3& lookup_dir, const glm::dvec3& sigma) {
   const double lp = glm::length(lookup_dir), ls = glm::length(sigma);
-  ABCUBE_CHECK(lp > 0.0 && ls > 0.0, "error_cp needs non-zero vectors");
+  ABCUBE_CHECK(lp > 0.0 && ls > 0.0, "error_cp needs non-zero vectors, got |lookup_dir| = " + std::to_string(lp) +
+                                         ", |sigma| = " + std::to_string(ls));
   // thesis 9.2, eq. 5: Error_CP = (1 - P' . [[Sigma]]) / 2
   return std::clamp((1.0 - glm::dot(lookup_dir / lp, sigma / ls)) * 0.5, 0.0, 1.0);
 }
@@ -106,7 +107,8 @@ double error_cp(const glm::dvec3& lookup_dir, const glm::dvec3& sigma) {
 double error_parallax(const glm::dvec3& found_point, const glm::dvec3& w, const glm::dvec3& r) {
   const glm::dvec3 x = found_point - w;
   const double lx = glm::length(x), lr = glm::length(r);
-  ABCUBE_CHECK(lx > 0.0 && lr > 0.0, "error_parallax needs found_point != W and R != 0");
+  ABCUBE_CHECK(lx > 0.0 && lr > 0.0, "error_parallax needs found_point != W and R != 0, got |X' - W| = " +
+                                         std::to_string(lx) + ", |R| = " + std::to_string(lr));
   // thesis 9.3, eq. 7: Error_Parallax = (1 - [[X' - W]] . R) / 2
   return std::clamp((1.0 - glm::dot(x / lx, r / lr)) * 0.5, 0.0, 1.0);
 }

@@ -50,10 +50,12 @@ Image error_heatmap(const Image& a, const Image& b);
 glm::dvec3 heatmap_ramp(double d);
 
 // thesis 9.2, eq. 5: (1 - [[lookup_dir]] . [[sigma]]) / 2; sigma relative to the centre.
-// Both vectors must be non-zero.
+// Both vectors must be non-zero (an always-on check: a zero vector is a caller's bug).
 double error_cp(const glm::dvec3& lookup_dir, const glm::dvec3& sigma);
 
-// thesis 9.3, eq. 7: (1 - [[found_point - W]] . [[R]]) / 2. found_point must differ from W.
+// thesis 9.3, eq. 7: (1 - [[found_point - W]] . [[R]]) / 2. found_point must differ from W
+// and R be non-zero (checked likewise; a search that returns its own start point W should
+// count that ray as a miss instead).
 double error_parallax(const glm::dvec3& found_point, const glm::dvec3& w, const glm::dvec3& r);
 
 // Accumulates one error measure over many rays: found values and misses (rays for which

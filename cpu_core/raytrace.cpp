@@ -182,7 +182,9 @@ glm::dvec3 RayTracer::shade(const Hit& hit, const glm::dvec3& dir, int depth, Ra
   const glm::dvec3 n = face_forward(hit.shading_normal, v);
   glm::dvec3 c = phong_ambient(m, scene_->ambient);
   for (const PointLight& light : scene_->lights) {
-    const glm::dvec3 lit = phong_light(m, n, v, glm::normalize(light.position - hit.point), light.color);
+    const glm::dvec3 to_light = light.position - hit.point;
+    if (to_light == glm::dvec3(0.0)) continue;  // a light on the surface has no direction
+    const glm::dvec3 lit = phong_light(m, n, v, glm::normalize(to_light), light.color);
     if (lit == glm::dvec3(0.0)) continue;
     c += lit * light_visibility(hit, light, counts);
   }

@@ -108,6 +108,7 @@ class RayTracer {
  public:
   // Builds the BVH. The scene must outlive the tracer (it is referenced, not copied).
   explicit RayTracer(const Scene& scene);
+  explicit RayTracer(Scene&&) = delete;
 
   // The first hit with 0 < t < tmax along origin + t*dir (dir non-zero, need not be unit).
   bool intersect(const glm::dvec3& origin, const glm::dvec3& dir, double tmax, Hit* hit) const;
