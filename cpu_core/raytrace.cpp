@@ -248,12 +248,13 @@ Image render_raytrace(const Scene& scene, const RaytraceOptions& options, Raytra
   std::atomic<int> next_row{0}, rows_done{0};
   std::vector<RayCounts> counts(static_cast<size_t>(threads));
   std::vector<std::exception_ptr> errors(static_cast<size_t>(threads));
+  double reported = 0;  // written by worker 0 only, which is the calling thread
   auto work = [&](int index) {
     try {
       for (int y = next_row++; y < frame.height; y = next_row++) {
         render_row(tracer, frame, options.samples_per_pixel, y, &image, &counts[static_cast<size_t>(index)]);
         const int done = ++rows_done;
-        if (index == 0 && options.progress) options.progress(static_cast<double>(done) / frame.height);
+        if (index == 0 && options.progress) options.progress(reported = static_cast<double>(done) / frame.height);
       }
     } catch (...) {
       errors[static_cast<size_t>(index)] = std::current_exception();
@@ -267,6 +268,7 @@ Image render_raytrace(const Scene& scene, const RaytraceOptions& options, Raytra
   for (const std::exception_ptr& e : errors) {
     if (e) std::rethrow_exception(e);
   }
+  if (options.progress && reported < 1.0) options.progress(1.0);  // the other threads did the last rows
 
   if (stats) {
     *stats = RaytraceStats{};

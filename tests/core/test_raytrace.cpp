@@ -1,10 +1,12 @@
 // Known-answer tests of the exact ray tracer (raytrace.hpp): every expected value is
 // computed analytically from the geometry, never from a golden image.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -696,6 +698,8 @@ TEST(Raytrace, ImageIdenticalForAnyThreadCount) {
   RaytraceOptions one, three;
   one.threads = 1;
   three.threads = 3;
+  std::vector<double> progress;
+  three.progress = [&](double done) { progress.push_back(done); };  // called on this thread
   RaytraceStats st1, st3;
   const Image a = render_raytrace(s, one, &st1);
   const Image b = render_raytrace(s, three, &st3);
@@ -708,6 +712,9 @@ TEST(Raytrace, ImageIdenticalForAnyThreadCount) {
   EXPECT_GT(st1.secondary_rays, 0u);
   EXPECT_GT(st1.shadow_rays, 0u);
   EXPECT_EQ(st3.threads, 3);
+  ASSERT_FALSE(progress.empty());
+  EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
+  EXPECT_EQ(progress.back(), 1.0);  // ends at 1 whichever thread did the last row
 }
 
 TEST(Raytrace, RejectsBadOptions) {
