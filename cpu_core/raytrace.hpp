@@ -24,6 +24,9 @@
 //   iff dot(N_g, d) < 0, eta = 1/ior entering and ior leaving (air on the far side of every
 //   interface: no medium stack), bent about N_s flipped to the incoming side of N_g; on
 //   total internal reflection the kt weight follows the mirror direction instead.
+//   A direction bent by an interpolated N_s may cross to the other side of the triangle's
+//   plane (near silhouettes of coarse meshes); it is traced as it is, from the side it
+//   travels into (no correction).
 //
 // Depth. Primary rays have depth 0; reflected and refracted rays depth k+1. At depth
 // max_depth (Scene::render.max_depth) no reflected or refracted ray is spawned: those
