@@ -61,7 +61,7 @@ PrepassError prepass_error(const Scene& scene, const RayTracer& rt, const CubeIm
   e.median_rel = rel[rel.size() / 2];
   e.p99_rel = rel[std::min(rel.size() - 1, rel.size() * 99 / 100)];
   e.max_rel = rel.back();
-  e.same_object = static_cast<double>(same) / rel.size();
+  e.same_object = static_cast<double>(same) / static_cast<double>(rel.size());
   return e;
 }
 

@@ -58,6 +58,20 @@ ImageError image_error(const Image& a, const Image& b) {
   return e;
 }
 
+double share_over(const Image& a, const Image& b, double threshold) {
+  check_same_size(a, b);
+  const size_t pixels = static_cast<size_t>(a.width) * static_cast<size_t>(a.height);
+  if (pixels == 0) return 0.0;
+  size_t over = 0;
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < a.width; ++x) {
+      const glm::dvec3 d = glm::abs(displayed(a, x, y) - displayed(b, x, y));
+      over += std::max(d.x, std::max(d.y, d.z)) > threshold + SHARE_SLACK;
+    }
+  }
+  return static_cast<double>(over) / static_cast<double>(pixels);
+}
+
 glm::dvec3 heatmap_ramp(double d) {
   struct Stop {
     double at;

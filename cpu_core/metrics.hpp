@@ -40,6 +40,10 @@ struct ImageError {
 // Throws InputError when the sizes differ (naming both).
 ImageError image_error(const Image& a, const Image& b);
 
+// Share of pixels whose largest displayed channel |d| exceeds `threshold` (idiff's
+// -fail; the same 1e-6 slack as share_over_1/2). Throws InputError when sizes differ.
+double share_over(const Image& a, const Image& b, double threshold);
+
 // Per-pixel largest channel |d| (as displayed, see above) on a colour ramp, ready to
 // write: black 0, dark blue 1/255, blue 2/255, cyan 4/255, green 8/255, yellow 32/255,
 // red 128/255 and above, linear between stops (the stops are the displayed colours:

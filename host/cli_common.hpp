@@ -43,5 +43,6 @@ bool stderr_is_terminal();
 int cmd_render(const std::vector<std::string>& words);
 int cmd_info(const std::vector<std::string>& words);
 int cmd_compare(const std::vector<std::string>& words);
+int cmd_export_pov(const std::vector<std::string>& words);
 
 }  // namespace abcube

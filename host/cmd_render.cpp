@@ -1,5 +1,7 @@
 // abcube render: load a scene, run the passes its method needs, write the image and stats.
+#include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -11,6 +13,8 @@
 #include "gl_passes.hpp"
 #include "image_io.hpp"
 #include "memory.hpp"
+#include "metrics.hpp"
+#include "raytrace.hpp"
 #include "scene_load.hpp"
 
 namespace abcube {
@@ -98,6 +102,34 @@ Image render_gpu(const Scene& scene, const RenderRequest& r, json* stats) {
   return image;
 }
 
+// Shows "label NN%" on stderr when it is a terminal; quiet otherwise (cli.md).
+std::function<void(double)> progress_printer(const char* label) {
+  if (!stderr_is_terminal()) return nullptr;
+  return [label](double done) { std::fprintf(stderr, "\r%s %3d%%%s", label, int(done * 100), done >= 1 ? "\n" : ""); };
+}
+
+// The exact Whitted tracer (--method raytrace, and the --reference image).
+Image render_reference(const Scene& scene, const RenderRequest& r, json* stats, const char* key) {
+  RaytraceOptions options;
+  options.threads = r.threads;
+  options.progress = progress_printer(key);
+  RaytraceStats rs;
+  Image image = render_raytrace(scene, options, &rs);
+  json& j = (*stats)[key];
+  j["timings_ms"] = {{"bvh_build", rs.build_ms}, {"trace", rs.trace_ms}};
+  j["counts"] = {{"primary_rays", rs.primary_rays}, {"secondary_rays", rs.secondary_rays},
+                 {"shadow_rays", rs.shadow_rays}, {"bvh_nodes", rs.bvh_nodes}, {"bvh_depth", rs.bvh_depth}};
+  j["threads"] = rs.threads;
+  return image;
+}
+
+json image_error_json(const ImageError& e) {
+  const bool identical = !std::isfinite(e.psnr);
+  return {{"rmse", e.rmse}, {"psnr_db", identical ? json("inf") : json(e.psnr)}, {"max_abs", e.max_abs},
+          {"share_over_1_255", e.share_over_1}, {"share_over_2_255", e.share_over_2},
+          {"compared_as", "sRGB-encoded, clamped to [0,1] (metrics.hpp)"}};
+}
+
 }  // namespace
 
 int cmd_render(const std::vector<std::string>& words) {
@@ -122,12 +154,22 @@ int cmd_render(const std::vector<std::string>& words) {
     case Method::gpu:
       image = render_gpu(scene, r, &stats);
       break;
+    case Method::raytrace:
+      image = render_reference(scene, r, &stats, "raytrace");
+      stats["plan"]["passes"] = {"raytrace"};
+      stats["plan"]["skipped"] = {{{"pass", "gl"}, {"why", "the exact tracer needs no GL"}}};
+      stats["gl"] = {{"path", "none"}, {"renderer", "none (the tracer is CPU only)"}};
+      break;
     default:
       throw RuntimeFailure(std::string("method '") + method_name(scene.render.method) +
                            "' is not in this build yet; use --method gpu");
   }
   if (r.reference) {
-    throw RuntimeFailure("--reference needs the exact tracer, which is not in this build yet");
+    // The error of this image against the exact tracer (the same one image, if raytrace).
+    const Image ref = scene.render.method == Method::raytrace ? image : render_reference(scene, r, &stats, "reference");
+    stats["reference"]["image_error"] = image_error_json(image_error(image, ref));
+    stats["reference"]["ray_error"] = std::string("n/a: method ") + method_name(scene.render.method) +
+                                      " does no map search (Error_CP and Error_Parallax measure searches)";
   }
 
   Clock::time_point t0 = Clock::now();

@@ -14,7 +14,8 @@ const char* USAGE =
     "                     [--cube-res N] [--max-depth D] [--threads K] [--gl auto|egl|egl-device|\n"
     "                     egl-surfaceless|osmesa|none] [--gl-device K] [--stats STATS.json] [--reference]\n"
     "       abcube compare A.png B.png [--diff HEAT.png] [--fail T] [--failpercent P]\n"
-    "       abcube info\n";
+    "       abcube info\n"
+    "       abcube export-pov SCENE.json -o OUT.pov\n";
 
 }  // namespace
 
@@ -27,8 +28,10 @@ int main(int argc, char** argv) {
   const std::vector<std::string> words(argv + 2, argv + argc);
   try {
     if (command == "render") return abcube::cmd_render(words);
+    if (command == "compare") return abcube::cmd_compare(words);
     if (command == "info") return abcube::cmd_info(words);
-    throw abcube::InputError("unknown command '" + command + "' (render, compare, info)");
+    if (command == "export-pov") return abcube::cmd_export_pov(words);
+    throw abcube::InputError("unknown command '" + command + "' (render, compare, info, export-pov)");
   } catch (const abcube::InputError& e) {
     std::string line = e.what();
     for (char& c : line) c = c == '\n' ? ' ' : c;

@@ -11,7 +11,7 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools
   nlohmann-json3-dev libtinyobjloader-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libembree-dev povray
+  povray
 )
 
 missing=()
