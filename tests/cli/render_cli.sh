@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# The abcube program end to end: render through each GL path, stats, forced-path failures,
+# atomic outputs, compare's exit codes and heatmap, export-pov, info (cli.md).
+# Usage (ctest runs it so): bash render_cli.sh /path/to/abcube /path/to/repo
+set -u
+ABCUBE=$1
+REPO=$2
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/abcube_render_cli.XXXXXX")
+trap 'rm -rf "$WORK"' EXIT
+passed=0
+failed=0
+ok() { passed=$((passed + 1)); }
+bad() { failed=$((failed + 1)); echo "FAIL: $*"; }
+check() { local what=$1; shift; if "$@"; then ok; else bad "$what"; fi; }
+
+# A small scene: a mirror, a red and a green triangle, a floor, one light.
+cat > "$WORK/small.json" <<'JSON'
+{ "version": 1,
+  "camera": {"position": [0, 1, 4], "look_at": [0, 0.5, 0], "fov_y": 50, "width": 48, "height": 36},
+  "background": [0.1, 0.1, 0.3], "ambient": [0.2, 0.2, 0.2],
+  "lights": [{"type": "point", "position": [2, 4, 3], "color": [1, 1, 1]}],
+  "materials": {"red": {"color": [0.9, 0.1, 0.1]}, "mirror": {"color": [0.1, 0.1, 0.1], "reflect": 0.8}},
+  "objects": [
+    {"type": "quad", "vertices": [[-3,0,-3],[-3,0,3],[3,0,3],[3,0,-3]]},
+    {"type": "sphere", "center": [0, 0.5, 0], "radius": 0.5, "segments": 16, "material": "red"},
+    {"type": "box", "min": [0.8, 0, -1], "max": [1.2, 1, 0], "material": "mirror"}
+  ] }
+JSON
+
+# --- render through each forced GL path; stats name the path and renderer
+for gl in egl osmesa egl-surfaceless auto; do
+  out="$WORK/gpu_$gl.png"
+  "$ABCUBE" render "$WORK/small.json" -o "$out" --method gpu --gl "$gl" --stats "$WORK/s_$gl.json" 2> "$WORK/err"
+  check "gpu --gl $gl exits 0 ($(cat "$WORK/err"))" [ $? -eq 0 ]
+  check "gpu --gl $gl writes the image" [ -s "$out" ]
+  check "stats of --gl $gl name a GL path" grep -q '"path": "egl\|"path": "osmesa' "$WORK/s_$gl.json"
+  check "stats of --gl $gl hold the renderer" grep -q '"renderer": "' "$WORK/s_$gl.json"
+  check "stats of --gl $gl hold per-pass ms" grep -q '"camera_raster"' "$WORK/s_$gl.json"
+done
+check "--gl osmesa stats say osmesa" grep -q '"path": "osmesa"' "$WORK/s_osmesa.json"
+
+# --- the two APIs draw the same picture
+"$ABCUBE" compare "$WORK/gpu_egl.png" "$WORK/gpu_osmesa.png" --fail 0.004 > "$WORK/cmp" 2>&1
+check "egl and osmesa images agree ($(tail -1 "$WORK/cmp"))" [ $? -eq 0 ]
+
+# --- a forced path that fails is an error naming the reason, and leaves old outputs alone
+printf 'old image' > "$WORK/keep.png"
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/keep.png" --method gpu --gl egl-device --gl-device 99 \
+  > /dev/null 2> "$WORK/err"
+status=$?
+check "forced EGL device 99 exits 1 (got $status)" [ $status -eq 1 ]
+check "forced failure says why on one line" [ "$(wc -l < "$WORK/err")" -eq 1 ]
+check "forced failure names the device" grep -q "device 99" "$WORK/err"
+check "failed render keeps the old output" [ "$(cat "$WORK/keep.png")" = "old image" ]
+check "no temporary file left behind" [ -z "$(ls -A "$WORK" | grep '\.tmp')" ]
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --method gpu --gl none > /dev/null 2> "$WORK/err"
+check "--method gpu with --gl none exits 2" [ $? -eq 2 ]
+ABCUBE_EGL_DEVICE=abc "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --method gpu > /dev/null 2> "$WORK/err"
+check "bad ABCUBE_EGL_DEVICE exits 2" [ $? -eq 2 ]
+check "nothing written on error" [ ! -e "$WORK/x.png" ]
+
+# --- the exact tracer with --reference, no GL needed
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/rt.exr" --method raytrace --gl none --threads 2 \
+  --reference --stats "$WORK/rt.json" 2> "$WORK/err"
+check "raytrace exits 0 ($(cat "$WORK/err"))" [ $? -eq 0 ]
+check "raytrace writes EXR" [ -s "$WORK/rt.exr" ]
+check "raytrace stats count rays" grep -q '"primary_rays": 55296' "$WORK/rt.json"
+check "reference of raytrace is itself" grep -q '"psnr_db": "inf"' "$WORK/rt.json"
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/rt.png" --method raytrace --gl none 2> /dev/null
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/gpu_ref.png" --method gpu --reference --stats "$WORK/g.json" 2> /dev/null
+check "gpu --reference reports an image error" grep -q '"share_over_2_255"' "$WORK/g.json"
+
+# --- compare: exit 0 within, 1 beyond, 2 for bad input; heatmap
+"$ABCUBE" compare "$WORK/rt.png" "$WORK/rt.png" > "$WORK/cmp"
+check "identical images compare 0" [ $? -eq 0 ]
+check "identical images: PSNR inf" grep -q "PSNR        inf" "$WORK/cmp"
+"$ABCUBE" compare "$WORK/rt.png" "$WORK/gpu_egl.png" --diff "$WORK/heat.png" > "$WORK/cmp"
+check "different images compare 1" [ $? -eq 1 ]
+check "heatmap written" [ -s "$WORK/heat.png" ]
+"$ABCUBE" compare "$WORK/rt.png" "$WORK/gpu_egl.png" --fail 1 > /dev/null
+check "--fail 1 lets everything pass" [ $? -eq 0 ]
+"$ABCUBE" compare "$WORK/rt.png" "$WORK/gpu_egl.png" --failpercent 100 > /dev/null
+check "--failpercent 100 lets everything pass" [ $? -eq 0 ]
+"$ABCUBE" compare "$WORK/rt.png" "$WORK/nothing.png" > /dev/null 2> "$WORK/err"
+check "unreadable image compares 2" [ $? -eq 2 ]
+check "unreadable image named" grep -q "nothing.png" "$WORK/err"
+oiiotool "$WORK/rt.png" --resize 20x10 -o "$WORK/small.png" 2> /dev/null
+"$ABCUBE" compare "$WORK/rt.png" "$WORK/small.png" > /dev/null 2> "$WORK/err"
+check "size mismatch compares 2" [ $? -eq 2 ]
+check "size mismatch on one line" [ "$(wc -l < "$WORK/err")" -eq 1 ]
+
+# --- export-pov and info
+"$ABCUBE" export-pov "$WORK/small.json" -o "$WORK/small.pov"
+check "export-pov exits 0" [ $? -eq 0 ]
+check "export-pov writes mesh2" grep -q "mesh2" "$WORK/small.pov"
+"$ABCUBE" info > "$WORK/info"
+check "info exits 0" [ $? -eq 0 ]
+check "info lists egl-surfaceless" grep -q "egl-surfaceless" "$WORK/info"
+check "info lists osmesa" grep -q "osmesa" "$WORK/info"
+check "info prints GL_RENDERER" grep -q "GL_RENDERER" "$WORK/info"
+
+echo "cli render_cli: $passed passed, $failed failed"
+[ $failed -eq 0 ]
