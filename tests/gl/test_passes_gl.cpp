@@ -154,3 +154,34 @@ TEST(ZbufferGl, PhongMatchesCpuShading) {
 
 }  // namespace
 }  // namespace abcube
+
+namespace abcube {
+namespace {
+
+// Thesis figures 11.1-11.2, the Z-buffer half: a white triangle on black through the GPU
+// raster has no intermediate edge values, every pixel is 0 or 1 (the A-buffer half, with
+// intermediate values matching the covered area, is in tests/core).
+TEST(ZbufferGl, WhiteTriangleEdgesAreAliased) {
+  test::test_context();
+  Scene s;
+  s.ambient = glm::dvec3(1);
+  s.background = glm::dvec3(0);
+  s.camera.position = glm::dvec3(0, 0, 3);
+  s.camera.look_at = glm::dvec3(0);
+  s.camera.width = 64;
+  s.camera.height = 64;
+  const uint32_t white = test::add_material(s, glm::dvec3(1));
+  test::add_triangle(s, {-1, -0.8, 0}, {1.1, -0.5, 0}, {-0.2, 1, 0}, white);
+  GlScene gl(s);
+  const Image img = gl.camera_color(s.camera);
+  int white_pixels = 0, other = 0;
+  for (float v : img.data) {
+    white_pixels += v == 1.f;
+    other += v != 0.f && v != 1.f;
+  }
+  EXPECT_EQ(other, 0);
+  EXPECT_GT(white_pixels, 3 * 500);
+}
+
+}  // namespace
+}  // namespace abcube
