@@ -34,7 +34,9 @@ struct CubeCoord {
   double s, t;  // in [0, 1]
 };
 
-// Face selection as in GL: ties go to the first of x, y, z with the largest magnitude.
+// Face selection by the largest-magnitude component. GL leaves exact ties (seams, corners)
+// to the implementation; ours go to the first of x, y, z, and a zero component counts as
+// positive.
 // r need not be unit; r must not be zero.
 CubeCoord direction_to_cube(const glm::dvec3& r);
 

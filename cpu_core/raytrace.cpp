@@ -14,16 +14,11 @@
 #include "error.hpp"
 #include "samples.hpp"
 #include "shading.hpp"
+#include "timer.hpp"
 
 namespace abcube {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 Bvh timed_build(const TriangleSoup& soup, double* ms) {
   const Clock::time_point start = Clock::now();

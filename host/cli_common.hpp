@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "timer.hpp"
+
 namespace abcube {
 
 // Command-line words after the subcommand. Options are "--name value" or "--flag";
@@ -29,10 +31,6 @@ class Args {
   std::vector<std::string> positional_;
 };
 
-using Clock = std::chrono::steady_clock;
-inline double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 // Thread count for --threads K: K >= 1 as given, 0 = every hardware thread.
 int resolve_threads(int requested);

@@ -43,6 +43,7 @@ int cmd_info(const std::vector<std::string>& words) {
   }
 
   std::printf("GL paths (auto tries them in this order):\n");
+  std::string auto_pick;  // what --gl auto opens, from the probes below
   bool any_device = false;
   for (const EglDeviceInfo& d : devices) {
     why.clear();
@@ -50,6 +51,7 @@ int cmd_info(const std::vector<std::string>& words) {
     const std::string label = "egl-device " + std::to_string(d.index);
     print_context(label.c_str(), ctx.get(), why);
     if (ctx && d.software) std::printf("    (software device: auto skips it)\n");
+    if (ctx && !d.software && auto_pick.empty()) auto_pick = label;
     any_device = true;
   }
   if (!any_device) print_context("egl-device", nullptr, why);
@@ -57,15 +59,15 @@ int cmd_info(const std::vector<std::string>& words) {
     why.clear();
     auto ctx = create_egl_surfaceless_context(&why);
     print_context("egl-surfaceless", ctx.get(), why);
+    if (ctx && auto_pick.empty()) auto_pick = "egl-surfaceless";
   }
   {
     why.clear();
     auto ctx = create_osmesa_context(&why);
     print_context("osmesa", ctx.get(), why);
+    if (ctx && auto_pick.empty()) auto_pick = "osmesa";
   }
-  std::string log;
-  auto chosen = open_gl_context(GlChoice::automatic, -1, &log);
-  std::printf("--gl auto picks: %s\n", chosen ? chosen->info().api.c_str() : "none (CPU only)");
+  std::printf("--gl auto picks: %s\n", auto_pick.empty() ? "none (CPU only)" : auto_pick.c_str());
   return 0;
 }
 

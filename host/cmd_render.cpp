@@ -1,6 +1,7 @@
 // abcube render: load a scene, run the passes its method needs, write the image and stats.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
@@ -46,6 +47,14 @@ RenderRequest parse_request(const std::vector<std::string>& words, Scene* scene)
     throw InputError(r.output + ": no image writer for this file extension");
   }
   r.stats_path = args.get("--stats");
+  for (const std::string* path : {&r.output, &r.stats_path}) {
+    // Refuse before any work a folder the output cannot be written to.
+    if (path->empty()) continue;
+    const std::filesystem::path dir = std::filesystem::path(*path).parent_path();
+    if (!dir.empty() && !std::filesystem::is_directory(dir)) {
+      throw InputError(*path + ": folder " + dir.string() + " does not exist");
+    }
+  }
   if (args.has("--gl") && !parse_gl_choice(args.get("--gl"), &r.gl)) {
     throw InputError("--gl: unknown path '" + args.get("--gl") +
                      "' (auto, egl, egl-device, egl-surfaceless, osmesa, none)");
@@ -84,7 +93,7 @@ Image render_gpu(const Scene& scene, const RenderRequest& r, json* stats) {
   std::unique_ptr<GlContext> ctx = open_gl_context(r.gl, r.gl_device, &log);
   if (!ctx) {
     if (r.gl == GlChoice::none) throw InputError("--method gpu needs OpenGL, but --gl none was given");
-    for (char& c : log) c = c == '\n' ? ';' : c;
+    for (char& c : log) c = c == '\n' ? ';' : c;  // one line (main flattens too)
     throw RuntimeFailure("--method gpu needs OpenGL and no GL path works here: " + log);
   }
   (*stats)["gl"] = gl_json(ctx.get());

@@ -1,5 +1,7 @@
 #include "gl_context.hpp"
 
+#include <glad/gl.h>
+
 #include <cstdlib>
 
 #include "error.hpp"
@@ -32,8 +34,23 @@ int device_from_environment(int device_index) {
 }
 }  // namespace
 
+void read_gl_strings(GlInfo* info) {
+  auto get = [](GLenum name) {
+    const GLubyte* s = glGetString(name);
+    return s ? std::string(reinterpret_cast<const char*>(s)) : std::string();
+  };
+  info->gl_version = get(GL_VERSION);
+  info->gl_renderer = get(GL_RENDERER);
+  info->gl_vendor = get(GL_VENDOR);
+}
+
 std::unique_ptr<GlContext> open_gl_context(GlChoice choice, int device_index, std::string* log) {
-  device_index = device_from_environment(device_index);
+  const bool uses_devices = choice == GlChoice::automatic || choice == GlChoice::egl || choice == GlChoice::egl_device;
+  if (device_index >= 0 && !uses_devices) {
+    throw InputError("--gl-device applies to EGL devices only (--gl auto, egl or egl-device)");
+  }
+  if (uses_devices) device_index = device_from_environment(device_index);
+  if (device_index >= 0) choice = GlChoice::egl_device;  // a named device is forced
   std::string why;
   std::unique_ptr<GlContext> ctx;
   auto note = [&](const char* api) {
@@ -52,9 +69,8 @@ std::unique_ptr<GlContext> open_gl_context(GlChoice choice, int device_index, st
       if ((ctx = create_osmesa_context(&why))) return ctx;
       throw RuntimeFailure("--gl osmesa failed: " + why);
     case GlChoice::egl: {
-      // EGL in whichever form works: a (hardware, or the chosen) device, else surfaceless.
+      // EGL in whichever form works: a hardware device, else surfaceless.
       if ((ctx = create_egl_device_context(device_index, &why))) return ctx;
-      if (device_index >= 0) throw RuntimeFailure("--gl egl failed: " + why);
       const std::string device_why = why;
       if ((ctx = create_egl_surfaceless_context(&why))) return ctx;
       throw RuntimeFailure("--gl egl failed: device: " + device_why + "; surfaceless: " + why);
@@ -66,6 +82,7 @@ std::unique_ptr<GlContext> open_gl_context(GlChoice choice, int device_index, st
       note("egl-surfaceless");
       if ((ctx = create_osmesa_context(&why))) return ctx;
       note("osmesa");
+      if (log && !log->empty() && log->back() == '\n') log->pop_back();
       return nullptr;
   }
   return nullptr;

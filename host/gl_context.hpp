@@ -3,8 +3,8 @@
 // `--gl auto` tries, in order: an EGL device with a hardware renderer (how a GPU is picked
 // on NVIDIA servers), EGL on Mesa's surfaceless platform, OSMesa, then none (CPU only).
 // A forced path that fails is an error naming the reason, never a silent fallback.
-// Every context is GL 4.5 core (the minimum abcube needs: clip control, DSA-free but
-// SSBOs and explicit attribute locations) and renders only into framebuffer objects.
+// Every context is GL 4.5 core (the minimum abcube needs: glClipControl for the infinite
+// reversed-Z projection, SSBOs, compute shaders in tests) and renders only into FBOs.
 #pragma once
 #include <memory>
 #include <string>
@@ -46,13 +46,17 @@ std::unique_ptr<GlContext> create_egl_device_context(int device_index, std::stri
 std::unique_ptr<GlContext> create_egl_surfaceless_context(std::string* why);
 std::unique_ptr<GlContext> create_osmesa_context(std::string* why);
 
+// Fills gl_version, gl_renderer and gl_vendor from the current context ("" if GL has none).
+void read_gl_strings(GlInfo* info);
+
 // EGL devices visible here (empty with *why set if enumeration is unavailable).
 std::vector<EglDeviceInfo> list_egl_devices(std::string* why);
 
 // Opens a context as `choice` says (see the top of this file). Returns nullptr for
 // GlChoice::none, and for automatic when nothing works (then *log says why each failed).
 // Throws RuntimeFailure when a forced path fails. device_index: --gl-device, or
-// ABCUBE_EGL_DEVICE when < 0 and that variable is set.
+// ABCUBE_EGL_DEVICE when < 0 and that variable is set; a named device forces the EGL
+// device path under auto and egl too (it fails rather than fall back).
 std::unique_ptr<GlContext> open_gl_context(GlChoice choice, int device_index, std::string* log);
 
 // The renderer string for --stats: "GL_RENDERER (api)" or "none (CPU only)".

@@ -41,7 +41,10 @@ class EglContext : public GlContext {
  public:
   ~EglContext() override {
     if (display_ != EGL_NO_DISPLAY) {
-      eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+      // Release only our own context: another display's may be current on this thread.
+      if (context_ != EGL_NO_CONTEXT && eglGetCurrentContext() == context_) {
+        eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+      }
       if (context_ != EGL_NO_CONTEXT) eglDestroyContext(display_, context_);
       eglTerminate(display_);
     }
@@ -72,7 +75,8 @@ class EglContext : public GlContext {
     }
     EGLConfig config = nullptr;
     if (!has_extension(dext, "EGL_KHR_no_config_context")) {
-      const EGLint attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+      // Device and surfaceless displays have no window configs (EGL's default type).
+      const EGLint attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_NONE};
       EGLint count = 0;
       if (!eglChooseConfig(display, attribs, &config, 1, &count) || count < 1) {
         *why = "no EGL config with EGL_OPENGL_BIT";
@@ -99,9 +103,7 @@ class EglContext : public GlContext {
     const char* vendor = eglQueryString(display, EGL_VENDOR);
     info_.egl_vendor = vendor ? vendor : "";
     info_.egl_version = std::to_string(major) + "." + std::to_string(minor);
-    info_.gl_version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
-    info_.gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    info_.gl_vendor = reinterpret_cast<const char*>(glGetString(GL_VENDOR));
+    read_gl_strings(&info_);
     return true;
   }
 
@@ -115,8 +117,10 @@ class EglContext : public GlContext {
 std::vector<EGLDeviceEXT> query_devices(std::string* why) {
   if (!load_egl_client(why)) return {};
   const char* cext = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-  if (!has_extension(cext, "EGL_EXT_device_enumeration") ||
-      !has_extension(cext, "EGL_EXT_platform_device") || !eglQueryDevicesEXT) {
+  // EGL_EXT_device_base is the older name of enumeration + query together.
+  const bool enumeration = has_extension(cext, "EGL_EXT_device_enumeration") ||
+                           has_extension(cext, "EGL_EXT_device_base");
+  if (!enumeration || !has_extension(cext, "EGL_EXT_platform_device") || !eglQueryDevicesEXT) {
     *why = "EGL_EXT_device_enumeration / EGL_EXT_platform_device not offered";
     return {};
   }
@@ -153,32 +157,56 @@ std::vector<EglDeviceInfo> list_egl_devices(std::string* why) {
   return out;
 }
 
+namespace {
+
+std::unique_ptr<EglContext> start_device(EGLDeviceEXT device, int index, std::string* why) {
+  EGLDisplay display = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
+  auto ctx = std::make_unique<EglContext>();
+  if (!ctx->start(display, "egl-device", why)) {
+    *why = "device " + std::to_string(index) + ": " + *why;
+    return nullptr;
+  }
+  ctx->set_device(index);
+  return ctx;
+}
+
+// Mesa may serve a DRM device in software too (kms_swrast): judge by the renderer.
+bool software_renderer(const std::string& renderer) {
+  for (const char* name : {"llvmpipe", "softpipe", "swrast", "Software Rasterizer"}) {
+    if (renderer.find(name) != std::string::npos) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 std::unique_ptr<GlContext> create_egl_device_context(int device_index, std::string* why) {
   const std::vector<EGLDeviceEXT> devices = query_devices(why);
   if (devices.empty()) return nullptr;
-  int chosen = device_index;
-  if (chosen < 0) {
-    for (size_t i = 0; i < devices.size() && chosen < 0; ++i) {
-      if (!describe_device(devices[i], static_cast<int>(i)).software) chosen = static_cast<int>(i);
-    }
-    if (chosen < 0) {
-      *why = "no hardware EGL device (" + std::to_string(devices.size()) +
-             " found, all software; choose one with --gl-device K)";
-      return nullptr;
-    }
-  } else if (chosen >= static_cast<int>(devices.size())) {
-    *why = "EGL device " + std::to_string(chosen) + " requested, " + std::to_string(devices.size()) +
+  if (device_index >= static_cast<int>(devices.size())) {
+    *why = "EGL device " + std::to_string(device_index) + " requested, " + std::to_string(devices.size()) +
            " found";
     return nullptr;
   }
-  EGLDisplay display = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, devices[static_cast<size_t>(chosen)], nullptr);
-  auto ctx = std::make_unique<EglContext>();
-  if (!ctx->start(display, "egl-device", why)) {
-    *why = "device " + std::to_string(chosen) + ": " + *why;
-    return nullptr;
+  if (device_index >= 0) {
+    return start_device(devices[static_cast<size_t>(device_index)], device_index, why);
   }
-  ctx->set_device(chosen);
-  return ctx;
+  // No device named: the first that works with a hardware renderer.
+  std::string tried;
+  for (size_t i = 0; i < devices.size(); ++i) {
+    const int index = static_cast<int>(i);
+    if (describe_device(devices[i], index).software) {
+      tried += (tried.empty() ? "" : ", ") + ("device " + std::to_string(index) + ": software");
+      continue;
+    }
+    auto ctx = start_device(devices[i], index, why);
+    if (ctx && !software_renderer(ctx->info().gl_renderer)) return ctx;
+    tried += (tried.empty() ? "" : ", ") + (ctx ? "device " + std::to_string(index) + ": software renderer " +
+                                                      ctx->info().gl_renderer
+                                                : *why);
+  }
+  *why = "no hardware EGL device (" + tried + "; choose one with --gl-device K)";
+  return nullptr;
 }
 
 std::unique_ptr<GlContext> create_egl_surfaceless_context(std::string* why) {

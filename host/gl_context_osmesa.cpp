@@ -25,8 +25,10 @@ using MakeCurrent = unsigned char (*)(OSMesaContextHandle, void*, unsigned int, 
 using DestroyContext = void (*)(OSMesaContextHandle);
 using GetProcAddress = GLADapiproc (*)(const char*);
 
-GetProcAddress g_get_proc = nullptr;  // glad's loader callback has no user pointer
-GLADapiproc osmesa_load(const char* name) { return g_get_proc(name); }
+// glad's loader callback with OSMesaGetProcAddress as its user pointer.
+GLADapiproc osmesa_load(void* get_proc, const char* name) {
+  return reinterpret_cast<GetProcAddress>(get_proc)(name);
+}
 
 class OsmesaContext : public GlContext {
  public:
@@ -50,8 +52,8 @@ class OsmesaContext : public GlContext {
     auto create = reinterpret_cast<CreateContextAttribs>(dlsym(library_, "OSMesaCreateContextAttribs"));
     auto make_current = reinterpret_cast<MakeCurrent>(dlsym(library_, "OSMesaMakeCurrent"));
     destroy_ = reinterpret_cast<DestroyContext>(dlsym(library_, "OSMesaDestroyContext"));
-    g_get_proc = reinterpret_cast<GetProcAddress>(dlsym(library_, "OSMesaGetProcAddress"));
-    if (!create || !make_current || !destroy_ || !g_get_proc) {
+    void* get_proc = dlsym(library_, "OSMesaGetProcAddress");
+    if (!create || !make_current || !destroy_ || !get_proc) {
       *why = "libOSMesa lacks OSMesaCreateContextAttribs";
       return false;
     }
@@ -68,14 +70,12 @@ class OsmesaContext : public GlContext {
       *why = "OSMesaMakeCurrent failed";
       return false;
     }
-    if (!gladLoadGL(osmesa_load)) {
+    if (!gladLoadGLUserPtr(osmesa_load, get_proc)) {
       *why = "glad could not load OpenGL 4.5 core entry points";
       return false;
     }
     info_.api = "osmesa";
-    info_.gl_version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
-    info_.gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    info_.gl_vendor = reinterpret_cast<const char*>(glGetString(GL_VENDOR));
+    read_gl_strings(&info_);
     return true;
   }
 

@@ -7,15 +7,12 @@
 
 #include "cube_map.hpp"
 #include "error.hpp"
+#include "timer.hpp"
 
 namespace abcube {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 struct Vertex {
   float position[3];
@@ -70,9 +67,17 @@ struct GlScene::Target {
     glDeleteFramebuffers(1, &fbo);
   }
 
+  // Binds the target, sets the state every pass relies on, and clears it.
   void clear(const glm::dvec3& background) const {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glViewport(0, 0, width, height);
+    // Infinite reversed-Z (cube_map.hpp): depth in [0, 1], 1 at the near plane.
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);  // back faces too: the map holds every surface
+    glDisable(GL_BLEND);
     const float zero_depth = 0.f;  // reversed Z: 0 is infinitely far
     glClearBufferfv(GL_DEPTH, 0, &zero_depth);
     if (distance_pass) {
@@ -141,12 +146,6 @@ GlScene::GlScene(const Scene& scene) : scene_(scene) {
   phong_program_ = std::make_unique<GlProgram>(
       std::vector<const char*>{"scene.vert"},
       std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "phong.frag"});
-
-  // Infinite reversed-Z (cube_map.hpp): depth in [0, 1], 1 at the near plane.
-  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_GREATER);
-  glDisable(GL_CULL_FACE);  // back faces too: the map holds every surface
   glFinish();
   check_gl("scene upload");
   timings_.upload_ms = ms_since(t0);

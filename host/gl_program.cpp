@@ -13,7 +13,7 @@ std::string assemble(const std::vector<const char*>& files) {
   std::string src = "#version 450 core\n";
   for (const char* f : files) {
     const char* text = embedded_shader(f);
-    ABCUBE_CHECK(text != nullptr, std::string("shader not embedded: ") + f);
+    if (text == nullptr) throw RuntimeFailure(std::string("shader not embedded in this build: ") + f);
     src += "// ---- " + std::string(f) + "\n" + text + "\n";
   }
   return src;
@@ -43,7 +43,13 @@ GLuint compile(GLenum stage, const std::vector<const char*>& files) {
 GlProgram::GlProgram(const std::vector<const char*>& vertex_files,
                      const std::vector<const char*>& fragment_files) {
   const GLuint vs = compile(GL_VERTEX_SHADER, vertex_files);
-  const GLuint fs = compile(GL_FRAGMENT_SHADER, fragment_files);
+  GLuint fs = 0;
+  try {
+    fs = compile(GL_FRAGMENT_SHADER, fragment_files);
+  } catch (...) {
+    glDeleteShader(vs);
+    throw;
+  }
   id_ = glCreateProgram();
   glAttachShader(id_, vs);
   glAttachShader(id_, fs);

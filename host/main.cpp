@@ -17,12 +17,30 @@ const char* USAGE =
     "       abcube info\n"
     "       abcube export-pov SCENE.json -o OUT.pov\n";
 
+// Every failure is reported on one line: embedded newlines (a GLSL log) become "; ".
+std::string one_line(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  std::string out;
+  for (char c : text) {
+    if (c == '\n') {
+      out += "; ";
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
-    std::fputs(USAGE, argc < 2 ? stderr : stdout);
-    return argc < 2 ? 2 : 0;
+  if (argc < 2) {
+    std::fputs("abcube: missing command (render, compare, info, export-pov; see abcube --help)\n", stderr);
+    return 2;
+  }
+  if (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
+    std::fputs(USAGE, stdout);
+    return 0;
   }
   const std::string command = argv[1];
   const std::vector<std::string> words(argv + 2, argv + argc);
@@ -33,12 +51,10 @@ int main(int argc, char** argv) {
     if (command == "export-pov") return abcube::cmd_export_pov(words);
     throw abcube::InputError("unknown command '" + command + "' (render, compare, info, export-pov)");
   } catch (const abcube::InputError& e) {
-    std::string line = e.what();
-    for (char& c : line) c = c == '\n' ? ' ' : c;
-    std::fprintf(stderr, "abcube: %s\n", line.c_str());
+    std::fprintf(stderr, "abcube: %s\n", one_line(e.what()).c_str());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "abcube: error: %s\n", e.what());
+    std::fprintf(stderr, "abcube: error: %s\n", one_line(e.what()).c_str());
     return 1;
   }
 }

@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Installs the Debian packages abcube needs (idempotent; skips what is present).
+# GL headers come from glad (generated at configure time); libEGL and libOSMesa are
+# opened at run time, so only their run-time packages are needed.
 # Run as root, or with sudo available. Safe to run many times.
 set -euo pipefail
 
 PACKAGES=(
-  build-essential cmake ninja-build pkg-config python3
-  libegl-dev libegl1-mesa-dev libgl-dev libosmesa6-dev libgles-dev mesa-utils
-  libegl-mesa0 libgl1-mesa-dri
+  build-essential cmake ninja-build python3
+  libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6
   libglm-dev python3-glad
   libopenimageio-dev openimageio-tools
   nlohmann-json3-dev libtinyobjloader-dev

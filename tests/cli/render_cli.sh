@@ -59,6 +59,15 @@ ABCUBE_EGL_DEVICE=abc "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --met
 check "bad ABCUBE_EGL_DEVICE exits 2" [ $? -eq 2 ]
 check "nothing written on error" [ ! -e "$WORK/x.png" ]
 
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --method gpu --gl osmesa --gl-device 0 > /dev/null 2> "$WORK/err"
+check "--gl-device with --gl osmesa exits 2" [ $? -eq 2 ]
+"$ABCUBE" > /dev/null 2> "$WORK/err"
+check "no command exits 2" [ $? -eq 2 ]
+check "no command: one line" [ "$(wc -l < "$WORK/err")" -eq 1 ]
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --method gpu --stats "$WORK/no/such/s.json" > /dev/null 2> "$WORK/err"
+check "--stats into a missing folder exits 2 before any work" [ $? -eq 2 ]
+check "--stats error leaves no image" [ ! -e "$WORK/x.png" ]
+
 # --- the exact tracer with --reference, no GL needed
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/rt.exr" --method raytrace --gl none --threads 2 \
   --reference --stats "$WORK/rt.json" 2> "$WORK/err"

@@ -185,3 +185,47 @@ TEST(ZbufferGl, WhiteTriangleEdgesAreAliased) {
 
 }  // namespace
 }  // namespace abcube
+
+namespace abcube {
+namespace {
+
+// The six-face Z-buffer colour pass: at every texel centre, the Phong colour cpu_core
+// computes for the exact point of a box wall seen from the centre.
+TEST(ZbufferGl, CubeColourMatchesCpuShading) {
+  test::test_context();
+  Scene s;
+  s.ambient = glm::dvec3(0.2);
+  s.lights.push_back({glm::dvec3(0.3, 0.5, -0.2), glm::dvec3(0.8, 0.7, 0.6), true});
+  const uint32_t m = test::add_material(s, glm::dvec3(0.3, 0.6, 0.9), 0.7);
+  s.materials[m].specular = 0.3;
+  s.materials[m].shininess = 8;
+  // Walls at unequal distances, so that no texel-centre ray meets a box edge exactly.
+  const glm::dvec3 lo(-1.0, -0.8, -1.3), hi(1.2, 1.0, 0.9), center(0.1, -0.13, 0.05);
+  test::add_box(s, lo, hi, m);
+  GlScene gl(s);
+  const int n = 24;
+  const CubeImage img = gl.cube_color(center, n);
+  double worst = 0;
+  for (int face = 0; face < CUBE_FACES; ++face) {
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const glm::dvec3 u = glm::normalize(texel_center_direction(face, i, j, n));
+        double t = INFINITY;
+        int axis = 0;
+        for (int a = 0; a < 3; ++a) {
+          const double ta = u[a] > 0 ? (hi[a] - center[a]) / u[a] : u[a] < 0 ? (lo[a] - center[a]) / u[a] : INFINITY;
+          if (ta < t) t = ta, axis = a;
+        }
+        glm::dvec3 normal(0);
+        normal[axis] = 1;
+        const glm::dvec3 expected = phong_local(s.materials[m], center + t * u, normal, center, s.ambient, s.lights);
+        const glm::vec3 got = img.faces[face].rgb(i, j);
+        for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(got[c] - expected[c]));
+      }
+    }
+  }
+  EXPECT_LT(worst, 2e-3);
+}
+
+}  // namespace
+}  // namespace abcube
