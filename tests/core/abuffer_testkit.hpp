@@ -1,0 +1,54 @@
+// Helpers shared by the raster, A-buffer and resolve tests.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "abuffer.hpp"
+#include "scene.hpp"
+
+// Scene builders, defined in test_raytrace.cpp.
+namespace abcube::testkit {
+Scene empty_scene(const glm::dvec3& eye, const glm::dvec3& look_at, double fov_y_deg, int width, int height);
+uint32_t add_material(Scene& s, const Material& m);
+Material emissive(const glm::dvec3& color);
+uint32_t begin_object(Scene& s, const std::string& type, uint32_t material, bool closed);
+void add_triangle(Scene& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& na,
+                  const glm::dvec3& nb, const glm::dvec3& nc);
+void add_flat_triangle(Scene& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
+uint32_t add_quad(Scene& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& d,
+                  uint32_t material);
+uint32_t add_box(Scene& s, const glm::dvec3& lo, const glm::dvec3& hi, uint32_t material);
+uint32_t add_sphere(Scene& s, const glm::dvec3& center, double radius, int segments, uint32_t material);
+}  // namespace abcube::testkit
+
+namespace abcube::abtest {
+
+// How many fragments of a pixel's list cover each of its 32 samples.
+inline std::array<int, MASK_SAMPLES> sample_cover_counts(FragmentList list) {
+  std::array<int, MASK_SAMPLES> n{};
+  for (const Fragment& f : list) {
+    for (int k = 0; k < MASK_SAMPLES; ++k) n[static_cast<size_t>(k)] += (f.mask >> k) & 1u;
+  }
+  return n;
+}
+
+// Every raster of a cube A-buffer, for loops over faces.
+inline std::vector<const ABuffer*> rasters(const CubeABuffer& cube) {
+  std::vector<const ABuffer*> out;
+  for (const ABuffer& b : cube.faces) out.push_back(&b);
+  return out;
+}
+
+// Options for tests: two threads, every triangle's fragment kept apart unless asked.
+inline ABufferOptions test_options(bool merge = false, int threads = 2) {
+  ABufferOptions o;
+  o.threads = threads;
+  o.merge = merge;
+  return o;
+}
+
+}  // namespace abcube::abtest
