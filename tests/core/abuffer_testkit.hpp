@@ -1,6 +1,7 @@
 // Helpers shared by the raster, A-buffer and resolve tests.
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -49,6 +50,31 @@ inline ABufferOptions test_options(bool merge = false, int threads = 2) {
   o.threads = threads;
   o.merge = merge;
   return o;
+}
+
+// Exact area of the part of the projected triangle inside pixel (x, y) (2D clipping).
+inline double pixel_area(const std::vector<glm::dvec2>& tri, int x, int y) {
+  std::vector<glm::dvec2> poly = tri;
+  const auto clip = [&](int axis, double bound, double sign) {
+    std::vector<glm::dvec2> out;
+    for (size_t i = 0; i < poly.size(); ++i) {
+      const glm::dvec2 a = poly[i], b = poly[(i + 1) % poly.size()];
+      const double fa = sign * (a[axis] - bound), fb = sign * (b[axis] - bound);
+      if (fa >= 0) out.push_back(a);
+      if ((fa >= 0) != (fb >= 0)) out.push_back(a + (fa / (fa - fb)) * (b - a));
+    }
+    poly = out;
+  };
+  clip(0, x, 1);
+  clip(0, x + 1, -1);
+  clip(1, y, 1);
+  clip(1, y + 1, -1);
+  double a = 0;
+  for (size_t i = 0; i < poly.size(); ++i) {
+    const glm::dvec2 p = poly[i], q = poly[(i + 1) % poly.size()];
+    a += p.x * q.y - q.x * p.y;
+  }
+  return std::fabs(0.5 * a);
 }
 
 }  // namespace abcube::abtest

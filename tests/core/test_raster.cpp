@@ -169,31 +169,6 @@ TEST(Raster, SharedEdgesThroughSamplesCoverEachSampleOnce) {
   EXPECT_GT(on_grid_lines, 100);  // the ties really happen
 }
 
-// Exact area of the part of the projected triangle inside pixel (x, y) (2D clipping).
-double pixel_area(const std::vector<dvec2>& tri, int x, int y) {
-  std::vector<dvec2> poly = tri;
-  const auto clip = [&](int axis, double bound, double sign) {
-    std::vector<dvec2> out;
-    for (size_t i = 0; i < poly.size(); ++i) {
-      const dvec2 a = poly[i], b = poly[(i + 1) % poly.size()];
-      const double fa = sign * (a[axis] - bound), fb = sign * (b[axis] - bound);
-      if (fa >= 0) out.push_back(a);
-      if ((fa >= 0) != (fb >= 0)) out.push_back(a + (fa / (fa - fb)) * (b - a));
-    }
-    poly = out;
-  };
-  clip(0, x, 1);
-  clip(0, x + 1, -1);
-  clip(1, y, 1);
-  clip(1, y + 1, -1);
-  double a = 0;
-  for (size_t i = 0; i < poly.size(); ++i) {
-    const dvec2 p = poly[i], q = poly[(i + 1) % poly.size()];
-    a += p.x * q.y - q.x * p.y;
-  }
-  return std::fabs(0.5 * a);
-}
-
 TEST(Raster, OneTriangleCoverageMatchesItsProjectedArea) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-0.7, 0.7), z(2.0, 6.0);
