@@ -23,10 +23,11 @@ uint32_t encode_octahedral(const glm::dvec3& n) {
     const glm::dvec2 sign(p.x >= 0.0 ? 1.0 : -1.0, p.y >= 0.0 ? 1.0 : -1.0);
     p = (1.0 - glm::dvec2(std::fabs(p.y), std::fabs(p.x))) * sign;
   }
-  const auto q = [](double v) {
-    return static_cast<uint32_t>(static_cast<uint16_t>(static_cast<int16_t>(std::lround(std::clamp(v, -1.0, 1.0) * 32767.0))));
+  const auto snorm16 = [](double v) {
+    const double q = std::floor(std::clamp(v, -1.0, 1.0) * 32767.0 + 0.5);  // round to nearest
+    return static_cast<uint32_t>(static_cast<uint16_t>(static_cast<int16_t>(q)));
   };
-  return q(p.x) | (q(p.y) << 16);
+  return snorm16(p.x) | (snorm16(p.y) << 16);
 }
 
 glm::dvec3 decode_octahedral(uint32_t code) {
@@ -79,15 +80,22 @@ struct BandResult {
   uint64_t dropped = 0, max_list = 0, stored = 0;
 };
 
-float round_down(double z) {
-  float f = static_cast<float>(z);
-  if (static_cast<double>(f) > z) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+// Distances (>= 0) to float, rounded outward. For a positive float the next float below
+// or above is one step of its bit pattern.
+float step_bits(float f, int step) {
+  uint32_t bits;
+  std::memcpy(&bits, &f, sizeof bits);
+  bits = static_cast<uint32_t>(static_cast<int64_t>(bits) + step);
+  std::memcpy(&f, &bits, sizeof bits);
   return f;
 }
+float round_down(double z) {
+  const float f = static_cast<float>(z);
+  return static_cast<double>(f) > z && f > 0.0f ? step_bits(f, -1) : f;
+}
 float round_up(double z) {
-  float f = static_cast<float>(z);
-  if (static_cast<double>(f) < z) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-  return f;
+  const float f = static_cast<float>(z);
+  return static_cast<double>(f) < z ? step_bits(f, +1) : f;
 }
 
 void bin_view(const TriangleSoup& soup, ViewBuild* vb) {

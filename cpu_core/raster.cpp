@@ -199,50 +199,79 @@ CoverageMask pixel_mask(const TriangleSetup& s, int x, int y) {
   }
   if (all_inside) return FULL_MASK;
 
-  // Per sample: E = a x + (b y + c), the same operations for every triangle, so the two
-  // sides of a shared edge see exactly opposite values (raster.hpp, "Watertight").
+  // Per sample: E = a x + (b y + c) > 0, or == 0 under the tie rule; the same operations
+  // for every triangle, so the two sides of a shared edge see exactly opposite values
+  // (raster.hpp, "Watertight").
   CoverageMask mask = FULL_MASK;
-  for (int k = 0; k < s.edge_count; ++k) {
+  for (int k = 0; k < s.edge_count && mask != 0; ++k) {
     const glm::dvec3& e = s.edge[static_cast<size_t>(k)];
+    double ax[MASK_COLUMNS];
+    for (int col = 0; col < MASK_COLUMNS; ++col) ax[col] = e.x * (x + sample_dx(col));
     const bool ties = s.owns_ties[static_cast<size_t>(k)];
     CoverageMask inside = 0;
     for (int row = 0; row < MASK_ROWS; ++row) {
       const double base = e.y * (y + sample_dy(sample_index(0, row))) + e.z;
-      for (int col = 0; col < MASK_COLUMNS; ++col) {
-        const double v = e.x * (x + sample_dx(col)) + base;
-        const bool in = v > 0.0 || (v == 0.0 && ties);
-        inside |= static_cast<CoverageMask>(in) << sample_index(col, row);
+      unsigned bits = 0;
+      if (ties) {
+        for (int col = 0; col < MASK_COLUMNS; ++col) bits |= static_cast<unsigned>(ax[col] + base >= 0.0) << col;
+      } else {
+        for (int col = 0; col < MASK_COLUMNS; ++col) bits |= static_cast<unsigned>(ax[col] + base > 0.0) << col;
       }
+      inside |= static_cast<CoverageMask>(bits) << (row * MASK_COLUMNS);
     }
     mask &= inside;
-    if (mask == 0) break;
   }
   return mask;
 }
 
 glm::dvec2 mask_centroid(CoverageMask mask) {
-  if (mask == 0) return {0.5, 0.5};
-  double sx = 0, sy = 0;
-  for (CoverageMask m = mask; m != 0; m &= m - 1) {
-    const int k = __builtin_ctz(m);
-    sx += sample_dx(k);
-    sy += sample_dy(k);
+  if (mask == 0 || mask == FULL_MASK) return {0.5, 0.5};
+  // Per row (one byte of the mask): its sample count and the sum of its column indices.
+  int count = 0, column_sum = 0, row_sum = 0;
+  for (int row = 0; row < MASK_ROWS; ++row) {
+    const unsigned bits = (mask >> (row * MASK_COLUMNS)) & 0xffu;
+    const int c = __builtin_popcount(bits);
+    int cols = 0;
+    for (unsigned b = bits; b != 0; b &= b - 1) cols += __builtin_ctz(b);
+    count += c;
+    column_sum += cols;
+    row_sum += c * row;
   }
-  const double n = mask_count(mask);
-  return {sx / n, sy / n};
+  // Sample (col, row) sits at ((col + 0.5)/8, (row + 0.5)/4) (samples.hpp).
+  return {(column_sum / double(count) + 0.5) / MASK_COLUMNS, (row_sum / double(count) + 0.5) / MASK_ROWS};
 }
 
 namespace {
 
-double segment_distance(const glm::dvec3& a, const glm::dvec3& b) {
+// Squared distance from the centre (the origin) to segment ab.
+double segment_distance2(const glm::dvec3& a, const glm::dvec3& b) {
   const glm::dvec3 ab = b - a;
   const double len2 = glm::dot(ab, ab);
   const double t = len2 > 0.0 ? std::clamp(-glm::dot(a, ab) / len2, 0.0, 1.0) : 0.0;
-  return glm::length(a + t * ab);
+  const glm::dvec3 p = a + t * ab;
+  return glm::dot(p, p);
+}
+
+// Whether the whole pixel square is inside every edge function (with the trivial margin).
+bool pixel_inside(const TriangleSetup& s, int x, int y) {
+  for (int k = 0; k < s.edge_count; ++k) {
+    const glm::dvec3& e = s.edge[static_cast<size_t>(k)];
+    const double tol = TRIVIAL_REL * (std::fabs(e.x) * (x + 2.0) + std::fabs(e.y) * (y + 2.0) + std::fabs(e.z));
+    if (!(e.x * (e.x > 0 ? x : x + 1.0) + e.y * (e.y > 0 ? y : y + 1.0) + e.z > tol)) return false;
+  }
+  return true;
 }
 
 // The triangle (already in front of the near plane) clipped to the frustum of pixel (x, y).
 int pixel_polygon(const RasterView& view, const TriangleSetup& s, int x, int y, glm::dvec3* out) {
+  if (pixel_inside(s, x, y)) {  // the pixel's corners on the plane
+    const double cx[4] = {0, 1, 1, 0}, cy[4] = {0, 0, 1, 1};
+    for (int i = 0; i < 4; ++i) {
+      const glm::dvec3 d = view.direction(x + cx[i], y + cy[i]);
+      out[i] = (s.plane_offset / glm::dot(s.plane_normal, d)) * d;
+    }
+    return 4;
+  }
   glm::dvec3 a[8], b[8];
   int m = s.polygon_size;
   std::copy(s.polygon.begin(), s.polygon.begin() + m, a);
@@ -265,7 +294,7 @@ FragmentGeometry fragment_geometry(const RasterView& view, const TriangleSetup& 
   // Perspective-correct barycentrics of the plane point along d: edge k's function is
   // proportional to the weight of the opposite vertex k+2.
   std::array<double, 3> lambda{};
-  for (size_t k = 0; k < 3; ++k) lambda[(k + 2) % 3] = std::fmax(glm::dot(s.edge_3d[k], d), 0.0);
+  for (size_t k = 0; k < 3; ++k) lambda[(k + 2) % 3] = std::max(glm::dot(s.edge_3d[k], d), 0.0);
   glm::dvec3 n(0.0);
   for (size_t k = 0; k < 3; ++k) n += lambda[k] * s.normal[k];
   const double len = glm::length(n);
@@ -278,14 +307,14 @@ FragmentGeometry fragment_geometry(const RasterView& view, const TriangleSetup& 
     g.zmin = g.zmax = denom != 0.0 ? std::fabs(s.plane_offset / denom) * glm::length(d) : s.plane_distance;
     return g;
   }
-  double zmax = 0.0, zmin = HUGE_VAL;
+  double zmax2 = 0.0, zmin2 = HUGE_VAL;  // squared
+  const bool foot_inside = x == s.foot_x && y == s.foot_y;
   for (int i = 0; i < m; ++i) {
-    zmax = std::fmax(zmax, glm::length(poly[i]));
-    zmin = std::fmin(zmin, segment_distance(poly[i], poly[(i + 1) % m]));
+    zmax2 = std::max(zmax2, glm::dot(poly[i], poly[i]));
+    if (!foot_inside) zmin2 = std::min(zmin2, segment_distance2(poly[i], poly[i + 1 < m ? i + 1 : 0]));
   }
-  if (x == s.foot_x && y == s.foot_y) zmin = s.plane_distance;  // the foot is inside
-  g.zmin = std::fmin(zmin, zmax);
-  g.zmax = zmax;
+  g.zmax = std::sqrt(zmax2);
+  g.zmin = std::min(foot_inside ? s.plane_distance : std::sqrt(zmin2), g.zmax);
   return g;
 }
 

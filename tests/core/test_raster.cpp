@@ -169,6 +169,46 @@ TEST(Raster, SharedEdgesThroughSamplesCoverEachSampleOnce) {
   EXPECT_GT(on_grid_lines, 100);  // the ties really happen
 }
 
+// The shortcuts (row spans, trivial accept and reject) give exactly the per-sample rule.
+TEST(Raster, PixelMasksFollowThePerSampleRuleExactly) {
+  std::mt19937 rng(19);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 8, 8);
+  add_material(s, Material{});
+  begin_object(s, "random", 0, false);
+  for (int t = 0; t < 60; ++t) add_flat_triangle(s, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
+  int partial = 0, full = 0;
+  for (int face = 0; face < CUBE_FACES; ++face) {
+    const RasterView v = cube_face_view(face, dvec3(0.05, -0.1, 0.02), 20, 0.3);
+    for (uint32_t t = 0; t < s.triangles.triangle_count(); ++t) {
+      TriangleSetup st;
+      if (setup_triangle(v, s.triangles, t, &st) != SetupResult::visible) continue;
+      for (int y = 0; y < v.height; ++y) {
+        int xb = 0, xe = 0;
+        row_span(st, y, &xb, &xe);
+        for (int x = 0; x < v.width; ++x) {
+          CoverageMask expect = 0;
+          for (int k = 0; k < MASK_SAMPLES; ++k) {
+            bool in = true;
+            for (int e = 0; e < st.edge_count; ++e) {
+              const dvec3& c = st.edge[static_cast<size_t>(e)];
+              const double val = c.x * (x + sample_dx(k)) + (c.y * (y + sample_dy(k)) + c.z);
+              in = in && (val > 0 || (val == 0 && st.owns_ties[static_cast<size_t>(e)]));
+            }
+            expect |= CoverageMask(in) << k;
+          }
+          const bool in_span = y >= st.y0 && y < st.y1 && x >= xb && x < xe;
+          ASSERT_EQ(in_span ? pixel_mask(st, x, y) : 0u, expect) << "face " << face << " triangle " << t << " pixel " << x << ", " << y;
+          partial += expect != 0 && expect != FULL_MASK;
+          full += expect == FULL_MASK;
+        }
+      }
+    }
+  }
+  EXPECT_GT(partial, 500);
+  EXPECT_GT(full, 500);
+}
+
 TEST(Raster, OneTriangleCoverageMatchesItsProjectedArea) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-0.7, 0.7), z(2.0, 6.0);
