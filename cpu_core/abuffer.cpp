@@ -77,7 +77,7 @@ struct Band {
 
 // Per band results of the fill, summed in band order.
 struct BandResult {
-  uint64_t dropped = 0, max_list = 0, stored = 0;
+  uint64_t dropped = 0, max_list = 0;
 };
 
 // Distances (>= 0) to float, rounded outward. For a positive float the next float below
@@ -184,7 +184,6 @@ uint32_t finish_list(const TriangleSoup& soup, const ABufferOptions& options, Fr
     kept = options.max_layers;
   }
   r->max_list = std::max<uint64_t>(r->max_list, kept);
-  r->stored += kept;
   return kept;
 }
 
@@ -261,6 +260,32 @@ uint64_t count_views(const TriangleSoup& soup, std::vector<ViewBuild>* views, co
   return total;
 }
 
+// The counters of ABufferStats from the finished build.
+ABufferStats summarise(const std::vector<ViewBuild>& views, const std::vector<ABuffer>& out,
+                       const std::vector<BandResult>& results, size_t triangles) {
+  ABufferStats st;
+  std::vector<unsigned char> seen(triangles, 0);
+  for (const ViewBuild& vb : views) {
+    st.triangle_views += vb.triangle_views;
+    st.triangles_clipped += vb.clipped;
+    for (const BinEntry& b : vb.bins) seen[b.triangle] = 1;
+  }
+  st.triangles_degenerate = views.front().degenerate;  // the same in every view of one centre
+  st.triangles_edge_on = views.front().edge_on;
+  st.triangles_culled = static_cast<uint64_t>(std::count(seen.begin(), seen.end(), 0)) - st.triangles_degenerate -
+                        st.triangles_edge_on;
+  for (const BandResult& r : results) {
+    st.dropped_by_cap += r.dropped;
+    st.max_list_length = std::max(st.max_list_length, r.max_list);
+  }
+  for (const ABuffer& b : out) {
+    st.fragments_per_view.push_back(b.fragments.size());
+    st.fragments += b.fragments.size();
+    st.bytes_total += b.fragments.size() * sizeof(Fragment) + b.offsets.size() * sizeof(uint32_t);
+  }
+  return st;
+}
+
 std::vector<ABuffer> build_views(const Scene& scene, std::vector<RasterView> rasters, const char* what,
                                  const ABufferOptions& options, ABufferStats* stats) {
   const Clock::time_point start = Clock::now();
@@ -306,35 +331,15 @@ std::vector<ABuffer> build_views(const Scene& scene, std::vector<RasterView> ras
     out[v].fragments = std::move(views[v].fragments);
   }
   if (stats) {
-    ABufferStats& st = *stats;
-    st = ABufferStats{};
-    std::vector<unsigned char> seen(soup.triangle_count(), 0);
-    for (const ViewBuild& vb : views) {
-      st.triangle_views += vb.triangle_views;
-      st.triangles_clipped += vb.clipped;
-      for (const BinEntry& b : vb.bins) seen[b.triangle] = 1;
-    }
-    st.triangles_degenerate = views.front().degenerate;  // the same in every view of one centre
-    st.triangles_edge_on = views.front().edge_on;
-    st.triangles_culled = static_cast<uint64_t>(std::count(seen.begin(), seen.end(), 0)) - st.triangles_degenerate -
-                          st.triangles_edge_on;
-    for (const BandResult& r : results) {
-      st.dropped_by_cap += r.dropped;
-      st.max_list_length = std::max(st.max_list_length, r.max_list);
-    }
-    for (const ABuffer& b : out) {
-      st.fragments_per_view.push_back(b.fragments.size());
-      st.fragments += b.fragments.size();
-      st.bytes_total += b.fragments.size() * sizeof(Fragment) + b.offsets.size() * sizeof(uint32_t);
-    }
-    st.raw_fragments = raw;
-    st.estimated_bytes = estimate;
-    st.budget_bytes = budget;
-    st.near_distance = rasters.front().near_distance;
-    st.count_ms = count_ms;
-    st.total_ms = ms_since(start);
-    st.fill_ms = st.total_ms - count_ms;
-    st.threads = threads;
+    *stats = summarise(views, out, results, soup.triangle_count());
+    stats->raw_fragments = raw;
+    stats->estimated_bytes = estimate;
+    stats->budget_bytes = budget;
+    stats->near_distance = rasters.front().near_distance;
+    stats->count_ms = count_ms;
+    stats->total_ms = ms_since(start);
+    stats->fill_ms = stats->total_ms - count_ms;
+    stats->threads = threads;
   }
   return out;
 }
@@ -378,33 +383,42 @@ const Fragment* centre_fragment(const ABuffer& buffer, int x, int y) {
   return nullptr;
 }
 
+namespace {
+
+// nearest_layer for one face.
+void nearest_layer_face(const CubeABuffer& cube, const TriangleSoup& triangles, int face, NearestLayer* out) {
+  const ABuffer& b = cube.faces[static_cast<size_t>(face)];
+  Image& distance = out->distance.faces[static_cast<size_t>(face)];
+  std::vector<uint32_t>& ids = out->object.faces[static_cast<size_t>(face)];
+  ids.assign(static_cast<size_t>(cube.n) * static_cast<size_t>(cube.n), std::numeric_limits<uint32_t>::max());
+  for (int y = 0; y < cube.n; ++y) {
+    for (int x = 0; x < cube.n; ++x) {
+      const glm::dvec3 d = b.view.direction(x + 0.5, y + 0.5);
+      double best = HUGE_VAL;
+      uint32_t best_id = std::numeric_limits<uint32_t>::max();
+      for (const Fragment& f : b.list(x, y)) {
+        if ((f.mask & CENTRE_SAMPLES) == 0) continue;
+        const glm::dvec3 r = point_on_triangle_plane(b.view, triangles, f.triangle(), x + 0.5, y + 0.5) - cube.centre;
+        const double dist = glm::length(r);
+        if (glm::dot(r, d) > 0.0 && dist < best) {
+          best = dist;
+          best_id = triangles.object_id[f.triangle()];
+        }
+      }
+      if (best < HUGE_VAL) distance.at(x, y)[0] = static_cast<float>(best);
+      ids[static_cast<size_t>(y) * static_cast<size_t>(cube.n) + static_cast<size_t>(x)] = best_id;
+    }
+  }
+}
+
+}  // namespace
+
 NearestLayer nearest_layer(const CubeABuffer& cube, const TriangleSoup& triangles) {
   NearestLayer out;
   out.distance = CubeImage(cube.n, 1, std::numeric_limits<float>::infinity());
   out.object.n = cube.n;
-  for (int f = 0; f < CUBE_FACES; ++f) {
-    const ABuffer& b = cube.faces[static_cast<size_t>(f)];
-    std::vector<uint32_t>& ids = out.object.faces[static_cast<size_t>(f)];
-    ids.assign(static_cast<size_t>(cube.n) * static_cast<size_t>(cube.n), std::numeric_limits<uint32_t>::max());
-    for (int y = 0; y < cube.n; ++y) {
-      for (int x = 0; x < cube.n; ++x) {
-        const glm::dvec3 d = b.view.direction(x + 0.5, y + 0.5);
-        double best = HUGE_VAL;
-        uint32_t best_id = std::numeric_limits<uint32_t>::max();
-        for (const Fragment& fr : b.list(x, y)) {
-          if ((fr.mask & CENTRE_SAMPLES) == 0) continue;
-          const glm::dvec3 r = point_on_triangle_plane(b.view, triangles, fr.triangle(), x + 0.5, y + 0.5) - cube.centre;
-          const double dist = glm::length(r);
-          if (glm::dot(r, d) > 0.0 && dist < best) {
-            best = dist;
-            best_id = triangles.object_id[fr.triangle()];
-          }
-        }
-        if (best < HUGE_VAL) out.distance.faces[static_cast<size_t>(f)].at(x, y)[0] = static_cast<float>(best);
-        ids[static_cast<size_t>(y) * static_cast<size_t>(cube.n) + static_cast<size_t>(x)] = best_id;
-      }
-    }
-  }
+  parallel_for(CUBE_FACES, thread_count(0, CUBE_FACES),
+               [&](size_t face, int) { nearest_layer_face(cube, triangles, static_cast<int>(face), &out); });
   return out;
 }
 

@@ -114,8 +114,10 @@ struct ABufferStats {
   uint64_t max_list_length = 0;
   uint64_t dropped_by_cap = 0;
   uint64_t bytes_per_fragment = sizeof(Fragment);
-  uint64_t bytes_total = 0;                // fragments and offsets as stored
-  uint64_t estimated_bytes = 0;            // the budget check's figure (before merging)
+  uint64_t bytes_total = 0;                // fragments and offsets as stored (after merging)
+  // The budget check's figure: the raw fragments, the per-pixel index and the triangle bins.
+  // It is the peak: the fragment arrays keep the raw count's capacity after merging.
+  uint64_t estimated_bytes = 0;
   uint64_t budget_bytes = 0;
   uint64_t triangle_views = 0;             // (triangle, view) pairs rasterised
   uint64_t triangles_clipped = 0;          // (triangle, view) pairs cut by the near plane

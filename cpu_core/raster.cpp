@@ -54,15 +54,21 @@ int clip_polygon(const glm::dvec3* in, int count, const glm::dvec3& plane, doubl
   return m;
 }
 
-// Pixel bounds of the near-clipped polygon, one pixel of margin, clamped to the view.
+// Pixel bounds of the near-clipped polygon, one pixel of margin, clamped to the view (the
+// whole view if a projection overflows: the edge functions decide coverage anyway).
 bool pixel_bounds(const RasterView& view, TriangleSetup* s) {
   double xmin = HUGE_VAL, xmax = -HUGE_VAL, ymin = HUGE_VAL, ymax = -HUGE_VAL;
   for (int k = 0; k < s->polygon_size; ++k) {
     const glm::dvec2 p = view.project(s->polygon[static_cast<size_t>(k)]);
-    xmin = std::fmin(xmin, p.x);
-    xmax = std::fmax(xmax, p.x);
-    ymin = std::fmin(ymin, p.y);
-    ymax = std::fmax(ymax, p.y);
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
+      xmin = ymin = -HUGE_VAL;
+      xmax = ymax = HUGE_VAL;
+      break;
+    }
+    xmin = std::min(xmin, p.x);
+    xmax = std::max(xmax, p.x);
+    ymin = std::min(ymin, p.y);
+    ymax = std::max(ymax, p.y);
   }
   const auto clamp_to = [](double v, int hi) { return static_cast<int>(std::clamp(v, 0.0, double(hi))); };
   s->x0 = clamp_to(std::floor(xmin) - 1.0, view.width);

@@ -20,11 +20,15 @@
 // iff every edge function is > 0 at it, or == 0 under the TIE RULE: an edge owns the
 // samples exactly on it iff a > 0, or a == 0 and b > 0 (D3D's top-left rule: left edges
 // and top edges, with y down; on a cube face "top" is smaller t). The rule is the limit
-// of moving every sample by (+eps, +eps^2), so a shared vertex has exactly one owner too.
+// of moving every sample by (+eps, +eps^2), so in exact arithmetic a vertex shared by a
+// closed fan has exactly one owner too. The near line keeps its ties (w == near is kept).
 // Watertight: the two triangles on either side of a shared edge compute the edge plane
 // normals n and -n exactly (cross products and their dot products negate exactly in IEEE
 // arithmetic), so every sample is owned by exactly one of them, whatever the winding of
-// the mesh. No vertex is ever moved by clipping, so clipping cannot open a crack.
+// the mesh; this holds in floating point, not only in exact arithmetic. (Only a sample
+// within rounding, ~1e-16 relative, of a vertex shared by three or more triangles could be
+// owned by none or two.) No vertex is ever moved by clipping, so clipping cannot open a
+// crack.
 //
 // Near plane. The part of a triangle with w < near is cut away by a fourth edge function
 // (the line where the triangle's plane meets w = near, in the same homogeneous form), so
