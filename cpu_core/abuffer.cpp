@@ -168,14 +168,17 @@ uint32_t finish_list(const TriangleSoup& soup, const ABufferOptions& options, Fr
   std::sort(list, list + count, before);
   uint32_t kept = 0;
   bool merged_any = false;
+  float reach = -1.0f;  // the largest zmax kept so far: no overlap in z beyond it
   for (uint32_t i = 0; i < count; ++i) {
     bool merged = false;
-    for (uint32_t j = 0; options.merge && j < kept && !merged; ++j) {
+    const bool may_merge = options.merge && list[i].zmin <= reach;
+    for (uint32_t j = 0; may_merge && j < kept && !merged; ++j) {
       if (mergeable(soup, list[j], list[i])) {
         merge_into(&list[j], list[i]);
         merged = merged_any = true;
       }
     }
+    reach = std::max(reach, list[i].zmax);
     if (!merged) list[kept++] = list[i];
   }
   if (merged_any) std::sort(list, list + kept, before);  // a merge may change the tie key

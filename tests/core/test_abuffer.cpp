@@ -220,7 +220,8 @@ TEST(ABuffer, BytesAreIdenticalForAnyThreadCount) {
   s.camera.height = 48;
   const auto same = [](const ABuffer& a, const ABuffer& b) {
     return a.offsets == b.offsets && a.fragments.size() == b.fragments.size() &&
-           std::memcmp(a.fragments.data(), b.fragments.data(), a.fragments.size() * sizeof(Fragment)) == 0;
+           (a.fragments.empty() ||  // the sky's face holds nothing
+            std::memcmp(a.fragments.data(), b.fragments.data(), a.fragments.size() * sizeof(Fragment)) == 0);
   };
   ABufferStats st1, st3;
   const CubeABuffer c1 = build_cube_abuffer(s, s.camera.position, 40, test_options(true, 1), &st1);
