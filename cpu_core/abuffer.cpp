@@ -140,12 +140,13 @@ bool before(const Fragment& a, const Fragment& b) {
 }
 
 // Thesis 5.2.1 merge (abuffer.hpp, "MERGE"): same object, material and facing, z ranges
-// overlapping, masks disjoint.
+// overlapping, masks disjoint; and, our addition, no crease between them.
 bool mergeable(const TriangleSoup& soup, const Fragment& a, const Fragment& b) {
   const uint32_t ta = a.triangle(), tb = b.triangle();
   return a.back_face() == b.back_face() && (a.mask & b.mask) == 0 && b.zmin <= a.zmax &&
          a.zmin <= b.zmax && soup.object_id[ta] == soup.object_id[tb] &&
-         soup.material_id[ta] == soup.material_id[tb];
+         soup.material_id[ta] == soup.material_id[tb] &&
+         glm::dot(a.shading_normal(), b.shading_normal()) >= MERGE_MIN_NORMAL_COS;
 }
 
 void merge_into(Fragment* into, const Fragment& f) {
@@ -154,9 +155,13 @@ void merge_into(Fragment* into, const Fragment& f) {
   const glm::dvec3 n = a1 * into->shading_normal() + a2 * f.shading_normal();
   const double len = glm::length(n);
   if (len > 0.0) into->normal = encode_octahedral(n / len);
-  if (a2 > a1 || (a2 == a1 && f.triangle_and_facing < into->triangle_and_facing)) {
-    into->triangle_and_facing = f.triangle_and_facing;
-  }
+  // The kept triangle (the fragment's plane) is the one under the pixel centre when only
+  // one of them covers a centre sample, so centre look-ups (nearest_layer, the pixel-centre
+  // shading point) use the right plane; else the one covering more samples.
+  const int c1 = mask_count(into->mask & CENTRE_SAMPLES), c2 = mask_count(f.mask & CENTRE_SAMPLES);
+  const bool take = c2 != c1 ? c2 > c1
+                             : a2 > a1 || (a2 == a1 && f.triangle_and_facing < into->triangle_and_facing);
+  if (take) into->triangle_and_facing = f.triangle_and_facing;
   into->mask |= f.mask;
   into->zmin = std::min(into->zmin, f.zmin);
   into->zmax = std::max(into->zmax, f.zmax);

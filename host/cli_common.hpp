@@ -42,5 +42,6 @@ int cmd_render(const std::vector<std::string>& words);
 int cmd_info(const std::vector<std::string>& words);
 int cmd_compare(const std::vector<std::string>& words);
 int cmd_export_pov(const std::vector<std::string>& words);
+int cmd_crosscheck(const std::vector<std::string>& words);
 
 }  // namespace abcube

@@ -11,6 +11,7 @@
 #include "cli_common.hpp"
 #include "error.hpp"
 #include "gl_context.hpp"
+#include "crosscheck.hpp"
 #include "gl_passes.hpp"
 #include "image_io.hpp"
 #include "memory.hpp"
@@ -30,13 +31,14 @@ struct RenderRequest {
   int gl_device = -1;
   int threads = 0;
   bool reference = false;
+  ABufferOptions abuffer;  // --threads, --max-layers, --max-memory (MiB)
 };
 
 // Parses the command line and applies its overrides to the scene (cli.md).
 RenderRequest parse_request(const std::vector<std::string>& words, Scene* scene) {
   const Args args(words,
                   {"-o", "--output", "--method", "--cube-res", "--max-depth", "--threads", "--gl",
-                   "--gl-device", "--stats"},
+                   "--gl-device", "--stats", "--max-memory", "--max-layers"},
                   {"--reference"});
   args.expect_positional(1, "SCENE.json");
   RenderRequest r;
@@ -62,6 +64,9 @@ RenderRequest parse_request(const std::vector<std::string>& words, Scene* scene)
   r.gl_device = args.get_int("--gl-device", -1, 0, 1024);
   r.threads = args.get_int("--threads", 0, 0, 4096);
   r.reference = args.has("--reference");
+  r.abuffer.threads = r.threads;
+  r.abuffer.max_layers = static_cast<uint32_t>(args.get_int("--max-layers", 0, 0, 1 << 20));
+  r.abuffer.max_memory_bytes = static_cast<uint64_t>(args.get_int("--max-memory", 0, 0, 1 << 30)) << 20;
   Method method{};
   if (args.has("--method") && !parse_method(args.get("--method"), &method)) {
     throw InputError("--method: unknown method '" + args.get("--method") +
@@ -162,6 +167,14 @@ int cmd_render(const std::vector<std::string>& words) {
   switch (scene.render.method) {
     case Method::gpu:
       image = render_gpu(scene, r, &stats);
+      break;
+    case Method::abuffer:
+      image = render_abuffer_local(scene, r.abuffer, &stats);
+      stats["plan"]["passes"] = {"camera_abuffer", "resolve"};
+      stats["plan"]["skipped"] = {
+          {{"pass", "cube_abuffer"}, {"why", "no search in this build uses the map yet (reflection, refraction and shadow searches come next): local Phong only"}},
+          {{"pass", "gl"}, {"why", "the A-buffer is built on the CPU"}}};
+      stats["gl"] = {{"path", "none"}, {"renderer", "none (CPU A-buffer)"}};
       break;
     case Method::raytrace:
       image = render_reference(scene, r, &stats, "raytrace");

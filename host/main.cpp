@@ -13,9 +13,11 @@ const char* USAGE =
     "usage: abcube render SCENE.json -o OUT.png [--method abuffer|zbuffer|envmap|raytrace|gpu]\n"
     "                     [--cube-res N] [--max-depth D] [--threads K] [--gl auto|egl|egl-device|\n"
     "                     egl-surfaceless|osmesa|none] [--gl-device K] [--stats STATS.json] [--reference]\n"
+    "                     [--max-layers K] [--max-memory MiB]\n"
     "       abcube compare A.png B.png [--diff HEAT.png] [--fail T] [--failpercent P]\n"
     "       abcube info\n"
-    "       abcube export-pov SCENE.json -o OUT.pov\n";
+    "       abcube export-pov SCENE.json -o OUT.pov\n"
+    "       abcube crosscheck SCENE.json [--cube-res N] [--gl ...] [--threads K] [--stats STATS.json]\n";
 
 // Every failure is reported on one line: embedded newlines (a GLSL log) become "; ".
 std::string one_line(std::string text) {
@@ -35,7 +37,7 @@ std::string one_line(std::string text) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fputs("abcube: missing command (render, compare, info, export-pov; see abcube --help)\n", stderr);
+    std::fputs("abcube: missing command (render, compare, info, export-pov, crosscheck; see abcube --help)\n", stderr);
     return 2;
   }
   if (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
@@ -49,7 +51,8 @@ int main(int argc, char** argv) {
     if (command == "compare") return abcube::cmd_compare(words);
     if (command == "info") return abcube::cmd_info(words);
     if (command == "export-pov") return abcube::cmd_export_pov(words);
-    throw abcube::InputError("unknown command '" + command + "' (render, compare, info, export-pov)");
+    if (command == "crosscheck") return abcube::cmd_crosscheck(words);
+    throw abcube::InputError("unknown command '" + command + "' (render, compare, info, export-pov, crosscheck)");
   } catch (const abcube::InputError& e) {
     std::fprintf(stderr, "abcube: %s\n", one_line(e.what()).c_str());
     return 2;
