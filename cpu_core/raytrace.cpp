@@ -4,14 +4,13 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "camera.hpp"
 #include "error.hpp"
+#include "parallel.hpp"
 #include "samples.hpp"
 #include "shading.hpp"
 #include "timer.hpp"
@@ -221,11 +220,6 @@ void render_row(const RayTracer& tracer, const CameraFrame& frame, int spp, int 
   }
 }
 
-int resolve_threads(int requested, int rows) {
-  int n = requested > 0 ? requested : static_cast<int>(std::thread::hardware_concurrency());
-  return std::clamp(n, 1, std::max(rows, 1));
-}
-
 }  // namespace
 
 Image render_raytrace(const Scene& scene, const RaytraceOptions& options, RaytraceStats* stats) {
@@ -237,32 +231,18 @@ Image render_raytrace(const Scene& scene, const RaytraceOptions& options, Raytra
   const RayTracer tracer(scene);
   const CameraFrame frame = make_camera_frame(scene.camera);
   Image image(frame.width, frame.height, 3);
-  const int threads = resolve_threads(options.threads, frame.height);
+  const int threads = thread_count(options.threads, static_cast<size_t>(frame.height));
 
   const Clock::time_point start = Clock::now();
-  std::atomic<int> next_row{0}, rows_done{0};
+  std::atomic<int> rows_done{0};
   std::vector<RayCounts> counts(static_cast<size_t>(threads));
-  std::vector<std::exception_ptr> errors(static_cast<size_t>(threads));
   double reported = 0;  // written by worker 0 only, which is the calling thread
-  auto work = [&](int index) {
-    try {
-      for (int y = next_row++; y < frame.height; y = next_row++) {
-        render_row(tracer, frame, options.samples_per_pixel, y, &image, &counts[static_cast<size_t>(index)]);
-        const int done = ++rows_done;
-        if (index == 0 && options.progress) options.progress(reported = static_cast<double>(done) / frame.height);
-      }
-    } catch (...) {
-      errors[static_cast<size_t>(index)] = std::current_exception();
-      next_row = frame.height;  // stop the others early
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int i = 1; i < threads; ++i) pool.emplace_back(work, i);
-  work(0);
-  for (std::thread& t : pool) t.join();
-  for (const std::exception_ptr& e : errors) {
-    if (e) std::rethrow_exception(e);
-  }
+  parallel_for(static_cast<size_t>(frame.height), threads, [&](size_t row, int worker) {
+    render_row(tracer, frame, options.samples_per_pixel, static_cast<int>(row), &image,
+               &counts[static_cast<size_t>(worker)]);
+    const int done = ++rows_done;
+    if (worker == 0 && options.progress) options.progress(reported = static_cast<double>(done) / frame.height);
+  });
   if (options.progress && reported < 1.0) options.progress(1.0);  // the other threads did the last rows
 
   if (stats) {
