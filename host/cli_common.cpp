@@ -6,7 +6,6 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
-#include <thread>
 
 #include "error.hpp"
 
@@ -78,12 +77,6 @@ double Args::get_double(const std::string& name, double fallback, double lo, dou
 void Args::expect_positional(size_t count, const std::string& what) const {
   if (positional_.size() < count) throw InputError("missing " + what);
   if (positional_.size() > count) throw InputError("unexpected argument '" + positional_[count] + "'");
-}
-
-int resolve_threads(int requested) {
-  if (requested > 0) return requested;
-  const unsigned n = std::thread::hardware_concurrency();
-  return n > 0 ? static_cast<int>(n) : 1;
 }
 
 bool stderr_is_terminal() { return isatty(STDERR_FILENO) == 1; }

@@ -32,8 +32,6 @@ class Args {
 };
 
 
-// Thread count for --threads K: K >= 1 as given, 0 = every hardware thread.
-int resolve_threads(int requested);
 
 // True when stderr is a terminal (progress is shown only then).
 bool stderr_is_terminal();

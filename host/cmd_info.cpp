@@ -3,6 +3,7 @@
 #include <string>
 
 #include "cli_common.hpp"
+#include "parallel.hpp"
 #include "gl_context.hpp"
 
 namespace abcube {
@@ -31,7 +32,7 @@ int cmd_info(const std::vector<std::string>& words) {
   const Args args(words, {}, {});
   args.expect_positional(0, "");
   std::printf("abcube info\n");
-  std::printf("threads: %d hardware\n", resolve_threads(0));
+  std::printf("threads: %d hardware\n", thread_count(0, SIZE_MAX));
 
   std::string why;
   const std::vector<EglDeviceInfo> devices = list_egl_devices(&why);

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "parallel.hpp"
 #include "error.hpp"
 #include "gl_context.hpp"
 #include "crosscheck.hpp"
@@ -161,7 +162,7 @@ int cmd_render(const std::vector<std::string>& words) {
   stats["size"] = {{"width", scene.camera.width}, {"height", scene.camera.height},
                    {"cube_resolution", scene.render.cube_resolution},
                    {"max_depth", scene.render.max_depth}};
-  stats["threads"] = resolve_threads(r.threads);
+  stats["threads"] = thread_count(r.threads, SIZE_MAX);
 
   Image image;
   switch (scene.render.method) {
