@@ -105,15 +105,36 @@ Image render_gpu(const Scene& scene, const RenderRequest& r, json* stats) {
   (*stats)["gl"] = gl_json(ctx.get());
   (*stats)["timings_ms"]["gl_init"] = ms_since(t0);
   GlScene gl(scene);
+  // Model only what the scene needs: shadow maps for shadow-casting lights, the
+  // environment map for reflecting or refracting materials.
+  json passes = json::array(), skipped = json::array();
+  const int n = scene.render.cube_resolution;
+  const int maps = gl.build_shadow_maps(n);
+  if (maps > 0) {
+    passes.push_back("shadow_maps");
+  } else {
+    skipped.push_back({{"pass", "shadow_maps"}, {"why", "no light casts shadows"}});
+  }
+  bool mirrors = false;
+  for (const Material& m : scene.materials) mirrors = mirrors || m.reflect > 0 || m.transmit > 0;
+  if (mirrors) {
+    gl.build_environment(scene.camera.position, n);
+    passes.push_back("environment_map");
+  } else {
+    skipped.push_back({{"pass", "environment_map"}, {"why", "no material reflects or transmits"}});
+  }
   Image image = gl.camera_color(scene.camera);
+  passes.push_back("camera_raster");
+  skipped.push_back({{"pass", "cube_distance"}, {"why", "method gpu does no map search"}});
   const GpuTimings& t = gl.timings();
   (*stats)["timings_ms"]["upload"] = t.upload_ms;
+  if (maps > 0) (*stats)["timings_ms"]["shadow_maps"] = t.shadow_maps_ms;
+  if (mirrors) (*stats)["timings_ms"]["environment_map"] = t.environment_ms;
   (*stats)["timings_ms"]["camera_raster"] = t.camera_ms;
   (*stats)["timings_ms"]["readback"] = t.readback_ms;
-  (*stats)["plan"]["passes"] = {"camera_raster"};
-  (*stats)["plan"]["skipped"] = {
-      {{"pass", "cube_distance"}, {"why", "method gpu is the plain Z-buffer raster: no map search"}},
-      {{"pass", "cube_color"}, {"why", "method gpu looks up no environment map"}}};
+  (*stats)["counts"]["shadow_maps"] = maps;
+  (*stats)["plan"]["passes"] = passes;
+  (*stats)["plan"]["skipped"] = skipped;
   return image;
 }
 

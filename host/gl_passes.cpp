@@ -24,12 +24,24 @@ struct Vertex {
 struct MaterialGpu {
   float color_ambient[4];
   float coefficients[4];
+  float transmission[4];
 };
 
 struct LightGpu {
   float position[4];
   float color[4];
 };
+
+// The state every pass relies on: infinite reversed-Z (cube_map.hpp: depth in [0, 1], 1 at
+// the near plane, GL_GREATER), no culling (the map holds every surface), no blending.
+void set_pass_state() {
+  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+}
 
 }  // namespace
 
@@ -71,13 +83,7 @@ struct GlScene::Target {
   void clear(const glm::dvec3& background) const {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glViewport(0, 0, width, height);
-    // Infinite reversed-Z (cube_map.hpp): depth in [0, 1], 1 at the near plane.
-    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GREATER);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_CULL_FACE);  // back faces too: the map holds every surface
-    glDisable(GL_BLEND);
+    set_pass_state();
     const float zero_depth = 0.f;  // reversed Z: 0 is infinitely far
     glClearBufferfv(GL_DEPTH, 0, &zero_depth);
     if (distance_pass) {
@@ -132,7 +138,8 @@ GlScene::GlScene(const Scene& scene) : scene_(scene) {
   std::vector<MaterialGpu> materials;
   for (const Material& m : scene.materials) {
     materials.push_back({{float(m.color.r), float(m.color.g), float(m.color.b), float(m.ambient)},
-                         {float(m.diffuse), float(m.specular), float(m.shininess), 0.f}});
+                         {float(m.diffuse), float(m.specular), float(m.shininess), float(m.reflect)},
+                         {float(m.transmit), float(m.ior), float(m.opacity), 0.f}});
   }
   if (materials.empty()) materials.push_back({});
   glGenBuffers(1, &materials_);
@@ -153,6 +160,10 @@ GlScene::GlScene(const Scene& scene) : scene_(scene) {
 
 GlScene::~GlScene() {
   target_.reset();
+  const GLuint textures[] = {shadow_maps_, environment_};
+  glDeleteTextures(2, textures);
+  glDeleteRenderbuffers(1, &lookup_depth_);
+  glDeleteFramebuffers(1, &lookup_fbo_);
   glDeleteBuffers(1, &vbo_);
   glDeleteBuffers(1, &materials_);
   glDeleteBuffers(1, &lights_);
@@ -174,9 +185,11 @@ GlScene::Target& GlScene::target(int width, int height, bool distance_pass) {
 
 void GlScene::upload_lights(const glm::dvec3& center) {
   std::vector<LightGpu> lights;
-  for (const PointLight& l : scene_.lights) {
+  for (size_t i = 0; i < scene_.lights.size(); ++i) {
+    const PointLight& l = scene_.lights[i];
     const glm::dvec3 p = l.position - center;
-    lights.push_back({{float(p.x), float(p.y), float(p.z), 1.f},
+    const float layer = i < shadow_layer_.size() ? float(shadow_layer_[i]) : -1.f;
+    lights.push_back({{float(p.x), float(p.y), float(p.z), layer},
                       {float(l.color.r), float(l.color.g), float(l.color.b), 0.f}});
   }
   if (lights.empty()) lights.push_back({});
@@ -196,6 +209,107 @@ void GlScene::draw(const GlProgram& program, const glm::mat4& clip, const glm::d
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, lights_);
   glBindVertexArray(vao_);
   if (vertex_count_ > 0) glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
+}
+
+// Binds the shadow maps (unit 1) and, if asked and built, the environment map (unit 2).
+void GlScene::bind_lookups(const GlProgram& program, bool with_environment) {
+  program.use();
+  const bool shadows = shadow_maps_ != 0;
+  glUniform1i(program.uniform("u_shadows"), shadows);
+  glUniform1i(program.uniform("u_shadow_maps"), 1);
+  glUniform1f(program.uniform("u_shadow_texel"), shadows ? float(2.0 / shadow_n_) : 0.f);
+  glUniform1f(program.uniform("u_shadow_bias_texels"), float(SHADOW_BIAS_TEXELS));
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, shadow_maps_);
+  const bool environment = with_environment && environment_ != 0;
+  glUniform1i(program.uniform("u_environment"), environment);
+  glUniform1i(program.uniform("u_environment_map"), 2);
+  glActiveTexture(GL_TEXTURE2);
+  glBindTexture(GL_TEXTURE_CUBE_MAP, environment ? environment_ : 0);
+  glActiveTexture(GL_TEXTURE0);
+}
+
+int GlScene::build_shadow_maps(int n) {
+  shadow_layer_.assign(scene_.lights.size(), -1);
+  int layers = 0;
+  for (size_t i = 0; i < scene_.lights.size(); ++i) {
+    if (scene_.lights[i].cast_shadows) shadow_layer_[i] = layers++;
+  }
+  if (layers == 0) return 0;
+  const Clock::time_point t0 = Clock::now();
+  if (n > max_size_) throw RuntimeFailure("shadow map " + std::to_string(n) + " exceeds GL_MAX_TEXTURE_SIZE");
+  shadow_n_ = n;
+  glGenTextures(1, &shadow_maps_);
+  glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, shadow_maps_);
+  glTexStorage3D(GL_TEXTURE_CUBE_MAP_ARRAY, 1, GL_R32F, n, n, 6 * layers);
+  glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  if (!lookup_fbo_) glGenFramebuffers(1, &lookup_fbo_);
+  glDeleteRenderbuffers(1, &lookup_depth_);
+  glGenRenderbuffers(1, &lookup_depth_);
+  glBindRenderbuffer(GL_RENDERBUFFER, lookup_depth_);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, n, n);
+  glBindFramebuffer(GL_FRAMEBUFFER, lookup_fbo_);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, lookup_depth_);
+  const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+  for (size_t i = 0; i < scene_.lights.size(); ++i) {
+    if (shadow_layer_[i] < 0) continue;
+    const glm::dvec3 light = scene_.lights[i].position;
+    for (int face = 0; face < CUBE_FACES; ++face) {
+      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, shadow_maps_, 0, 6 * shadow_layer_[i] + face);
+      glDrawBuffers(1, buffers);
+      clear_lookup_target(n, true);
+      draw(*distance_program_, face_clip_matrix(face, light, near_), light);
+    }
+  }
+  glFinish();
+  check_gl("cube shadow maps");
+  timings_.shadow_maps_ms += ms_since(t0);
+  return layers;
+}
+
+void GlScene::build_environment(const glm::dvec3& center, int n) {
+  const Clock::time_point t0 = Clock::now();
+  if (n > max_size_) throw RuntimeFailure("environment map " + std::to_string(n) + " exceeds GL_MAX_TEXTURE_SIZE");
+  glDeleteTextures(1, &environment_);
+  glGenTextures(1, &environment_);
+  glBindTexture(GL_TEXTURE_CUBE_MAP, environment_);
+  glTexStorage2D(GL_TEXTURE_CUBE_MAP, 1, GL_RGBA32F, n, n);
+  glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+  if (!lookup_fbo_) glGenFramebuffers(1, &lookup_fbo_);
+  glDeleteRenderbuffers(1, &lookup_depth_);
+  glGenRenderbuffers(1, &lookup_depth_);
+  glBindRenderbuffer(GL_RENDERBUFFER, lookup_depth_);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, n, n);
+  glBindFramebuffer(GL_FRAMEBUFFER, lookup_fbo_);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, lookup_depth_);
+  upload_lights(center);
+  bind_lookups(*phong_program_, false);  // no environment inside the environment
+  const GLenum buffers[] = {GL_COLOR_ATTACHMENT0};
+  for (int face = 0; face < CUBE_FACES; ++face) {
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
+                           GL_TEXTURE_CUBE_MAP_POSITIVE_X + static_cast<GLenum>(face), environment_, 0);
+    glDrawBuffers(1, buffers);
+    clear_lookup_target(n, false);
+    draw(*phong_program_, face_clip_matrix(face, center, near_), center);
+  }
+  glFinish();
+  check_gl("environment map");
+  timings_.environment_ms += ms_since(t0);
+}
+
+// Clears the lookup framebuffer (shadow map: +infinity; environment: background).
+void GlScene::clear_lookup_target(int n, bool distance) {
+  glViewport(0, 0, n, n);
+  set_pass_state();
+  const float zero_depth = 0.f;
+  glClearBufferfv(GL_DEPTH, 0, &zero_depth);
+  const glm::dvec3& b = scene_.background;
+  const float far[4] = {NO_DISTANCE, 0, 0, 0};
+  const float bg[4] = {float(b.x), float(b.y), float(b.z), 1.f};
+  glClearBufferfv(GL_COLOR, 0, distance ? far : bg);
 }
 
 void GlScene::cube_distance(const glm::dvec3& center, int n, CubeImage* distance, CubeIds* ids, int n_t) {
@@ -227,6 +341,7 @@ CubeImage GlScene::cube_color(const glm::dvec3& center, int n) {
   Target& t = target(n, n, false);
   CubeImage out(n, 3);
   upload_lights(center);
+  bind_lookups(*phong_program_, false);
   std::vector<float> rgba(static_cast<size_t>(n) * n * 4);
   for (int face = 0; face < CUBE_FACES; ++face) {
     Clock::time_point t0 = Clock::now();
@@ -249,6 +364,7 @@ CubeImage GlScene::cube_color(const glm::dvec3& center, int n) {
 Image GlScene::camera_color(const Camera& camera) {
   Target& t = target(camera.width, camera.height, false);
   upload_lights(camera.position);
+  bind_lookups(*phong_program_, true);
   Clock::time_point t0 = Clock::now();
   t.clear(scene_.background);
   const double aspect = static_cast<double>(camera.width) / camera.height;

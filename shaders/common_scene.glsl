@@ -2,13 +2,25 @@
 // per-vertex material id. Layout mirrors host/gl_passes.cpp (std430).
 struct MaterialGpu {
   vec4 color_ambient;  // rgb = Od, a = ka
-  vec4 coefficients;   // x = kd, y = ks, z = shininess n, w unused
+  vec4 coefficients;   // x = kd, y = ks, z = shininess n, w = kr (reflect)
+  vec4 transmission;   // x = kt (transmit), y = ior, z = opacity, w unused
 };
 struct LightGpu {
-  vec4 position;  // xyz relative to the pass centre (the eye)
+  vec4 position;  // xyz relative to the pass centre (the eye); w = shadow-map layer, -1 = none
   vec4 color;     // rgb intensity
 };
 layout(std430, binding = 0) readonly buffer Materials { MaterialGpu materials[]; };
 layout(std430, binding = 1) readonly buffer Lights { LightGpu lights[]; };
 uniform int u_light_count;
 uniform vec3 u_ambient;
+
+// Cube shadow maps, one cube-array layer per shadow-casting light: the distance from the
+// light to the nearest surface (the distance prepass rendered from the light).
+uniform bool u_shadows;
+uniform samplerCubeArray u_shadow_maps;
+uniform float u_shadow_texel;        // 2/N: a texel's width at unit distance, face centre
+uniform float u_shadow_bias_texels;  // the bias, in texels of the shadow map
+
+// The environment cube map around the eye (Blinn & Newell 1976), for kr and kt lookups.
+uniform bool u_environment;
+uniform samplerCube u_environment_map;

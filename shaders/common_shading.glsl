@@ -1,6 +1,22 @@
-// Phong local shading, the GLSL mirror of cpu_core/shading.hpp phong_local (thesis ch. 6):
-//   C = ka Ia Od + sum_l I_l (kd Od max(0, N.L) + ks max(0, R.V)^n),  R = reflect(-L, N),
+// Phong local shading, the GLSL mirror of cpu_core/shading.hpp (thesis ch. 6):
+//   C = ka Ia Od + sum_l S_l I_l (kd Od max(0, N.L) + ks max(0, R.V)^n),  R = reflect(-L, N),
 // with N turned to face the viewer (two-sided lighting). p is relative to the eye.
+
+// S_l from the light's cube shadow map: 1 if p is no farther from the light than the
+// nearest surface the map stored in that direction, plus a bias of u_shadow_bias_texels
+// texels (a texel at distance d is about u_shadow_texel * d wide), grown at grazing
+// light. Every blocker is opaque here (the GPU path does not attenuate by kt).
+float light_visibility(int i, vec3 p, vec3 n) {
+  float layer = lights[i].position.w;
+  if (!u_shadows || layer < 0.0) return 1.0;
+  vec3 d = p - lights[i].position.xyz;
+  float dist = length(d);
+  float stored = texture(u_shadow_maps, vec4(d, layer)).r;
+  float slope = max(abs(dot(n, d / dist)), 0.2);
+  float bias = u_shadow_bias_texels * u_shadow_texel * dist / slope;
+  return dist <= stored + bias ? 1.0 : 0.0;
+}
+
 vec3 phong_local(MaterialGpu m, vec3 p, vec3 n_in) {
   vec3 v = normalize(-p);
   vec3 n = normalize(n_in);
@@ -17,7 +33,27 @@ vec3 phong_local(MaterialGpu m, vec3 p, vec3 n_in) {
       float rdotv = dot(r, v);
       if (rdotv > 0.0) term += vec3(m.coefficients.y * pow(rdotv, m.coefficients.z));
     }
-    c += lights[i].color.rgb * term;
+    c += light_visibility(i, p, n) * lights[i].color.rgb * term;
+  }
+  return c;
+}
+
+// Blinn & Newell 1976: what a mirror (kr) and a refracting surface (kt) show, looked up in
+// the environment map around the eye in the reflected and refracted directions, as if
+// everything were infinitely far away. Refraction is one interface (Snell with eta =
+// 1/ior; total internal reflection looks up the mirror direction).
+vec3 environment_terms(MaterialGpu m, vec3 p, vec3 n_in) {
+  float kr = m.coefficients.w, kt = m.transmission.x;
+  if (!u_environment || (kr <= 0.0 && kt <= 0.0)) return vec3(0.0);
+  vec3 i = normalize(p);
+  vec3 n = normalize(n_in);
+  if (dot(n, i) > 0.0) n = -n;
+  vec3 c = vec3(0.0);
+  if (kr > 0.0) c += kr * texture(u_environment_map, reflect(i, n)).rgb;
+  if (kt > 0.0) {
+    vec3 t = refract(i, n, 1.0 / m.transmission.y);
+    if (t == vec3(0.0)) t = reflect(i, n);
+    c += kt * texture(u_environment_map, t).rgb;
   }
   return c;
 }
