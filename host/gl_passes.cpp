@@ -244,13 +244,7 @@ int GlScene::build_shadow_maps(int n) {
   glTexStorage3D(GL_TEXTURE_CUBE_MAP_ARRAY, 1, GL_R32F, n, n, 6 * layers);
   glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
   glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  if (!lookup_fbo_) glGenFramebuffers(1, &lookup_fbo_);
-  glDeleteRenderbuffers(1, &lookup_depth_);
-  glGenRenderbuffers(1, &lookup_depth_);
-  glBindRenderbuffer(GL_RENDERBUFFER, lookup_depth_);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, n, n);
-  glBindFramebuffer(GL_FRAMEBUFFER, lookup_fbo_);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, lookup_depth_);
+  bind_lookup_target(n);
   const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
   for (size_t i = 0; i < scene_.lights.size(); ++i) {
     if (shadow_layer_[i] < 0) continue;
@@ -278,13 +272,7 @@ void GlScene::build_environment(const glm::dvec3& center, int n) {
   glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
-  if (!lookup_fbo_) glGenFramebuffers(1, &lookup_fbo_);
-  glDeleteRenderbuffers(1, &lookup_depth_);
-  glGenRenderbuffers(1, &lookup_depth_);
-  glBindRenderbuffer(GL_RENDERBUFFER, lookup_depth_);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, n, n);
-  glBindFramebuffer(GL_FRAMEBUFFER, lookup_fbo_);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, lookup_depth_);
+  bind_lookup_target(n);
   upload_lights(center);
   bind_lookups(*phong_program_, false);  // no environment inside the environment
   const GLenum buffers[] = {GL_COLOR_ATTACHMENT0};
@@ -298,6 +286,17 @@ void GlScene::build_environment(const glm::dvec3& center, int n) {
   glFinish();
   check_gl("environment map");
   timings_.environment_ms += ms_since(t0);
+}
+
+// Binds the framebuffer that renders into the lookup textures, with an n x n depth buffer.
+void GlScene::bind_lookup_target(int n) {
+  if (!lookup_fbo_) glGenFramebuffers(1, &lookup_fbo_);
+  glDeleteRenderbuffers(1, &lookup_depth_);
+  glGenRenderbuffers(1, &lookup_depth_);
+  glBindRenderbuffer(GL_RENDERBUFFER, lookup_depth_);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, n, n);
+  glBindFramebuffer(GL_FRAMEBUFFER, lookup_fbo_);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, lookup_depth_);
 }
 
 // Clears the lookup framebuffer (shadow map: +infinity; environment: background).

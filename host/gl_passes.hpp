@@ -69,6 +69,7 @@ class GlScene {
   struct Target;
   void draw(const GlProgram& program, const glm::mat4& clip, const glm::dvec3& center);
   void bind_lookups(const GlProgram& program, bool with_environment);
+  void bind_lookup_target(int n);
   void clear_lookup_target(int n, bool distance);
   void upload_lights(const glm::dvec3& center);
   Target& target(int width, int height, bool distance_pass);
