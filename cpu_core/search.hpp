@@ -1,0 +1,199 @@
+// The searches in the A-buffered cube map (thesis 7.4, 7.5, 8.3, 9.3.4; design.md
+// "Searches in the A-buffered cube map"): reflection, refraction exit and shadow rays
+// answered from ONE cube A-buffer (abuffer.hpp) centred on C, by walking the texels of the
+// ray's projection (cube_walk.hpp) in order of increasing ray parameter l.
+//
+// CANDIDATES. In each texel the walk gives the parameter interval [l0, l1] the ray spends
+// there, hence the ray's distance range [dmin, dmax] from C (thesis 7.5: "podemos descartar
+// totalmente una lista ... si la posición del rayo para ese pixel es mayor que la mayor
+// distancia guardada o menor que la menor"). A fragment is tested iff its [zmin, zmax]
+// overlaps [dmin, dmax]. Layers: SearchLayers::all tests every fragment of the list (the
+// A-buffer, thesis 7.5); SearchLayers::nearest tests only the fragment nearest_layer()
+// would keep (centre sample covered, nearest plane along the texel centre): the one-layer
+// Z-buffered map of Patow 1995 (thesis 7.4), same walk, same rules.
+//
+// MODE crossing (default). Each tested fragment is refined with its triangle's exact plane
+// (the fragment stores the triangle index): X' = X(l') where the ray meets the plane. Its
+// error is its distance e from the triangle (0 inside), in texels at X' (texel_size_at).
+// It is accepted iff e <= tolerance_texels, and either e == 0 (an exact crossing: the
+// point is on the triangle) or l' lies in the texel's own interval [l0, l1] (the fragment
+// is the map's evidence that a surface is there; its triangle may be a neighbour of the
+// surface the ray really crosses: merged fragments, triangles too thin to cover a sample).
+// The hit is the first crossing: after the first texel with an accepted candidate the walk
+// goes on for CROSSING_WINDOW_TEXELS more texels (and while l0 <= the best l'); the
+// result is the exact crossing with the smallest l' if there is one, else the accepted
+// candidate with the smallest l'. So a surface's neighbouring triangle, whose extended
+// plane the ray meets a little before the triangle it really crosses, does not win over
+// it, and a near silhouette missed by less than the tolerance only wins when no exact
+// crossing lies just behind it. The point X' is on the ray: Error_Parallax is 0 to
+// rounding; the error of this mode is the wrong surface near silhouettes.
+//
+// MODE thesis (thesis 7.4.1 pseudo-code, 9.3.4). Each tested fragment gives the point
+// a V, V the texel-centre direction and a its distance to the fragment's plane along V
+// (the Z-buffer's alpha); the angle between R and (a V - W) is its error. The best
+// approximator is the smallest angle, accepted iff <= theta_max (default 2 degrees), else a
+// threshold rejection (the thesis reflects the background). OUR RESTRICTION: the thesis
+// takes the minimum over the whole arc, which can pick a surface hidden behind the first
+// one the ray meets; we take it over the first candidates: from the first texel holding a
+// candidate under theta_max to THESIS_WINDOW_TEXELS texels after it. Error_Parallax of an
+// accepted point is (1 - cos angle)/2 <= theta_max^2/4 (thesis 9.3.4); the 1/(2 N^2) bound
+// holds only where the angle seen from W is no larger than seen from C (see the report).
+//
+// SELF-HITS (rule "offset", in texel units instead of shading.hpp's absolute epsilon).
+// s = self_offset_texels * texel_size_at(W): a fragment whose triangle's plane passes
+// within s of W (W's own surface: a ray cannot meet the plane it leaves), and any found
+// point within s of W, are ignored. So a grazing ray never finds its own surface, and a
+// surface closer to W than s (a concave corner, a blocker touching P) is not found either:
+// with the default 0.5 at N = 512 and |W| = 5, s = 0.005 world units.
+//
+// ZERO-AREA SURFACES. A triangle whose plane contains C (within the raster's edge-on rule)
+// has no fragment: no search can find it. SearchContext lists them; when the exact ray
+// meets one before the found point (or when nothing was found), the result is a miss
+// with reason zero_area_surface (counted, never a silent wrong hit).
+//
+// THE CENTRE. The walk skips the ball |X| < near_distance around C (the map holds nothing
+// there). A ray through C (R . [[W]] = -1) jumps from the texel of [[W]] to the texel of
+// its antipode R; R . [[W]] = +1 is a walk of one texel (cube_walk.hpp).
+//
+// SHADOWS (thesis 8.3). The segment from P to the light: every accepted crossing with
+// s <= |X' - P| <= |L - P| - s is a blocker; blockers multiply the light by
+// blocker_transmittance (shading.hpp); the walk stops at the first opaque one. Shadow rays
+// are not refracted. Crossings of one object with the same facing within
+// (tolerance_texels + 1) texels of each other are one crossing (a ray through a shared edge,
+// or the same surface found in two texels).
+//
+// REFRACTION. The exit point of a ray inside a closed object is the first crossing of the
+// SAME object along the refracted direction (back faces are in the map):
+// refraction_exit_search. The caller bends the ray there (shading.hpp transmission; total
+// internal reflection gives a mirror direction, searched again with refraction_exit_search)
+// and searches what the emerging ray sees with reflection_search.
+//
+// Every search is a pure function of its inputs (thread safe); stats are per caller.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "abuffer.hpp"
+#include "cube_map.hpp"
+#include "scene.hpp"
+
+namespace abcube {
+
+enum class SearchMode { crossing, thesis };
+enum class SearchLayers { all, nearest };  // A-buffer (thesis 7.5) or Z-buffer (Patow 1995)
+const char* search_mode_name(SearchMode m);
+bool parse_search_mode(const std::string& s, SearchMode* out);  // "crossing" | "thesis"
+
+// Texels the crossing mode walks past its first accepted candidate, and the thesis mode
+// past its first candidate under theta_max.
+constexpr int CROSSING_WINDOW_TEXELS = 2;
+constexpr int THESIS_WINDOW_TEXELS = 2;
+
+struct SearchOptions {
+  SearchMode mode = SearchMode::crossing;
+  SearchLayers layers = SearchLayers::all;
+  double theta_max = 0.034906585039886591;  // thesis mode: 2 degrees, in radians
+  double tolerance_texels = 1.0;            // crossing mode: largest accepted e
+  double self_offset_texels = 0.5;          // W's own surface and points closer than this
+  uint32_t max_texels = 0;                  // walk cap; 0 = CubeWalk's default
+};
+
+enum class MissReason { none, no_crossing, threshold_rejection, zero_area_surface, aborted };
+const char* miss_reason_name(MissReason r);
+
+// The geometry a search needs, prepared once per cube map: per triangle its plane relative
+// to the centre, and the triangles the map cannot hold (plane through the centre).
+// Scene and cube must outlive it.
+class SearchContext {
+ public:
+  SearchContext(const Scene& scene, const CubeABuffer& cube);
+
+  const Scene& scene() const { return *scene_; }
+  const CubeABuffer& cube() const { return *cube_; }
+  const std::vector<uint32_t>& zero_area_triangles() const { return zero_area_; }
+
+  struct Plane {
+    glm::dvec3 normal{0.0};  // unit geometric normal, cross(b-a, c-a) direction
+    double offset = 0;       // normal . X for X on the plane, X relative to the centre
+  };
+  const Plane& plane(uint32_t triangle) const { return planes_[triangle]; }
+  // The vertices of a triangle relative to the centre.
+  glm::dvec3 vertex(uint32_t triangle, int k) const;
+
+ private:
+  const Scene* scene_;
+  const CubeABuffer* cube_;
+  std::vector<Plane> planes_;
+  std::vector<uint32_t> zero_area_;
+};
+
+struct SearchResult {
+  bool hit = false;
+  MissReason miss = MissReason::no_crossing;  // none when hit
+  uint32_t triangle = 0;       // the found fragment's triangle (index into Scene::triangles)
+  uint32_t object_id = 0, material_id = 0;
+  bool back_face = false;      // the fragment's facing as seen from the cube centre
+  glm::dvec3 point{0.0};       // X', world space
+  double distance = 0;         // |X' - W|
+  double angle = 0;            // angle between the ray and X' - W (radians; 0 in crossing mode)
+  double outside_texels = 0;   // crossing mode: X''s distance from its triangle, in texels
+  CubeTexel texel{0, 0, 0};    // where the fragment was found
+  uint32_t texels_visited = 0;
+  uint32_t fragments_tested = 0;  // z-interval tests
+  uint32_t candidates = 0;        // fragments refined (z overlap, not own surface)
+};
+
+struct ShadowResult {
+  glm::dvec3 transmittance{1.0};  // S_l: product of blocker_transmittance over blockers
+  bool blocked = false;           // an opaque blocker stopped the walk
+  uint32_t blockers = 0;          // distinct crossings counted
+  uint32_t first_blocker = 0;     // triangle of the nearest counted blocker (if blockers > 0)
+  bool aborted = false;
+  bool zero_area = false;         // the segment meets a surface the map cannot hold
+  uint32_t texels_visited = 0;
+  uint32_t fragments_tested = 0;
+  uint32_t candidates = 0;
+  uint32_t threshold_rejections = 0;  // candidates refused by the tolerance / theta_max
+};
+
+// Reflection (or any secondary ray seen from outside): the first surface along the ray
+// W + l R, l > 0 (W world space on the reflecting surface, R unit).
+SearchResult reflection_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& r,
+                               const SearchOptions& options = {});
+
+// The exit point of a ray inside object `object_id`: its first crossing of that object's
+// surface along W + l T (W world space, on the entry surface; T unit, refracted inwards).
+SearchResult refraction_exit_search(const SearchContext& ctx, const glm::dvec3& w,
+                                    const glm::dvec3& t, uint32_t object_id,
+                                    const SearchOptions& options = {});
+
+// Visibility of point light `light_position` from surface point p (world space).
+ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p,
+                           const glm::dvec3& light_position, const SearchOptions& options = {});
+
+// Counters of one kind of search (issue item 10).
+struct SearchKindStats {
+  uint64_t rays = 0;
+  uint64_t texels = 0, max_texels = 0;  // texels visited: sum and max per ray
+  uint64_t fragments = 0;               // z-interval tests
+  uint64_t candidates = 0;              // fragments refined
+  uint64_t hits = 0;                    // shadows: rays with a blocker
+  uint64_t misses = 0;                  // every miss, whatever the reason; shadows: unblocked
+  uint64_t threshold_rejections = 0;    // misses whose best candidate failed the threshold
+  uint64_t zero_area = 0;               // misses on a surface through the centre
+  uint64_t aborted = 0;                 // walks stopped by the cap
+  double mean_texels() const { return rays ? static_cast<double>(texels) / static_cast<double>(rays) : 0.0; }
+  void add(const SearchResult& r);
+  void add(const ShadowResult& r);
+  void merge(const SearchKindStats& o);
+};
+
+struct SearchStats {
+  SearchKindStats reflection, refraction_exit, shadow;
+  void merge(const SearchStats& o);
+};
+
+}  // namespace abcube
