@@ -1,0 +1,268 @@
+// The lens refraction modes (lens.hpp; Patow-Delrieux, seeds/scanline-refraction-lens.es.txt):
+// the fit against lenses of known shape, the transfer against the lensmaker's and thick-lens
+// formulas, and both against the exact tracer on the same triangles.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "lens.hpp"
+#include "raytrace.hpp"
+
+// Scene builders, defined in test_raytrace.cpp.
+namespace abcube::testkit {
+Scene empty_scene(const glm::dvec3& eye, const glm::dvec3& look_at, double fov_y_deg, int width, int height);
+uint32_t add_material(Scene& s, const Material& m);
+uint32_t begin_object(Scene& s, const std::string& type, uint32_t material, bool closed);
+void add_triangle(Scene& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& na,
+                  const glm::dvec3& nb, const glm::dvec3& nc);
+uint32_t add_box(Scene& s, const glm::dvec3& lo, const glm::dvec3& hi, uint32_t material);
+uint32_t add_sphere(Scene& s, const glm::dvec3& center, double radius, int segments, uint32_t material);
+}  // namespace abcube::testkit
+
+namespace abcube {
+namespace {
+
+using glm::dvec2;
+using glm::dvec3;
+using namespace testkit;
+
+constexpr double PI = 3.14159265358979323846;
+
+// A lens of revolution with a knife edge: two spherical caps (or a cap and a disc) meeting
+// on the rim circle of radius `aperture`. c1, c2 >= 0 are the curvatures of the faces on the
+// +axis and -axis sides, convex outward (0 = flat).
+struct LensShape {
+  double c1 = 0, c2 = 0, aperture = 1;
+  double sag1() const { return sag(c1, aperture); }
+  double sag2() const { return sag(c2, aperture); }
+  double thickness() const { return sag1() + sag2(); }
+  static double sag(double c, double r) { return c * r * r / (1.0 + std::sqrt(1.0 - c * c * r * r)); }
+};
+
+// Where a lens sits: world = center + e1 x + e2 y + axis z (an orthonormal frame).
+struct LensPlacement {
+  dvec3 center{0.0}, e1{1, 0, 0}, e2{0, 1, 0}, axis{0, 0, 1};
+  dvec3 world(const dvec3& p) const { return center + p.x * e1 + p.y * e2 + p.z * axis; }
+  dvec3 direction(const dvec3& v) const { return v.x * e1 + v.y * e2 + v.z * axis; }
+};
+
+LensPlacement tilted_placement() {
+  LensPlacement pl;
+  pl.center = dvec3(0.7, -0.4, 2.1);
+  pl.axis = glm::normalize(dvec3(0.3, 0.9, 0.2));  // largest component +y: the fit's sign keeps it
+  pl.e1 = glm::normalize(glm::cross(dvec3(0, 0, 1), pl.axis));
+  pl.e2 = glm::cross(pl.axis, pl.e1);
+  return pl;
+}
+
+Scene lens_scene() { return empty_scene({0, 0, 10}, {0, 0, 0}, 40, 8, 8); }
+
+uint32_t glass(Scene& s, double ior) {
+  Material m;
+  m.transmit = 1;
+  m.diffuse = 0;
+  m.ior = ior;
+  return add_material(s, m);
+}
+
+// Polar grid on both faces, `rings` rings and `segments` segments, outward winding, the
+// faces' exact normals at the corners. Rim corners are computed once, so the mesh is closed.
+uint32_t add_lens(Scene& s, const LensShape& shape, const LensPlacement& pl, int rings, int segments,
+                  uint32_t material) {
+  const uint32_t id = begin_object(s, "mesh", material, true);
+  auto corner = [&](int face, int ring, int seg, dvec3* p, dvec3* n) {
+    const double r = shape.aperture * ring / rings, phi = 2.0 * PI * (seg % segments) / segments;
+    const double x = r * std::cos(phi), y = r * std::sin(phi);
+    const double c = face == 1 ? shape.c1 : shape.c2;
+    const double sag = LensShape::sag(c, r);
+    double z = face == 1 ? shape.sag1() - sag : -shape.sag2() + sag;
+    if (ring == rings) z = 0;
+    const dvec3 local_n = face == 1 ? dvec3(c * x, c * y, 1.0 - c * sag) : dvec3(c * x, c * y, -(1.0 - c * sag));
+    *p = pl.world({x, y, z});
+    *n = glm::normalize(pl.direction(local_n));
+  };
+  auto tri = [&](int face, int r0, int s0, int r1, int s1, int r2, int s2) {
+    dvec3 p[3], n[3];
+    corner(face, r0, s0, &p[0], &n[0]);
+    corner(face, r1, s1, &p[1], &n[1]);
+    corner(face, r2, s2, &p[2], &n[2]);
+    if (face == 1) {
+      add_triangle(s, p[0], p[1], p[2], n[0], n[1], n[2]);
+    } else {
+      add_triangle(s, p[0], p[2], p[1], n[0], n[2], n[1]);
+    }
+  };
+  for (int face = 1; face <= 2; ++face) {
+    for (int j = 0; j < segments; ++j) {
+      tri(face, 0, 0, 1, j, 1, j + 1);
+      for (int i = 1; i < rings; ++i) {
+        tri(face, i, j, i + 1, j, i + 1, j + 1);
+        tri(face, i, j, i + 1, j + 1, i, j + 1);
+      }
+    }
+  }
+  return id;
+}
+
+// The exact path through the object (RayTracer's refraction rule): the ray that leaves it.
+bool exact_exit(const RayTracer& tracer, dvec3 o, dvec3 d, LensRay* out) {
+  for (int i = 0; i < 8; ++i) {
+    Hit h;
+    if (!tracer.intersect(o, d, &h)) return false;
+    if (i == 0 && !h.front_face) return false;
+    bool tir = false;
+    const Ray r = tracer.transmitted_ray(h, d, &tir);
+    if (!h.front_face && !tir) {
+      out->point = h.point;
+      out->dir = r.dir;
+      return true;
+    }
+    o = r.origin;
+    d = r.dir;
+  }
+  return false;
+}
+
+double angle_between(const dvec3& a, const dvec3& b) {
+  return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+}
+
+// Signed distance along `travel` from plane point `plane` to where the ray crosses the
+// line through `plane` along `travel`, measured by the transverse closest approach in the
+// plane of the ray and the axis (the ray is meridional in these tests).
+double axis_crossing(const LensRay& ray, const dvec3& on_axis, const dvec3& travel) {
+  const dvec3 r = ray.point - on_axis;
+  const dvec3 radial = r - glm::dot(r, travel) * travel;
+  const dvec3 slope = ray.dir - glm::dot(ray.dir, travel) * travel;
+  // ray.point + t dir meets the axis where its radial part vanishes.
+  const double t = -glm::dot(radial, slope) / glm::dot(slope, slope);
+  return glm::dot(r + t * ray.dir, travel);
+}
+
+// Incident ray at height h (along e1 rotated by azimuth phi) and slope `tilt` (transverse
+// direction component along e1), travelling along -axis (from_top) or +axis, starting a unit
+// beyond the lens.
+struct Incident {
+  dvec3 origin, dir;
+};
+Incident incident(const LensPlacement& pl, const LensShape& shape, bool from_top, double h, double phi,
+                  double tilt) {
+  const double z = from_top ? shape.sag1() + 1.0 : -shape.sag2() - 1.0;
+  const dvec3 across = std::cos(phi) * pl.e1 + std::sin(phi) * pl.e2;
+  const dvec3 travel = from_top ? -pl.axis : pl.axis;
+  // Aim so the line passes height h at the rim plane.
+  const dvec3 dir = glm::normalize(travel + tilt * across);
+  const dvec3 at_rim = pl.center + h * across;
+  const double back = std::fabs(z) / glm::dot(dir, travel);
+  return {at_rim - back * dir, dir};
+}
+
+// ---------------------------------------------------------------------------------------
+
+TEST(LensMode, ParsesTheThreeModes) {
+  for (RefractionMode m : {RefractionMode::search, RefractionMode::thick_lens, RefractionMode::thin_lens}) {
+    RefractionMode parsed = RefractionMode::search;
+    ASSERT_TRUE(parse_refraction_mode(refraction_mode_name(m), &parsed)) << refraction_mode_name(m);
+    EXPECT_EQ(parsed, m);
+  }
+  EXPECT_STREQ(refraction_mode_name(RefractionMode::thick_lens), "thick_lens");
+  RefractionMode out = RefractionMode::thin_lens;
+  for (const char* bad : {"", "thick", "Thin_lens", "search ", "lens"}) {
+    EXPECT_FALSE(parse_refraction_mode(bad, &out)) << bad;
+  }
+  EXPECT_EQ(out, RefractionMode::thin_lens);  // untouched on failure
+}
+
+// Eq. 14 composes eq. 13 as printed; determinant 1; d = 0 gives eq. 16.
+TEST(LensMatrix, Equation14AndThinLimit) {
+  const double rho1 = 0.45, rho2 = -0.3, d = 0.7, nu = 1.6;
+  const LensMatrix m = thick_lens_matrix(rho1, rho2, d, nu);
+  EXPECT_NEAR(m.alpha, (d / nu) * (1 - nu) * rho1 + 1, 1e-15);
+  EXPECT_NEAR(m.beta, d / nu, 1e-15);
+  EXPECT_NEAR(m.gamma, (1 - nu) * (rho1 - rho2) - (nu - 1) * (nu - 1) * rho1 * rho2 * d / nu, 1e-15);
+  EXPECT_NEAR(m.delta, 1 + (d / nu) * (nu - 1) * rho2, 1e-15);
+  EXPECT_NEAR(m.alpha * m.delta - m.beta * m.gamma, 1.0, 1e-14);
+  const LensMatrix thin = thin_lens_matrix(rho1, rho2, nu);
+  const LensMatrix zero = thick_lens_matrix(rho1, rho2, 0.0, nu);
+  EXPECT_DOUBLE_EQ(thin.alpha, 1.0);
+  EXPECT_DOUBLE_EQ(thin.beta, 0.0);
+  EXPECT_DOUBLE_EQ(thin.delta, 1.0);
+  EXPECT_NEAR(thin.gamma, zero.gamma, 1e-15);
+  EXPECT_NEAR(thin.gamma, -(nu - 1) * (rho1 - rho2), 1e-15);
+}
+
+// A biconvex lens R1 = 2, R2 = 3 (a = 1.2) tilted in space: rho1 = 1/R1, rho2 = -1/R2,
+// d = sag1 + sag2, the axis and the vertices where they are.
+TEST(LensFit, BiconvexRecoversCurvaturesAndThickness) {
+  Scene s = lens_scene();
+  const LensShape shape{1.0 / 2.0, 1.0 / 3.0, 1.2};
+  const LensPlacement pl = tilted_placement();
+  add_lens(s, shape, pl, 64, 128, glass(s, 1.5));
+  const LensFit f = fit_lens(s, 0);
+  ASSERT_TRUE(f.valid) << f.why_invalid;
+  std::printf("biconvex R1=2 R2=3: rho1 - 1/R1 %.1e, rho2 + 1/R2 %.1e, d error %.1e, rms %.1e %.1e\n",
+              f.rho1 - 0.5, f.rho2 + 1.0 / 3.0, f.thickness - shape.thickness(), f.rms_residual1, f.rms_residual2);
+  EXPECT_GT(glm::dot(f.axis, pl.axis), 1.0 - 1e-12);
+  // Vertices are stored as floats (rounding 6e-8 relative): the fit is exact to ~1e-9.
+  EXPECT_NEAR(f.rho1, 0.5, 1e-6);
+  EXPECT_NEAR(f.rho2, -1.0 / 3.0, 1e-6);
+  EXPECT_NEAR(f.thickness, shape.thickness(), 1e-6);
+  // The vertices (heights from the centroid) land on the caps' apexes.
+  EXPECT_NEAR(glm::length(f.centroid + f.vertex1 * f.axis - pl.world({0, 0, shape.sag1()})), 0.0, 1e-6);
+  EXPECT_NEAR(glm::length(f.centroid + f.vertex2 * f.axis - pl.world({0, 0, -shape.sag2()})), 0.0, 1e-6);
+  EXPECT_NEAR(f.radius, 1.2, 1e-6);
+  EXPECT_LT(f.rms_residual1, 1e-6);
+  EXPECT_LT(f.rms_residual2, 1e-6);
+  EXPECT_DOUBLE_EQ(f.nu, 1.5);
+  EXPECT_NEAR(glm::dot(glm::cross(f.u_axis, f.v_axis), f.axis), 1.0, 1e-12);  // right-handed frame
+}
+
+// Plano-convex (R1 = 2, flat back): rho2 ~ 0. The centroid lies above the rim, so the text's
+// words read literally (points below the plane) put the curved face's rim into the flat
+// face's fit; the facing split does not.
+TEST(LensFit, PlanoConvexHasFlatBack) {
+  Scene s = lens_scene();
+  const LensShape shape{1.0 / 2.0, 0.0, 1.2};
+  const LensPlacement pl = tilted_placement();
+  add_lens(s, shape, pl, 64, 128, glass(s, 1.5));
+  const LensFit f = fit_lens(s, 0);
+  ASSERT_TRUE(f.valid) << f.why_invalid;
+  LensFitOptions literal;
+  literal.split = LensSplit::side_of_plane;
+  const LensFit g = fit_lens(s, 0, literal);
+  std::printf("plano-convex R1=2: facing rho1 %.6f rho2 %.1e d %.6f (%.6f) rms %.1e %.1e | side_of_plane rho1 %.6f "
+              "rho2 %.4f d %.6f rms %.1e %.1e\n",
+              f.rho1, f.rho2, f.thickness, shape.thickness(), f.rms_residual1, f.rms_residual2, g.rho1, g.rho2,
+              g.thickness, g.rms_residual1, g.rms_residual2);
+  EXPECT_NEAR(f.rho1, 0.5, 1e-6);
+  EXPECT_NEAR(f.rho2, 0.0, 1e-6);
+  EXPECT_NEAR(f.thickness, shape.thickness(), 1e-6);
+  EXPECT_LT(f.rms_residual2, 1e-6);
+  // Measured: side_of_plane gives rho2 = -0.054 with an rms residual of 0.028 on the back.
+  EXPECT_GT(g.rms_residual2, 1e-3);
+  EXPECT_GT(std::fabs(g.rho2), 0.01);
+}
+
+// The project's lat-long sphere: rho1 = 1/r, rho2 = -1/r, d = 2r, whatever axis the
+// (nearly isotropic) spread picks.
+TEST(LensFit, SphereIsALensOfEqualRadii) {
+  Scene s = lens_scene();
+  const dvec3 c(0.3, -1.1, 0.8);
+  const double r = 0.75;
+  add_sphere(s, c, r, 96, glass(s, 1.5));
+  const LensFit f = fit_lens(s, 0);
+  ASSERT_TRUE(f.valid) << f.why_invalid;
+  std::printf("sphere r=0.75: rho1 r %.8f rho2 r %.8f d/2r %.8f rms %.1e %.1e axis (%.3f %.3f %.3f)\n", f.rho1 * r,
+              f.rho2 * r, f.thickness / (2 * r), f.rms_residual1, f.rms_residual2, f.axis.x, f.axis.y, f.axis.z);
+  EXPECT_NEAR(f.rho1, 1.0 / r, 1e-6);
+  EXPECT_NEAR(f.rho2, -1.0 / r, 1e-6);
+  EXPECT_NEAR(f.thickness, 2 * r, 1e-6);
+  EXPECT_NEAR(glm::length(f.centroid - c), 0.0, 1e-6);
+}
+
+}  // namespace
+}  // namespace abcube
