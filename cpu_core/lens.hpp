@@ -23,7 +23,8 @@
 //   LensSplit::side_of_plane takes z >= 0 and z <= 0, the text's words read literally.
 //   They agree when P holds the rim (a symmetric lens, a sphere); for a plano-convex lens
 //   the centroid lies above the rim and side_of_plane puts the rim of the curved face into
-//   the flat one's fit (tests/core/test_lens.cpp measures it).
+//   the flat one's fit (R1 = 2, a = 1.2: rho2 = -0.054 instead of 0, rms residual 0.028
+//   instead of 2e-8; LensFit.PlanoConvexHasFlatBack).
 // Curvature: for each surface, least squares of the text's form
 //     F(u, z) = (z - z0) - rho (u + (z - z0)^2 / 2)
 //   over both parameters rho and z0 ("F es biparametrica"): minimise sum F_i^2, nonlinear in
@@ -61,6 +62,21 @@
 //     A' = alpha A + beta S,   S' = gamma A + delta S                   (eq. 12)
 // per transverse coordinate, and the emerging unit direction is S' plus
 // sqrt(1 - |S'|^2) along the direction of travel (eq. 9, no reflection).
+//
+// ACCURACY (tests/core/test_lens.cpp, LensTransfer.AgainstExactTracer: the exact tracer on
+// the same triangles, nu = 1.5, worst of both sides and four azimuths)
+// The fit of a finely tessellated spherical lens is exact to ~1e-9. Thick lens mode, biconvex
+// R1 = 2, R2 = 3, aperture a = 1.2, d = 0.65: emerging direction within 2e-7 rad at h = 0.01 a,
+// 2.3e-5 rad for h <= 0.05 a with slopes up to 0.05; the error grows as h^3 (third-order
+// spherical aberration, dropped by the Gaussian approximation): 1e-4 rad at 0.1 a, 1e-3 at
+// 0.2 a, 2e-2 at 0.5 a, 0.12-0.25 rad at 0.9 a (deviations 0.05, 0.1, 0.26, 0.6-0.7 rad).
+// Thin lens mode also drops the power term (nu-1)^2 rho1 rho2 d / nu (4.5 % of the
+// deflection on that lens, 0.17 % on a d = 0.1 one) and the slope term (d/nu)(nu-1) rho2 S
+// (Property 4's condition): 3.5e-3 rad for a 0.05 slope on the thick lens, 1.5e-4 on the
+// thin one.
+// One axis per object: the model holds for rays near the fitted axis. For a sphere, whose
+// spread is isotropic, that axis is whichever diameter the tessellation favours (`spread`
+// shows how well the axis is determined); a ray across it is far from paraxial.
 #pragma once
 #include <cstdint>
 #include <string>
