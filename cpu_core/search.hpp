@@ -15,18 +15,18 @@
 // MODE crossing (default). Each tested fragment is refined with its triangle's exact plane
 // (the fragment stores the triangle index): X' = X(l') where the ray meets the plane. Its
 // error is its distance e from the triangle (0 inside), in texels at X' (texel_size_at).
-// It is accepted iff e <= tolerance_texels, and either e == 0 (an exact crossing: the
-// point is on the triangle) or l' lies in the texel's own interval [l0, l1] (the fragment
-// is the map's evidence that a surface is there; its triangle may be a neighbour of the
-// surface the ray really crosses: merged fragments, triangles too thin to cover a sample).
-// The hit is the first crossing: after the first texel with an accepted candidate the walk
-// goes on for CROSSING_WINDOW_TEXELS more texels (and while l0 <= the best l'); the
-// result is the exact crossing with the smallest l' if there is one, else the accepted
-// candidate with the smallest l'. So a surface's neighbouring triangle, whose extended
+// It is accepted iff X' lies in the texel holding the fragment (l' in [l0, l1]: the map's
+// evidence that a surface is there) and e <= tolerance_texels. e > 0 happens when the
+// fragment's triangle is a neighbour of the surface the ray really crosses there (merged
+// fragments; a triangle too thin to cover a sample of that texel). The hit is the first
+// crossing: after the first texel with an accepted candidate the walk goes on for
+// CROSSING_WINDOW_TEXELS more texels (and while l0 <= the best l'); the result is the
+// accepted candidate ON its triangle (e ~ 0) with the smallest l' if there is one, else the
+// accepted one with the smallest l'. So a surface's neighbouring triangle, whose extended
 // plane the ray meets a little before the triangle it really crosses, does not win over
-// it, and a near silhouette missed by less than the tolerance only wins when no exact
-// crossing lies just behind it. The point X' is on the ray: Error_Parallax is 0 to
-// rounding; the error of this mode is the wrong surface near silhouettes.
+// it, and a silhouette missed by less than the tolerance only wins when no exact crossing
+// lies just behind it. The point X' is on the ray: Error_Parallax is 0 to rounding; the
+// error of this mode is the wrong surface within the tolerance of silhouettes.
 //
 // MODE thesis (thesis 7.4.1 pseudo-code, 9.3.4). Each tested fragment gives the point
 // a V, V the texel-centre direction and a its distance to the fragment's plane along V
@@ -37,14 +37,19 @@
 // one the ray meets; we take it over the first candidates: from the first texel holding a
 // candidate under theta_max to THESIS_WINDOW_TEXELS texels after it. Error_Parallax of an
 // accepted point is (1 - cos angle)/2 <= theta_max^2/4 (thesis 9.3.4); the 1/(2 N^2) bound
-// holds only where the angle seen from W is no larger than seen from C (see the report).
+// holds only where the angle seen from W is no larger than seen from C: the thesis takes
+// the half texel diagonal seen from C, atan(sqrt(2)/N), as the angle seen from W; seen from
+// W it is amplified by about |S - C| / (|S - W| cos(view angle on the hit plane)), S the
+// true point (tests/core/test_search.cpp measures it; bench_search reports it).
 //
 // SELF-HITS (rule "offset", in texel units instead of shading.hpp's absolute epsilon).
-// s = self_offset_texels * texel_size_at(W): a fragment whose triangle's plane passes
-// within s of W (W's own surface: a ray cannot meet the plane it leaves), and any found
-// point within s of W, are ignored. So a grazing ray never finds its own surface, and a
-// surface closer to W than s (a concave corner, a blocker touching P) is not found either:
-// with the default 0.5 at N = 512 and |W| = 5, s = 0.005 world units.
+// s = self_offset_texels * texel_size_at(W - C): one texel at W's distance is 2 |W - C|_inf / N
+// world units (cube_walk.hpp). Ignored: (1) W's own surface: a fragment whose plane passes
+// within s of W and that the ray leaves, runs along, or meets again within s (a ray cannot
+// meet the plane it leaves; a neighbouring face near W that the ray crosses further on is
+// kept); (2) any found point closer than s to W. So a grazing ray never finds its own
+// surface, and a surface closer to W than s (a concave corner, a thin object's far side)
+// is not found either: with the default 0.5 at N = 512 and |W - C| = 5, s = 0.005 world units.
 //
 // ZERO-AREA SURFACES. A triangle whose plane contains C (within the raster's edge-on rule)
 // has no fragment: no search can find it. SearchContext lists them; when the exact ray
@@ -55,18 +60,24 @@
 // there). A ray through C (R . [[W]] = -1) jumps from the texel of [[W]] to the texel of
 // its antipode R; R . [[W]] = +1 is a walk of one texel (cube_walk.hpp).
 //
-// SHADOWS (thesis 8.3). The segment from P to the light: every accepted crossing with
-// s <= |X' - P| <= |L - P| - s is a blocker; blockers multiply the light by
-// blocker_transmittance (shading.hpp); the walk stops at the first opaque one. Shadow rays
-// are not refracted. Crossings of one object with the same facing within
-// (tolerance_texels + 1) texels of each other are one crossing (a ray through a shared edge,
-// or the same surface found in two texels).
+// SHADOWS (thesis 8.3). The segment from P to the light: every accepted candidate with
+// s <= |X' - P| < |L - P| is a blocker (crossing mode: accepted as above; thesis mode: angle
+// under theta_max); blockers multiply the light by blocker_transmittance (shading.hpp); the
+// walk stops at the first opaque one. Shadow rays are not refracted. One triangle counts
+// once; so do crossings of one object with the same facing within (tolerance_texels + 1)
+// texels of each other (a ray through a shared edge, one surface found in two texels) or,
+// in thesis mode, anywhere on the segment (its points under theta_max spread along a grazing
+// surface; a concave transparent object crossed twice with one facing then counts once).
+// A blocker within the tolerance of a silhouette darkens (the crossing mode's silhouette
+// error, as for reflections).
 //
 // REFRACTION. The exit point of a ray inside a closed object is the first crossing of the
 // SAME object along the refracted direction (back faces are in the map):
 // refraction_exit_search. The caller bends the ray there (shading.hpp transmission; total
 // internal reflection gives a mirror direction, searched again with refraction_exit_search)
-// and searches what the emerging ray sees with reflection_search.
+// and searches what the emerging ray sees with reflection_search. With
+// SearchLayers::nearest the back faces are rarely the nearest layer: the one-layer map
+// finds few exits (its limitation, thesis 7.4.2).
 //
 // Every search is a pure function of its inputs (thread safe); stats are per caller.
 #pragma once

@@ -1,0 +1,469 @@
+#include "search.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "cube_walk.hpp"
+#include "error.hpp"
+#include "raster.hpp"
+#include "shading.hpp"
+
+namespace abcube {
+
+namespace {
+
+constexpr double INF = std::numeric_limits<double>::infinity();
+// A refined point this close to its triangle (in texels) is on it: rounding, not tolerance.
+constexpr double ON_TRIANGLE_TEXELS = 1e-6;
+
+// One search's ray, relative to the cube centre.
+struct RayQuery {
+  glm::dvec3 w{0.0}, d{0.0};  // origin and unit direction
+  double l_max = INF;         // end of the ray (shadow segments)
+  double self = 0;            // self offset in world units (header, SELF-HITS)
+  bool restrict_object = false;
+  uint32_t object = 0;
+};
+
+// What the walk over the map saw of one ray.
+struct ScanCounts {
+  uint32_t texels = 0, fragments = 0, candidates = 0;
+  bool aborted = false;
+};
+
+// Distance from p, on the plane of triangle (a, b, c) with unit normal n, to the triangle.
+double distance_to_triangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
+                            const glm::dvec3& n) {
+  const glm::dvec3 v[3] = {a, b, c};
+  bool inside = true;
+  for (int k = 0; k < 3; ++k) {
+    inside = inside && glm::dot(glm::cross(v[(k + 1) % 3] - v[k], p - v[k]), n) >= 0.0;
+  }
+  if (inside) return 0.0;
+  double best = INF;
+  for (int k = 0; k < 3; ++k) {
+    const glm::dvec3 e = v[(k + 1) % 3] - v[k];
+    const double len2 = glm::dot(e, e);
+    const double u = len2 > 0.0 ? std::clamp(glm::dot(p - v[k], e) / len2, 0.0, 1.0) : 0.0;
+    best = std::min(best, glm::length(p - (v[k] + u * e)));
+  }
+  return best;
+}
+
+// The fragment nearest_layer() keeps for texel (x, y): a centre sample covered, the nearest
+// plane along the texel-centre direction v (abuffer.hpp, the Z-buffered map's layer).
+const Fragment* nearest_fragment(const SearchContext& ctx, FragmentList list, const glm::dvec3& v) {
+  const Fragment* best = nullptr;
+  double best_a = INF;
+  for (const Fragment& f : list) {
+    if ((f.mask & CENTRE_SAMPLES) == 0) continue;
+    const SearchContext::Plane& p = ctx.plane(f.triangle());
+    const double den = glm::dot(p.normal, v);
+    if (den == 0.0) continue;
+    const double a = p.offset / den;
+    if (a > 0.0 && a < best_a) {
+      best_a = a;
+      best = &f;
+    }
+  }
+  return best;
+}
+
+// W's own surface (header, SELF-HITS): a plane passing within the self offset of W that the
+// ray leaves, runs along, or crosses again within the offset. A neighbouring face near W
+// that the ray really crosses further on is not.
+bool own_surface(const SearchContext::Plane& p, const RayQuery& q) {
+  const double delta = glm::dot(p.normal, q.w) - p.offset;
+  if (!(std::fabs(delta) <= q.self)) return false;
+  const double den = glm::dot(p.normal, q.d);
+  return !(den != 0.0 && -delta / den > q.self);
+}
+
+// Walks the ray's texels; for each texel calls on_fragment(texel, fragment, v) for every
+// fragment that passes the layer choice, the object restriction, the z-interval test
+// (thesis 7.5) and the own-surface test, then after_texel(texel, index) -> keep walking?
+template <class OnFragment, class AfterTexel>
+ScanCounts scan(const SearchContext& ctx, const RayQuery& q, const SearchOptions& o, OnFragment&& on_fragment,
+                AfterTexel&& after_texel) {
+  const CubeABuffer& cube = ctx.cube();
+  const TriangleSoup& soup = ctx.scene().triangles;
+  CubeWalk walk(q.w, q.d, cube.n, q.l_max, cube.near_distance, o.max_texels);
+  ScanCounts counts;
+  WalkTexel t;
+  while (walk.next(&t)) {
+    ++counts.texels;
+    const ABuffer& b = cube.faces[static_cast<size_t>(t.face)];
+    const FragmentList list = b.list(t.i, t.j);
+    if (!list.empty()) {
+      const glm::dvec3 v = b.view.direction(t.i + 0.5, t.j + 0.5);  // texel centre
+      const glm::dvec2 range = ray_distance_range(q.w, q.d, t.l0, t.l1);
+      const Fragment* only = o.layers == SearchLayers::nearest ? nearest_fragment(ctx, list, v) : nullptr;
+      for (const Fragment& f : list) {
+        if (o.layers == SearchLayers::nearest && &f != only) continue;
+        ++counts.fragments;
+        if (f.zmax < range.x || f.zmin > range.y) continue;
+        if (q.restrict_object && soup.object_id[f.triangle()] != q.object) continue;
+        const SearchContext::Plane& p = ctx.plane(f.triangle());
+        if (own_surface(p, q)) continue;
+        ++counts.candidates;
+        on_fragment(t, f, v);
+      }
+    }
+    if (!after_texel(t, counts.texels - 1)) break;
+  }
+  counts.aborted = walk.aborted();
+  return counts;
+}
+
+// One fragment's answer for a ray.
+struct Candidate {
+  bool valid = false;
+  bool exact = false;  // crossing mode: the refined point is on the triangle
+  bool in_texel = false;  // crossing mode: the refined point lies in the fragment's texel
+  double l = INF;      // crossing: ray parameter; thesis: projection of X' - W on the ray
+  double angle = INF;  // thesis: angle between the ray and X' - W
+  double outside = 0;  // crossing: distance from the triangle, in texels
+  glm::dvec3 x{0.0};   // X', relative to the centre
+  const Fragment* fragment = nullptr;
+  CubeTexel texel{0, 0, 0};
+};
+
+// Crossing mode (header): the ray meets the fragment's triangle plane at X(l').
+Candidate crossing_candidate(const SearchContext& ctx, const RayQuery& q, const SearchOptions& o, const WalkTexel& t,
+                             const Fragment& f) {
+  Candidate c;
+  const uint32_t tri = f.triangle();
+  const SearchContext::Plane& p = ctx.plane(tri);
+  const double den = glm::dot(p.normal, q.d);
+  if (den == 0.0) return c;
+  const double l = (p.offset - glm::dot(p.normal, q.w)) / den;
+  if (!(l >= q.self) || !(l <= q.l_max)) return c;
+  c.x = q.w + l * q.d;
+  c.l = l;
+  c.angle = 0.0;
+  c.outside = distance_to_triangle(c.x, ctx.vertex(tri, 0), ctx.vertex(tri, 1), ctx.vertex(tri, 2), p.normal) /
+              texel_size_at(c.x, ctx.cube().n);
+  // The map's evidence: the point lies in the texel holding the fragment (to rounding).
+  const double slack = 1e-9 * (l + glm::length(q.w));
+  c.exact = c.outside <= ON_TRIANGLE_TEXELS;
+  c.in_texel = l >= t.l0 - slack && l <= t.l1 + slack;
+  c.valid = c.in_texel && c.outside <= o.tolerance_texels;
+  c.fragment = &f;
+  c.texel = {t.face, t.i, t.j};
+  return c;
+}
+
+// Thesis mode (thesis 7.4.1, 9.3.4): the point a V of the texel centre on the fragment's plane.
+Candidate thesis_candidate(const SearchContext& ctx, const RayQuery& q, const WalkTexel& t, const Fragment& f,
+                           const glm::dvec3& v) {
+  Candidate c;
+  const SearchContext::Plane& p = ctx.plane(f.triangle());
+  const double den = glm::dot(p.normal, v);
+  if (den == 0.0) return c;
+  const double a = p.offset / den;
+  if (!(a > 0.0)) return c;
+  c.x = a * v;
+  const glm::dvec3 e = c.x - q.w;
+  const double dist = glm::length(e);
+  c.l = glm::dot(e, q.d);
+  if (!(dist >= q.self) || !(c.l <= q.l_max)) return c;
+  c.angle = std::atan2(glm::length(glm::cross(e, q.d)), c.l);
+  c.valid = true;
+  c.fragment = &f;
+  c.texel = {t.face, t.i, t.j};
+  return c;
+}
+
+// Does the exact ray meet a triangle the map cannot hold before parameter l_end?
+bool meets_zero_area(const SearchContext& ctx, const RayQuery& q, double l_end) {
+  for (const uint32_t tri : ctx.zero_area_triangles()) {
+    if (q.restrict_object && ctx.scene().triangles.object_id[tri] != q.object) continue;
+    // Moller & Trumbore 1997.
+    const glm::dvec3 a = ctx.vertex(tri, 0), e1 = ctx.vertex(tri, 1) - a, e2 = ctx.vertex(tri, 2) - a;
+    const glm::dvec3 pv = glm::cross(q.d, e2);
+    const double det = glm::dot(e1, pv);
+    if (det == 0.0) continue;
+    const glm::dvec3 tv = q.w - a;
+    const double u = glm::dot(tv, pv) / det;
+    const glm::dvec3 qv = glm::cross(tv, e1);
+    const double v = glm::dot(q.d, qv) / det;
+    const double l = glm::dot(e2, qv) / det;
+    if (u >= 0 && v >= 0 && u + v <= 1 && l > q.self && l < l_end) return true;
+  }
+  return false;
+}
+
+SearchResult make_result(const SearchContext& ctx, const RayQuery& q, const Candidate& c) {
+  SearchResult r;
+  r.hit = true;
+  r.miss = MissReason::none;
+  r.triangle = c.fragment->triangle();
+  r.object_id = ctx.scene().triangles.object_id[r.triangle];
+  r.material_id = ctx.scene().triangles.material_id[r.triangle];
+  r.back_face = c.fragment->back_face();
+  r.point = ctx.cube().centre + c.x;
+  r.distance = glm::length(c.x - q.w);
+  r.angle = c.angle;
+  r.outside_texels = c.outside;
+  r.texel = c.texel;
+  return r;
+}
+
+// The answer: the chosen candidate or a miss (`miss` unless the walk was aborted); a surface
+// the map cannot hold met before it turns it into a zero-area miss.
+SearchResult finish(const SearchContext& ctx, const RayQuery& q, const Candidate* best, MissReason miss,
+                    const ScanCounts& counts) {
+  SearchResult r;
+  if (best) r = make_result(ctx, q, *best);
+  else r.miss = counts.aborted ? MissReason::aborted : miss;
+  if (meets_zero_area(ctx, q, best ? best->l : q.l_max)) {
+    r.hit = false;
+    r.miss = MissReason::zero_area_surface;
+  }
+  r.texels_visited = counts.texels;
+  r.fragments_tested = counts.fragments;
+  r.candidates = counts.candidates;
+  return r;
+}
+
+// Crossing mode: the first crossing, exact ones first (header).
+SearchResult search_crossing(const SearchContext& ctx, const RayQuery& q, const SearchOptions& o) {
+  Candidate exact, near;
+  bool rejected = false;
+  int64_t first = -1;
+  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3&) {
+    const Candidate c = crossing_candidate(ctx, q, o, t, f);
+    if (!c.valid) {
+      rejected = rejected || c.in_texel;
+      return;
+    }
+    Candidate& best = c.exact ? exact : near;
+    if (c.l < best.l) best = c;
+  };
+  const auto after_texel = [&](const WalkTexel& t, uint32_t index) {
+    const double best_l = std::min(exact.l, near.l);
+    if (best_l == INF) return true;
+    if (first < 0) first = index;
+    return index < first + CROSSING_WINDOW_TEXELS || t.l1 <= best_l;
+  };
+  const ScanCounts counts = scan(ctx, q, o, on_fragment, after_texel);
+  const Candidate& best = exact.fragment ? exact : near;
+  return finish(ctx, q, best.fragment ? &best : nullptr,
+                rejected ? MissReason::threshold_rejection : MissReason::no_crossing, counts);
+}
+
+// Thesis mode: the smallest angle over the first candidates under theta_max (header).
+SearchResult search_thesis(const SearchContext& ctx, const RayQuery& q, const SearchOptions& o) {
+  Candidate best;
+  int64_t first = -1;
+  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v) {
+    const Candidate c = thesis_candidate(ctx, q, t, f, v);
+    if (c.valid && c.angle < best.angle) best = c;
+  };
+  const auto after_texel = [&](const WalkTexel&, uint32_t index) {
+    if (first < 0 && best.angle <= o.theta_max) first = index;
+    return first < 0 || index < first + THESIS_WINDOW_TEXELS;
+  };
+  const ScanCounts counts = scan(ctx, q, o, on_fragment, after_texel);
+  const bool accepted = best.fragment && best.angle <= o.theta_max;
+  SearchResult r = finish(ctx, q, accepted ? &best : nullptr,
+                          best.fragment ? MissReason::threshold_rejection : MissReason::no_crossing, counts);
+  if (!accepted) r.angle = best.angle;  // the best approximator's angle, for diagnostics
+  return r;
+}
+
+RayQuery make_query(const SearchContext& ctx, const glm::dvec3& w_world, const glm::dvec3& dir,
+                    const SearchOptions& o) {
+  ABCUBE_CHECK(std::fabs(glm::length(dir) - 1.0) < 1e-6, "search direction must be unit");
+  RayQuery q;
+  q.w = w_world - ctx.cube().centre;
+  q.d = dir;
+  q.self = o.self_offset_texels * texel_size_at(q.w, ctx.cube().n);
+  return q;
+}
+
+SearchResult search_ray(const SearchContext& ctx, const RayQuery& q, const SearchOptions& o) {
+  return o.mode == SearchMode::thesis ? search_thesis(ctx, q, o) : search_crossing(ctx, q, o);
+}
+
+}  // namespace
+
+const char* search_mode_name(SearchMode m) { return m == SearchMode::thesis ? "thesis" : "crossing"; }
+
+bool parse_search_mode(const std::string& s, SearchMode* out) {
+  if (s == "crossing") *out = SearchMode::crossing;
+  else if (s == "thesis") *out = SearchMode::thesis;
+  else return false;
+  return true;
+}
+
+const char* miss_reason_name(MissReason r) {
+  switch (r) {
+    case MissReason::none: return "none";
+    case MissReason::no_crossing: return "no_crossing";
+    case MissReason::threshold_rejection: return "threshold_rejection";
+    case MissReason::zero_area_surface: return "zero_area_surface";
+    case MissReason::aborted: return "aborted";
+  }
+  return "?";
+}
+
+SearchContext::SearchContext(const Scene& scene, const CubeABuffer& cube) : scene_(&scene), cube_(&cube) {
+  const TriangleSoup& soup = scene.triangles;
+  const uint32_t count = static_cast<uint32_t>(soup.triangle_count());
+  planes_.resize(count);
+  // The raster's own rule decides which triangles the map cannot hold (raster.hpp).
+  const RasterView view = cube_face_view(0, cube.centre, std::max(cube.n, 1), cube.near_distance);
+  TriangleSetup setup;
+  for (uint32_t k = 0; k < count; ++k) {
+    const glm::dvec3 a = vertex(k, 0);
+    const glm::dvec3 n = glm::cross(vertex(k, 1) - a, vertex(k, 2) - a);
+    const double len = glm::length(n);
+    if (len > 0.0 && std::isfinite(len)) planes_[k] = {n / len, glm::dot(n / len, a)};
+    if (setup_triangle(view, soup, k, &setup) == SetupResult::edge_on) zero_area_.push_back(k);
+  }
+}
+
+glm::dvec3 SearchContext::vertex(uint32_t triangle, int k) const {
+  return glm::dvec3(scene_->triangles.positions[3 * static_cast<size_t>(triangle) + static_cast<size_t>(k)]) -
+         cube_->centre;
+}
+
+SearchResult reflection_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& r,
+                               const SearchOptions& options) {
+  return search_ray(ctx, make_query(ctx, w, r, options), options);
+}
+
+SearchResult refraction_exit_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& t,
+                                    uint32_t object_id, const SearchOptions& options) {
+  RayQuery q = make_query(ctx, w, t, options);
+  q.restrict_object = true;
+  q.object = object_id;
+  return search_ray(ctx, q, options);
+}
+
+
+namespace {
+
+// A surface already counted on a shadow segment.
+struct ShadowCrossing {
+  uint32_t triangle, object;
+  bool back_face;
+  glm::dvec3 x;
+  double l;
+};
+
+// Is c the same surface crossing as one already counted? The same triangle always (a plane
+// is crossed once); in crossing mode the same object and facing within (tolerance + 1)
+// texels (a shared edge, or one surface found in two texels); in thesis mode the same
+// object and facing anywhere on the segment (its points under theta_max spread along a
+// grazing surface, so a concave transparent object crossed twice with one facing counts once).
+bool already_counted(const std::vector<ShadowCrossing>& counted, const SearchContext& ctx, const SearchOptions& o,
+                     const Candidate& c) {
+  const uint32_t tri = c.fragment->triangle();
+  const uint32_t object = ctx.scene().triangles.object_id[tri];
+  const double near = (o.tolerance_texels + 1.0) * texel_size_at(c.x, ctx.cube().n);
+  for (const ShadowCrossing& k : counted) {
+    if (k.triangle == tri) return true;
+    if (k.object != object || k.back_face != c.fragment->back_face()) continue;
+    if (o.mode == SearchMode::thesis || glm::length(k.x - c.x) <= near) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const glm::dvec3& light_position,
+                           const SearchOptions& options) {
+  ShadowResult res;
+  const glm::dvec3 seg = light_position - p;
+  const double len = glm::length(seg);
+  if (!(len > 0.0)) return res;
+  RayQuery q = make_query(ctx, p, seg / len, options);
+  q.l_max = len;
+  std::vector<ShadowCrossing> counted;
+  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v) {
+    if (res.blocked) return;
+    const Candidate c = options.mode == SearchMode::thesis ? thesis_candidate(ctx, q, t, f, v)
+                                                           : crossing_candidate(ctx, q, options, t, f);
+    const bool accepted = options.mode == SearchMode::thesis ? c.valid && c.angle <= options.theta_max : c.valid;
+    if (!accepted || !(c.l < len)) {
+      if (c.l < len && (options.mode == SearchMode::thesis ? c.valid : c.in_texel)) {
+        ++res.threshold_rejections;
+      }
+      return;
+    }
+    if (already_counted(counted, ctx, options, c)) return;
+    const uint32_t tri = f.triangle();
+    counted.push_back({tri, ctx.scene().triangles.object_id[tri], f.back_face(), c.x, c.l});
+    // thesis 8.3; rule "shadows" (shading.hpp): S_l is the product over the blockers.
+    res.transmittance *= blocker_transmittance(ctx.scene().materials[ctx.scene().triangles.material_id[tri]]);
+    res.blocked = res.transmittance == glm::dvec3(0.0);
+  };
+  const auto after_texel = [&](const WalkTexel&, uint32_t) { return !res.blocked; };
+  const ScanCounts counts = scan(ctx, q, options, on_fragment, after_texel);
+  res.blockers = static_cast<uint32_t>(counted.size());
+  if (!counted.empty()) {
+    res.first_blocker = std::min_element(counted.begin(), counted.end(), [](const ShadowCrossing& a,
+                                                                            const ShadowCrossing& b) {
+                          return a.l < b.l;
+                        })->triangle;
+  }
+  res.aborted = counts.aborted;
+  res.zero_area = meets_zero_area(ctx, q, len);
+  res.texels_visited = counts.texels;
+  res.fragments_tested = counts.fragments;
+  res.candidates = counts.candidates;
+  return res;
+}
+
+void SearchKindStats::add(const SearchResult& r) {
+  ++rays;
+  texels += r.texels_visited;
+  max_texels = std::max<uint64_t>(max_texels, r.texels_visited);
+  fragments += r.fragments_tested;
+  candidates += r.candidates;
+  if (r.hit) {
+    ++hits;
+    return;
+  }
+  ++misses;
+  threshold_rejections += r.miss == MissReason::threshold_rejection;
+  zero_area += r.miss == MissReason::zero_area_surface;
+  aborted += r.miss == MissReason::aborted;
+}
+
+void SearchKindStats::add(const ShadowResult& r) {
+  ++rays;
+  texels += r.texels_visited;
+  max_texels = std::max<uint64_t>(max_texels, r.texels_visited);
+  fragments += r.fragments_tested;
+  candidates += r.candidates;
+  if (r.blockers > 0) ++hits;
+  else ++misses;
+  threshold_rejections += r.blockers == 0 && r.threshold_rejections > 0;
+  zero_area += r.zero_area;
+  aborted += r.aborted;
+}
+
+void SearchKindStats::merge(const SearchKindStats& o) {
+  rays += o.rays;
+  texels += o.texels;
+  max_texels = std::max(max_texels, o.max_texels);
+  fragments += o.fragments;
+  candidates += o.candidates;
+  hits += o.hits;
+  misses += o.misses;
+  threshold_rejections += o.threshold_rejections;
+  zero_area += o.zero_area;
+  aborted += o.aborted;
+}
+
+void SearchStats::merge(const SearchStats& o) {
+  reflection.merge(o.reflection);
+  refraction_exit.merge(o.refraction_exit);
+  shadow.merge(o.shadow);
+}
+
+}  // namespace abcube
