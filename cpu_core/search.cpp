@@ -22,6 +22,7 @@ struct RayQuery {
   glm::dvec3 w{0.0}, d{0.0};  // origin and unit direction
   double l_max = INF;         // end of the ray (shadow segments)
   double self = 0;            // self offset in world units (header, SELF-HITS)
+  double self_tolerance = 0;  // nearest tolerance candidate accepted, world units (SELF-HITS)
   bool restrict_object = false;
   uint32_t object = 0;
 };
@@ -32,23 +33,25 @@ struct ScanCounts {
   bool aborted = false;
 };
 
-// Distance from p, on the plane of triangle (a, b, c) with unit normal n, to the triangle.
+// Distance from p to triangle (a, b, c) whose plane has unit normal n and offset o.
 double distance_to_triangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
-                            const glm::dvec3& n) {
+                            const glm::dvec3& n, double o) {
+  const double off_plane = glm::dot(n, p) - o;
+  const glm::dvec3 q = p - off_plane * n;  // p's projection on the plane
   const glm::dvec3 v[3] = {a, b, c};
   bool inside = true;
   for (int k = 0; k < 3; ++k) {
-    inside = inside && glm::dot(glm::cross(v[(k + 1) % 3] - v[k], p - v[k]), n) >= 0.0;
+    inside = inside && glm::dot(glm::cross(v[(k + 1) % 3] - v[k], q - v[k]), n) >= 0.0;
   }
-  if (inside) return 0.0;
-  double best = INF;
+  if (inside) return std::fabs(off_plane);
+  double in_plane = INF;
   for (int k = 0; k < 3; ++k) {
     const glm::dvec3 e = v[(k + 1) % 3] - v[k];
     const double len2 = glm::dot(e, e);
-    const double u = len2 > 0.0 ? std::clamp(glm::dot(p - v[k], e) / len2, 0.0, 1.0) : 0.0;
-    best = std::min(best, glm::length(p - (v[k] + u * e)));
+    const double u = len2 > 0.0 ? std::clamp(glm::dot(q - v[k], e) / len2, 0.0, 1.0) : 0.0;
+    in_plane = std::min(in_plane, glm::length(q - (v[k] + u * e)));
   }
-  return best;
+  return std::sqrt(in_plane * in_plane + off_plane * off_plane);
 }
 
 // The fragment nearest_layer() keeps for texel (x, y): a centre sample covered, the nearest
@@ -120,7 +123,7 @@ ScanCounts scan(const SearchContext& ctx, const RayQuery& q, const SearchOptions
 struct Candidate {
   bool valid = false;
   bool exact = false;  // crossing mode: the refined point is on the triangle
-  bool in_texel = false;  // crossing mode: the refined point lies in the fragment's texel
+  bool tested = false;    // crossing mode: a refined point was measured against the tolerance
   double l = INF;      // crossing: ray parameter; thesis: projection of X' - W on the ray
   double angle = INF;  // thesis: angle between the ray and X' - W
   double outside = 0;  // crossing: distance from the triangle, in texels
@@ -138,17 +141,18 @@ Candidate crossing_candidate(const SearchContext& ctx, const RayQuery& q, const 
   const double den = glm::dot(p.normal, q.d);
   if (den == 0.0) return c;
   const double l = (p.offset - glm::dot(p.normal, q.w)) / den;
-  if (!(l >= q.self) || !(l <= q.l_max)) return c;
+  // The map's evidence: the point lies in the texel holding the fragment (to rounding).
+  const double slack = 1e-9 * (std::fabs(l) + glm::length(q.w));
+  if (!(l >= q.self) || !(l <= q.l_max) || !(l >= t.l0 - slack && l <= t.l1 + slack)) return c;
   c.x = q.w + l * q.d;
   c.l = l;
   c.angle = 0.0;
-  c.outside = distance_to_triangle(c.x, ctx.vertex(tri, 0), ctx.vertex(tri, 1), ctx.vertex(tri, 2), p.normal) /
+  c.outside = distance_to_triangle(c.x, ctx.vertex(tri, 0), ctx.vertex(tri, 1), ctx.vertex(tri, 2), p.normal,
+                                   p.offset) /
               texel_size_at(c.x, ctx.cube().n);
-  // The map's evidence: the point lies in the texel holding the fragment (to rounding).
-  const double slack = 1e-9 * (l + glm::length(q.w));
   c.exact = c.outside <= ON_TRIANGLE_TEXELS;
-  c.in_texel = l >= t.l0 - slack && l <= t.l1 + slack;
-  c.valid = c.in_texel && c.outside <= o.tolerance_texels;
+  c.tested = true;
+  c.valid = c.outside <= o.tolerance_texels && (c.exact || l >= q.self_tolerance);
   c.fragment = &f;
   c.texel = {t.face, t.i, t.j};
   return c;
@@ -235,7 +239,7 @@ SearchResult search_crossing(const SearchContext& ctx, const RayQuery& q, const 
   const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3&) {
     const Candidate c = crossing_candidate(ctx, q, o, t, f);
     if (!c.valid) {
-      rejected = rejected || c.in_texel;
+      rejected = rejected || (c.tested && c.outside > o.tolerance_texels);
       return;
     }
     Candidate& best = c.exact ? exact : near;
@@ -279,7 +283,9 @@ RayQuery make_query(const SearchContext& ctx, const glm::dvec3& w_world, const g
   RayQuery q;
   q.w = w_world - ctx.cube().centre;
   q.d = dir;
-  q.self = o.self_offset_texels * texel_size_at(q.w, ctx.cube().n);
+  const double texel = texel_size_at(q.w, ctx.cube().n);
+  q.self = self_offset_texels(o) * texel;
+  q.self_tolerance = 2.0 * o.tolerance_texels * texel;
   return q;
 }
 
@@ -288,6 +294,11 @@ SearchResult search_ray(const SearchContext& ctx, const RayQuery& q, const Searc
 }
 
 }  // namespace
+
+double self_offset_texels(const SearchOptions& o) {
+  if (o.self_offset_texels > 0.0) return o.self_offset_texels;
+  return o.mode == SearchMode::thesis ? SELF_OFFSET_THESIS_TEXELS : SELF_OFFSET_CROSSING_TEXELS;
+}
 
 const char* search_mode_name(SearchMode m) { return m == SearchMode::thesis ? "thesis" : "crossing"; }
 
@@ -389,7 +400,7 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
                                                            : crossing_candidate(ctx, q, options, t, f);
     const bool accepted = options.mode == SearchMode::thesis ? c.valid && c.angle <= options.theta_max : c.valid;
     if (!accepted || !(c.l < len)) {
-      if (c.l < len && (options.mode == SearchMode::thesis ? c.valid : c.in_texel)) {
+      if (c.l < len && (options.mode == SearchMode::thesis ? c.valid : c.tested)) {
         ++res.threshold_rejections;
       }
       return;

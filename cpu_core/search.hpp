@@ -26,7 +26,15 @@
 // plane the ray meets a little before the triangle it really crosses, does not win over
 // it, and a silhouette missed by less than the tolerance only wins when no exact crossing
 // lies just behind it. The point X' is on the ray: Error_Parallax is 0 to rounding; the
-// error of this mode is the wrong surface within the tolerance of silhouettes.
+// error of this mode is the wrong surface within the tolerance of silhouettes. Tolerance
+// candidates closer to W than 2 * tolerance_texels texels are ignored: there the extended
+// planes of W's own neighbouring triangles (a tessellated convex mirror) pass within the
+// tolerance of the ray and cannot be told from another surface; exact crossings are kept.
+// MERGED MAPS: a merged fragment keeps one triangle's plane for a patch of several
+// (abuffer.hpp MERGE); a ray crossing the patch at a grazing angle meets that plane more
+// than the tolerance away from its triangle and the crossing is lost (a threshold
+// rejection): bench_search measures it on the terrain of scenes/bench/spheres_terrain.json
+// (--merge off for the unmerged map).
 //
 // MODE thesis (thesis 7.4.1 pseudo-code, 9.3.4). Each tested fragment gives the point
 // a V, V the texel-centre direction and a its distance to the fragment's plane along V
@@ -46,10 +54,15 @@
 // s = self_offset_texels * texel_size_at(W - C): one texel at W's distance is 2 |W - C|_inf / N
 // world units (cube_walk.hpp). Ignored: (1) W's own surface: a fragment whose plane passes
 // within s of W and that the ray leaves, runs along, or meets again within s (a ray cannot
-// meet the plane it leaves; a neighbouring face near W that the ray crosses further on is
-// kept); (2) any found point closer than s to W. So a grazing ray never finds its own
-// surface, and a surface closer to W than s (a concave corner, a thin object's far side)
-// is not found either: with the default 0.5 at N = 512 and |W - C| = 5, s = 0.005 world units.
+// meet the plane it leaves; a face near W that the ray crosses further on is kept); (2) any
+// found point closer than s to W. The default depends on the mode. Crossing mode:
+// SELF_OFFSET_CROSSING_TEXELS = 1e-3, far above the rounding of a W computed on its
+// triangle's plane (1e-16 |W|; even float rounding, 6e-8 |W|, is under 1e-3 texel up to
+// N = 16384), so a grazing ray never finds its own plane while a surface meeting W's
+// at a concave corner is found from 1e-3 texel on. Thesis mode: SELF_OFFSET_THESIS_TEXELS =
+// 0.5: its points a V are texel centres, and those of W's own surface or of its neighbours
+// within half a texel of W are at arbitrary angles from R; surfaces closer to W than that
+// (concave corners) are not found (with N = 512 and |W - C| = 5, s = 0.005 world units).
 //
 // ZERO-AREA SURFACES. A triangle whose plane contains C (within the raster's edge-on rule)
 // has no fragment: no search can find it. SearchContext lists them; when the exact ray
@@ -102,15 +115,21 @@ bool parse_search_mode(const std::string& s, SearchMode* out);  // "crossing" | 
 // past its first candidate under theta_max.
 constexpr int CROSSING_WINDOW_TEXELS = 2;
 constexpr int THESIS_WINDOW_TEXELS = 2;
+// Default self offsets per mode, in texels at W (SELF-HITS above).
+constexpr double SELF_OFFSET_CROSSING_TEXELS = 1e-3;
+constexpr double SELF_OFFSET_THESIS_TEXELS = 0.5;
 
 struct SearchOptions {
   SearchMode mode = SearchMode::crossing;
   SearchLayers layers = SearchLayers::all;
   double theta_max = 0.034906585039886591;  // thesis mode: 2 degrees, in radians
   double tolerance_texels = 1.0;            // crossing mode: largest accepted e
-  double self_offset_texels = 0.5;          // W's own surface and points closer than this
+  double self_offset_texels = 0;            // W's own surface and points closer; 0 = the mode's default
   uint32_t max_texels = 0;                  // walk cap; 0 = CubeWalk's default
 };
+
+// The self offset `options` gives, in texels at W (its own, or the mode's default).
+double self_offset_texels(const SearchOptions& options);
 
 enum class MissReason { none, no_crossing, threshold_rejection, zero_area_surface, aborted };
 const char* miss_reason_name(MissReason r);

@@ -302,7 +302,7 @@ TEST(Search, RefractionExitMatchesExactTracer) {
       const SearchResult r = refraction_exit_search(*world->ctx, s.w, s.r, h.object_id);
       if (!r.hit) {
         // Only an exit closer to W than the self offset (header, SELF-HITS) may be missed.
-        EXPECT_LT(out.t, SearchOptions().self_offset_texels * texel_size_at(s.w - world->cube.centre, world->n))
+        EXPECT_LT(out.t, self_offset_texels(SearchOptions()) * texel_size_at(s.w - world->cube.centre, world->n))
             << miss_reason_name(r.miss);
         ++near_misses;
         continue;
@@ -460,6 +460,33 @@ Scene room_scene() {
                                          << miss_reason_name(r.miss) << ")";
   }
   return ::testing::AssertionSuccess();
+}
+
+TEST(Search, TessellatedMirrorSphereDoesNotFindItself) {
+  // A coarse mirror sphere: near W the extended planes of its neighbouring triangles pass
+  // within the tolerance of every reflected ray; only an exact crossing may be found there.
+  Scene s = room_scene();
+  Material mirror;
+  mirror.reflect = 1.0;
+  add_sphere(s, {0.2, -0.3, -2.6}, 0.5, 16, add_material(s, mirror));
+  const auto world = make_world(std::move(s), 64);
+  const uint32_t sphere = static_cast<uint32_t>(world->scene.objects.size() - 1);
+  int interior = 0, agree = 0, self = 0;
+  for (const SurfaceRay& r : mirror_rays(*world, 160, 160)) {
+    Hit at;
+    if (!world->tracer->intersect(world->cube.centre, r.w - world->cube.centre, &at) || at.object_id != sphere) continue;
+    if (!away_from_silhouettes(*world, r)) continue;
+    ++interior;
+    agree += static_cast<bool>(matches_tracer(*world, r));
+    Hit h;
+    const bool exact = exact_hit(*world, r, &h);
+    const SearchResult res = reflection_search(*world->ctx, r.w, r.r);
+    self += res.hit && res.object_id == sphere && !(exact && h.object_id == sphere);
+  }
+  std::printf("mirror sphere: %d interior rays, agree %d, found itself wrongly %d\n", interior, agree, self);
+  ASSERT_GT(interior, 100);
+  EXPECT_EQ(self, 0);
+  EXPECT_GE(agree, 0.99 * interior);
 }
 
 TEST(SearchDegenerate, DirectionAlongW) {

@@ -1,0 +1,237 @@
+// Search benchmark: the cost and the error of reflection searches in the cube A-buffer
+// (search.hpp) against the map's resolution N. Reflection rays leave camera-visible points
+// of reflective surfaces (the exact tracer gives W and R: pixel samples on a seeded random
+// grid); each is searched in the map (one thread, so ns/ray is per core) and traced exactly.
+// Per scene, N and mode: hit rate, agreement with the exact tracer (same object, or both
+// find nothing), texels visited per ray (mean, max), fragments tested per ray, ns per ray
+// (median of R runs, min, max) and its ratio to the previous N (the walk crosses O(N)
+// texels: about 2 per doubling if the cost is linear in N), Error_Parallax of the found
+// points (mean, p99, max; thesis 9.3) against the thesis bound 1/(2 N^2) and the share of
+// hits above it; misses by reason (no crossing, threshold, zero-area surface, walk cap).
+//
+//   bench_search SCENE.json... [--sizes 64,128,256,512,1024] [--runs 3] [--rays 20000]
+//                [--modes crossing,thesis] [--layers all|nearest] [--merge on|off] [--seed 1]
+#include <algorithm>
+#include <cstdio>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "abuffer.hpp"
+#include "camera.hpp"
+#include "error.hpp"
+#include "metrics.hpp"
+#include "raytrace.hpp"
+#include "scene_load.hpp"
+#include "search.hpp"
+#include "timer.hpp"
+
+namespace abcube {
+namespace {
+
+struct Options {
+  std::vector<std::string> scenes;
+  std::vector<int> sizes{64, 128, 256, 512, 1024};
+  std::vector<SearchMode> modes{SearchMode::crossing, SearchMode::thesis};
+  SearchLayers layers = SearchLayers::all;
+  bool merge = true;  // the renderer's default map
+  int runs = 3;
+  int rays = 20000;
+  unsigned seed = 1;
+};
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');) out.push_back(item);
+  return out;
+}
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw InputError(a + ": needs a value");
+      return argv[++i];
+    };
+    if (a == "--sizes") {
+      o.sizes.clear();
+      for (const std::string& s : split(value())) o.sizes.push_back(std::stoi(s));
+    } else if (a == "--modes") {
+      o.modes.clear();
+      for (const std::string& s : split(value())) {
+        SearchMode m;
+        if (!parse_search_mode(s, &m)) throw InputError("--modes: unknown mode " + s);
+        o.modes.push_back(m);
+      }
+    } else if (a == "--layers") {
+      const std::string v = value();
+      if (v != "all" && v != "nearest") throw InputError("--layers: all or nearest, got " + v);
+      o.layers = v == "all" ? SearchLayers::all : SearchLayers::nearest;
+    } else if (a == "--merge") {
+      const std::string v = value();
+      if (v != "on" && v != "off") throw InputError("--merge: on or off, got " + v);
+      o.merge = v == "on";
+    } else if (a == "--runs") {
+      o.runs = std::stoi(value());
+    } else if (a == "--rays") {
+      o.rays = std::stoi(value());
+    } else if (a == "--seed") {
+      o.seed = static_cast<unsigned>(std::stoul(value()));
+    } else if (!a.empty() && a[0] == '-') {
+      throw InputError("unknown option " + a);
+    } else {
+      o.scenes.push_back(a);
+    }
+  }
+  if (o.scenes.empty() || o.runs < 1 || o.rays < 1) {
+    throw InputError("usage: bench_search SCENE.json... [--sizes 64,128] [--runs 3] [--rays 20000] "
+                     "[--modes crossing,thesis] [--layers all|nearest] [--merge on|off]");
+  }
+  return o;
+}
+
+// A reflection ray and the exact answer for it.
+struct ReflectionRay {
+  glm::dvec3 w, r;
+  bool exact = false;
+  uint32_t object = 0;
+};
+
+// Up to `count` reflection rays from camera-visible reflective points (random pixel samples).
+std::vector<ReflectionRay> reflection_rays(const Scene& scene, const RayTracer& tracer, int count, unsigned seed) {
+  const CameraFrame frame = make_camera_frame(scene.camera);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> x(0.0, frame.width), y(0.0, frame.height);
+  std::vector<ReflectionRay> out;
+  for (long tries = 0; static_cast<int>(out.size()) < count && tries < 200L * count; ++tries) {
+    const glm::dvec3 d = glm::normalize(frame.direction(x(rng), y(rng)));
+    Hit h;
+    if (!tracer.intersect(frame.eye, d, &h) || scene.materials[h.material_id].reflect <= 0.0) continue;
+    const Ray ray = tracer.reflected_ray(h, d);
+    ReflectionRay rr{h.point, ray.dir};
+    Hit e;
+    rr.exact = tracer.intersect(ray.origin, ray.dir, &e);
+    rr.object = e.object_id;
+    out.push_back(rr);
+  }
+  return out;
+}
+
+struct Row {
+  double ns_median = 0, ns_min = 0, ns_max = 0;
+  SearchKindStats stats;
+  ErrorStats parallax;
+  uint64_t agree = 0, over_bound = 0;
+};
+
+Row measure(const SearchContext& ctx, const std::vector<ReflectionRay>& rays, const SearchOptions& so, int runs) {
+  Row row;
+  std::vector<double> ns;
+  for (int run = 0; run < runs; ++run) {
+    SearchKindStats stats;
+    const Clock::time_point start = Clock::now();
+    for (const ReflectionRay& rr : rays) stats.add(reflection_search(ctx, rr.w, rr.r, so));
+    ns.push_back(ms_since(start) * 1e6 / static_cast<double>(rays.size()));
+    row.stats = stats;
+  }
+  std::sort(ns.begin(), ns.end());
+  row.ns_median = ns[ns.size() / 2];
+  row.ns_min = ns.front();
+  row.ns_max = ns.back();
+  // Errors, outside the timed loop.
+  const double bound = 1.0 / (2.0 * ctx.cube().n * ctx.cube().n);
+  for (const ReflectionRay& rr : rays) {
+    const SearchResult r = reflection_search(ctx, rr.w, rr.r, so);
+    row.agree += r.hit == rr.exact && (!r.hit || r.object_id == rr.object);
+    if (r.hit && glm::length(r.point - rr.w) > 0.0) {
+      const double e = error_parallax(r.point, rr.w, rr.r);
+      row.parallax.add(e);
+      row.over_bound += e > bound;
+    } else if (rr.exact) {
+      row.parallax.add_miss();
+    }
+  }
+  return row;
+}
+
+void print_header() {
+  std::printf("%-36s %5s %-8s %6s %6s %6s %7s %6s %7s %9s %9s %9s %6s %9s %9s %9s %9s %6s %6s %6s %5s %5s\n",
+              "scene", "N", "mode", "rays", "hit%", "agree%", "texels", "max", "frags", "ns/ray", "min", "max", "x/2N",
+              "EP mean", "EP p99", "EP max", "1/(2N^2)", ">bnd%", "m:none", "m:thr", "m:0A", "m:cap");
+}
+
+void print_row(const std::string& scene, int n, SearchMode mode, const Row& r, double previous_ns) {
+  const double rays = static_cast<double>(r.stats.rays);
+  const double hits = static_cast<double>(r.parallax.count());
+  char ratio[16] = "-";
+  if (previous_ns > 0) std::snprintf(ratio, sizeof ratio, "%.2f", r.ns_median / previous_ns);
+  std::printf("%-36s %5d %-8s %6llu %6.1f %6.1f %7.1f %6llu %7.1f %9.0f %9.0f %9.0f %6s %9.2e %9.2e %9.2e %9.2e %6.1f"
+              " %6llu %6llu %5llu %5llu\n",
+              scene.c_str(), n, search_mode_name(mode), static_cast<unsigned long long>(r.stats.rays),
+              100.0 * static_cast<double>(r.stats.hits) / rays, 100.0 * static_cast<double>(r.agree) / rays,
+              r.stats.mean_texels(), static_cast<unsigned long long>(r.stats.max_texels),
+              static_cast<double>(r.stats.fragments) / rays, r.ns_median, r.ns_min, r.ns_max, ratio, r.parallax.mean(),
+              r.parallax.percentile(0.99), r.parallax.max(), 1.0 / (2.0 * n * n),
+              hits > 0 ? 100.0 * static_cast<double>(r.over_bound) / hits : 0.0,
+              static_cast<unsigned long long>(r.stats.misses - r.stats.threshold_rejections - r.stats.zero_area -
+                                              r.stats.aborted),
+              static_cast<unsigned long long>(r.stats.threshold_rejections),
+              static_cast<unsigned long long>(r.stats.zero_area), static_cast<unsigned long long>(r.stats.aborted));
+  std::fflush(stdout);
+}
+
+int run(int argc, char** argv) {
+  const Options o = parse(argc, argv);
+  std::printf("# bench_search: reflection rays from camera-visible reflective points, one thread; ns/ray median of "
+              "%d runs (min, max); x/2N = ns/ray ratio to the previous N (2.00 = linear in N); agree = same object "
+              "as the exact tracer or both miss; EP = Error_Parallax of hits (thesis 9.3); layers %s, merge %s\n",
+              o.runs, o.layers == SearchLayers::all ? "all" : "nearest", o.merge ? "on" : "off");
+  print_header();
+  for (const std::string& path : o.scenes) {
+    const Scene scene = load_scene(path);
+    const RayTracer tracer(scene);
+    const std::vector<ReflectionRay> rays = reflection_rays(scene, tracer, o.rays, o.seed);
+    if (rays.empty()) {
+      std::printf("%-36s no reflective surface visible\n", path.c_str());
+      continue;
+    }
+    std::vector<double> previous(o.modes.size(), 0.0);
+    for (const int n : o.sizes) {
+      const Clock::time_point start = Clock::now();
+      ABufferOptions ao;
+      ao.merge = o.merge;
+      const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, n, ao);
+      const double build_ms = ms_since(start);
+      const SearchContext ctx(scene, cube);
+      for (size_t m = 0; m < o.modes.size(); ++m) {
+        SearchOptions so;
+        so.mode = o.modes[m];
+        so.layers = o.layers;
+        const Row row = measure(ctx, rays, so, o.runs);
+        print_row(path, n, o.modes[m], row, previous[m]);
+        previous[m] = row.ns_median;
+      }
+      std::printf("# %s N=%d: cube A-buffer built in %.0f ms, %zu zero-area triangles\n", path.c_str(), n, build_ms,
+                  ctx.zero_area_triangles().size());
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace abcube
+
+int main(int argc, char** argv) {
+  try {
+    return abcube::run(argc, argv);
+  } catch (const abcube::InputError& e) {
+    std::fprintf(stderr, "bench_search: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_search: %s\n", e.what());
+    return 1;
+  }
+}
