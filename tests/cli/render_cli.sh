@@ -79,6 +79,24 @@ check "reference of raytrace is itself" grep -q '"psnr_db": "inf"' "$WORK/rt.jso
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/gpu_ref.png" --method gpu --reference --stats "$WORK/g.json" 2> /dev/null
 check "gpu --reference reports an image error" grep -q '"share_over_2_255"' "$WORK/g.json"
 
+# --- the cube-map methods and their options; stats count the searches
+for v in "abuffer" "abuffer --search thesis --theta-max 1" "zbuffer" "envmap --envmap-lookup bisector" \
+         "abuffer --refraction thin_lens"; do
+  set -- $v
+  name=$(echo "$v" | tr ' ' '_')
+  "$ABCUBE" render "$WORK/small.json" -o "$WORK/m_$name.png" --method $v --cube-res 64 --stats "$WORK/m_$name.json" \
+    --reference 2> "$WORK/err"
+  check "--method $v exits 0 ($(cat "$WORK/err"))" [ $? -eq 0 ]
+  check "--method $v counts shadow searches" grep -q '"shadow": {' "$WORK/m_$name.json"
+  check "--method $v reports Error_Parallax" grep -q '"error_parallax"' "$WORK/m_$name.json"
+done
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --search sideways > /dev/null 2> "$WORK/err"
+check "--search sideways exits 2" [ $? -eq 2 ]
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --refraction prism > /dev/null 2> "$WORK/err"
+check "--refraction prism exits 2" [ $? -eq 2 ]
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --envmap-lookup up > /dev/null 2> "$WORK/err"
+check "--envmap-lookup up exits 2" [ $? -eq 2 ]
+
 # --- compare: exit 0 within, 1 beyond, 2 for bad input; heatmap
 "$ABCUBE" compare "$WORK/rt.png" "$WORK/rt.png" > "$WORK/cmp"
 check "identical images compare 0" [ $? -eq 0 ]

@@ -1,0 +1,321 @@
+#include "map_shading.hpp"
+
+#include <cmath>
+#include <mutex>
+#include <thread>
+#include <utility>
+
+#include "camera.hpp"
+#include "cube_map.hpp"
+#include "error.hpp"
+#include "parallel.hpp"
+#include "raytrace.hpp"
+#include "resolve.hpp"
+#include "shading.hpp"
+
+namespace abcube {
+
+namespace {
+
+constexpr uint32_t OUTSIDE = UINT32_MAX;  // a ray in the open, not inside a closed object
+
+constexpr const char* LOOKUP_NAMES[] = {"R", "bisector", "position"};
+
+}  // namespace
+
+const char* envmap_lookup_name(EnvmapLookup l) { return LOOKUP_NAMES[static_cast<int>(l)]; }
+
+bool parse_envmap_lookup(const std::string& s, EnvmapLookup* out) {
+  for (int i = 0; i < 3; ++i) {
+    if (s == LOOKUP_NAMES[i]) {
+      *out = static_cast<EnvmapLookup>(i);
+      return true;
+    }
+  }
+  return false;
+}
+
+void RayErrors::merge(const RayErrors& o) {
+  error_cp.merge(o.error_cp);
+  error_parallax.merge(o.error_parallax);
+  false_hits += o.false_hits;
+  wrong_object += o.wrong_object;
+}
+
+void MapShadingStats::merge(const MapShadingStats& o) {
+  searches.merge(o.searches);
+  lens_transfers += o.lens_transfers;
+  lens_fallbacks += o.lens_fallbacks;
+  envmap_lookups += o.envmap_lookups;
+  errors.merge(o.errors);
+}
+
+SurfacePoint surface_point(const Scene& scene, uint32_t triangle, const glm::dvec3& point) {
+  const TriangleSoup& t = scene.triangles;
+  const size_t base = 3 * static_cast<size_t>(triangle);
+  const glm::dvec3 a(t.positions[base]), b(t.positions[base + 1]), c(t.positions[base + 2]);
+  SurfacePoint sp;
+  sp.point = point;
+  sp.triangle = triangle;
+  sp.object = t.object_id[triangle];
+  sp.material = t.material_id[triangle];
+  const glm::dvec3 ng = glm::cross(b - a, c - a);
+  const double area2 = glm::dot(ng, ng);
+  sp.geometric_normal = area2 > 0.0 ? ng / std::sqrt(area2) : glm::dvec3(0, 0, 1);
+  // Barycentric weights of the point's projection on the plane (Ericson 2005, 3.4).
+  const double wa = glm::dot(glm::cross(b - point, c - point), ng) / area2;
+  const double wb = glm::dot(glm::cross(c - point, a - point), ng) / area2;
+  const glm::dvec3 n = wa * glm::dvec3(t.normals[base]) + wb * glm::dvec3(t.normals[base + 1]) +
+                       (1.0 - wa - wb) * glm::dvec3(t.normals[base + 2]);
+  const double len = glm::length(n);
+  sp.shading_normal = len > 0.0 && std::isfinite(len) ? n / len : sp.geometric_normal;
+  return sp;
+}
+
+MapShader::MapShader(const Scene& scene, const CubeABuffer& cube, const MapShadingOptions& options,
+                     const RayTracer* reference)
+    : scene_(scene), cube_(cube), options_(options), reference_(reference) {
+  options_.search.layers = options.method == Method::zbuffer ? SearchLayers::nearest : SearchLayers::all;
+  ctx_ = std::make_unique<SearchContext>(scene, cube);
+  lens_of_object_.assign(scene.objects.size(), -1);
+  if (options_.refraction != RefractionMode::search) {
+    lenses_ = fit_lenses(scene);
+    for (size_t i = 0; i < lenses_.size(); ++i) {
+      if (lenses_[i].valid) lens_of_object_[lenses_[i].object] = static_cast<int>(i);
+    }
+  }
+  if (options_.method == Method::envmap) build_envmap_colours();
+}
+
+MapShader::~MapShader() = default;
+
+// Which closed object a ray leaving sp along d runs inside of (N_g is outward).
+static uint32_t inside_after(const Scene& scene, const SurfacePoint& sp, const glm::dvec3& d) {
+  return scene.objects[sp.object].closed && glm::dot(sp.geometric_normal, d) < 0.0 ? sp.object : OUTSIDE;
+}
+
+glm::dvec3 MapShader::shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
+                            MapShadingStats* stats) const {
+  const Material& m = scene_.materials[sp.material];
+  // Coverage transparency of a found surface: the ray goes on behind it, same depth.
+  glm::dvec3 behind(0.0);
+  const bool blend = !primary && m.opacity < 1.0;
+  if (blend) {
+    behind = trace(sp.point, dir, depth, inside_after(scene_, sp, dir), stats, nullptr);
+    if (m.opacity <= 0.0) return behind;
+  }
+  const glm::dvec3 v = -dir;
+  const glm::dvec3 n = face_forward(sp.shading_normal, v);
+  glm::dvec3 c = phong_ambient(m, scene_.ambient) + lights(sp, v, n, stats);
+  if (depth < scene_.render.max_depth && m.reflect > 0.0) c += m.reflect * reflected(sp, dir, depth, primary, stats);
+  if (depth < scene_.render.max_depth && m.transmit > 0.0) c += m.transmit * transmitted(sp, dir, depth, stats);
+  return blend ? blend_coverage(m.opacity, c, behind) : c;
+}
+
+// sum_l S_l phong_light, S_l from the shadow search (thesis 8.3).
+glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n,
+                             MapShadingStats* stats) const {
+  const Material& m = scene_.materials[sp.material];
+  glm::dvec3 c(0.0);
+  for (const PointLight& light : scene_.lights) {
+    const glm::dvec3 to_light = light.position - sp.point;
+    if (to_light == glm::dvec3(0.0)) continue;
+    const glm::dvec3 lit = phong_light(m, n, v, glm::normalize(to_light), light.color);
+    if (lit == glm::dvec3(0.0)) continue;
+    if (!light.cast_shadows) {
+      c += lit;
+      continue;
+    }
+    const ShadowResult s = shadow_search(*ctx_, sp.point, light.position, options_.search);
+    if (stats) stats->searches.shadow.add(s);
+    c += lit * s.transmittance;
+  }
+  return c;
+}
+
+// What a ray from w along dir finds in the map, shaded one bounce deeper (or background).
+glm::dvec3 MapShader::trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, uint32_t inside,
+                            MapShadingStats* stats, SearchResult* found) const {
+  const SearchResult r = inside != OUTSIDE ? refraction_exit_search(*ctx_, w, dir, inside, options_.search)
+                                           : reflection_search(*ctx_, w, dir, options_.search);
+  if (stats) (inside != OUTSIDE ? stats->searches.refraction_exit : stats->searches.reflection).add(r);
+  if (found) *found = r;
+  if (!r.hit) return scene_.background;
+  return shade(surface_point(scene_, r.triangle, r.point), dir, depth, false, stats);
+}
+
+glm::dvec3 MapShader::reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
+                                MapShadingStats* stats) const {
+  const glm::dvec3 r = glm::normalize(reflect_dir(dir, sp.shading_normal));
+  if (options_.method == Method::envmap) {
+    if (stats) ++stats->envmap_lookups;
+    const glm::dvec3 lookup = envmap_direction(sp.point, r);
+    if (primary && reference_ && stats) measure(sp.point, r, nullptr, &lookup, stats);
+    return envmap_at(lookup);
+  }
+  SearchResult found;
+  const glm::dvec3 c = trace(sp.point, r, depth + 1, inside_after(scene_, sp, r), stats, &found);
+  if (primary && reference_ && stats) measure(sp.point, r, &found, nullptr, stats);
+  return c;
+}
+
+glm::dvec3 MapShader::transmitted(const SurfacePoint& sp, const glm::dvec3& dir, int depth,
+                                  MapShadingStats* stats) const {
+  const Material& m = scene_.materials[sp.material];
+  const Transmission tr = transmission(dir, sp.geometric_normal, sp.shading_normal, m.ior);
+  const glm::dvec3 t = glm::normalize(tr.dir);
+  if (options_.method == Method::envmap) {
+    if (stats) ++stats->envmap_lookups;
+    return envmap_at(envmap_direction(sp.point, t));
+  }
+  // Patow-Delrieux lens: entry to emergence in one paraxial transfer, no exit search.
+  const int lens = lens_of_object_[sp.object];
+  if (lens >= 0 && tr.entering) {
+    LensRay out;
+    if (lens_transfer(lenses_[static_cast<size_t>(lens)], options_.refraction, sp.point, dir, &out)) {
+      if (stats) ++stats->lens_transfers;
+      return trace(out.point, out.dir, depth + 1, OUTSIDE, stats, nullptr);
+    }
+    if (stats) ++stats->lens_fallbacks;
+  }
+  return trace(sp.point, t, depth + 1, inside_after(scene_, sp, t), stats, nullptr);
+}
+
+// The lookup direction of thesis 9.2: R, the bisector [[R + [[W]]]], or [[W]].
+glm::dvec3 MapShader::envmap_direction(const glm::dvec3& w, const glm::dvec3& r) const {
+  const glm::dvec3 wc = w - cube_.centre;
+  const double len = glm::length(wc);
+  const glm::dvec3 wu = len > 0.0 ? wc / len : r;
+  switch (options_.lookup) {
+    case EnvmapLookup::reflected:
+      return r;
+    case EnvmapLookup::bisector: {
+      const glm::dvec3 b = r + wu;
+      return glm::dot(b, b) > 1e-24 ? glm::normalize(b) : r;  // R = -[[W]]: no bisector
+    }
+    case EnvmapLookup::position:
+      return wu;
+  }
+  return r;
+}
+
+glm::dvec3 MapShader::envmap_at(const glm::dvec3& direction) const {
+  const CubeTexel t = direction_to_texel(direction, env_colour_.n);
+  return glm::dvec3(env_colour_.faces[static_cast<size_t>(t.face)].rgb(t.i, t.j));
+}
+
+// The map as a picture (Blinn & Newell): every texel's list resolved by Pack_Under_Mask,
+// each fragment lit by local Phong and the shadow searches, seen from the centre.
+void MapShader::build_envmap_colours() {
+  const int n = cube_.n;
+  env_colour_ = CubeImage(n, 3);
+  parallel_for(static_cast<size_t>(CUBE_FACES) * static_cast<size_t>(n), thread_count(options_.threads, 6u * n),
+               [&](size_t item, int) {
+                 const int face = static_cast<int>(item / static_cast<size_t>(n));
+                 const int j = static_cast<int>(item % static_cast<size_t>(n));
+                 const ABuffer& buffer = cube_.faces[static_cast<size_t>(face)];
+                 PackScratch scratch;
+                 for (int i = 0; i < n; ++i) {
+                   const FragmentShader shade_fragment = [&](const Fragment& f) {
+                     const glm::dvec3 p = fragment_point(buffer, scene_.triangles, f, i, j);
+                     const SurfacePoint sp = surface_point(scene_, f.triangle(), p);
+                     const Material& m = scene_.materials[sp.material];
+                     const glm::dvec3 v = glm::normalize(cube_.centre - p);
+                     const glm::dvec3 nn = face_forward(sp.shading_normal, v);
+                     return ShadedFragment{phong_ambient(m, scene_.ambient) + lights(sp, v, nn, nullptr), m.opacity};
+                   };
+                   const glm::dvec3 c = pack_under_mask(buffer.list(i, j), FULL_MASK, shade_fragment, scene_.triangles,
+                                                        scene_.background, &scratch);
+                   env_colour_.faces[static_cast<size_t>(face)].set_rgb(i, j, glm::vec3(c));
+                 }
+               });
+}
+
+// Error_CP and Error_Parallax of one reflection ray against the exact tracer (thesis 9).
+void MapShader::measure(const glm::dvec3& w, const glm::dvec3& r, const SearchResult* found,
+                        const glm::dvec3* lookup, MapShadingStats* stats) const {
+  RayErrors& e = stats->errors;
+  const glm::dvec3 origin = w + r * (1e-9 * reference_->scene_scale());
+  Hit exact;
+  const bool exact_hit = reference_->intersect(origin, r, &exact);
+  const glm::dvec3 c = cube_.centre;
+  // The method's found point X': the search's, or for a lookup the surface seen from C
+  // in the lookup direction.
+  bool has_point = false;
+  glm::dvec3 x(0.0);
+  uint32_t object = 0;
+  if (found && found->hit) {
+    has_point = true;
+    x = found->point;
+    object = found->object_id;
+  } else if (lookup) {
+    Hit seen;
+    if (reference_->intersect(c, *lookup, &seen)) {
+      has_point = true;
+      x = seen.point;
+      object = seen.object_id;
+    }
+  }
+  if (!exact_hit) {
+    if (has_point) ++e.false_hits;
+    return;
+  }
+  const glm::dvec3 sigma = exact.point - c;
+  if (lookup) {
+    e.error_cp.add(error_cp(*lookup, sigma));
+  } else if (has_point && glm::length(x - c) > 0.0) {
+    e.error_cp.add(error_cp(x - c, sigma));
+  } else {
+    e.error_cp.add_miss();
+  }
+  if (has_point && glm::length(x - w) > 0.0) {
+    e.error_parallax.add(error_parallax(x, w, r));
+    if (object != exact.object_id) ++e.wrong_object;
+  } else {
+    e.error_parallax.add_miss();
+  }
+}
+
+namespace {
+
+// Per-thread statistics for a parallel resolve: a thread finds its own slot once per call.
+class ThreadStats {
+ public:
+  MapShadingStats* slot() {
+    const std::thread::id me = std::this_thread::get_id();
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto& [id, s] : slots_) {
+      if (id == me) return s.get();
+    }
+    slots_.emplace_back(me, std::make_unique<MapShadingStats>());
+    return slots_.back().second.get();
+  }
+  void merge_into(MapShadingStats* out) const {
+    for (const auto& [id, s] : slots_) out->merge(*s);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::pair<std::thread::id, std::unique_ptr<MapShadingStats>>> slots_;
+};
+
+}  // namespace
+
+Image render_with_map(const Scene& scene, const ABuffer& camera, const MapShader& shader, int threads,
+                      MapShadingStats* stats) {
+  ThreadStats per_thread;
+  const PixelShader shade = [&](const Fragment& f, int x, int y) {
+    const glm::dvec3 p = fragment_point(camera, scene.triangles, f, x, y);
+    const SurfacePoint sp = surface_point(scene, f.triangle(), p);
+    const glm::dvec3 dir = glm::normalize(p - scene.camera.position);
+    const glm::dvec3 c = shader.shade(sp, dir, 0, true, per_thread.slot());
+    return ShadedFragment{c, scene.materials[sp.material].opacity};
+  };
+  ResolveOptions ro;
+  ro.threads = threads;
+  Image image = resolve_image(camera, scene.triangles, shade, scene.background, ro);
+  if (stats) per_thread.merge_into(stats);
+  return image;
+}
+
+}  // namespace abcube

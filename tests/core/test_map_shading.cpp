@@ -1,0 +1,143 @@
+// The cube-map methods end to end (map_shading.hpp): the thesis's hidden-point result,
+// and each method's image against the exact tracer on the repository scenes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "abuffer.hpp"
+#include "camera.hpp"
+#include "map_shading.hpp"
+#include "metrics.hpp"
+#include "raytrace.hpp"
+#include "scene_load.hpp"
+
+namespace abcube {
+namespace {
+
+Scene small_scene(const char* name, int width, int cube_n) {
+  Scene s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/" + name);
+  const double aspect = static_cast<double>(s.camera.width) / s.camera.height;
+  s.camera.width = width;
+  s.camera.height = static_cast<int>(width / aspect + 0.5);
+  s.render.cube_resolution = cube_n;
+  return s;
+}
+
+struct Rendered {
+  Image image;
+  MapShadingStats stats;
+};
+
+Rendered render_method(const Scene& s, Method method, const RayTracer* reference = nullptr,
+                       SearchMode mode = SearchMode::crossing) {
+  const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, s.render.cube_resolution);
+  MapShadingOptions o;
+  o.method = method;
+  o.search.mode = mode;
+  const MapShader shader(s, cube, o, reference);
+  const ABuffer camera = build_camera_abuffer(s);
+  Rendered r;
+  r.image = render_with_map(s, camera, shader, 0, &r.stats);
+  return r;
+}
+
+// Thesis 7.4.2 and figures 11.3-11.5: in the mirror pixels whose exact reflected ray meets
+// the part of the green triangle hidden from the camera by the red one, the A-buffered map
+// shows green and the one-layer Z-buffered map does not. The pixel set comes from the
+// exact tracer's geometry; only pixels whose 3x3 neighbourhood is in the set are judged.
+TEST(MapShading, HiddenPointIsFoundOnlyWithAllLayers) {
+  const Scene s = small_scene("hidden_point.json", 192, 256);
+  const RayTracer rt(s);
+  uint32_t green = UINT32_MAX, mirror = UINT32_MAX;
+  for (uint32_t o = 0; o < s.objects.size(); ++o) {
+    const glm::dvec3 c = s.materials[s.objects[o].material].color;
+    if (c.g > 0.5 && c.r < 0.5) green = o;
+    if (s.materials[s.objects[o].material].reflect > 0) mirror = o;
+  }
+  ASSERT_NE(green, UINT32_MAX);
+  ASSERT_NE(mirror, UINT32_MAX);
+  const CameraFrame f = make_camera_frame(s.camera);
+  const int w = s.camera.width, h = s.camera.height;
+  std::vector<char> hidden(static_cast<size_t>(w * h), 0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      Hit m;
+      if (!rt.intersect(f.eye, f.direction(x + 0.5, y + 0.5), &m) || m.object_id != mirror) continue;
+      const Ray r = rt.reflected_ray(m, glm::normalize(f.direction(x + 0.5, y + 0.5)));
+      Hit g;
+      if (!rt.intersect(r.origin, r.dir, &g) || g.object_id != green) continue;
+      Hit seen;  // what the camera sees in the direction of that green point
+      rt.intersect(f.eye, g.point - f.eye, &seen);
+      hidden[static_cast<size_t>(y * w + x)] = seen.object_id != green;
+    }
+  }
+  const Image ab = render_method(s, Method::abuffer).image;
+  const Image zb = render_method(s, Method::zbuffer).image;
+  int judged = 0, ab_green = 0, zb_green = 0;
+  for (int y = 1; y + 1 < h; ++y) {
+    for (int x = 1; x + 1 < w; ++x) {
+      bool inside = true;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) inside = inside && hidden[static_cast<size_t>((y + dy) * w + x + dx)];
+      if (!inside) continue;
+      ++judged;
+      auto is_green = [](glm::vec3 c) { return c.g > 0.2f && c.g > 2.f * c.r && c.g > 2.f * c.b; };
+      ab_green += is_green(ab.rgb(x, y));
+      zb_green += is_green(zb.rgb(x, y));
+    }
+  }
+  std::printf("[ hidden   ] %d interior pixels see hidden green: abuffer green %d, zbuffer green %d\n", judged,
+              ab_green, zb_green);
+  EXPECT_GT(judged, 50);
+  EXPECT_EQ(ab_green, judged);
+  EXPECT_EQ(zb_green, 0);
+}
+
+// Each method against the exact tracer on the scenes with hidden points and near
+// reflectors (hidden_point, cornell): the A-buffered map is clearly closer than the
+// Z-buffered map and Blinn-Newell. Measured at these sizes (2026-11-21):
+//   hidden_point 128 px, N = 256: abuffer 40.6 dB, thesis 40.4, zbuffer 29.2, envmap 25.4
+//   cornell      96 px,  N = 256: abuffer 30.0 dB, thesis 22.7, zbuffer 16.5, envmap 15.5
+// The floors below are those figures less 2 dB; the margins are what the thesis claims.
+struct MethodCase {
+  const char* scene;
+  int width;
+  double abuffer_min_psnr;
+};
+
+class MethodsAgainstReference : public ::testing::TestWithParam<MethodCase> {};
+
+TEST_P(MethodsAgainstReference, AbufferIsClosestToTheExactImage) {
+  const MethodCase& c = GetParam();
+  const Scene s = small_scene(c.scene, c.width, 256);
+  const RayTracer rt(s);
+  const Image ref = render_raytrace(s);
+  const Rendered ab = render_method(s, Method::abuffer, &rt);
+  const Rendered th = render_method(s, Method::abuffer, &rt, SearchMode::thesis);
+  const Rendered zb = render_method(s, Method::zbuffer, &rt);
+  const Rendered em = render_method(s, Method::envmap, &rt);
+  const double p_ab = image_error(ab.image, ref).psnr, p_th = image_error(th.image, ref).psnr;
+  const double p_zb = image_error(zb.image, ref).psnr, p_em = image_error(em.image, ref).psnr;
+  std::printf("[ methods  ] %s %dpx N=256: abuffer %.1f dB, thesis %.1f, zbuffer %.1f, envmap %.1f\n", c.scene,
+              c.width, p_ab, p_th, p_zb, p_em);
+  std::printf("[ parallax ] abuffer crossing p99 %.2e, thesis p99 %.2e max %.2e, zbuffer misses %.3f\n",
+              ab.stats.errors.error_parallax.percentile(0.99), th.stats.errors.error_parallax.percentile(0.99),
+              th.stats.errors.error_parallax.max(), zb.stats.errors.error_parallax.miss_share());
+  EXPECT_GE(p_ab, c.abuffer_min_psnr);
+  EXPECT_GT(p_ab, p_zb + 5.0);
+  EXPECT_GT(p_ab, p_em + 5.0);
+  // Crossing mode: the found point is on the ray (Error_Parallax 0 to rounding).
+  EXPECT_LT(ab.stats.errors.error_parallax.max(), 1e-12);
+  // Thesis mode: accepted under theta_max, so Error_Parallax <= (1 - cos theta_max)/2.
+  const double bound = (1.0 - std::cos(SearchOptions{}.theta_max)) / 2.0;
+  EXPECT_LE(th.stats.errors.error_parallax.max(), bound);
+  EXPECT_GT(ab.stats.errors.error_parallax.count(), 100u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, MethodsAgainstReference,
+                         ::testing::Values(MethodCase{"hidden_point.json", 128, 38.6},
+                                           MethodCase{"cornell.json", 96, 28.0}));
+
+}  // namespace
+}  // namespace abcube
