@@ -122,12 +122,12 @@ ScanCounts scan(const SearchContext& ctx, const RayQuery& q, const SearchOptions
 // One fragment's answer for a ray.
 struct Candidate {
   bool valid = false;
-  bool exact = false;  // crossing mode: the refined point is on the triangle
-  bool tested = false;    // crossing mode: a refined point was measured against the tolerance
-  double l = INF;      // crossing: ray parameter; thesis: projection of X' - W on the ray
-  double angle = INF;  // thesis: angle between the ray and X' - W
-  double outside = 0;  // crossing: distance from the triangle, in texels
-  glm::dvec3 x{0.0};   // X', relative to the centre
+  bool exact = false;   // crossing mode: the refined point is on the triangle
+  bool tested = false;  // crossing mode: a refined point in the texel was measured
+  double l = INF;       // crossing: ray parameter; thesis: projection of X' - W on the ray
+  double angle = INF;   // thesis: angle between the ray and X' - W
+  double outside = 0;   // crossing: distance from the triangle, in texels
+  glm::dvec3 x{0.0};    // X', relative to the centre
   const Fragment* fragment = nullptr;
   CubeTexel texel{0, 0, 0};
 };
