@@ -107,8 +107,11 @@ glm::dvec3 MapShader::shade(const SurfacePoint& sp, const glm::dvec3& dir, int d
   const glm::dvec3 v = -dir;
   const glm::dvec3 n = face_forward(sp.shading_normal, v);
   glm::dvec3 c = phong_ambient(m, scene_.ambient) + lights(sp, v, n, stats);
-  if (depth < scene_.render.max_depth && m.reflect > 0.0) c += m.reflect * reflected(sp, dir, depth, primary, stats);
-  if (depth < scene_.render.max_depth && m.transmit > 0.0) c += m.transmit * transmitted(sp, dir, depth, stats);
+  const SecondaryWeights w =
+      secondary_weights(m, scene_.render.fresnel, dir,
+                        transmission(dir, sp.geometric_normal, sp.shading_normal, m.ior), sp.geometric_normal);
+  if (depth < scene_.render.max_depth && w.reflect > 0.0) c += w.reflect * reflected(sp, dir, depth, primary, stats);
+  if (depth < scene_.render.max_depth && w.transmit > 0.0) c += w.transmit * transmitted(sp, dir, depth, stats);
   return blend ? blend_coverage(m.opacity, c, behind) : c;
 }
 

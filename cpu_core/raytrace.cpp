@@ -182,16 +182,19 @@ glm::dvec3 RayTracer::shade(const Hit& hit, const glm::dvec3& dir, int depth, Ra
     if (lit == glm::dvec3(0.0)) continue;
     c += lit * light_visibility(hit, light, counts);
   }
-  // Whitted 1980: mirror and refracted rays, to the depth limit.
-  if (depth < max_depth && m.reflect > 0.0) {
+  // Whitted 1980: mirror and refracted rays, to the depth limit (weights: rule "fresnel").
+  const SecondaryWeights w =
+      secondary_weights(m, scene_->render.fresnel, dir,
+                        transmission(dir, hit.geometric_normal, hit.shading_normal, m.ior), hit.geometric_normal);
+  if (depth < max_depth && w.reflect > 0.0) {
     const Ray r = reflected_ray(hit, dir);
     ++counts->secondary;
-    c += m.reflect * trace(r.origin, r.dir, depth + 1, counts);
+    c += w.reflect * trace(r.origin, r.dir, depth + 1, counts);
   }
-  if (depth < max_depth && m.transmit > 0.0) {
+  if (depth < max_depth && w.transmit > 0.0) {
     const Ray r = transmitted_ray(hit, dir, nullptr);
     ++counts->secondary;
-    c += m.transmit * trace(r.origin, r.dir, depth + 1, counts);
+    c += w.transmit * trace(r.origin, r.dir, depth + 1, counts);
   }
   return m.opacity < 1.0 ? blend_coverage(m.opacity, c, behind) : c;
 }

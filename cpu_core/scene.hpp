@@ -66,6 +66,7 @@ struct RenderSettings {
   Method method = Method::abuffer;
   int cube_resolution = 512;
   int max_depth = 4;
+  bool fresnel = false;  // Schlick weights for kr/kt (shading.hpp secondary_weights); off = thesis
 };
 
 struct Bounds {

@@ -133,6 +133,29 @@ inline Transmission transmission(const glm::dvec3& d, const glm::dvec3& geometri
   return r;
 }
 
+// The weights of the reflected and transmitted terms (rule "fresnel"). Off (the thesis's
+// model, the default): kr and kt as the material says. On (--fresnel): for a material with
+// kt > 0, Schlick 1994's reflectance F = F0 + (1 - F0)(1 - cos)^5, F0 = ((ior-1)/(ior+1))^2,
+// cos the angle in the outer medium (the incident one entering, the transmitted one
+// leaving), moves the share F of kt to the mirror term: kr' = kr + F kt, kt' = (1 - F) kt.
+// Under total internal reflection kt already follows the mirror direction (transmission).
+struct SecondaryWeights {
+  double reflect = 0, transmit = 0;
+};
+inline SecondaryWeights secondary_weights(const Material& m, bool fresnel, const glm::dvec3& d,
+                                          const Transmission& tr, const glm::dvec3& geometric_normal) {
+  SecondaryWeights w{m.reflect, m.transmit};
+  if (!fresnel || m.transmit <= 0.0 || tr.total_internal_reflection) return w;
+  const double cos_d = std::abs(glm::dot(d, geometric_normal));
+  const double cos_t = std::abs(glm::dot(tr.dir, geometric_normal)) / std::max(glm::length(tr.dir), 1e-300);
+  const double c = tr.entering ? cos_d : cos_t;
+  const double f0 = ((m.ior - 1.0) / (m.ior + 1.0)) * ((m.ior - 1.0) / (m.ior + 1.0));
+  const double f = f0 + (1.0 - f0) * std::pow(1.0 - std::min(c, 1.0), 5.0);
+  w.reflect = m.reflect + f * m.transmit;
+  w.transmit = (1.0 - f) * m.transmit;
+  return w;
+}
+
 // Light let through by one surface crossing the shadow segment P..L (rule "shadows";
 // shadow rays are not refracted):  (1 - op) + op * kt * Od, component-wise.
 // An opaque blocker (kt = 0, op = 1) gives 0; a refractive one (op = 1) gives kt * Od;

@@ -43,7 +43,7 @@ RenderRequest parse_request(const std::vector<std::string>& words, Scene* scene)
                   {"-o", "--output", "--method", "--cube-res", "--max-depth", "--threads", "--gl",
                    "--gl-device", "--stats", "--max-memory", "--max-layers", "--search", "--theta-max",
                    "--refraction", "--envmap-lookup"},
-                  {"--reference"});
+                  {"--reference", "--fresnel"});
   args.expect_positional(1, "SCENE.json");
   RenderRequest r;
   r.scene_path = args.positional()[0];
@@ -92,6 +92,7 @@ RenderRequest parse_request(const std::vector<std::string>& words, Scene* scene)
   if (args.has("--method")) scene->render.method = method;
   scene->render.cube_resolution = args.get_int("--cube-res", scene->render.cube_resolution, 1, 16384);
   scene->render.max_depth = args.get_int("--max-depth", scene->render.max_depth, 0, 64);
+  if (args.has("--fresnel")) scene->render.fresnel = true;
   check_render_size(*scene, available_memory_bytes());
   return r;
 }
@@ -277,7 +278,8 @@ int cmd_render(const std::vector<std::string>& words) {
   stats["method_options"] = {{"search", search_mode_name(r.map.search.mode)},
                              {"theta_max_deg", glm::degrees(r.map.search.theta_max)},
                              {"refraction", refraction_mode_name(r.map.refraction)},
-                             {"envmap_lookup", envmap_lookup_name(r.map.lookup)}};
+                             {"envmap_lookup", envmap_lookup_name(r.map.lookup)},
+                             {"fresnel", scene.render.fresnel}};
   switch (scene.render.method) {
     case Method::gpu:
       image = render_gpu(scene, r, &stats);

@@ -15,7 +15,7 @@ const char* USAGE =
     "                     egl-surfaceless|osmesa|none] [--gl-device K] [--stats STATS.json] [--reference]\n"
     "                     [--max-layers K] [--max-memory MiB] [--search crossing|thesis]\n"
     "                     [--theta-max DEG] [--refraction search|thick_lens|thin_lens]\n"
-    "                     [--envmap-lookup R|bisector|position]\n"
+    "                     [--envmap-lookup R|bisector|position] [--fresnel]\n"
     "       abcube compare A.png B.png [--diff HEAT.png] [--fail T] [--failpercent P]\n"
     "       abcube info\n"
     "       abcube export-pov SCENE.json -o OUT.pov\n"

@@ -81,7 +81,7 @@ check "gpu --reference reports an image error" grep -q '"share_over_2_255"' "$WO
 
 # --- the cube-map methods and their options; stats count the searches
 for v in "abuffer" "abuffer --search thesis --theta-max 1" "zbuffer" "envmap --envmap-lookup bisector" \
-         "abuffer --refraction thin_lens"; do
+         "abuffer --refraction thin_lens" "abuffer --fresnel"; do
   set -- $v
   name=$(echo "$v" | tr ' ' '_')
   "$ABCUBE" render "$WORK/small.json" -o "$WORK/m_$name.png" --method $v --cube-res 64 --stats "$WORK/m_$name.json" \
