@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_common.hpp"
 #include "abuffer.hpp"
 #include "error.hpp"
 #include "memory.hpp"
@@ -164,13 +165,5 @@ int run(int argc, char** argv) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  try {
-    return abcube::run(argc, argv);
-  } catch (const abcube::InputError& e) {
-    std::fprintf(stderr, "bench_abuffer: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_abuffer: %s\n", e.what());
-    return 1;
-  }
+  return abcube::guarded_main("bench_abuffer", [&] { return abcube::run(argc, argv); });
 }

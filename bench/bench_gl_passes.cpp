@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_common.hpp"
 #include "abuffer.hpp"
 #include "cli_common.hpp"
 #include "cube_map.hpp"
@@ -129,13 +130,5 @@ int run(const std::vector<std::string>& words) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  try {
-    return abcube::run(std::vector<std::string>(argv + 1, argv + argc));
-  } catch (const abcube::InputError& e) {
-    std::fprintf(stderr, "bench_gl_passes: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_gl_passes: error: %s\n", e.what());
-    return 1;
-  }
+  return abcube::guarded_main("bench_gl_passes", [&] { return abcube::run(std::vector<std::string>(argv + 1, argv + argc)); });
 }

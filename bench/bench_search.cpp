@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_common.hpp"
 #include "abuffer.hpp"
 #include "camera.hpp"
 #include "error.hpp"
@@ -225,13 +226,5 @@ int run(int argc, char** argv) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  try {
-    return abcube::run(argc, argv);
-  } catch (const abcube::InputError& e) {
-    std::fprintf(stderr, "bench_search: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_search: %s\n", e.what());
-    return 1;
-  }
+  return abcube::guarded_main("bench_search", [&] { return abcube::run(argc, argv); });
 }
