@@ -126,6 +126,10 @@ glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const 
     const glm::dvec3 lit = phong_light(m, n, v, glm::normalize(to_light), light.color);
     if (lit == glm::dvec3(0.0)) continue;
     if (!light.cast_shadows) {
+      if (options_.walk_all_shadows) {
+        const ShadowResult unused = shadow_search(*ctx_, sp.point, light.position, options_.search);
+        if (stats) stats->searches.shadow.add(unused);
+      }
       c += lit;
       continue;
     }

@@ -54,6 +54,9 @@ struct MapShadingOptions {
   RefractionMode refraction = RefractionMode::search;
   EnvmapLookup lookup = EnvmapLookup::reflected;
   int threads = 0;
+  // --plan everything: also walk the shadows of lights that cast none (result unused), to
+  // measure what the plan's skip saves. The image does not change.
+  bool walk_all_shadows = false;
 };
 
 // Ray-level error against the exact tracer (thesis ch. 9), for the reflection rays of

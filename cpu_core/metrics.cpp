@@ -152,6 +152,13 @@ double ErrorStats::percentile(double q) const {
   return v[rank - 1];
 }
 
+double ErrorStats::share_within(double bound) const {
+  if (values_.empty()) return 0.0;
+  size_t within = 0;
+  for (double v : values_) within += v <= bound;
+  return static_cast<double>(within) / static_cast<double>(values_.size());
+}
+
 double ErrorStats::miss_share() const {
   const uint64_t n = total();
   return n == 0 ? 0.0 : static_cast<double>(misses_) / static_cast<double>(n);

@@ -79,6 +79,8 @@ class ErrorStats {
   // least q of the values at or below it (q = 0 gives the minimum); 0 when there are none.
   double percentile(double q) const;
   double miss_share() const;           // misses / total; 0 when empty
+  // Share of the found values <= bound (e.g. thesis 9.3.4's 1/(2 N^2)); 0 when none.
+  double share_within(double bound) const;
 
  private:
   std::vector<double> values_;

@@ -67,6 +67,7 @@ struct RenderSettings {
   int cube_resolution = 512;
   int max_depth = 4;
   bool fresnel = false;  // Schlick weights for kr/kt (shading.hpp secondary_weights); off = thesis
+  double error_target = 0;  // > 0: choose cube_resolution from the Error_Parallax bound (plan.hpp)
 };
 
 struct Bounds {

@@ -423,6 +423,10 @@ RenderSettings read_render(const Fields& f) {
   r.cube_resolution = f.integer("cube_resolution", r.cube_resolution, 1, MAX_CUBE_RESOLUTION);
   r.max_depth = f.integer("max_depth", r.max_depth, 0, MAX_BOUNCES);
   if (const Json* v = f.find("fresnel")) r.fresnel = read_bool(f.src(), *v, f.at("fresnel"));
+  if (const Json* v = f.find("error_target")) {
+    r.error_target = read_number(f.src(), *v, f.at("error_target"));
+    check_range(f.src(), f.at("error_target"), r.error_target, 1e-12, 0.5);
+  }
   return r;
 }
 
@@ -769,7 +773,7 @@ Scene read_scene(const Json& doc, const Source& src) {
   const Json& objects = read_array(src, top.need("objects"), "objects");
   for (size_t i = 0; i < objects.size(); ++i) read_object(st, objects[i], i);
   if (const Json* render = top.find("render")) {
-    scene.render = read_render(Fields(src, *render, "render", {"method", "cube_resolution", "max_depth", "fresnel"}));
+    scene.render = read_render(Fields(src, *render, "render", {"method", "cube_resolution", "max_depth", "fresnel", "error_target"}));
   }
   return scene;
 }

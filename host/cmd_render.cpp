@@ -18,6 +18,7 @@
 #include "memory.hpp"
 #include "map_shading.hpp"
 #include "metrics.hpp"
+#include "plan.hpp"
 #include "raytrace.hpp"
 #include "scene_load.hpp"
 
@@ -33,6 +34,8 @@ struct RenderRequest {
   int gl_device = -1;
   int threads = 0;
   bool reference = false;
+  std::string reference_image;  // --reference-image: the exact image, rendered before
+  bool plan_everything = false;  // --plan everything
   ABufferOptions abuffer;  // --threads, --max-layers, --max-memory (MiB)
   MapShadingOptions map;   // --search, --theta-max, --refraction, --envmap-lookup
 };
@@ -42,7 +45,7 @@ RenderRequest parse_request(const std::vector<std::string>& words, Scene* scene)
   const Args args(words,
                   {"-o", "--output", "--method", "--cube-res", "--max-depth", "--threads", "--gl",
                    "--gl-device", "--stats", "--max-memory", "--max-layers", "--search", "--theta-max",
-                   "--refraction", "--envmap-lookup"},
+                   "--refraction", "--envmap-lookup", "--error-target", "--reference-image", "--plan"},
                   {"--reference", "--fresnel"});
   args.expect_positional(1, "SCENE.json");
   RenderRequest r;
@@ -67,7 +70,13 @@ RenderRequest parse_request(const std::vector<std::string>& words, Scene* scene)
   }
   r.gl_device = args.get_int("--gl-device", -1, 0, 1024);
   r.threads = args.get_int("--threads", 0, 0, 4096);
-  r.reference = args.has("--reference");
+  r.reference_image = args.get("--reference-image");
+  r.reference = args.has("--reference") || !r.reference_image.empty();
+  const std::string plan = args.get("--plan", "needed");
+  if (plan != "needed" && plan != "everything") {
+    throw InputError("--plan: must be needed or everything, got '" + plan + "'");
+  }
+  r.plan_everything = plan == "everything";
   r.abuffer.threads = r.threads;
   r.map.threads = r.threads;
   if (args.has("--search") && !parse_search_mode(args.get("--search"), &r.map.search.mode)) {
@@ -90,6 +99,11 @@ RenderRequest parse_request(const std::vector<std::string>& words, Scene* scene)
 
   *scene = load_scene(r.scene_path);
   if (args.has("--method")) scene->render.method = method;
+  scene->render.error_target = args.get_double("--error-target", scene->render.error_target, 0.0, 0.5);
+  if (scene->render.error_target > 0 && !args.has("--cube-res")) {
+    // thesis 9.3.4: the N whose bound 1/(2 N^2) meets the target (plan.hpp).
+    scene->render.cube_resolution = resolution_for_error(scene->render.error_target);
+  }
   scene->render.cube_resolution = args.get_int("--cube-res", scene->render.cube_resolution, 1, 16384);
   scene->render.max_depth = args.get_int("--max-depth", scene->render.max_depth, 0, 64);
   if (args.has("--fresnel")) scene->render.fresnel = true;
@@ -189,17 +203,13 @@ json error_stats_json(const ErrorStats& e) {
 // The cube-map methods (abuffer, zbuffer, envmap; map_shading.hpp). The map is built only
 // when something needs it: a reflecting or refracting material, or a shadow-casting light.
 Image render_map_method(const Scene& scene, const RenderRequest& r, json* stats) {
-  bool needs_map = false;
-  for (const Material& m : scene.materials) needs_map = needs_map || m.reflect > 0 || m.transmit > 0;
-  bool shadows = false;
-  for (const PointLight& l : scene.lights) shadows = shadows || l.cast_shadows;
-  if (!needs_map && !shadows) {
-    Image image = render_abuffer_local(scene, r.abuffer, stats);
-    (*stats)["plan"]["passes"] = {"camera_abuffer", "resolve"};
-    (*stats)["plan"]["skipped"] = {{{"pass", "cube_abuffer"},
-                                    {"why", "no reflecting or refracting material and no shadow-casting light"}}};
-    return image;
-  }
+  const RenderPlan plan = make_plan(scene, r.plan_everything);
+  json passes = json::array(), skipped = json::array();
+  for (const PlanStep& s : plan.steps) (s.run ? passes : skipped).push_back({{"pass", s.pass}, {"why", s.why}});
+  (*stats)["plan"]["passes"] = passes;
+  (*stats)["plan"]["skipped"] = skipped;
+  (*stats)["plan"]["mode"] = r.plan_everything ? "everything" : "needed";
+  if (!plan.cube_map) return render_abuffer_local(scene, r.abuffer, stats);
   Clock::time_point t0 = Clock::now();
   ABufferStats cs;
   const CubeABuffer cube =
@@ -212,6 +222,7 @@ Image render_map_method(const Scene& scene, const RenderRequest& r, json* stats)
   if (r.reference) reference = std::make_unique<RayTracer>(scene);
   MapShadingOptions options = r.map;
   options.method = scene.render.method;
+  options.walk_all_shadows = r.plan_everything;
   t0 = Clock::now();
   const MapShader shader(scene, cube, options, reference.get());
   (*stats)["timings_ms"]["map_setup"] = ms_since(t0);
@@ -230,20 +241,16 @@ Image render_map_method(const Scene& scene, const RenderRequest& r, json* stats)
                           {"shadow", search_kind_json(ms.searches.shadow)},
                           {"lens_transfers", ms.lens_transfers}, {"lens_fallbacks", ms.lens_fallbacks},
                           {"envmap_lookups", ms.envmap_lookups}};
-  json passes = {"cube_abuffer", "camera_abuffer", "shade_and_resolve"};
-  json skipped = json::array();
-  if (!shadows) skipped.push_back({{"pass", "shadow searches"}, {"why", "no light casts shadows"}});
-  if (!needs_map) skipped.push_back({{"pass", "reflection and refraction searches"}, {"why", "no material reflects or transmits"}});
-  (*stats)["plan"]["passes"] = passes;
-  (*stats)["plan"]["skipped"] = skipped;
   if (reference) {
+    const double bound = parallax_bound(scene.render.cube_resolution);
     (*stats)["reference"]["ray_error"] = {
         {"rays", "reflection rays of camera-visible surfaces"},
         {"error_cp", error_stats_json(ms.errors.error_cp)},
         {"error_parallax", error_stats_json(ms.errors.error_parallax)},
         {"false_hits", ms.errors.false_hits},
         {"wrong_object", ms.errors.wrong_object},
-        {"bound_1_over_2n2", 1.0 / (2.0 * scene.render.cube_resolution * scene.render.cube_resolution)}};
+        {"bound_1_over_2n2", bound},
+        {"error_parallax_within_bound", ms.errors.error_parallax.share_within(bound)}};
   }
   return image;
 }
@@ -269,6 +276,11 @@ int cmd_render(const std::vector<std::string>& words) {
                      {"dropped_triangles", scene.dropped_triangles},
                      {"objects", scene.objects.size()},
                      {"lights", scene.lights.size()}};
+  if (scene.render.error_target > 0) {
+    stats["error_target"] = {{"target", scene.render.error_target},
+                             {"cube_resolution", scene.render.cube_resolution},
+                             {"bound_at_that_n", parallax_bound(scene.render.cube_resolution)}};
+  }
   stats["size"] = {{"width", scene.camera.width}, {"height", scene.camera.height},
                    {"cube_resolution", scene.render.cube_resolution},
                    {"max_depth", scene.render.max_depth}};
@@ -302,7 +314,17 @@ int cmd_render(const std::vector<std::string>& words) {
   }
   if (r.reference) {
     // The error of this image against the exact tracer (the same one image, if raytrace).
-    const Image ref = scene.render.method == Method::raytrace ? image : render_reference(scene, r, &stats, "reference");
+    Image ref;
+    if (!r.reference_image.empty()) {
+      ref = read_image(r.reference_image);
+      if (ref.width != image.width || ref.height != image.height) {
+        throw InputError(r.reference_image + ": is " + std::to_string(ref.width) + "x" + std::to_string(ref.height) +
+                         ", the render is " + std::to_string(image.width) + "x" + std::to_string(image.height));
+      }
+      stats["reference"]["image"] = r.reference_image;
+    } else {
+      ref = scene.render.method == Method::raytrace ? image : render_reference(scene, r, &stats, "reference");
+    }
     stats["reference"]["image_error"] = image_error_json(image_error(image, ref));
     if (!stats["reference"].contains("ray_error")) {
       stats["reference"]["ray_error"] = std::string("n/a: method ") + method_name(scene.render.method) +

@@ -90,6 +90,22 @@ for v in "abuffer" "abuffer --search thesis --theta-max 1" "zbuffer" "envmap --e
   check "--method $v counts shadow searches" grep -q '"shadow": {' "$WORK/m_$name.json"
   check "--method $v reports Error_Parallax" grep -q '"error_parallax"' "$WORK/m_$name.json"
 done
+# --- the plan: --plan everything changes the time, never the image; --error-target picks N
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/p1.png" --cube-res 64 --stats "$WORK/p1.json" 2> /dev/null
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/p2.png" --cube-res 64 --plan everything 2> /dev/null
+"$ABCUBE" compare "$WORK/p1.png" "$WORK/p2.png" --fail 0 > /dev/null
+check "--plan everything gives the same image" [ $? -eq 0 ]
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/p3.png" --error-target 1.25e-5 --stats "$WORK/p3.json" 2> /dev/null
+check "--error-target 1.25e-5 picks N = 200 (thesis 9.3.4)" grep -q '"cube_resolution": 200' "$WORK/p3.json"
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/rt.exr" --method raytrace 2> /dev/null
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/p4.png" --cube-res 64 --reference-image "$WORK/rt.exr" \
+  --stats "$WORK/p4.json" 2> /dev/null
+check "--reference-image gives the image error" grep -q '"psnr_db"' "$WORK/p4.json"
+check "--reference-image reports the bound share" grep -q '"error_parallax_within_bound"' "$WORK/p4.json"
+oiiotool "$WORK/rt.exr" --resize 20x10 -o "$WORK/tiny.exr" 2> /dev/null
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --reference-image "$WORK/tiny.exr" > /dev/null 2> "$WORK/err"
+check "--reference-image of another size exits 2" [ $? -eq 2 ]
+check "--reference-image size message names the file" grep -q "tiny.exr: is 20x10" "$WORK/err"
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --search sideways > /dev/null 2> "$WORK/err"
 check "--search sideways exits 2" [ $? -eq 2 ]
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --refraction prism > /dev/null 2> "$WORK/err"
