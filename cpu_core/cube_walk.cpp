@@ -95,11 +95,9 @@ CubeWalk::CubeWalk(const glm::dvec3& w, const glm::dvec3& d, int n, double l_max
 
 double CubeWalk::crossing(int axis, int boundary) const {
   // Plane n (A . X) - (2k - n) (F . X) = 0 through the centre: s or t = k / n on this face.
-  const CubeFaceBasis& b = cube_face_basis(face_);
-  const glm::dvec3& a = axis == 0 ? b.s_axis : b.t_axis;
   const double u = 2.0 * boundary - n_;
-  const double num = n_ * glm::dot(a, w_) - u * glm::dot(b.forward, w_);
-  const double den = n_ * glm::dot(a, d_) - u * glm::dot(b.forward, d_);
+  const double num = n_ * axis_w_[axis] - u * forward_w_;
+  const double den = n_ * axis_d_[axis] - u * forward_d_;
   if (!(den * step_[axis] > 0.0)) return INF;  // moving away from (or along) this plane
   return std::max(l_, -num / den);
 }
@@ -117,12 +115,16 @@ void CubeWalk::start_texel_on_face() {
   const double sc[2] = {glm::dot(b.s_axis, x), glm::dot(b.t_axis, x)};
   const double fw = glm::dot(b.forward, w_), fd = glm::dot(b.forward, d_);
   const glm::dvec3* axes[2] = {&b.s_axis, &b.t_axis};
+  forward_w_ = fw;
+  forward_d_ = fd;
   l_ = face_begin_;
   for (int axis = 0; axis < 2; ++axis) {
+    axis_w_[axis] = glm::dot(*axes[axis], w_);
+    axis_d_[axis] = glm::dot(*axes[axis], d_);
     const double coord = 0.5 * (sc[axis] / ma + 1.0) * n_;
     ij_[axis] = std::clamp(static_cast<int>(std::floor(coord)), 0, n_ - 1);
     // d(sc/ma)/dl has the constant sign of (A . D)(F . W) - (A . W)(F . D) on the face.
-    const double rate = glm::dot(*axes[axis], d_) * fw - glm::dot(*axes[axis], w_) * fd;
+    const double rate = axis_d_[axis] * fw - axis_w_[axis] * fd;
     step_[axis] = rate > 0.0 ? 1 : (rate < 0.0 ? -1 : 0);
   }
   next_crossing(0);

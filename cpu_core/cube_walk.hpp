@@ -73,6 +73,13 @@ class CubeWalk {
   // The next texel in order of increasing l; false when the walk is over (or aborted).
   bool next(WalkTexel* texel);
 
+  // The DDA's direction on the current face per axis (0: s / column i, 1: t / row j): +1,
+  // -1 or 0; a face's texels are visited with i and j moving that way only.
+  int step(int axis) const { return step_[axis]; }
+  // Skips the rest of the current face segment: the next texel is on the next face (the
+  // caller knows that nothing it looks for lies on the rest of this face).
+  void leave_face() { face_active_ = false; }
+
   bool aborted() const { return aborted_; }
   uint32_t texels() const { return texels_; }  // reported so far
   // The skipped parameter interval (gap_begin < gap_end) or an empty one.
@@ -98,7 +105,9 @@ class CubeWalk {
   int face_ = -1, next_face_ = -1;
   double face_begin_ = 0, face_end_ = 0;
   bool face_active_ = false;
-  // The DDA on the current face.
+  // The DDA on the current face. A crossing's plane is N (A . X) - u (F . X) = 0, so its
+  // parameter needs only A . W, A . D (A the s or t axis) and F . W, F . D, fixed per face.
+  double axis_w_[2] = {0, 0}, axis_d_[2] = {0, 0}, forward_w_ = 0, forward_d_ = 0;
   int ij_[2] = {0, 0};      // column i, row j
   int step_[2] = {0, 0};    // +1, -1 or 0 per axis
   double next_l_[2] = {0, 0};
