@@ -83,15 +83,50 @@ bool own_surface(const SearchContext::Plane& p, const RayQuery& q) {
   return !(den != 0.0 && -delta / den > q.self);
 }
 
+// ray_distance_range (cube_walk.hpp) along one ray, the same values from the same
+// operations, with |W + l D| at the last texel's end kept: consecutive texels share it
+// (l1 of one is l0 of the next), so most texels need one length instead of three.
+class DistanceRange {
+ public:
+  DistanceRange(const glm::dvec3& w, const glm::dvec3& d) : w_(w), d_(d), closest_(-glm::dot(w, d)) {}
+  glm::dvec2 operator()(double l0, double l1) {
+    const double lc = std::clamp(closest_, l0, l1);
+    const double at_l0 = length_at(l0);
+    const double at_l1 = std::isinf(l1) ? INF : length_at(l1);
+    const double dmin = lc == l0 ? at_l0 : (lc == l1 ? at_l1 : glm::length(w_ + lc * d_));
+    return {dmin, std::isinf(l1) ? INF : std::max(at_l0, at_l1)};
+  }
+
+ private:
+  double length_at(double l) {
+    if (l != cached_l_) {
+      cached_l_ = l;
+      cached_length_ = glm::length(w_ + l * d_);
+    }
+    return cached_length_;
+  }
+  glm::dvec3 w_, d_;
+  double closest_;
+  double cached_l_ = std::numeric_limits<double>::quiet_NaN(), cached_length_ = 0;
+};
+
 // Walks the ray's texels; for each texel calls on_fragment(texel, fragment, v) for every
 // fragment that passes the layer choice, the object restriction, the z-interval test
 // (thesis 7.5) and the own-surface test, then after_texel(texel, index) -> keep walking?
-template <class OnFragment, class AfterTexel>
+//
+// EMPTY FACES. When the rest of the walk on a face can only meet empty lists
+// (SearchContext::empty_ahead), the walk goes on at the next face: nothing changes but the
+// texels counted as visited. Only while may_skip() holds: the crossing and thesis windows
+// count texels once they have a candidate.
+template <class OnFragment, class AfterTexel, class MaySkip>
 ScanCounts scan(const SearchContext& ctx, const RayQuery& q, const SearchOptions& o, OnFragment&& on_fragment,
-                AfterTexel&& after_texel) {
+                AfterTexel&& after_texel, MaySkip&& may_skip) {
   const CubeABuffer& cube = ctx.cube();
   const TriangleSoup& soup = ctx.scene().triangles;
   CubeWalk walk(q.w, q.d, cube.n, q.l_max, cube.near_distance, o.max_texels);
+  DistanceRange distances(q.w, q.d);
+  // Only the thesis mode and the nearest layer look at the texel-centre direction.
+  const bool need_v = o.mode == SearchMode::thesis || o.layers == SearchLayers::nearest;
   ScanCounts counts;
   WalkTexel t;
   while (walk.next(&t)) {
@@ -99,8 +134,8 @@ ScanCounts scan(const SearchContext& ctx, const RayQuery& q, const SearchOptions
     const ABuffer& b = cube.faces[static_cast<size_t>(t.face)];
     const FragmentList list = b.list(t.i, t.j);
     if (!list.empty()) {
-      const glm::dvec3 v = b.view.direction(t.i + 0.5, t.j + 0.5);  // texel centre
-      const glm::dvec2 range = ray_distance_range(q.w, q.d, t.l0, t.l1);
+      const glm::dvec3 v = need_v ? b.view.direction(t.i + 0.5, t.j + 0.5) : glm::dvec3(0.0);  // texel centre
+      const glm::dvec2 range = distances(t.l0, t.l1);
       const Fragment* only = o.layers == SearchLayers::nearest ? nearest_fragment(ctx, list, v) : nullptr;
       for (const Fragment& f : list) {
         if (o.layers == SearchLayers::nearest && &f != only) continue;
@@ -114,6 +149,7 @@ ScanCounts scan(const SearchContext& ctx, const RayQuery& q, const SearchOptions
       }
     }
     if (!after_texel(t, counts.texels - 1)) break;
+    if (may_skip() && ctx.empty_ahead(t.face, t.i, t.j, walk.step(0), walk.step(1))) walk.leave_face();
   }
   counts.aborted = walk.aborted();
   return counts;
@@ -251,7 +287,7 @@ SearchResult search_crossing(const SearchContext& ctx, const RayQuery& q, const 
     if (first < 0) first = index;
     return index < first + CROSSING_WINDOW_TEXELS || t.l1 <= best_l;
   };
-  const ScanCounts counts = scan(ctx, q, o, on_fragment, after_texel);
+  const ScanCounts counts = scan(ctx, q, o, on_fragment, after_texel, [&] { return first < 0; });
   const Candidate& best = exact.fragment ? exact : near;
   return finish(ctx, q, best.fragment ? &best : nullptr,
                 rejected ? MissReason::threshold_rejection : MissReason::no_crossing, counts);
@@ -269,7 +305,7 @@ SearchResult search_thesis(const SearchContext& ctx, const RayQuery& q, const Se
     if (first < 0 && best.angle <= o.theta_max) first = index;
     return first < 0 || index < first + THESIS_WINDOW_TEXELS;
   };
-  const ScanCounts counts = scan(ctx, q, o, on_fragment, after_texel);
+  const ScanCounts counts = scan(ctx, q, o, on_fragment, after_texel, [&] { return first < 0; });
   const bool accepted = best.fragment && best.angle <= o.theta_max;
   SearchResult r = finish(ctx, q, accepted ? &best : nullptr,
                           best.fragment ? MissReason::threshold_rejection : MissReason::no_crossing, counts);
@@ -334,6 +370,48 @@ SearchContext::SearchContext(const Scene& scene, const CubeABuffer& cube) : scen
     if (len > 0.0 && std::isfinite(len)) planes_[k] = {n / len, glm::dot(n / len, a)};
     if (setup_triangle(view, soup, k, &setup) == SetupResult::edge_on) zero_area_.push_back(k);
   }
+  // Where each face holds fragments, row by row (empty_ahead).
+  const int n = cube.n;
+  for (size_t f = 0; f < occupied_.size(); ++f) {
+    RowBounds& rb = occupied_[f];
+    const ABuffer& b = cube.faces[f];
+    const bool known = b.width() == n && b.height() == n &&
+                       b.offsets.size() == static_cast<size_t>(n) * static_cast<size_t>(n) + 1;
+    // A face not laid out as n x n lists is taken as full: never skipped.
+    rb.min_row.assign(static_cast<size_t>(std::max(n, 0)), known ? n : 0);
+    rb.max_row.assign(static_cast<size_t>(std::max(n, 0)), known ? -1 : n - 1);
+    for (int j = 0; known && j < n; ++j) {
+      const uint32_t* row = b.offsets.data() + static_cast<size_t>(j) * static_cast<size_t>(n);
+      for (int i = 0; i < n; ++i) {
+        if (row[i + 1] == row[i]) continue;
+        rb.min_row[static_cast<size_t>(j)] = std::min(rb.min_row[static_cast<size_t>(j)], i);
+        rb.max_row[static_cast<size_t>(j)] = i;
+      }
+    }
+    rb.min_prefix = rb.min_row;
+    rb.max_prefix = rb.max_row;
+    for (size_t j = 1; j < rb.min_prefix.size(); ++j) {
+      rb.min_prefix[j] = std::min(rb.min_prefix[j], rb.min_prefix[j - 1]);
+      rb.max_prefix[j] = std::max(rb.max_prefix[j], rb.max_prefix[j - 1]);
+    }
+    rb.min_suffix = rb.min_row;
+    rb.max_suffix = rb.max_row;
+    for (size_t j = rb.min_suffix.size(); j-- > 1;) {
+      rb.min_suffix[j - 1] = std::min(rb.min_suffix[j - 1], rb.min_suffix[j]);
+      rb.max_suffix[j - 1] = std::max(rb.max_suffix[j - 1], rb.max_suffix[j]);
+    }
+  }
+}
+
+bool SearchContext::empty_ahead(int face, int i, int j, int step_i, int step_j) const {
+  const RowBounds& rb = occupied_[static_cast<size_t>(face)];
+  const size_t row = static_cast<size_t>(j);
+  // The occupied columns over the rows the walk may still visit.
+  const int lo = step_j > 0 ? rb.min_suffix[row] : (step_j < 0 ? rb.min_prefix[row] : rb.min_row[row]);
+  const int hi = step_j > 0 ? rb.max_suffix[row] : (step_j < 0 ? rb.max_prefix[row] : rb.max_row[row]);
+  if (step_i > 0) return hi < i;
+  if (step_i < 0) return lo > i;
+  return hi < i || lo > i;  // column i only
 }
 
 glm::dvec3 SearchContext::vertex(uint32_t triangle, int k) const {
@@ -413,7 +491,7 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
     res.blocked = res.transmittance == glm::dvec3(0.0);
   };
   const auto after_texel = [&](const WalkTexel&, uint32_t) { return !res.blocked; };
-  const ScanCounts counts = scan(ctx, q, options, on_fragment, after_texel);
+  const ScanCounts counts = scan(ctx, q, options, on_fragment, after_texel, [] { return true; });
   res.blockers = static_cast<uint32_t>(counted.size());
   if (!counted.empty()) {
     res.first_blocker = std::min_element(counted.begin(), counted.end(), [](const ShadowCrossing& a,

@@ -94,6 +94,7 @@
 //
 // Every search is a pure function of its inputs (thread safe); stats are per caller.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -153,11 +154,22 @@ class SearchContext {
   // The vertices of a triangle relative to the centre.
   glm::dvec3 vertex(uint32_t triangle, int k) const;
 
+  // Whether every texel (i', j') of `face` with i' - i of the sign of step_i (or 0) and
+  // j' - j of the sign of step_j (or 0) holds an empty list: the rest of a walk on that
+  // face from (i, j) then meets no fragment (its indices only move that way).
+  bool empty_ahead(int face, int i, int j, int step_i, int step_j) const;
+
  private:
   const Scene* scene_;
   const CubeABuffer* cube_;
   std::vector<Plane> planes_;
   std::vector<uint32_t> zero_area_;
+  // Per face and row j: the smallest and largest column holding a fragment over rows
+  // <= j (prefix) and >= j (suffix), and in row j alone (n and -1 when none).
+  struct RowBounds {
+    std::vector<int> min_row, max_row, min_prefix, max_prefix, min_suffix, max_suffix;
+  };
+  std::array<RowBounds, 6> occupied_;
 };
 
 struct SearchResult {
