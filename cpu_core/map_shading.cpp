@@ -1,5 +1,6 @@
 #include "map_shading.hpp"
 
+#include <atomic>
 #include <cmath>
 #include <mutex>
 #include <thread>
@@ -84,7 +85,10 @@ MapShader::MapShader(const Scene& scene, const CubeABuffer& cube, const MapShadi
       if (lenses_[i].valid) lens_of_object_[lenses_[i].object] = static_cast<int>(i);
     }
   }
-  if (options_.method == Method::envmap) build_envmap_colours();
+  if (options_.method == Method::envmap) {
+    env_colour_ = CubeImage(cube.n, 3);
+    texel_state_ = std::make_unique<std::atomic<uint8_t>[]>(6 * static_cast<size_t>(cube.n) * static_cast<size_t>(cube.n));
+  }
 }
 
 MapShader::~MapShader() = default;
@@ -206,36 +210,38 @@ glm::dvec3 MapShader::envmap_direction(const glm::dvec3& w, const glm::dvec3& r)
   return r;
 }
 
+// The map as a picture (Blinn & Newell): a texel's list resolved by Pack_Under_Mask, each
+// fragment lit by local Phong and the shadow searches, seen from the centre. Computed on
+// first lookup and kept (texel_state_: 0 not yet, 1 being computed, 2 done): the picture
+// of all 6 N^2 texels, each with shadow walks of ~N texels, costs N^3 and is mostly never
+// looked at (cornell at N = 2048 ran for over 10 minutes before this).
 glm::dvec3 MapShader::envmap_at(const glm::dvec3& direction) const {
-  const CubeTexel t = direction_to_texel(direction, env_colour_.n);
+  const int n = cube_.n;
+  const CubeTexel t = direction_to_texel(direction, n);
+  const size_t index = (static_cast<size_t>(t.face) * static_cast<size_t>(n) + static_cast<size_t>(t.j)) *
+                           static_cast<size_t>(n) + static_cast<size_t>(t.i);
+  std::atomic<uint8_t>& state = texel_state_[index];
+  uint8_t expected = 0;
+  if (state.compare_exchange_strong(expected, 1, std::memory_order_acq_rel)) {
+    env_colour_.faces[static_cast<size_t>(t.face)].set_rgb(t.i, t.j, glm::vec3(envmap_texel(t.face, t.i, t.j)));
+    state.store(2, std::memory_order_release);
+  } else {
+    while (state.load(std::memory_order_acquire) != 2) std::this_thread::yield();
+  }
   return glm::dvec3(env_colour_.faces[static_cast<size_t>(t.face)].rgb(t.i, t.j));
 }
 
-// The map as a picture (Blinn & Newell): every texel's list resolved by Pack_Under_Mask,
-// each fragment lit by local Phong and the shadow searches, seen from the centre.
-void MapShader::build_envmap_colours() {
-  const int n = cube_.n;
-  env_colour_ = CubeImage(n, 3);
-  parallel_for(static_cast<size_t>(CUBE_FACES) * static_cast<size_t>(n), thread_count(options_.threads, 6u * n),
-               [&](size_t item, int) {
-                 const int face = static_cast<int>(item / static_cast<size_t>(n));
-                 const int j = static_cast<int>(item % static_cast<size_t>(n));
-                 const ABuffer& buffer = cube_.faces[static_cast<size_t>(face)];
-                 PackScratch scratch;
-                 for (int i = 0; i < n; ++i) {
-                   const FragmentShader shade_fragment = [&](const Fragment& f) {
-                     const glm::dvec3 p = fragment_point(buffer, scene_.triangles, f, i, j);
-                     const SurfacePoint sp = surface_point(scene_, f.triangle(), p);
-                     const Material& m = scene_.materials[sp.material];
-                     const glm::dvec3 v = glm::normalize(cube_.centre - p);
-                     const glm::dvec3 nn = face_forward(sp.shading_normal, v);
-                     return ShadedFragment{phong_ambient(m, scene_.ambient) + lights(sp, v, nn, nullptr), m.opacity};
-                   };
-                   const glm::dvec3 c = pack_under_mask(buffer.list(i, j), FULL_MASK, shade_fragment, scene_.triangles,
-                                                        scene_.background, &scratch);
-                   env_colour_.faces[static_cast<size_t>(face)].set_rgb(i, j, glm::vec3(c));
-                 }
-               });
+glm::dvec3 MapShader::envmap_texel(int face, int i, int j) const {
+  const ABuffer& buffer = cube_.faces[static_cast<size_t>(face)];
+  const FragmentShader shade_fragment = [&](const Fragment& f) {
+    const glm::dvec3 p = fragment_point(buffer, scene_.triangles, f, i, j);
+    const SurfacePoint sp = surface_point(scene_, f.triangle(), p);
+    const Material& m = scene_.materials[sp.material];
+    const glm::dvec3 v = glm::normalize(cube_.centre - p);
+    const glm::dvec3 nn = face_forward(sp.shading_normal, v);
+    return ShadedFragment{phong_ambient(m, scene_.ambient) + lights(sp, v, nn, nullptr), m.opacity};
+  };
+  return pack_under_mask(buffer.list(i, j), FULL_MASK, shade_fragment, scene_.triangles, scene_.background);
 }
 
 // Error_CP and Error_Parallax of one reflection ray against the exact tracer (thesis 9).

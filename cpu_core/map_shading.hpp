@@ -26,6 +26,7 @@
 // Which shadows the envmap method casts: the same shadow search as abuffer, so that
 // comparing the methods isolates the reflection and refraction lookups.
 #pragma once
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -100,7 +101,6 @@ class MapShader {
                    MapShadingStats* stats) const;
 
   const std::vector<LensFit>& lenses() const { return lenses_; }
-  const CubeImage& envmap_colours() const { return env_colour_; }
 
  private:
   glm::dvec3 trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, uint32_t inside,
@@ -114,7 +114,7 @@ class MapShader {
   glm::dvec3 envmap_at(const glm::dvec3& direction) const;
   void measure(const glm::dvec3& w, const glm::dvec3& r, const SearchResult* found, const glm::dvec3* lookup,
                MapShadingStats* stats) const;
-  void build_envmap_colours();
+  glm::dvec3 envmap_texel(int face, int i, int j) const;
 
   const Scene& scene_;
   const CubeABuffer& cube_;
@@ -123,7 +123,9 @@ class MapShader {
   std::unique_ptr<SearchContext> ctx_;
   std::vector<LensFit> lenses_;
   std::vector<int> lens_of_object_;  // index into lenses_, -1 if none
-  CubeImage env_colour_;             // envmap: resolved colour of every texel
+  // envmap: the resolved colour of each texel looked up so far (envmap_at).
+  mutable CubeImage env_colour_;
+  std::unique_ptr<std::atomic<uint8_t>[]> texel_state_;
 };
 
 // The camera view through the camera A-buffer, every fragment shaded by `shader`, resolved
