@@ -10,6 +10,7 @@
 #include "cube_map.hpp"
 #include "error.hpp"
 #include "parallel.hpp"
+#include "raster.hpp"
 #include "raytrace.hpp"
 #include "resolve.hpp"
 #include "shading.hpp"
@@ -99,7 +100,7 @@ static uint32_t inside_after(const Scene& scene, const SurfacePoint& sp, const g
 }
 
 glm::dvec3 MapShader::shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
-                            MapShadingStats* stats) const {
+                            MapShadingStats* stats, const ShadowSamples* shadow_samples) const {
   const Material& m = scene_.materials[sp.material];
   // Coverage transparency of a found surface: the ray goes on behind it, same depth.
   glm::dvec3 behind(0.0);
@@ -110,7 +111,7 @@ glm::dvec3 MapShader::shade(const SurfacePoint& sp, const glm::dvec3& dir, int d
   }
   const glm::dvec3 v = -dir;
   const glm::dvec3 n = face_forward(sp.shading_normal, v);
-  glm::dvec3 c = phong_ambient(m, scene_.ambient) + lights(sp, v, n, stats);
+  glm::dvec3 c = phong_ambient(m, scene_.ambient) + lights(sp, v, n, stats, shadow_samples);
   const SecondaryWeights w =
       secondary_weights(m, scene_.render.fresnel, dir,
                         transmission(dir, sp.geometric_normal, sp.shading_normal, m.ior), sp.geometric_normal);
@@ -120,8 +121,14 @@ glm::dvec3 MapShader::shade(const SurfacePoint& sp, const glm::dvec3& dir, int d
 }
 
 // sum_l S_l phong_light, S_l from the shadow search (thesis 8.3).
+glm::dvec3 MapShader::visibility(const glm::dvec3& p, const PointLight& light, MapShadingStats* stats) const {
+  const ShadowResult s = shadow_search(*ctx_, p, light.position, options_.search);
+  if (stats) stats->searches.shadow.add(s);
+  return s.transmittance;
+}
+
 glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n,
-                             MapShadingStats* stats) const {
+                             MapShadingStats* stats, const ShadowSamples* shadow_samples) const {
   const Material& m = scene_.materials[sp.material];
   glm::dvec3 c(0.0);
   for (const PointLight& light : scene_.lights) {
@@ -137,9 +144,22 @@ glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const 
       c += lit;
       continue;
     }
-    const ShadowResult s = shadow_search(*ctx_, sp.point, light.position, options_.search);
-    if (stats) stats->searches.shadow.add(s);
-    c += lit * s.transmittance;
+    if (shadow_samples && shadow_samples->count > 1) {
+      // Adaptive: the first and last quarters (diagonal when all four are covered) first;
+      // only where they differ does an edge cross the pixel, and the others are walked too.
+      const ShadowSamples& q = *shadow_samples;
+      const glm::dvec3 first = visibility(q.point[0], light, stats);
+      const glm::dvec3 last = visibility(q.point[q.count - 1], light, stats);
+      glm::dvec3 s = q.weight[0] * first + q.weight[q.count - 1] * last;
+      if (first == last) {
+        for (int k = 1; k + 1 < q.count; ++k) s += q.weight[k] * first;
+      } else {
+        for (int k = 1; k + 1 < q.count; ++k) s += q.weight[k] * visibility(q.point[k], light, stats);
+      }
+      c += lit * s;
+    } else {
+      c += lit * visibility(sp.point, light, stats);
+    }
   }
   return c;
 }
@@ -314,6 +334,23 @@ class ThreadStats {
 
 }  // namespace
 
+// The quarters of the 4x8 mask (samples.hpp): columns 0-3 / 4-7 of rows 0-1 / 2-3.
+static constexpr CoverageMask QUARTERS[4] = {0x00000f0fu, 0x0000f0f0u, 0x0f0f0000u, 0xf0f00000u};
+
+static ShadowSamples shadow_samples(const ABuffer& camera, const TriangleSoup& triangles, const Fragment& f, int x, int y) {
+  ShadowSamples s;
+  const double total = mask_count(f.mask);
+  for (CoverageMask q : QUARTERS) {
+    const CoverageMask m = f.mask & q;
+    if (!m) continue;
+    const glm::dvec2 c = mask_centroid(m);
+    s.point[s.count] = point_on_triangle_plane(camera.view, triangles, f.triangle(), x + c.x, y + c.y);
+    s.weight[s.count] = mask_count(m) / total;
+    ++s.count;
+  }
+  return s;
+}
+
 Image render_with_map(const Scene& scene, const ABuffer& camera, const MapShader& shader, int threads,
                       MapShadingStats* stats) {
   ThreadStats per_thread;
@@ -321,7 +358,8 @@ Image render_with_map(const Scene& scene, const ABuffer& camera, const MapShader
     const glm::dvec3 p = fragment_point(camera, scene.triangles, f, x, y);
     const SurfacePoint sp = surface_point(scene, f.triangle(), p);
     const glm::dvec3 dir = glm::normalize(p - scene.camera.position);
-    const glm::dvec3 c = shader.shade(sp, dir, 0, true, per_thread.slot());
+    const ShadowSamples samples = shadow_samples(camera, scene.triangles, f, x, y);
+    const glm::dvec3 c = shader.shade(sp, dir, 0, true, per_thread.slot(), &samples);
     return ShadedFragment{c, scene.materials[sp.material].opacity};
   };
   ResolveOptions ro;

@@ -98,7 +98,7 @@ TEST(MapShading, HiddenPointIsFoundOnlyWithAllLayers) {
 // reflectors (hidden_point, cornell): the A-buffered map is clearly closer than the
 // Z-buffered map and Blinn-Newell. Measured at these sizes (2026-11-21):
 //   hidden_point 128 px, N = 256: abuffer 40.6 dB, thesis 40.4, zbuffer 29.2, envmap 25.4
-//   cornell      96 px,  N = 256: abuffer 30.0 dB, thesis 22.7, zbuffer 16.5, envmap 15.5
+//   cornell      96 px,  N = 256: abuffer 30.8 dB, thesis 22.7, zbuffer 16.6, envmap 15.5
 // The floors below are those figures less 2 dB; the margins are what the thesis claims.
 struct MethodCase {
   const char* scene;
@@ -137,7 +137,7 @@ TEST_P(MethodsAgainstReference, AbufferIsClosestToTheExactImage) {
 
 INSTANTIATE_TEST_SUITE_P(Scenes, MethodsAgainstReference,
                          ::testing::Values(MethodCase{"hidden_point.json", 128, 38.6},
-                                           MethodCase{"cornell.json", 96, 28.0}));
+                                           MethodCase{"cornell.json", 96, 28.8}));
 
 }  // namespace
 }  // namespace abcube
