@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -39,13 +38,6 @@ struct Result {
   char error[256] = {0};
 };
 
-std::vector<int> parse_sizes(const std::string& s) {
-  std::vector<int> out;
-  std::stringstream ss(s);
-  for (std::string item; std::getline(ss, item, ',');) out.push_back(std::stoi(item));
-  return out;
-}
-
 Options parse(int argc, char** argv) {
   Options o;
   for (int i = 1; i < argc; ++i) {
@@ -55,11 +47,11 @@ Options parse(int argc, char** argv) {
       return argv[++i];
     };
     if (a == "--sizes") {
-      o.sizes = parse_sizes(value());
+      o.sizes = parse_int_list(a, value());
     } else if (a == "--runs") {
-      o.runs = std::stoi(value());
+      o.runs = parse_int(a, value());
     } else if (a == "--threads") {
-      o.threads = std::stoi(value());
+      o.threads = parse_int(a, value());
     } else if (a == "--camera") {
       o.camera = true;
     } else if (!a.empty() && a[0] == '-') {

@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -76,9 +75,7 @@ int run(const std::vector<std::string>& words) {
   const int samples = args.get_int("--error-samples", 20000, 0, 100000000);
   GlChoice choice = GlChoice::automatic;
   if (args.has("--gl") && !parse_gl_choice(args.get("--gl"), &choice)) throw InputError("--gl: unknown path");
-  std::vector<int> sizes;
-  std::stringstream ss(args.get("--sizes", "256,512,1024"));
-  for (std::string item; std::getline(ss, item, ',');) sizes.push_back(std::stoi(item));
+  const std::vector<int> sizes = parse_int_list("--sizes", args.get("--sizes", "256,512,1024"));
 
   std::string log;
   auto ctx = open_gl_context(choice, -1, &log);

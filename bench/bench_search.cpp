@@ -14,7 +14,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <random>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -42,13 +41,6 @@ struct Options {
   unsigned seed = 1;
 };
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  for (std::string item; std::getline(ss, item, ',');) out.push_back(item);
-  return out;
-}
-
 Options parse(int argc, char** argv) {
   Options o;
   for (int i = 1; i < argc; ++i) {
@@ -58,11 +50,10 @@ Options parse(int argc, char** argv) {
       return argv[++i];
     };
     if (a == "--sizes") {
-      o.sizes.clear();
-      for (const std::string& s : split(value())) o.sizes.push_back(std::stoi(s));
+      o.sizes = parse_int_list(a, value());
     } else if (a == "--modes") {
       o.modes.clear();
-      for (const std::string& s : split(value())) {
+      for (const std::string& s : split_list(value())) {
         SearchMode m;
         if (!parse_search_mode(s, &m)) throw InputError("--modes: unknown mode " + s);
         o.modes.push_back(m);
@@ -76,9 +67,9 @@ Options parse(int argc, char** argv) {
       if (v != "on" && v != "off") throw InputError("--merge: on or off, got " + v);
       o.merge = v == "on";
     } else if (a == "--runs") {
-      o.runs = std::stoi(value());
+      o.runs = parse_int(a, value());
     } else if (a == "--rays") {
-      o.rays = std::stoi(value());
+      o.rays = parse_int(a, value());
     } else if (a == "--seed") {
       o.seed = static_cast<unsigned>(std::stoul(value()));
     } else if (!a.empty() && a[0] == '-') {
