@@ -1,5 +1,6 @@
 #include "map_shading.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <mutex>
@@ -9,6 +10,7 @@
 #include "camera.hpp"
 #include "cube_map.hpp"
 #include "error.hpp"
+#include "image_io.hpp"
 #include "parallel.hpp"
 #include "raster.hpp"
 #include "raytrace.hpp"
@@ -100,7 +102,7 @@ static uint32_t inside_after(const Scene& scene, const SurfacePoint& sp, const g
 }
 
 glm::dvec3 MapShader::shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
-                            MapShadingStats* stats, const ShadowSamples* shadow_samples) const {
+                            MapShadingStats* stats) const {
   const Material& m = scene_.materials[sp.material];
   // Coverage transparency of a found surface: the ray goes on behind it, same depth.
   glm::dvec3 behind(0.0);
@@ -111,7 +113,7 @@ glm::dvec3 MapShader::shade(const SurfacePoint& sp, const glm::dvec3& dir, int d
   }
   const glm::dvec3 v = -dir;
   const glm::dvec3 n = face_forward(sp.shading_normal, v);
-  glm::dvec3 c = phong_ambient(m, scene_.ambient) + lights(sp, v, n, stats, shadow_samples);
+  glm::dvec3 c = phong_ambient(m, scene_.ambient) + lights(sp, v, n, stats);
   const SecondaryWeights w =
       secondary_weights(m, scene_.render.fresnel, dir,
                         transmission(dir, sp.geometric_normal, sp.shading_normal, m.ior), sp.geometric_normal);
@@ -128,7 +130,7 @@ glm::dvec3 MapShader::visibility(const glm::dvec3& p, const PointLight& light, M
 }
 
 glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n,
-                             MapShadingStats* stats, const ShadowSamples* shadow_samples) const {
+                             MapShadingStats* stats) const {
   const Material& m = scene_.materials[sp.material];
   glm::dvec3 c(0.0);
   for (const PointLight& light : scene_.lights) {
@@ -144,22 +146,7 @@ glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const 
       c += lit;
       continue;
     }
-    if (shadow_samples && shadow_samples->count > 1) {
-      // Adaptive: the first and last quarters (diagonal when all four are covered) first;
-      // only where they differ does an edge cross the pixel, and the others are walked too.
-      const ShadowSamples& q = *shadow_samples;
-      const glm::dvec3 first = visibility(q.point[0], light, stats);
-      const glm::dvec3 last = visibility(q.point[q.count - 1], light, stats);
-      glm::dvec3 s = q.weight[0] * first + q.weight[q.count - 1] * last;
-      if (first == last) {
-        for (int k = 1; k + 1 < q.count; ++k) s += q.weight[k] * first;
-      } else {
-        for (int k = 1; k + 1 < q.count; ++k) s += q.weight[k] * visibility(q.point[k], light, stats);
-      }
-      c += lit * s;
-    } else {
-      c += lit * visibility(sp.point, light, stats);
-    }
+    c += lit * visibility(sp.point, light, stats);
   }
   return c;
 }
@@ -337,30 +324,63 @@ class ThreadStats {
 // The quarters of the 4x8 mask (samples.hpp): columns 0-3 / 4-7 of rows 0-1 / 2-3.
 static constexpr CoverageMask QUARTERS[4] = {0x00000f0fu, 0x0000f0f0u, 0x0f0f0000u, 0xf0f00000u};
 
-static ShadowSamples shadow_samples(const ABuffer& camera, const TriangleSoup& triangles, const Fragment& f, int x, int y) {
-  ShadowSamples s;
-  const double total = mask_count(f.mask);
-  for (CoverageMask q : QUARTERS) {
-    const CoverageMask m = f.mask & q;
-    if (!m) continue;
-    const glm::dvec2 c = mask_centroid(m);
-    s.point[s.count] = point_on_triangle_plane(camera.view, triangles, f.triangle(), x + c.x, y + c.y);
-    s.weight[s.count] = mask_count(m) / total;
-    ++s.count;
+// Is the sRGB-encoded difference of two colours above QUARTER_SPLIT_SRGB in any channel?
+static bool differ(const glm::dvec3& a, const glm::dvec3& b) {
+  for (int k = 0; k < 3; ++k) {
+    const double ea = srgb_encode(static_cast<float>(std::clamp(a[k], 0.0, 1.0)));
+    const double eb = srgb_encode(static_cast<float>(std::clamp(b[k], 0.0, 1.0)));
+    if (std::fabs(ea - eb) > QUARTER_SPLIT_SRGB) return true;
   }
-  return s;
+  return false;
 }
 
 Image render_with_map(const Scene& scene, const ABuffer& camera, const MapShader& shader, int threads,
                       MapShadingStats* stats) {
   ThreadStats per_thread;
+  // The fragment shaded at its covered quarters, adaptively (header, QUARTER_SPLIT_SRGB).
   const PixelShader shade = [&](const Fragment& f, int x, int y) {
-    const glm::dvec3 p = fragment_point(camera, scene.triangles, f, x, y);
-    const SurfacePoint sp = surface_point(scene, f.triangle(), p);
-    const glm::dvec3 dir = glm::normalize(p - scene.camera.position);
-    const ShadowSamples samples = shadow_samples(camera, scene.triangles, f, x, y);
-    const glm::dvec3 c = shader.shade(sp, dir, 0, true, per_thread.slot(), &samples);
-    return ShadedFragment{c, scene.materials[sp.material].opacity};
+    MapShadingStats* s = per_thread.slot();
+    const glm::dvec3 eye = scene.camera.position;
+    // One pixel's width seen from the eye, in radians (the mesh refinement's radius).
+    const double pixel = glm::length(glm::normalize(camera.view.direction(x + 1.5, y + 0.5)) -
+                                     glm::normalize(camera.view.direction(x + 0.5, y + 0.5)));
+    // A point of the fragment's plane, moved onto the surface the eye ray through it really
+    // crosses (a merged fragment keeps one triangle of several: abuffer.hpp MERGE).
+    const auto shade_at = [&](const glm::dvec3& p) {
+      const glm::dvec3 dir = glm::normalize(p - eye);
+      uint32_t tri = f.triangle();
+      glm::dvec3 on = p;
+      double l = 0;
+      const double dist = glm::length(p - eye);
+      if (shader.refines_on_mesh() && mesh_crossing(shader.context(), eye, dir, tri, dist, dist * pixel, &tri, &l)) {
+        on = eye + l * dir;
+      } else {
+        tri = f.triangle();
+      }
+      return shader.shade(surface_point(scene, tri, on), dir, 0, true, s);
+    };
+    glm::dvec3 point[4];
+    double weight[4];
+    int count = 0;
+    const double total = mask_count(f.mask);
+    for (CoverageMask q : QUARTERS) {
+      const CoverageMask m = f.mask & q;
+      if (!m) continue;
+      const glm::dvec2 c = mask_centroid(m);
+      point[count] = point_on_triangle_plane(camera.view, scene.triangles, f.triangle(), x + c.x, y + c.y);
+      weight[count] = mask_count(m) / total;
+      ++count;
+    }
+    glm::dvec3 c(0.0);
+    if (count <= 1) {
+      c = shade_at(fragment_point(camera, scene.triangles, f, x, y));
+    } else {
+      const glm::dvec3 first = shade_at(point[0]), last = shade_at(point[count - 1]);
+      c = weight[0] * first + weight[count - 1] * last;
+      const bool split = differ(first, last);
+      for (int k = 1; k + 1 < count; ++k) c += weight[k] * (split ? shade_at(point[k]) : 0.5 * (first + last));
+    }
+    return ShadedFragment{c, scene.materials[scene.triangles.material_id[f.triangle()]].opacity};
   };
   ResolveOptions ro;
   ro.threads = threads;

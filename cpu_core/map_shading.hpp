@@ -78,18 +78,18 @@ struct MapShadingStats {
 };
 
 // A point on a triangle: what the rules need to shade it.
-// Where a camera fragment's shadows are sampled: up to four points of its triangle's plane
-// (the centroids of its covered samples in each 4x2 quarter of the 4x8 mask), weighted by
-// their sample counts. One shading point per fragment is the A-buffer's design, but a
-// hard shadow edge through a pixel is then all or nothing where the tracer averages its
-// 32 samples: on scenes/default.json that alone cost 5 dB (35.6 dB; 40.7 without shadows).
-// The shadow of each light is walked from the first and last points; only where they
-// differ (an edge crosses the pixel) from the others too.
-struct ShadowSamples {
-  glm::dvec3 point[4];
-  double weight[4] = {0, 0, 0, 0};
-  int count = 0;
-};
+// Where a camera fragment is shaded (render_with_map): at up to four points of its
+// triangle's plane, the centroids of its covered samples in each 4x2 quarter of the 4x8
+// mask, weighted by their sample counts. One shading point per fragment is the A-buffer's
+// design, but an edge through the pixel of anything the point's shading depends on (a hard
+// shadow, a silhouette seen in a mirror or through glass) is then all or nothing where
+// the tracer averages its 32 samples: on scenes/default.json the shadows alone cost 5 dB
+// (35.6 dB; 40.7 without shadows), on cornell.json the edges of the room seen in its mirror
+// made most of the remaining error. ADAPTIVE: the first and last covered quarters (the
+// diagonal when all four are) are shaded; only where their colours differ by more than
+// QUARTER_SPLIT_SRGB (sRGB-encoded, any channel) are the others shaded too, else they take
+// the mean of the two.
+constexpr double QUARTER_SPLIT_SRGB = 1.0 / 255.0;
 
 struct SurfacePoint {
   glm::dvec3 point{0.0};
@@ -111,15 +111,21 @@ class MapShader {
   // marks a camera fragment: its coverage transparency is the resolve's business, and
   // its reflection rays are the ones measured against the reference.
   glm::dvec3 shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
-                   MapShadingStats* stats, const ShadowSamples* shadow_samples = nullptr) const;
+                   MapShadingStats* stats) const;
 
   const std::vector<LensFit>& lenses() const { return lenses_; }
+  const SearchContext& context() const { return *ctx_; }
+  // Crossing searches with MESH REFINEMENT (search.hpp): camera fragments' shading points
+  // are moved onto the surface the same way.
+  bool refines_on_mesh() const {
+    return options_.search.mode == SearchMode::crossing && options_.search.refine == SearchRefine::mesh;
+  }
 
  private:
   glm::dvec3 trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, uint32_t inside,
                    MapShadingStats* stats, SearchResult* found) const;
   glm::dvec3 lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n,
-                    MapShadingStats* stats, const ShadowSamples* shadow_samples = nullptr) const;
+                    MapShadingStats* stats) const;
   glm::dvec3 visibility(const glm::dvec3& p, const PointLight& light, MapShadingStats* stats) const;
   glm::dvec3 reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
                        MapShadingStats* stats) const;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <tuple>
 #include <limits>
 
 #include "cube_walk.hpp"
@@ -165,32 +167,136 @@ struct Candidate {
   double outside = 0;   // crossing: distance from the triangle, in texels
   glm::dvec3 x{0.0};    // X', relative to the centre
   const Fragment* fragment = nullptr;
+  uint32_t triangle = 0;   // the surface found: the fragment's triangle or, refined on the mesh, the one crossed
+  bool back_face = false;  // its facing as seen from the centre (abuffer.hpp)
   CubeTexel texel{0, 0, 0};
 };
 
-// Crossing mode (header): the ray meets the fragment's triangle plane at X(l').
+// The exact crossing of the ray with triangle `tri` (its plane met at l in [self, l_max],
+// the point on the triangle to ON_TRIANGLE_TEXELS): the parameter l, or INF.
+double exact_crossing(const SearchContext& ctx, const RayQuery& q, uint32_t tri) {
+  const SearchContext::Plane& p = ctx.plane(tri);
+  const double den = glm::dot(p.normal, q.d);
+  if (den == 0.0) return INF;
+  const double l = (p.offset - glm::dot(p.normal, q.w)) / den;
+  if (!(l >= q.self) || !(l <= q.l_max)) return INF;
+  const glm::dvec3 x = q.w + l * q.d;
+  // In-plane distance outside each edge line: within the tolerance of all three is on the
+  // triangle (near a corner this admits up to the tolerance times 1/sin(corner angle / 2)).
+  const SearchContext::Bounds& b = ctx.bounds(tri);
+  const double tolerance = -ON_TRIANGLE_TEXELS * texel_size_at(x, ctx.cube().n);
+  for (size_t k = 0; k < 3; ++k) {
+    if (glm::dot(b.edge_normal[k], x) - b.edge_offset[k] < tolerance) return INF;
+  }
+  return b.radius > 0.0 ? l : INF;
+}
+
+// MESH REFINEMENT (crossing mode; header). The answer of the mesh around a fragment's
+// triangle when the ray does not cross that triangle itself.
+enum class Refined { hit, miss, unknown };
+struct MeshAnswer {
+  Refined result = Refined::unknown;
+  uint32_t triangle = 0;
+  double l = INF;
+};
+
+// Does a triangle's bounding sphere come within `radius` of the ray's stretch [l_lo, l_hi]?
+bool near_ray(const SearchContext::Bounds& b, const RayQuery& q, double l_lo, double l_hi, double radius) {
+  const double along = std::clamp(glm::dot(b.centroid - q.w, q.d), l_lo, l_hi);
+  const glm::dvec3 off = b.centroid - (q.w + along * q.d);
+  const double reach = b.radius + radius;
+  return glm::dot(off, off) <= reach * reach;
+}
+
+// Floods the edge-connected triangles of `start` that come within `radius` of the ray's
+// stretch [l_lo, l_hi] (bounding spheres), testing each for an exact crossing: hit (the
+// smallest l), miss (the flood ended with none), or unknown (more than
+// REFINE_MAX_TRIANGLES triangles were near: the caller falls back on the plane tolerance).
+MeshAnswer refine_on_mesh(const SearchContext& ctx, const RayQuery& q, uint32_t start, double l_lo, double l_hi,
+                          double radius) {
+  MeshAnswer a;
+  // A start triangle away from the ray: the mesh near the ray may be elsewhere in the
+  // fragment's patch (merged), the flood cannot say.
+  if (!near_ray(ctx.bounds(start), q, l_lo, l_hi, radius)) return a;
+  std::array<uint32_t, REFINE_MAX_TRIANGLES> seen{};
+  size_t count = 0, next = 0;
+  seen[count++] = start;
+  bool overflow = false;
+  while (next < count) {
+    const uint32_t tri = seen[next++];
+    const double l = exact_crossing(ctx, q, tri);
+    if (l < a.l) {
+      a.l = l;
+      a.triangle = tri;
+      if (tri == start) break;  // the ray crosses the start triangle itself
+    }
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t nb = ctx.neighbour(tri, k);
+      if (nb == SearchContext::NO_NEIGHBOUR || std::find(seen.begin(), seen.begin() + static_cast<std::ptrdiff_t>(count), nb) !=
+                                                     seen.begin() + static_cast<std::ptrdiff_t>(count)) {
+        continue;
+      }
+      if (!near_ray(ctx.bounds(nb), q, l_lo, l_hi, radius)) continue;
+      if (count == seen.size()) {
+        overflow = true;
+        continue;
+      }
+      seen[count++] = nb;
+    }
+  }
+  if (a.l < INF) a.result = Refined::hit;
+  else a.result = overflow ? Refined::unknown : Refined::miss;
+  return a;
+}
+
+// Crossing mode (header): the ray meets the fragment's triangle plane at X(l'); refined on
+// the mesh around that triangle unless the ray crosses the triangle itself there.
 Candidate crossing_candidate(const SearchContext& ctx, const RayQuery& q, const SearchOptions& o, const WalkTexel& t,
                              const Fragment& f) {
   Candidate c;
   const uint32_t tri = f.triangle();
   const SearchContext::Plane& p = ctx.plane(tri);
   const double den = glm::dot(p.normal, q.d);
-  if (den == 0.0) return c;
-  const double l = (p.offset - glm::dot(p.normal, q.w)) / den;
+  const double l = den == 0.0 ? INF : (p.offset - glm::dot(p.normal, q.w)) / den;
   // The map's evidence: the point lies in the texel holding the fragment (to rounding).
   const double slack = 1e-9 * (std::fabs(l) + glm::length(q.w));
-  if (!(l >= q.self) || !(l <= q.l_max) || !(l >= t.l0 - slack && l <= t.l1 + slack)) return c;
-  c.x = q.w + l * q.d;
-  c.l = l;
-  c.angle = 0.0;
-  c.outside = distance_to_triangle(c.x, ctx.vertex(tri, 0), ctx.vertex(tri, 1), ctx.vertex(tri, 2), p.normal,
-                                   p.offset) /
-              texel_size_at(c.x, ctx.cube().n);
-  c.exact = c.outside <= ON_TRIANGLE_TEXELS;
-  c.tested = true;
-  c.valid = c.outside <= o.tolerance_texels && (c.exact || l >= q.self_tolerance);
+  const bool in_texel = den != 0.0 && l >= q.self && l <= q.l_max && l >= t.l0 - slack && l <= t.l1 + slack;
   c.fragment = &f;
   c.texel = {t.face, t.i, t.j};
+  if (in_texel) {
+    c.x = q.w + l * q.d;
+    c.l = l;
+    c.angle = 0.0;
+    c.outside = distance_to_triangle(c.x, ctx.vertex(tri, 0), ctx.vertex(tri, 1), ctx.vertex(tri, 2), p.normal,
+                                     p.offset) /
+                texel_size_at(c.x, ctx.cube().n);
+    c.exact = c.outside <= ON_TRIANGLE_TEXELS;
+    c.tested = true;
+  }
+  if (!c.exact && o.refine == SearchRefine::mesh) {
+    const double l_ref = std::isinf(t.l1) ? t.l0 : 0.5 * (t.l0 + t.l1);
+    const double radius = std::max(o.tolerance_texels, 1.0) * texel_size_at(q.w + l_ref * q.d, ctx.cube().n);
+    const MeshAnswer m = refine_on_mesh(ctx, q, tri, t.l0 - radius, t.l1 + radius, radius);
+    if (m.result == Refined::hit) {
+      c.x = q.w + m.l * q.d;
+      c.l = m.l;
+      c.angle = 0.0;
+      c.outside = 0.0;
+      c.exact = c.tested = c.valid = true;
+      c.triangle = m.triangle;
+      c.back_face = ctx.plane(m.triangle).offset > 0.0;
+      return c;
+    }
+    if (m.result == Refined::miss) {  // the mesh says the ray passes by: not a crossing
+      c.tested = in_texel;
+      c.outside = INF;
+      return c;
+    }
+  }
+  if (!c.tested) return Candidate{};
+  c.valid = c.outside <= o.tolerance_texels && (c.exact || l >= q.self_tolerance);
+  c.triangle = tri;
+  c.back_face = f.back_face();
   return c;
 }
 
@@ -211,6 +317,8 @@ Candidate thesis_candidate(const SearchContext& ctx, const RayQuery& q, const Wa
   c.angle = std::atan2(glm::length(glm::cross(e, q.d)), c.l);
   c.valid = true;
   c.fragment = &f;
+  c.triangle = f.triangle();
+  c.back_face = f.back_face();
   c.texel = {t.face, t.i, t.j};
   return c;
 }
@@ -238,10 +346,10 @@ SearchResult make_result(const SearchContext& ctx, const RayQuery& q, const Cand
   SearchResult r;
   r.hit = true;
   r.miss = MissReason::none;
-  r.triangle = c.fragment->triangle();
+  r.triangle = c.triangle;
   r.object_id = ctx.scene().triangles.object_id[r.triangle];
   r.material_id = ctx.scene().triangles.material_id[r.triangle];
-  r.back_face = c.fragment->back_face();
+  r.back_face = c.back_face;
   r.point = ctx.cube().centre + c.x;
   r.distance = glm::length(c.x - q.w);
   r.angle = c.angle;
@@ -345,6 +453,15 @@ bool parse_search_mode(const std::string& s, SearchMode* out) {
   return true;
 }
 
+const char* search_refine_name(SearchRefine r) { return r == SearchRefine::plane ? "plane" : "mesh"; }
+
+bool parse_search_refine(const std::string& s, SearchRefine* out) {
+  if (s == "mesh") *out = SearchRefine::mesh;
+  else if (s == "plane") *out = SearchRefine::plane;
+  else return false;
+  return true;
+}
+
 const char* miss_reason_name(MissReason r) {
   switch (r) {
     case MissReason::none: return "none";
@@ -360,6 +477,7 @@ SearchContext::SearchContext(const Scene& scene, const CubeABuffer& cube) : scen
   const TriangleSoup& soup = scene.triangles;
   const uint32_t count = static_cast<uint32_t>(soup.triangle_count());
   planes_.resize(count);
+  bounds_.resize(count);
   // The raster's own rule decides which triangles the map cannot hold (raster.hpp).
   const RasterView view = cube_face_view(0, cube.centre, std::max(cube.n, 1), cube.near_distance);
   TriangleSetup setup;
@@ -367,9 +485,22 @@ SearchContext::SearchContext(const Scene& scene, const CubeABuffer& cube) : scen
     const glm::dvec3 a = vertex(k, 0);
     const glm::dvec3 n = glm::cross(vertex(k, 1) - a, vertex(k, 2) - a);
     const double len = glm::length(n);
-    if (len > 0.0 && std::isfinite(len)) planes_[k] = {n / len, glm::dot(n / len, a)};
+    if (len > 0.0 && std::isfinite(len)) {
+      planes_[k] = {n / len, glm::dot(n / len, a)};
+      Bounds& b = bounds_[k];
+      const glm::dvec3 v[3] = {a, vertex(k, 1), vertex(k, 2)};
+      b.centroid = (v[0] + v[1] + v[2]) / 3.0;
+      for (size_t e = 0; e < 3; ++e) {
+        const glm::dvec3 m = glm::cross(n / len, v[(e + 1) % 3] - v[e]);
+        const double ml = glm::length(m);
+        if (ml > 0.0) b.edge_normal[e] = m / ml;
+        b.edge_offset[e] = glm::dot(b.edge_normal[e], v[e]);
+        b.radius = std::max(b.radius, glm::length(v[e] - b.centroid));
+      }
+    }
     if (setup_triangle(view, soup, k, &setup) == SetupResult::edge_on) zero_area_.push_back(k);
   }
+  build_neighbours();
   // Where each face holds fragments, row by row (empty_ahead).
   const int n = cube.n;
   for (size_t f = 0; f < occupied_.size(); ++f) {
@@ -403,6 +534,59 @@ SearchContext::SearchContext(const Scene& scene, const CubeABuffer& cube) : scen
   }
 }
 
+// Vertices are the same when their object and float position are (bit for bit, -0 = +0);
+// an edge links the two triangles that have it, in either direction.
+void SearchContext::build_neighbours() {
+  const TriangleSoup& soup = scene_->triangles;
+  const size_t count = soup.triangle_count();
+  neighbours_.assign(count, {NO_NEIGHBOUR, NO_NEIGHBOUR, NO_NEIGHBOUR});
+  struct Corner {
+    uint32_t object;
+    std::array<uint32_t, 3> bits;
+    uint32_t index;  // 3 * triangle + k
+  };
+  std::vector<Corner> corners(3 * count);
+  for (size_t c = 0; c < corners.size(); ++c) {
+    const glm::vec3 v = soup.positions[c] + glm::vec3(0.0f);  // -0 -> +0
+    Corner& k = corners[c];
+    k.object = soup.object_id[c / 3];
+    std::memcpy(k.bits.data(), &v[0], sizeof(float));
+    std::memcpy(k.bits.data() + 1, &v[1], sizeof(float));
+    std::memcpy(k.bits.data() + 2, &v[2], sizeof(float));
+    k.index = static_cast<uint32_t>(c);
+  }
+  std::sort(corners.begin(), corners.end(), [](const Corner& a, const Corner& b) {
+    return std::tie(a.object, a.bits, a.index) < std::tie(b.object, b.bits, b.index);
+  });
+  std::vector<uint32_t> vertex_id(corners.size());
+  uint32_t id = 0;
+  for (size_t c = 0; c < corners.size(); ++c) {
+    if (c > 0 && (corners[c].object != corners[c - 1].object || corners[c].bits != corners[c - 1].bits)) ++id;
+    vertex_id[corners[c].index] = id;
+  }
+  // (smaller vertex id, larger vertex id, 3 * triangle + edge), sorted: equal edges adjacent.
+  std::vector<std::pair<uint64_t, uint32_t>> edges;
+  edges.reserve(3 * count);
+  for (size_t t = 0; t < count; ++t) {
+    for (size_t k = 0; k < 3; ++k) {
+      const uint64_t a = vertex_id[3 * t + k], b = vertex_id[3 * t + (k + 1) % 3];
+      if (a == b) continue;
+      edges.push_back({std::min(a, b) << 32 | std::max(a, b), static_cast<uint32_t>(3 * t + k)});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  for (size_t e = 0; e < edges.size();) {
+    size_t end = e + 1;
+    while (end < edges.size() && edges[end].first == edges[e].first) ++end;
+    if (end - e == 2) {  // manifold edge; a border (1) or a non-manifold edge (> 2) links nothing
+      const uint32_t x = edges[e].second, y = edges[e + 1].second;
+      neighbours_[x / 3][x % 3] = y / 3;
+      neighbours_[y / 3][y % 3] = x / 3;
+    }
+    e = end;
+  }
+}
+
 bool SearchContext::empty_ahead(int face, int i, int j, int step_i, int step_j) const {
   const RowBounds& rb = occupied_[static_cast<size_t>(face)];
   const size_t row = static_cast<size_t>(j);
@@ -417,6 +601,19 @@ bool SearchContext::empty_ahead(int face, int i, int j, int step_i, int step_j) 
 glm::dvec3 SearchContext::vertex(uint32_t triangle, int k) const {
   return glm::dvec3(scene_->triangles.positions[3 * static_cast<size_t>(triangle) + static_cast<size_t>(k)]) -
          cube_->centre;
+}
+
+bool mesh_crossing(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& dir, uint32_t triangle,
+                   double l_near, double radius, uint32_t* crossed, double* l) {
+  RayQuery q;
+  q.w = w - ctx.cube().centre;
+  q.d = dir;
+  q.self = -INF;
+  const MeshAnswer m = refine_on_mesh(ctx, q, triangle, l_near - radius, l_near + radius, radius);
+  if (m.result != Refined::hit) return false;
+  *crossed = m.triangle;
+  *l = m.l;
+  return true;
 }
 
 SearchResult reflection_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& r,
@@ -450,12 +647,12 @@ struct ShadowCrossing {
 // grazing surface, so a concave transparent object crossed twice with one facing counts once).
 bool already_counted(const std::vector<ShadowCrossing>& counted, const SearchContext& ctx, const SearchOptions& o,
                      const Candidate& c) {
-  const uint32_t tri = c.fragment->triangle();
+  const uint32_t tri = c.triangle;
   const uint32_t object = ctx.scene().triangles.object_id[tri];
   const double near = (o.tolerance_texels + 1.0) * texel_size_at(c.x, ctx.cube().n);
   for (const ShadowCrossing& k : counted) {
     if (k.triangle == tri) return true;
-    if (k.object != object || k.back_face != c.fragment->back_face()) continue;
+    if (k.object != object || k.back_face != c.back_face) continue;
     if (o.mode == SearchMode::thesis || glm::length(k.x - c.x) <= near) return true;
   }
   return false;
@@ -484,8 +681,8 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
       return;
     }
     if (already_counted(counted, ctx, options, c)) return;
-    const uint32_t tri = f.triangle();
-    counted.push_back({tri, ctx.scene().triangles.object_id[tri], f.back_face(), c.x, c.l});
+    const uint32_t tri = c.triangle;
+    counted.push_back({tri, ctx.scene().triangles.object_id[tri], c.back_face, c.x, c.l});
     // thesis 8.3; rule "shadows" (shading.hpp): S_l is the product over the blockers.
     res.transmittance *= blocker_transmittance(ctx.scene().materials[ctx.scene().triangles.material_id[tri]]);
     res.blocked = res.transmittance == glm::dvec3(0.0);

@@ -36,6 +36,24 @@
 // rejection): bench_search measures it on the terrain of scenes/bench/spheres_terrain.json
 // (--merge off for the unmerged map).
 //
+// MESH REFINEMENT (crossing mode, SearchRefine::mesh, the default; --refine mesh|plane).
+// The plane of one triangle says little near that triangle's edges: a ray passing within
+// the tolerance outside a silhouette, or crossing the extension of a box's top face just
+// beyond the crease, was accepted as a crossing (a false hit, a false shadow); and a
+// merged fragment's triangle is often not the one the ray crosses. So a candidate whose
+// ray does not cross its own triangle asks the mesh around it: the triangles
+// edge-connected to it (SearchContext::neighbour: same object, shared vertex positions
+// bit for bit) whose bounding spheres come within max(tolerance, 1) texel of the ray's
+// stretch in that texel (widened by the same), flooded breadth-first and each tested for
+// an exact crossing (on the triangle to ON_TRIANGLE_TEXELS, anywhere on the ray past the
+// self offset). A crossing found is an exact candidate (its triangle and facing replace
+// the fragment's); a flood that ends with none rejects the candidate (the ray passes by
+// that surface here); a flood that reaches REFINE_MAX_TRIANGLES, or a fragment triangle
+// whose sphere is not near the ray, leaves the plane rule above to decide. Plain meshes
+// without shared vertices (triangle soups) therefore behave as before. Measured on the
+// repository scenes (abuffer, N = 512): default 37.3 -> 41.3 dB, cornell 34.3 -> 39.4 dB
+// (the rest of the gain there is map_shading.hpp's per-quarter shading).
+//
 // MODE thesis (thesis 7.4.1 pseudo-code, 9.3.4). Each tested fragment gives the point
 // a V, V the texel-centre direction and a its distance to the fragment's plane along V
 // (the Z-buffer's alpha); the angle between R and (a V - W) is its error. The best
@@ -109,8 +127,11 @@ namespace abcube {
 
 enum class SearchMode { crossing, thesis };
 enum class SearchLayers { all, nearest };  // A-buffer (thesis 7.5) or Z-buffer (Patow 1995)
+enum class SearchRefine { mesh, plane };   // crossing mode: MESH REFINEMENT on or off
 const char* search_mode_name(SearchMode m);
 bool parse_search_mode(const std::string& s, SearchMode* out);  // "crossing" | "thesis"
+const char* search_refine_name(SearchRefine r);
+bool parse_search_refine(const std::string& s, SearchRefine* out);  // "mesh" | "plane"
 
 // Texels the crossing mode walks past its first accepted candidate, and the thesis mode
 // past its first candidate under theta_max.
@@ -119,12 +140,15 @@ constexpr int THESIS_WINDOW_TEXELS = 2;
 // Default self offsets per mode, in texels at W (SELF-HITS above).
 constexpr double SELF_OFFSET_CROSSING_TEXELS = 1e-3;
 constexpr double SELF_OFFSET_THESIS_TEXELS = 0.5;
+// MESH REFINEMENT: the most triangles one refinement floods before it gives up (unknown).
+constexpr size_t REFINE_MAX_TRIANGLES = 32;
 
 struct SearchOptions {
   SearchMode mode = SearchMode::crossing;
   SearchLayers layers = SearchLayers::all;
   double theta_max = 0.034906585039886591;  // thesis mode: 2 degrees, in radians
   double tolerance_texels = 1.0;            // crossing mode: largest accepted e
+  SearchRefine refine = SearchRefine::mesh;  // crossing mode: refine on the mesh (header)
   double self_offset_texels = 0;            // W's own surface and points closer; 0 = the mode's default
   uint32_t max_texels = 0;                  // walk cap; 0 = CubeWalk's default
 };
@@ -151,8 +175,22 @@ class SearchContext {
     double offset = 0;       // normal . X for X on the plane, X relative to the centre
   };
   const Plane& plane(uint32_t triangle) const { return planes_[triangle]; }
+  // What the MESH REFINEMENT tests per triangle, relative to the centre: the in-plane
+  // inward unit normals of its edges (edge k from vertex k to k+1) with their offsets, and
+  // a bounding sphere (centroid, largest vertex distance). Zero for a degenerate triangle.
+  struct Bounds {
+    std::array<glm::dvec3, 3> edge_normal{};
+    std::array<double, 3> edge_offset{};
+    glm::dvec3 centroid{0.0};
+    double radius = 0;
+  };
+  const Bounds& bounds(uint32_t triangle) const { return bounds_[triangle]; }
   // The vertices of a triangle relative to the centre.
   glm::dvec3 vertex(uint32_t triangle, int k) const;
+  // The triangle across edge k (vertices k, k+1) of `triangle`: same object, the same two
+  // vertex positions bit for bit; NO_NEIGHBOUR on a border or a non-manifold edge.
+  static constexpr uint32_t NO_NEIGHBOUR = 0xffffffffu;
+  uint32_t neighbour(uint32_t triangle, int k) const { return neighbours_[triangle][static_cast<size_t>(k)]; }
 
   // Whether every texel (i', j') of `face` with i' - i of the sign of step_i (or 0) and
   // j' - j of the sign of step_j (or 0) holds an empty list: the rest of a walk on that
@@ -163,13 +201,16 @@ class SearchContext {
   const Scene* scene_;
   const CubeABuffer* cube_;
   std::vector<Plane> planes_;
+  std::vector<Bounds> bounds_;
   std::vector<uint32_t> zero_area_;
+  std::vector<std::array<uint32_t, 3>> neighbours_;
   // Per face and row j: the smallest and largest column holding a fragment over rows
   // <= j (prefix) and >= j (suffix), and in row j alone (n and -1 when none).
   struct RowBounds {
     std::vector<int> min_row, max_row, min_prefix, max_prefix, min_suffix, max_suffix;
   };
   std::array<RowBounds, 6> occupied_;
+  void build_neighbours();
 };
 
 struct SearchResult {
@@ -211,6 +252,13 @@ SearchResult reflection_search(const SearchContext& ctx, const glm::dvec3& w, co
 SearchResult refraction_exit_search(const SearchContext& ctx, const glm::dvec3& w,
                                     const glm::dvec3& t, uint32_t object_id,
                                     const SearchOptions& options = {});
+
+// The exact crossing of the ray W + l D (W world space, D unit) with the mesh around
+// `triangle`: the edge-connected triangles within `radius` of the stretch
+// [l_near - radius, l_near + radius] (MESH REFINEMENT). True with the triangle crossed and
+// its l (the smallest); false when none is crossed or the flood gave up.
+bool mesh_crossing(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& dir, uint32_t triangle,
+                   double l_near, double radius, uint32_t* crossed, double* l);
 
 // Visibility of point light `light_position` from surface point p (world space).
 ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p,

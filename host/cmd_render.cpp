@@ -37,14 +37,14 @@ struct RenderRequest {
   std::string reference_image;  // --reference-image: the exact image, rendered before
   bool plan_everything = false;  // --plan everything
   ABufferOptions abuffer;  // --threads, --max-layers, --max-memory (MiB)
-  MapShadingOptions map;   // --search, --theta-max, --refraction, --envmap-lookup
+  MapShadingOptions map;   // --search, --refine, --theta-max, --refraction, --envmap-lookup
 };
 
 // Parses the command line and applies its overrides to the scene (cli.md).
 RenderRequest parse_request(const std::vector<std::string>& words, Scene* scene) {
   const Args args(words,
                   {"-o", "--output", "--method", "--cube-res", "--max-depth", "--threads", "--gl",
-                   "--gl-device", "--stats", "--max-memory", "--max-layers", "--search", "--theta-max",
+                   "--gl-device", "--stats", "--max-memory", "--max-layers", "--search", "--refine", "--theta-max",
                    "--refraction", "--envmap-lookup", "--error-target", "--reference-image", "--plan"},
                   {"--reference", "--fresnel"});
   args.expect_positional(1, "SCENE.json");
@@ -81,6 +81,9 @@ RenderRequest parse_request(const std::vector<std::string>& words, Scene* scene)
   r.map.threads = r.threads;
   if (args.has("--search") && !parse_search_mode(args.get("--search"), &r.map.search.mode)) {
     throw InputError("--search: unknown mode '" + args.get("--search") + "' (crossing, thesis)");
+  }
+  if (args.has("--refine") && !parse_search_refine(args.get("--refine"), &r.map.search.refine)) {
+    throw InputError("--refine: unknown refinement '" + args.get("--refine") + "' (mesh, plane)");
   }
   r.map.search.theta_max = glm::radians(args.get_double("--theta-max", 2.0, 1e-6, 90.0));
   if (args.has("--refraction") && !parse_refraction_mode(args.get("--refraction"), &r.map.refraction)) {
@@ -288,6 +291,7 @@ int cmd_render(const std::vector<std::string>& words) {
 
   Image image;
   stats["method_options"] = {{"search", search_mode_name(r.map.search.mode)},
+                             {"refine", search_refine_name(r.map.search.refine)},
                              {"theta_max_deg", glm::degrees(r.map.search.theta_max)},
                              {"refraction", refraction_mode_name(r.map.refraction)},
                              {"envmap_lookup", envmap_lookup_name(r.map.lookup)},

@@ -14,6 +14,7 @@ const char* USAGE =
     "                     [--cube-res N] [--max-depth D] [--threads K] [--gl auto|egl|egl-device|\n"
     "                     egl-surfaceless|osmesa|none] [--gl-device K] [--stats STATS.json] [--reference]\n"
     "                     [--max-layers K] [--max-memory MiB] [--search crossing|thesis]\n"
+    "                     [--refine mesh|plane]\n"
     "                     [--theta-max DEG] [--refraction search|thick_lens|thin_lens]\n"
     "                     [--envmap-lookup R|bisector|position] [--fresnel] [--error-target E]\n"
     "                     [--reference-image REF.exr] [--plan needed|everything]\n"

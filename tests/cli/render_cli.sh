@@ -81,7 +81,7 @@ check "gpu --reference reports an image error" grep -q '"share_over_2_255"' "$WO
 
 # --- the cube-map methods and their options; stats count the searches
 for v in "abuffer" "abuffer --search thesis --theta-max 1" "zbuffer" "envmap --envmap-lookup bisector" \
-         "abuffer --refraction thin_lens" "abuffer --fresnel"; do
+         "abuffer --refraction thin_lens" "abuffer --fresnel" "abuffer --refine plane"; do
   set -- $v
   name=$(echo "$v" | tr ' ' '_')
   "$ABCUBE" render "$WORK/small.json" -o "$WORK/m_$name.png" --method $v --cube-res 64 --stats "$WORK/m_$name.json" \
@@ -108,6 +108,9 @@ check "--reference-image of another size exits 2" [ $? -eq 2 ]
 check "--reference-image size message names the file" grep -q "tiny.exr: is 20x10" "$WORK/err"
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --search sideways > /dev/null 2> "$WORK/err"
 check "--search sideways exits 2" [ $? -eq 2 ]
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --refine polygon > /dev/null 2> "$WORK/err"
+check "--refine polygon exits 2" [ $? -eq 2 ]
+check "--refine polygon names the option" grep -q -- "--refine: unknown refinement 'polygon'" "$WORK/err"
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --refraction prism > /dev/null 2> "$WORK/err"
 check "--refraction prism exits 2" [ $? -eq 2 ]
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --envmap-lookup up > /dev/null 2> "$WORK/err"

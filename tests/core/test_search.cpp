@@ -620,5 +620,126 @@ TEST(Search, StatsCountEveryRay) {
   EXPECT_FALSE(parse_search_mode("march", &mode));
 }
 
+// MESH REFINEMENT (search.hpp): the crossing search checks a candidate against the mesh
+// around its fragment's triangle, so a ray passing within a texel of a silhouette or of a
+// crease is no longer taken for a crossing. Each test runs the same rays with
+// SearchRefine::plane too: the scenario must show the error the refinement removes, or
+// the test would prove nothing. Merged maps, as the renderer builds them.
+SearchOptions with_refine(SearchRefine r) {
+  SearchOptions o;
+  o.refine = r;
+  return o;
+}
+
+TEST(MeshRefine, ClosedMeshesAreLinkedAcrossEveryEdgeAndObjectsAreNot) {
+  Scene s = empty_scene({0, 0, 5}, {0, 0, 0}, 50, 32, 32);
+  const uint32_t m = add_material(s, Material{});
+  add_sphere(s, {0, 0, 0}, 1.0, 24, m);
+  add_box(s, {1.0, -0.5, -0.5}, {2.0, 0.5, 0.5}, m);  // touches the sphere at (1, 0, 0)
+  const uint32_t quad = begin_object(s, "quad", m, false);
+  add_flat_triangle(s, {-3, -2, 0}, {-2, -2, 0}, {-2, -1, 0});
+  add_flat_triangle(s, {-3, -2, 0}, {-2, -1, 0}, {-3, -1, 0});
+  const auto w = make_world(s, 8, true);
+  const TriangleSoup& t = w->scene.triangles;
+  size_t border = 0;
+  for (uint32_t k = 0; k < t.triangle_count(); ++k) {
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t nb = w->ctx->neighbour(k, e);
+      if (nb == SearchContext::NO_NEIGHBOUR) {
+        ++border;
+        EXPECT_EQ(t.object_id[k], quad) << "triangle " << k << " edge " << e;  // only the open quad has borders
+        continue;
+      }
+      EXPECT_EQ(t.object_id[nb], t.object_id[k]);  // never across objects, even where they touch
+      int back = 0;
+      for (int f = 0; f < 3; ++f) back += w->ctx->neighbour(nb, f) == k;
+      EXPECT_EQ(back, 1) << "triangle " << k << " edge " << e;
+    }
+  }
+  EXPECT_EQ(border, 4u);  // the quad's outline; its diagonal links its two triangles
+}
+
+// Rays from a mirror floor aimed at points within half a texel of a sphere's silhouette,
+// inside and outside it: what they meet first, against the exact tracer.
+TEST(MeshRefine, RaysGrazingASilhouetteMeetWhatTheExactRayMeets) {
+  Scene s = empty_scene({0, 1.2, 4}, {0, 0.5, 0}, 50, 64, 48);
+  Material mirror;
+  mirror.reflect = 1.0;
+  const uint32_t mm = add_material(s, mirror);
+  const uint32_t red = add_material(s, emissive({1, 0, 0}));
+  const uint32_t blue = add_material(s, emissive({0, 0, 1}));
+  add_quad(s, {-4, 0, -4}, {-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, mm);
+  add_sphere(s, {0.2, 0.9, -0.8}, 0.6, 32, red);
+  add_quad(s, {-4, 0, -3}, {4, 0, -3}, {4, 4, -3}, {-4, 4, -3}, blue);
+  const int n = 128;
+  const auto w = make_world(s, n, true);
+  const dvec3 centre(0.2, 0.9, -0.8);
+  int rays = 0, mesh_right = 0, plane_right = 0;
+  for (int k = 0; k < 400; ++k) {
+    const dvec3 origin(-1.5 + 3.0 * ((k * 37) % 400) / 400.0, 0.0, 0.5 + 1.5 * ((k * 91) % 400) / 400.0);
+    // The silhouette seen from the origin: unit directions u (to the centre) and e (across).
+    const dvec3 to_c = centre - origin;
+    const double dist = glm::length(to_c);
+    const dvec3 u = to_c / dist;
+    const double angle = 2.0 * 3.14159265358979 * ((k * 13) % 400) / 400.0;
+    const dvec3 a = glm::normalize(glm::cross(u, dvec3(0, 1, 0)));
+    const dvec3 b = glm::cross(a, u);
+    const dvec3 e = std::cos(angle) * a + std::sin(angle) * b;
+    const double r = 0.6 * std::sqrt(1.0 - 0.36 / (dist * dist));  // silhouette circle radius
+    const dvec3 rim = origin + u * (dist - 0.36 / dist) + r * e;
+    const double texel = texel_size_at(rim - w->cube.centre, n);
+    for (const double off : {-0.45, -0.25, 0.25, 0.45}) {
+      const dvec3 dir = glm::normalize(rim + off * texel * e - origin);
+      if (dir.y <= 0.0) continue;
+      ++rays;
+      Hit h;
+      const bool exact = w->tracer->intersect(origin + 1e-9 * dir, dir, &h);
+      const auto right = [&](const SearchResult& res) {
+        return res.hit == exact && (!exact || res.object_id == h.object_id);
+      };
+      mesh_right += right(reflection_search(*w->ctx, origin, dir, with_refine(SearchRefine::mesh)));
+      plane_right += right(reflection_search(*w->ctx, origin, dir, with_refine(SearchRefine::plane)));
+    }
+  }
+  std::printf("silhouette rays %d: right with mesh refinement %d, with plane only %d\n", rays, mesh_right,
+              plane_right);
+  ASSERT_GT(rays, 1000);
+  EXPECT_GE(mesh_right, 0.998 * rays);
+  EXPECT_GT(rays - plane_right, 10);  // the scenario shows the plane tolerance's error
+}
+
+// Points on a box's front face 2.75 to 8 texels under its top edge, a light nearly above
+// them (slightly in front): each shadow ray crosses the top face's plane 0.07 to 0.2
+// texel outside the top face, but never the face itself (the box is convex), and further
+// from the point than the 2 texels within which tolerance candidates are ignored. No
+// false shadow.
+TEST(MeshRefine, ACreaseDoesNotShadowItsOwnFace) {
+  Scene s = empty_scene({0.3, 1.1, 3}, {0, 0.5, 0}, 50, 64, 48);
+  const uint32_t white = add_material(s, Material{});
+  add_box(s, {-0.5, 0, -0.5}, {0.5, 1.0, 0.5}, white);
+  const int n = 128;
+  const auto w = make_world(s, n, true);
+  const dvec3 light(0.1, 5.0, 0.6);
+  int points = 0, mesh_false = 0, plane_false = 0;
+  for (int i = 0; i < 50; ++i) {
+    for (int j = 1; j <= 8; ++j) {
+      const dvec3 probe(-0.45 + 0.9 * i / 49.0, 1.0, 0.5);
+      const double texel = texel_size_at(probe - w->cube.centre, n);
+      const dvec3 p = probe - dvec3(0, (2.0 + 0.75 * j) * texel, 0);
+      Hit h;
+      ASSERT_TRUE(w->tracer->intersect(p + dvec3(0, 0, 1e-3), {0, 0, -1}, &h));
+      if (w->tracer->light_visibility(h, PointLight{light, dvec3(1.0), true}, nullptr) != dvec3(1.0)) continue;
+      ++points;
+      mesh_false += shadow_search(*w->ctx, p, light, with_refine(SearchRefine::mesh)).blockers > 0;
+      plane_false += shadow_search(*w->ctx, p, light, with_refine(SearchRefine::plane)).blockers > 0;
+    }
+  }
+  std::printf("crease: %d lit points, false shadows with mesh refinement %d, with plane only %d\n", points,
+              mesh_false, plane_false);
+  ASSERT_GT(points, 300);
+  EXPECT_EQ(mesh_false, 0);
+  EXPECT_GT(plane_false, points / 10);  // the scenario shows the plane tolerance's error
+}
+
 }  // namespace
 }  // namespace abcube
