@@ -42,6 +42,7 @@ MAP_METHODS = {
     "zbuffer": ["--method", "zbuffer"],
     "abuffer_thesis": ["--method", "abuffer", "--search", "thesis"],
     "abuffer_crossing": ["--method", "abuffer", "--search", "crossing"],
+    "abuffer_plane": ["--method", "abuffer", "--search", "crossing", "--refine", "plane"],
     "thick_lens": ["--method", "abuffer", "--refraction", "thick_lens"],
     "thin_lens": ["--method", "abuffer", "--refraction", "thin_lens"],
 }
@@ -590,7 +591,7 @@ def write_markdown(path, sweep, args, meta):
 # SVG plots (hand-written: log-log axes with decade ticks, a legend, one colour per method)
 
 COLOURS = {"gpu": "#1f77b4", "envmap_R": "#ff7f0e", "envmap_bisector": "#bcbd22", "zbuffer": "#2ca02c",
-           "abuffer_thesis": "#d62728", "abuffer_crossing": "#9467bd", "thick_lens": "#8c564b",
+           "abuffer_thesis": "#d62728", "abuffer_crossing": "#9467bd", "abuffer_plane": "#7f7f7f", "thick_lens": "#8c564b",
            "thin_lens": "#e377c2", "raytrace": "#000000", "povray": "#17becf"}
 SCENE_COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"]
 SUPERSCRIPT = str.maketrans("-0123456789", "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079")

@@ -352,10 +352,8 @@ Image render_with_map(const Scene& scene, const ABuffer& camera, const MapShader
       glm::dvec3 on = p;
       double l = 0;
       const double dist = glm::length(p - eye);
-      if (shader.refines_on_mesh() && mesh_crossing(shader.context(), eye, dir, tri, dist, dist * pixel, &tri, &l)) {
+      if (shader.refines_on_mesh() && mesh_crossing(shader.context(), eye, dir, f.triangle(), dist, dist * pixel, &tri, &l)) {
         on = eye + l * dir;
-      } else {
-        tri = f.triangle();
       }
       return shader.shade(surface_point(scene, tri, on), dir, 0, true, s);
     };

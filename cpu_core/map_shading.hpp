@@ -115,11 +115,9 @@ class MapShader {
 
   const std::vector<LensFit>& lenses() const { return lenses_; }
   const SearchContext& context() const { return *ctx_; }
-  // Crossing searches with MESH REFINEMENT (search.hpp): camera fragments' shading points
-  // are moved onto the surface the same way.
-  bool refines_on_mesh() const {
-    return options_.search.mode == SearchMode::crossing && options_.search.refine == SearchRefine::mesh;
-  }
+  // SearchRefine::mesh (search.hpp MESH REFINEMENT): besides the crossing searches' candidates,
+  // camera fragments' shading points are moved onto the surface the same way (any mode).
+  bool refines_on_mesh() const { return options_.search.refine == SearchRefine::mesh; }
 
  private:
   glm::dvec3 trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, uint32_t inside,

@@ -36,7 +36,8 @@
 // rejection): bench_search measures it on the terrain of scenes/bench/spheres_terrain.json
 // (--merge off for the unmerged map).
 //
-// MESH REFINEMENT (crossing mode, SearchRefine::mesh, the default; --refine mesh|plane).
+// MESH REFINEMENT (crossing mode, SearchRefine::mesh, the default; --refine mesh|plane; the
+// same flood moves camera fragments' shading points onto the mesh, map_shading.hpp).
 // The plane of one triangle says little near that triangle's edges: a ray passing within
 // the tolerance outside a silhouette, or crossing the extension of a box's top face just
 // beyond the crease, was accepted as a crossing (a false hit, a false shadow); and a
@@ -148,7 +149,7 @@ struct SearchOptions {
   SearchLayers layers = SearchLayers::all;
   double theta_max = 0.034906585039886591;  // thesis mode: 2 degrees, in radians
   double tolerance_texels = 1.0;            // crossing mode: largest accepted e
-  SearchRefine refine = SearchRefine::mesh;  // crossing mode: refine on the mesh (header)
+  SearchRefine refine = SearchRefine::mesh;  // MESH REFINEMENT (header)
   double self_offset_texels = 0;            // W's own surface and points closer; 0 = the mode's default
   uint32_t max_texels = 0;                  // walk cap; 0 = CubeWalk's default
 };
