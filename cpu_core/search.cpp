@@ -85,31 +85,34 @@ bool own_surface(const SearchContext::Plane& p, const RayQuery& q) {
   return !(den != 0.0 && -delta / den > q.self);
 }
 
-// ray_distance_range (cube_walk.hpp) along one ray, the same values from the same
-// operations, with |W + l D| at the last texel's end kept: consecutive texels share it
-// (l1 of one is l0 of the next), so most texels need one length instead of three.
-class DistanceRange {
+// The squares of ray_distance_range (cube_walk.hpp) along one ray: [dmin^2, dmax^2] of
+// |W + l D| over a texel's [l0, l1], with the value at the last texel's end kept
+// (consecutive texels share it). Squares, because a square root per texel was a tenth
+// of a render's time; a fragment's float zmin and zmax square exactly in double.
+class SquaredDistanceRange {
  public:
-  DistanceRange(const glm::dvec3& w, const glm::dvec3& d) : w_(w), d_(d), closest_(-glm::dot(w, d)) {}
+  SquaredDistanceRange(const glm::dvec3& w, const glm::dvec3& d) : w_(w), d_(d), closest_(-glm::dot(w, d)) {}
   glm::dvec2 operator()(double l0, double l1) {
     const double lc = std::clamp(closest_, l0, l1);
-    const double at_l0 = length_at(l0);
-    const double at_l1 = std::isinf(l1) ? INF : length_at(l1);
-    const double dmin = lc == l0 ? at_l0 : (lc == l1 ? at_l1 : glm::length(w_ + lc * d_));
+    const double at_l0 = length2_at(l0);
+    const double at_l1 = std::isinf(l1) ? INF : length2_at(l1);
+    const glm::dvec3 xc = w_ + lc * d_;
+    const double dmin = lc == l0 ? at_l0 : (lc == l1 ? at_l1 : glm::dot(xc, xc));
     return {dmin, std::isinf(l1) ? INF : std::max(at_l0, at_l1)};
   }
 
  private:
-  double length_at(double l) {
+  double length2_at(double l) {
     if (l != cached_l_) {
       cached_l_ = l;
-      cached_length_ = glm::length(w_ + l * d_);
+      const glm::dvec3 x = w_ + l * d_;
+      cached_length2_ = glm::dot(x, x);
     }
-    return cached_length_;
+    return cached_length2_;
   }
   glm::dvec3 w_, d_;
   double closest_;
-  double cached_l_ = std::numeric_limits<double>::quiet_NaN(), cached_length_ = 0;
+  double cached_l_ = std::numeric_limits<double>::quiet_NaN(), cached_length2_ = 0;
 };
 
 // Walks the ray's texels; for each texel calls on_fragment(texel, fragment, v) for every
@@ -126,7 +129,7 @@ ScanCounts scan(const SearchContext& ctx, const RayQuery& q, const SearchOptions
   const CubeABuffer& cube = ctx.cube();
   const TriangleSoup& soup = ctx.scene().triangles;
   CubeWalk walk(q.w, q.d, cube.n, q.l_max, cube.near_distance, o.max_texels);
-  DistanceRange distances(q.w, q.d);
+  SquaredDistanceRange distances2(q.w, q.d);
   // Only the thesis mode and the nearest layer look at the texel-centre direction.
   const bool need_v = o.mode == SearchMode::thesis || o.layers == SearchLayers::nearest;
   ScanCounts counts;
@@ -134,15 +137,20 @@ ScanCounts scan(const SearchContext& ctx, const RayQuery& q, const SearchOptions
   while (walk.next(&t)) {
     ++counts.texels;
     const ABuffer& b = cube.faces[static_cast<size_t>(t.face)];
-    const FragmentList list = b.list(t.i, t.j);
+    glm::dvec2 range2(0.0);  // squared distances from the centre
+    bool skip = ctx.block_empty(t.face, t.i, t.j);  // BLOCK BOUNDS
+    if (!skip) {
+      range2 = distances2(t.l0, t.l1);
+      skip = ctx.block_misses2(t.face, t.i, t.j, range2.x, range2.y);
+    }
+    const FragmentList list = skip ? FragmentList{} : b.list(t.i, t.j);
     if (!list.empty()) {
       const glm::dvec3 v = need_v ? b.view.direction(t.i + 0.5, t.j + 0.5) : glm::dvec3(0.0);  // texel centre
-      const glm::dvec2 range = distances(t.l0, t.l1);
       const Fragment* only = o.layers == SearchLayers::nearest ? nearest_fragment(ctx, list, v) : nullptr;
       for (const Fragment& f : list) {
         if (o.layers == SearchLayers::nearest && &f != only) continue;
         ++counts.fragments;
-        if (f.zmax < range.x || f.zmin > range.y) continue;
+        if (static_cast<double>(f.zmax) * f.zmax < range2.x || static_cast<double>(f.zmin) * f.zmin > range2.y) continue;
         if (q.restrict_object && soup.object_id[f.triangle()] != q.object) continue;
         const SearchContext::Plane& p = ctx.plane(f.triangle());
         if (own_surface(p, q)) continue;
@@ -218,6 +226,40 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const RayQuery& q, uint32_t 
   // A start triangle away from the ray: the mesh near the ray may be elsewhere in the
   // fragment's patch (merged), the flood cannot say.
   if (!near_ray(ctx.bounds(start), q, l_lo, l_hi, radius)) return a;
+  // First the straight way: from triangle to triangle across the edge the ray's crossing
+  // of the current plane lies furthest outside of, while the next is near the ray. On a
+  // smooth patch this reaches the triangle crossed in a few steps.
+  uint32_t walker = start;
+  for (size_t step = 0; step < REFINE_MAX_TRIANGLES; ++step) {
+    const SearchContext::Plane& p = ctx.plane(walker);
+    const double den = glm::dot(p.normal, q.d);
+    if (den == 0.0) break;
+    const double l = (p.offset - glm::dot(p.normal, q.w)) / den;
+    const glm::dvec3 x = q.w + l * q.d;
+    const SearchContext::Bounds& b = ctx.bounds(walker);
+    int worst = -1;
+    double worst_outside = -ON_TRIANGLE_TEXELS * texel_size_at(x, ctx.cube().n);
+    for (int k = 0; k < 3; ++k) {
+      const double outside = glm::dot(b.edge_normal[static_cast<size_t>(k)], x) - b.edge_offset[static_cast<size_t>(k)];
+      if (outside < worst_outside) {
+        worst_outside = outside;
+        worst = k;
+      }
+    }
+    if (worst < 0) {  // on this triangle
+      if (b.radius > 0.0 && l >= q.self && l <= q.l_max) {
+        a.result = Refined::hit;
+        a.triangle = walker;
+        a.l = l;
+        return a;
+      }
+      break;
+    }
+    const uint32_t nb = ctx.neighbour(walker, worst);
+    if (nb == SearchContext::NO_NEIGHBOUR || !near_ray(ctx.bounds(nb), q, l_lo, l_hi, radius)) break;
+    walker = nb;
+  }
+  // Then every triangle near the ray, breadth-first.
   std::array<uint32_t, REFINE_MAX_TRIANGLES> seen{};
   size_t count = 0, next = 0;
   seen[count++] = start;
@@ -501,8 +543,9 @@ SearchContext::SearchContext(const Scene& scene, const CubeABuffer& cube) : scen
     if (setup_triangle(view, soup, k, &setup) == SetupResult::edge_on) zero_area_.push_back(k);
   }
   build_neighbours();
-  // Where each face holds fragments, row by row (empty_ahead).
+  // Where each face holds fragments, row by row (empty_ahead), and BLOCK BOUNDS.
   const int n = cube.n;
+  blocks_per_row_ = (std::max(n, 0) + BOUNDS_BLOCK - 1) / BOUNDS_BLOCK;
   for (size_t f = 0; f < occupied_.size(); ++f) {
     RowBounds& rb = occupied_[f];
     const ABuffer& b = cube.faces[f];
@@ -517,6 +560,20 @@ SearchContext::SearchContext(const Scene& scene, const CubeABuffer& cube) : scen
         if (row[i + 1] == row[i]) continue;
         rb.min_row[static_cast<size_t>(j)] = std::min(rb.min_row[static_cast<size_t>(j)], i);
         rb.max_row[static_cast<size_t>(j)] = i;
+      }
+    }
+    // A face not laid out as n x n lists gets blocks spanning every depth: never passed.
+    const float inf = std::numeric_limits<float>::infinity();
+    block_z_[f].assign(static_cast<size_t>(blocks_per_row_) * static_cast<size_t>(blocks_per_row_),
+                       known ? glm::vec2(inf, -inf) : glm::vec2(-inf, inf));
+    for (int j = 0; known && j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        glm::vec2& z = block_z_[f][static_cast<size_t>(j / BOUNDS_BLOCK) * static_cast<size_t>(blocks_per_row_) +
+                                   static_cast<size_t>(i / BOUNDS_BLOCK)];
+        for (const Fragment& frag : b.list(i, j)) {
+          z.x = std::min(z.x, frag.zmin);
+          z.y = std::max(z.y, frag.zmax);
+        }
       }
     }
     rb.min_prefix = rb.min_row;
