@@ -180,23 +180,39 @@ struct Candidate {
   CubeTexel texel{0, 0, 0};
 };
 
-// The exact crossing of the ray with triangle `tri` (its plane met at l in [self, l_max],
-// the point on the triangle to ON_TRIANGLE_TEXELS): the parameter l, or INF.
-double exact_crossing(const SearchContext& ctx, const RayQuery& q, uint32_t tri) {
+// Where the ray meets triangle `tri`'s plane: l (INF when parallel or degenerate) and the
+// edge whose line the point lies furthest outside of, in the plane, by more than
+// ON_TRIANGLE_TEXELS (-1: on the triangle; near a corner this admits up to the tolerance
+// times 1/sin(corner angle / 2)).
+struct PlaneCrossing {
+  double l = INF;
+  int outside_edge = -1;
+};
+
+PlaneCrossing plane_crossing(const SearchContext& ctx, const RayQuery& q, uint32_t tri) {
+  PlaneCrossing c;
   const SearchContext::Plane& p = ctx.plane(tri);
-  const double den = glm::dot(p.normal, q.d);
-  if (den == 0.0) return INF;
-  const double l = (p.offset - glm::dot(p.normal, q.w)) / den;
-  if (!(l >= q.self) || !(l <= q.l_max)) return INF;
-  const glm::dvec3 x = q.w + l * q.d;
-  // In-plane distance outside each edge line: within the tolerance of all three is on the
-  // triangle (near a corner this admits up to the tolerance times 1/sin(corner angle / 2)).
   const SearchContext::Bounds& b = ctx.bounds(tri);
-  const double tolerance = -ON_TRIANGLE_TEXELS * texel_size_at(x, ctx.cube().n);
-  for (size_t k = 0; k < 3; ++k) {
-    if (glm::dot(b.edge_normal[k], x) - b.edge_offset[k] < tolerance) return INF;
+  const double den = glm::dot(p.normal, q.d);
+  if (den == 0.0 || !(b.radius > 0.0)) return c;
+  c.l = (p.offset - glm::dot(p.normal, q.w)) / den;
+  const glm::dvec3 x = q.w + c.l * q.d;
+  double worst = -ON_TRIANGLE_TEXELS * texel_size_at(x, ctx.cube().n);
+  for (int k = 0; k < 3; ++k) {
+    const double outside = glm::dot(b.edge_normal[static_cast<size_t>(k)], x) - b.edge_offset[static_cast<size_t>(k)];
+    if (outside < worst) {
+      worst = outside;
+      c.outside_edge = k;
+    }
   }
-  return b.radius > 0.0 ? l : INF;
+  return c;
+}
+
+// The exact crossing of the ray with triangle `tri` (on the triangle, l in [self, l_max]):
+// its parameter l, or INF.
+double exact_crossing(const SearchContext& ctx, const RayQuery& q, uint32_t tri) {
+  const PlaneCrossing c = plane_crossing(ctx, q, tri);
+  return c.outside_edge < 0 && c.l >= q.self && c.l <= q.l_max ? c.l : INF;
 }
 
 // MESH REFINEMENT (crossing mode; header). The answer of the mesh around a fragment's
@@ -231,31 +247,18 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const RayQuery& q, uint32_t 
   // smooth patch this reaches the triangle crossed in a few steps.
   uint32_t walker = start;
   for (size_t step = 0; step < REFINE_MAX_TRIANGLES; ++step) {
-    const SearchContext::Plane& p = ctx.plane(walker);
-    const double den = glm::dot(p.normal, q.d);
-    if (den == 0.0) break;
-    const double l = (p.offset - glm::dot(p.normal, q.w)) / den;
-    const glm::dvec3 x = q.w + l * q.d;
-    const SearchContext::Bounds& b = ctx.bounds(walker);
-    int worst = -1;
-    double worst_outside = -ON_TRIANGLE_TEXELS * texel_size_at(x, ctx.cube().n);
-    for (int k = 0; k < 3; ++k) {
-      const double outside = glm::dot(b.edge_normal[static_cast<size_t>(k)], x) - b.edge_offset[static_cast<size_t>(k)];
-      if (outside < worst_outside) {
-        worst_outside = outside;
-        worst = k;
-      }
-    }
-    if (worst < 0) {  // on this triangle
-      if (b.radius > 0.0 && l >= q.self && l <= q.l_max) {
+    const PlaneCrossing c = plane_crossing(ctx, q, walker);
+    if (c.l == INF) break;
+    if (c.outside_edge < 0) {  // on this triangle
+      if (c.l >= q.self && c.l <= q.l_max) {
         a.result = Refined::hit;
         a.triangle = walker;
-        a.l = l;
+        a.l = c.l;
         return a;
       }
       break;
     }
-    const uint32_t nb = ctx.neighbour(walker, worst);
+    const uint32_t nb = ctx.neighbour(walker, c.outside_edge);
     if (nb == SearchContext::NO_NEIGHBOUR || !near_ray(ctx.bounds(nb), q, l_lo, l_hi, radius)) break;
     walker = nb;
   }
@@ -274,10 +277,8 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const RayQuery& q, uint32_t 
     }
     for (int k = 0; k < 3; ++k) {
       const uint32_t nb = ctx.neighbour(tri, k);
-      if (nb == SearchContext::NO_NEIGHBOUR || std::find(seen.begin(), seen.begin() + static_cast<std::ptrdiff_t>(count), nb) !=
-                                                     seen.begin() + static_cast<std::ptrdiff_t>(count)) {
-        continue;
-      }
+      const auto seen_end = seen.begin() + static_cast<std::ptrdiff_t>(count);
+      if (nb == SearchContext::NO_NEIGHBOUR || std::find(seen.begin(), seen_end, nb) != seen_end) continue;
       if (!near_ray(ctx.bounds(nb), q, l_lo, l_hi, radius)) continue;
       if (count == seen.size()) {
         overflow = true;
