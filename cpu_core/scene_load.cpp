@@ -780,10 +780,12 @@ Scene read_scene(const Json& doc, const Source& src) {
 
 // Bytes per unit of work, for the estimate: a camera pixel holds its colour and A-buffer
 // fragment headroom; a cube texel its distance and fragment headroom; a triangle its
-// soup entry (3 positions, 3 normals, 2 ids) plus acceleration-structure headroom.
+// soup entry (3 positions, 3 normals, 2 ids), acceleration-structure headroom (64), and
+// the searches' per-triangle data (search.hpp SearchContext: plane 32, refinement bounds
+// 128, neighbours 12 bytes, and 120 more while the neighbours are being built).
 constexpr uint64_t PIXEL_BYTES = 3 * sizeof(float) + 64;
 constexpr uint64_t TEXEL_BYTES = 64;
-constexpr uint64_t TRIANGLE_BYTES = 6 * sizeof(glm::vec3) + 2 * sizeof(uint32_t) + 64;
+constexpr uint64_t TRIANGLE_BYTES = 6 * sizeof(glm::vec3) + 2 * sizeof(uint32_t) + 64 + 32 + 128 + 12 + 120;
 
 }  // namespace
 

@@ -13,6 +13,10 @@
 
 namespace abcube {
 
+// scene_load.cpp's memory estimate (TRIANGLE_BYTES) counts these sizes per triangle.
+static_assert(sizeof(SearchContext::Plane) <= 32 && sizeof(SearchContext::Bounds) <= 128,
+              "update TRIANGLE_BYTES in scene_load.cpp");
+
 namespace {
 
 constexpr double INF = std::numeric_limits<double>::infinity();
