@@ -40,18 +40,15 @@ struct Result {
 
 Options parse(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw InputError(a + ": needs a value");
-      return argv[++i];
-    };
+  ArgWalk args(argc, argv);
+  while (args.next()) {
+    const std::string a = args.word();
     if (a == "--sizes") {
-      o.sizes = parse_int_list(a, value());
+      o.sizes = parse_int_list(a, args.value());
     } else if (a == "--runs") {
-      o.runs = parse_int(a, value());
+      o.runs = parse_int(a, args.value());
     } else if (a == "--threads") {
-      o.threads = parse_int(a, value());
+      o.threads = parse_int(a, args.value());
     } else if (a == "--camera") {
       o.camera = true;
     } else if (!a.empty() && a[0] == '-') {

@@ -38,6 +38,24 @@ inline std::vector<int> parse_int_list(const std::string& option, const std::str
   return out;
 }
 
+// The words of a command line, one option at a time: next() moves to the next word,
+// word() is it, value() takes the word after it as its argument (InputError when missing).
+class ArgWalk {
+ public:
+  ArgWalk(int argc, char** argv) : argc_(argc), argv_(argv) {}
+  bool next() { return ++i_ < argc_; }
+  std::string word() const { return argv_[i_]; }
+  std::string value() {
+    if (i_ + 1 >= argc_) throw InputError(word() + ": needs a value");
+    return argv_[++i_];
+  }
+
+ private:
+  int argc_;
+  char** argv_;
+  int i_ = 0;
+};
+
 // Runs fn(); bad input -> "name: message", exit 2; any other failure -> exit 1.
 template <class Fn>
 int guarded_main(const char* name, Fn&& fn) {

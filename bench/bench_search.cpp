@@ -43,35 +43,32 @@ struct Options {
 
 Options parse(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw InputError(a + ": needs a value");
-      return argv[++i];
-    };
+  ArgWalk args(argc, argv);
+  while (args.next()) {
+    const std::string a = args.word();
     if (a == "--sizes") {
-      o.sizes = parse_int_list(a, value());
+      o.sizes = parse_int_list(a, args.value());
     } else if (a == "--modes") {
       o.modes.clear();
-      for (const std::string& s : split_list(value())) {
+      for (const std::string& s : split_list(args.value())) {
         SearchMode m;
         if (!parse_search_mode(s, &m)) throw InputError("--modes: unknown mode " + s);
         o.modes.push_back(m);
       }
     } else if (a == "--layers") {
-      const std::string v = value();
+      const std::string v = args.value();
       if (v != "all" && v != "nearest") throw InputError("--layers: all or nearest, got " + v);
       o.layers = v == "all" ? SearchLayers::all : SearchLayers::nearest;
     } else if (a == "--merge") {
-      const std::string v = value();
+      const std::string v = args.value();
       if (v != "on" && v != "off") throw InputError("--merge: on or off, got " + v);
       o.merge = v == "on";
     } else if (a == "--runs") {
-      o.runs = parse_int(a, value());
+      o.runs = parse_int(a, args.value());
     } else if (a == "--rays") {
-      o.rays = parse_int(a, value());
+      o.rays = parse_int(a, args.value());
     } else if (a == "--seed") {
-      o.seed = static_cast<unsigned>(std::stoul(value()));
+      o.seed = static_cast<unsigned>(parse_int(a, args.value()));
     } else if (!a.empty() && a[0] == '-') {
       throw InputError("unknown option " + a);
     } else {

@@ -92,12 +92,17 @@ std::vector<SurfaceRay> mirror_rays(const World& world, int cols, int rows) {
   return out;
 }
 
+// A perfect mirror material added to s.
+uint32_t add_mirror(Scene& s) {
+  Material mirror;
+  mirror.reflect = 1.0;
+  return add_material(s, mirror);
+}
+
 // Mirror floor and back wall, a box, a sphere, a tilted triangle, and a box behind the camera.
 Scene reflection_scene() {
   Scene s = empty_scene({0.3, 1.6, 4.2}, {0, 0.3, 0}, 60, 320, 240);
-  Material mirror;
-  mirror.reflect = 1.0;
-  const uint32_t m = add_material(s, mirror);
+  const uint32_t m = add_mirror(s);
   const uint32_t red = add_material(s, emissive({1, 0, 0}));
   const uint32_t blue = add_material(s, emissive({0, 0, 1}));
   add_quad(s, {-4, 0, -4}, {-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, m);
@@ -425,9 +430,7 @@ TEST(Search, OwnSurfaceNeverShadowsGrazingLight) {
 // y = 0 that contains the centre (zero area in the map).
 Scene room_scene() {
   Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 64, 64);
-  Material mirror;
-  mirror.reflect = 1.0;
-  const uint32_t m = add_material(s, mirror);
+  const uint32_t m = add_mirror(s);
   const uint32_t a = add_material(s, emissive({1, 0.5, 0}));
   const uint32_t b = add_material(s, emissive({0, 0.5, 1}));
   add_box(s, {-1.5, -1.5, -4.0}, {1.5, -1.0, -3.0}, a);             // 0: behind the mirror
@@ -466,9 +469,7 @@ TEST(Search, TessellatedMirrorSphereDoesNotFindItself) {
   // A coarse mirror sphere: near W the extended planes of its neighbouring triangles pass
   // within the tolerance of every reflected ray; only an exact crossing may be found there.
   Scene s = room_scene();
-  Material mirror;
-  mirror.reflect = 1.0;
-  add_sphere(s, {0.2, -0.3, -2.6}, 0.5, 16, add_material(s, mirror));
+  add_sphere(s, {0.2, -0.3, -2.6}, 0.5, 16, add_mirror(s));
   const auto world = make_world(std::move(s), 64);
   const uint32_t sphere = static_cast<uint32_t>(world->scene.objects.size() - 1);
   int interior = 0, agree = 0, self = 0;
@@ -663,9 +664,7 @@ TEST(MeshRefine, ClosedMeshesAreLinkedAcrossEveryEdgeAndObjectsAreNot) {
 // inside and outside it: what they meet first, against the exact tracer.
 TEST(MeshRefine, RaysGrazingASilhouetteMeetWhatTheExactRayMeets) {
   Scene s = empty_scene({0, 1.2, 4}, {0, 0.5, 0}, 50, 64, 48);
-  Material mirror;
-  mirror.reflect = 1.0;
-  const uint32_t mm = add_material(s, mirror);
+  const uint32_t mm = add_mirror(s);
   const uint32_t red = add_material(s, emissive({1, 0, 0}));
   const uint32_t blue = add_material(s, emissive({0, 0, 1}));
   add_quad(s, {-4, 0, -4}, {-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, mm);
