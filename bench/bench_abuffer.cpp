@@ -15,10 +15,10 @@
 #include <vector>
 
 #include "bench_common.hpp"
-#include "abuffer.hpp"
-#include "error.hpp"
-#include "memory.hpp"
-#include "scene_load.hpp"
+#include "raster/abuffer.hpp"
+#include "base/error.hpp"
+#include "base/memory.hpp"
+#include "scene/scene_load.hpp"
 
 namespace abcube {
 namespace {

@@ -13,14 +13,14 @@
 #include <vector>
 
 #include "bench_common.hpp"
-#include "abuffer.hpp"
-#include "cli_common.hpp"
-#include "cube_map.hpp"
-#include "error.hpp"
-#include "gl_context.hpp"
-#include "gl_passes.hpp"
-#include "raytrace.hpp"
-#include "scene_load.hpp"
+#include "raster/abuffer.hpp"
+#include "cli/cli_common.hpp"
+#include "raster/cube_map.hpp"
+#include "base/error.hpp"
+#include "gl/gl_context.hpp"
+#include "gl/gl_passes.hpp"
+#include "reference/raytrace.hpp"
+#include "scene/scene_load.hpp"
 
 namespace abcube {
 namespace {

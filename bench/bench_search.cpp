@@ -18,14 +18,14 @@
 #include <vector>
 
 #include "bench_common.hpp"
-#include "abuffer.hpp"
-#include "camera.hpp"
-#include "error.hpp"
-#include "metrics.hpp"
-#include "raytrace.hpp"
-#include "scene_load.hpp"
-#include "search.hpp"
-#include "timer.hpp"
+#include "raster/abuffer.hpp"
+#include "scene/camera.hpp"
+#include "base/error.hpp"
+#include "io/metrics.hpp"
+#include "reference/raytrace.hpp"
+#include "scene/scene_load.hpp"
+#include "search/search.hpp"
+#include "base/timer.hpp"
 
 namespace abcube {
 namespace {

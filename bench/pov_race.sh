@@ -23,7 +23,7 @@
 # `abcube compare` reads as linear (it sRGB-decodes 8/16-bit files only).
 # REFERENCE. REF.exr = `abcube render --method raytrace --threads T`, rendered once per scene
 # and kept in DIR (--fresh renders it again).
-# POV-Ray's PSNR includes the residual model differences of cpu_core/pov_export.hpp (glass:
+# POV-Ray's PSNR includes the residual model differences of cpu_core/io/pov_export.hpp (glass:
 # POV-Ray scales ambient and diffuse by 1 - T; uncoloured shadows through glass; Phong).
 set -euo pipefail
 

@@ -1,5 +1,5 @@
 // Scene data shared by the GL passes: materials and point lights in SSBOs, indexed by the
-// per-vertex material id. Layout mirrors host/gl_passes.cpp (std430).
+// per-vertex material id. Layout mirrors host/gl/gl_passes.cpp (std430).
 struct MaterialGpu {
   vec4 color_ambient;  // rgb = Od, a = ka
   vec4 coefficients;   // x = kd, y = ks, z = shininess n, w = kr (reflect)

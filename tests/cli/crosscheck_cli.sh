@@ -2,7 +2,7 @@
 # `abcube crosscheck` on every repository scene, through both GL APIs: the GPU distance
 # prepass against the CPU A-buffer texel by texel, and the GPU Z-buffer image against the
 # CPU A-buffer image away from silhouettes, within the tolerances documented in
-# host/crosscheck.hpp (the command exits 1 beyond them). Also --method abuffer renders.
+# host/render/crosscheck.hpp (the command exits 1 beyond them). Also --method abuffer renders.
 # Usage (ctest runs it so): bash crosscheck_cli.sh /path/to/abcube /path/to/repo
 set -u
 ABCUBE=$1

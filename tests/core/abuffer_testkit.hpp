@@ -8,8 +8,8 @@
 
 #include <glm/glm.hpp>
 
-#include "abuffer.hpp"
-#include "scene.hpp"
+#include "raster/abuffer.hpp"
+#include "scene/scene.hpp"
 
 // Scene builders, defined in test_raytrace.cpp.
 namespace abcube::testkit {

@@ -13,12 +13,12 @@
 
 #include <gtest/gtest.h>
 
-#include "abuffer.hpp"
+#include "raster/abuffer.hpp"
 #include "abuffer_testkit.hpp"
-#include "cube_map.hpp"
-#include "error.hpp"
-#include "raytrace.hpp"
-#include "scene_load.hpp"
+#include "raster/cube_map.hpp"
+#include "base/error.hpp"
+#include "reference/raytrace.hpp"
+#include "scene/scene_load.hpp"
 
 namespace abcube {
 namespace {

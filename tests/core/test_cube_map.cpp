@@ -3,9 +3,9 @@
 
 #include <gtest/gtest.h>
 
-#include "camera.hpp"
-#include "cube_map.hpp"
-#include "samples.hpp"
+#include "scene/camera.hpp"
+#include "raster/cube_map.hpp"
+#include "raster/samples.hpp"
 
 namespace abcube {
 namespace {

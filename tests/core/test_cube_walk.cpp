@@ -9,8 +9,8 @@
 #include <sstream>
 #include <vector>
 
-#include "cube_map.hpp"
-#include "cube_walk.hpp"
+#include "raster/cube_map.hpp"
+#include "search/cube_walk.hpp"
 
 namespace abcube {
 namespace {

@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "raytrace.hpp"
-#include "shading.hpp"
+#include "reference/raytrace.hpp"
+#include "shading/shading.hpp"
 
 namespace abcube {
 namespace {

@@ -10,8 +10,8 @@
 
 #include <gtest/gtest.h>
 
-#include "lens.hpp"
-#include "raytrace.hpp"
+#include "search/lens.hpp"
+#include "reference/raytrace.hpp"
 
 // Scene builders, defined in test_raytrace.cpp.
 namespace abcube::testkit {

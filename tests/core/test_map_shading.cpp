@@ -5,12 +5,12 @@
 #include <cmath>
 #include <cstdio>
 
-#include "abuffer.hpp"
-#include "camera.hpp"
-#include "map_shading.hpp"
-#include "metrics.hpp"
-#include "raytrace.hpp"
-#include "scene_load.hpp"
+#include "raster/abuffer.hpp"
+#include "scene/camera.hpp"
+#include "shading/map_shading.hpp"
+#include "io/metrics.hpp"
+#include "reference/raytrace.hpp"
+#include "scene/scene_load.hpp"
 
 namespace abcube {
 namespace {

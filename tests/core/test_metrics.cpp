@@ -4,10 +4,10 @@
 
 #include <gtest/gtest.h>
 
-#include "error.hpp"
-#include "image_io.hpp"
-#include "metrics.hpp"
-#include "raytrace.hpp"
+#include "base/error.hpp"
+#include "io/image_io.hpp"
+#include "io/metrics.hpp"
+#include "reference/raytrace.hpp"
 
 namespace abcube {
 namespace {

@@ -18,13 +18,13 @@
 
 #include <gtest/gtest.h>
 
-#include "error.hpp"
-#include "image_io.hpp"
-#include "metrics.hpp"
-#include "pov_export.hpp"
-#include "raytrace.hpp"
-#include "samples.hpp"
-#include "scene_load.hpp"
+#include "base/error.hpp"
+#include "io/image_io.hpp"
+#include "io/metrics.hpp"
+#include "io/pov_export.hpp"
+#include "reference/raytrace.hpp"
+#include "raster/samples.hpp"
+#include "scene/scene_load.hpp"
 
 // Scene builders, defined in test_raytrace.cpp.
 namespace abcube::testkit {

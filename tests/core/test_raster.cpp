@@ -8,11 +8,11 @@
 
 #include <gtest/gtest.h>
 
-#include "abuffer.hpp"
+#include "raster/abuffer.hpp"
 #include "abuffer_testkit.hpp"
-#include "camera.hpp"
-#include "cube_map.hpp"
-#include "raster.hpp"
+#include "scene/camera.hpp"
+#include "raster/cube_map.hpp"
+#include "raster/raster.hpp"
 
 namespace abcube {
 namespace {

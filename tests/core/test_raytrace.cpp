@@ -10,12 +10,12 @@
 
 #include <gtest/gtest.h>
 
-#include "camera.hpp"
-#include "error.hpp"
-#include "image_io.hpp"
-#include "metrics.hpp"
-#include "raytrace.hpp"
-#include "shading.hpp"
+#include "scene/camera.hpp"
+#include "base/error.hpp"
+#include "io/image_io.hpp"
+#include "io/metrics.hpp"
+#include "reference/raytrace.hpp"
+#include "shading/shading.hpp"
 
 // Scene builders for hand-made test scenes, independent of the scene loader. External
 // linkage: test_pov.cpp declares and uses them too.

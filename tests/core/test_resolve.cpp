@@ -8,10 +8,10 @@
 
 #include <gtest/gtest.h>
 
-#include "abuffer.hpp"
+#include "raster/abuffer.hpp"
 #include "abuffer_testkit.hpp"
-#include "resolve.hpp"
-#include "scene_load.hpp"
+#include "shading/resolve.hpp"
+#include "scene/scene_load.hpp"
 
 namespace abcube {
 namespace {

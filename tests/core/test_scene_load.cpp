@@ -1,4 +1,4 @@
-// Scene loading (cpu_core/scene_load.cpp, tessellate.cpp) against scene-format.md:
+// Scene loading (cpu_core/scene/scene_load.cpp, tessellate.cpp) against scene-format.md:
 // the format's own example, one test per class of bad input (each message must name
 // its place), and known answers for the tessellated primitives and the transform.
 #include <gtest/gtest.h>
@@ -12,9 +12,9 @@
 #include <string>
 #include <tuple>
 
-#include "error.hpp"
-#include "scene_load.hpp"
-#include "tessellate.hpp"
+#include "base/error.hpp"
+#include "scene/scene_load.hpp"
+#include "scene/tessellate.hpp"
 
 namespace abcube {
 namespace {

@@ -11,15 +11,15 @@
 #include <random>
 #include <vector>
 
-#include "abuffer.hpp"
+#include "raster/abuffer.hpp"
 #include "abuffer_testkit.hpp"
-#include "camera.hpp"
-#include "cube_walk.hpp"
-#include "metrics.hpp"
-#include "raytrace.hpp"
-#include "scene_load.hpp"
-#include "search.hpp"
-#include "shading.hpp"
+#include "scene/camera.hpp"
+#include "search/cube_walk.hpp"
+#include "io/metrics.hpp"
+#include "reference/raytrace.hpp"
+#include "scene/scene_load.hpp"
+#include "search/search.hpp"
+#include "shading/shading.hpp"
 
 namespace abcube {
 namespace {

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "abuffer.hpp"
-#include "cube_walk.hpp"
-#include "scene_load.hpp"
-#include "search.hpp"
+#include "raster/abuffer.hpp"
+#include "search/cube_walk.hpp"
+#include "scene/scene_load.hpp"
+#include "search/search.hpp"
 
 namespace abcube {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "shading.hpp"
+#include "shading/shading.hpp"
 
 namespace abcube {
 namespace {

@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "gl_context.hpp"
-#include "scene.hpp"
+#include "gl/gl_context.hpp"
+#include "scene/scene.hpp"
 
 namespace abcube::test {
 

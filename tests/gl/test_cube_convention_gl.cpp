@@ -4,10 +4,10 @@
 
 #include <gtest/gtest.h>
 
-#include "cube_map.hpp"
-#include "gl_passes.hpp"
+#include "raster/cube_map.hpp"
+#include "gl/gl_passes.hpp"
 #include "gl_test_support.hpp"
-#include "samples.hpp"
+#include "raster/samples.hpp"
 
 namespace abcube {
 namespace {

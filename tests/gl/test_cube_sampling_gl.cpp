@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "cube_map.hpp"
-#include "gl_passes.hpp"
+#include "raster/cube_map.hpp"
+#include "gl/gl_passes.hpp"
 #include "gl_test_support.hpp"
 
 namespace abcube {

@@ -2,10 +2,10 @@
 // and Blinn-Newell reflection from the environment cube texture.
 #include <gtest/gtest.h>
 
-#include "camera.hpp"
-#include "gl_passes.hpp"
+#include "scene/camera.hpp"
+#include "gl/gl_passes.hpp"
 #include "gl_test_support.hpp"
-#include "raytrace.hpp"
+#include "reference/raytrace.hpp"
 
 namespace abcube {
 namespace {

@@ -1,14 +1,14 @@
 // The GL passes against known answers: prepass distances inside a box, a Z-buffer image
-// of a quad, and the GLSL Phong mirror against cpu_core/shading.hpp.
+// of a quad, and the GLSL Phong mirror against cpu_core/shading/shading.hpp.
 #include <cmath>
 
 #include <gtest/gtest.h>
 
-#include "camera.hpp"
-#include "cube_map.hpp"
-#include "gl_passes.hpp"
+#include "scene/camera.hpp"
+#include "raster/cube_map.hpp"
+#include "gl/gl_passes.hpp"
 #include "gl_test_support.hpp"
-#include "shading.hpp"
+#include "shading/shading.hpp"
 
 namespace abcube {
 namespace {

@@ -1,0 +1,135 @@
+#include "io/image_io.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include <OpenImageIO/imageio.h>
+
+#include "base/error.hpp"
+
+namespace abcube {
+
+namespace fs = std::filesystem;
+
+float srgb_encode(float x) {
+  x = std::clamp(x, 0.f, 1.f);
+  return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.f / 2.4f) - 0.055f;
+}
+
+float srgb_decode(float x) {
+  return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f);
+}
+
+namespace {
+
+std::string lower_extension(const std::string& path) {
+  std::string e = fs::path(path).extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+  return e;
+}
+
+bool is_float_format(const std::string& path) {
+  const std::string e = lower_extension(path);
+  return e == ".exr" || e == ".hdr" || e == ".pfm";
+}
+
+// A temporary name beside `path` that keeps its extension (OpenImageIO picks by it).
+std::string temporary_name(const std::string& path) {
+  const fs::path p(path);
+  const std::string name = "." + p.stem().string() + ".tmp" + std::to_string(getpid()) +
+                           p.extension().string();
+  return (p.parent_path() / name).string();
+}
+
+void rename_into_place(const std::string& tmp, const std::string& path) {
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const std::string why = std::strerror(errno);
+    std::remove(tmp.c_str());
+    throw RuntimeFailure(path + ": cannot write: " + why);
+  }
+}
+
+}  // namespace
+
+bool image_format_supported(const std::string& path) {
+  auto out = OIIO::ImageOutput::create(path);
+  return static_cast<bool>(out);
+}
+
+void write_image(const std::string& path, const Image& image) {
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) throw InputError(path + ": no image writer for this file extension");
+  const bool linear = is_float_format(path);
+  const int channels = image.channels;
+  OIIO::ImageSpec spec(image.width, image.height, channels,
+                       linear ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+  spec.attribute("oiio:ColorSpace", linear ? "linear" : "sRGB");
+  std::vector<float> pixels(image.data);
+  if (!linear) {
+    for (size_t k = 0; k < pixels.size(); ++k) {
+      const bool alpha = channels == 4 && k % 4 == 3;
+      pixels[k] = alpha ? std::clamp(pixels[k], 0.f, 1.f) : srgb_encode(pixels[k]);
+    }
+  }
+  const std::string tmp = temporary_name(path);
+  bool ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, pixels.data());
+  ok = out->close() && ok;
+  if (!ok) {
+    std::remove(tmp.c_str());
+    std::string why = out->geterror();
+    if (why.empty()) why = "write failed";
+    throw RuntimeFailure(path + ": cannot write image: " + why);
+  }
+  rename_into_place(tmp, path);
+}
+
+Image read_image(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    std::string why = OIIO::geterror();
+    if (why.empty()) why = "cannot open";
+    std::replace(why.begin(), why.end(), '\n', ' ');
+    throw InputError(path + ": cannot read image: " + why);
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  Image img(spec.width, spec.height, std::min(spec.nchannels, 4));
+  std::vector<float> all(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) {
+    throw InputError(path + ": cannot read image: " + in->geterror());
+  }
+  const bool encoded = !(spec.format == OIIO::TypeDesc::FLOAT || spec.format == OIIO::TypeDesc::HALF ||
+                         spec.format == OIIO::TypeDesc::DOUBLE);
+  for (size_t p = 0; p < static_cast<size_t>(spec.width) * spec.height; ++p) {
+    for (int c = 0; c < img.channels; ++c) {
+      float v = all[p * spec.nchannels + c];
+      if (encoded && c < 3) v = srgb_decode(v);
+      img.data[p * img.channels + c] = v;
+    }
+  }
+  in->close();
+  return img;
+}
+
+void write_text_atomic(const std::string& path, const std::string& text) {
+  const std::string tmp = temporary_name(path);
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    if (!f) throw RuntimeFailure(path + ": cannot write: " + std::strerror(errno));
+    f << text;
+    f.flush();
+    if (!f) {
+      std::remove(tmp.c_str());
+      throw RuntimeFailure(path + ": cannot write: " + std::strerror(errno));
+    }
+  }
+  rename_into_place(tmp, path);
+}
+
+}  // namespace abcube

@@ -1,0 +1,167 @@
+#include "io/metrics.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "base/error.hpp"
+#include "io/image_io.hpp"
+
+namespace abcube {
+
+namespace {
+
+// Allowance so that two 8-bit values one code apart are not "over 1/255".
+constexpr double SHARE_SLACK = 1e-6;
+
+glm::dvec3 displayed(const Image& img, int x, int y) {
+  const glm::vec3 c = img.rgb(x, y);
+  return glm::dvec3(srgb_encode(c.r), srgb_encode(c.g), srgb_encode(c.b));
+}
+
+void check_same_size(const Image& a, const Image& b) {
+  if (a.width != b.width || a.height != b.height) {
+    throw InputError("images differ in size: " + std::to_string(a.width) + "x" + std::to_string(a.height) +
+                     " vs " + std::to_string(b.width) + "x" + std::to_string(b.height));
+  }
+  if (a.channels < 1 || b.channels < 1) throw InputError("images must have at least one channel");
+}
+
+}  // namespace
+
+ImageError image_error(const Image& a, const Image& b) {
+  check_same_size(a, b);
+  ImageError e;
+  const size_t pixels = static_cast<size_t>(a.width) * static_cast<size_t>(a.height);
+  if (pixels == 0) {
+    e.psnr = std::numeric_limits<double>::infinity();
+    return e;
+  }
+  double sum_sq = 0;
+  size_t over1 = 0, over2 = 0;
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < a.width; ++x) {
+      const glm::dvec3 d = glm::abs(displayed(a, x, y) - displayed(b, x, y));
+      sum_sq += glm::dot(d, d);
+      const double m = std::max(d.x, std::max(d.y, d.z));
+      e.max_abs = std::max(e.max_abs, m);
+      if (m > 1.0 / 255.0 + SHARE_SLACK) ++over1;
+      if (m > 2.0 / 255.0 + SHARE_SLACK) ++over2;
+    }
+  }
+  e.rmse = std::sqrt(sum_sq / (3.0 * static_cast<double>(pixels)));
+  e.psnr = e.rmse > 0.0 ? 20.0 * std::log10(1.0 / e.rmse) : std::numeric_limits<double>::infinity();
+  e.share_over_1 = static_cast<double>(over1) / static_cast<double>(pixels);
+  e.share_over_2 = static_cast<double>(over2) / static_cast<double>(pixels);
+  return e;
+}
+
+double share_over(const Image& a, const Image& b, double threshold) {
+  check_same_size(a, b);
+  const size_t pixels = static_cast<size_t>(a.width) * static_cast<size_t>(a.height);
+  if (pixels == 0) return 0.0;
+  size_t over = 0;
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < a.width; ++x) {
+      const glm::dvec3 d = glm::abs(displayed(a, x, y) - displayed(b, x, y));
+      over += std::max(d.x, std::max(d.y, d.z)) > threshold + SHARE_SLACK;
+    }
+  }
+  return static_cast<double>(over) / static_cast<double>(pixels);
+}
+
+glm::dvec3 heatmap_ramp(double d) {
+  struct Stop {
+    double at;
+    glm::dvec3 rgb;
+  };
+  static const std::array<Stop, 7> STOPS = {{
+      {0.0, {0, 0, 0}},
+      {1.0 / 255, {0, 0, 0.35}},
+      {2.0 / 255, {0, 0, 1}},
+      {4.0 / 255, {0, 1, 1}},
+      {8.0 / 255, {0, 1, 0}},
+      {32.0 / 255, {1, 1, 0}},
+      {128.0 / 255, {1, 0, 0}},
+  }};
+  if (!(d > 0.0)) return STOPS[0].rgb;
+  for (size_t i = 1; i < STOPS.size(); ++i) {
+    if (d <= STOPS[i].at) {
+      const double f = (d - STOPS[i - 1].at) / (STOPS[i].at - STOPS[i - 1].at);
+      return glm::mix(STOPS[i - 1].rgb, STOPS[i].rgb, f);
+    }
+  }
+  return STOPS.back().rgb;
+}
+
+Image error_heatmap(const Image& a, const Image& b) {
+  check_same_size(a, b);
+  Image out(a.width, a.height, 3);
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < a.width; ++x) {
+      const glm::dvec3 d = glm::abs(displayed(a, x, y) - displayed(b, x, y));
+      const glm::dvec3 shown = heatmap_ramp(std::max(d.x, std::max(d.y, d.z)));
+      out.set_rgb(x, y, glm::vec3(srgb_decode(static_cast<float>(shown.r)), srgb_decode(static_cast<float>(shown.g)),
+                                  srgb_decode(static_cast<float>(shown.b))));
+    }
+  }
+  return out;
+}
+
+double error_cp(const glm::dvec3& lookup_dir, const glm::dvec3& sigma) {
+  const double lp = glm::length(lookup_dir), ls = glm::length(sigma);
+  ABCUBE_CHECK(lp > 0.0 && ls > 0.0, "error_cp needs non-zero vectors, got |lookup_dir| = " + std::to_string(lp) +
+                                         ", |sigma| = " + std::to_string(ls));
+  // thesis 9.2, eq. 5: Error_CP = (1 - P' . [[Sigma]]) / 2
+  return std::clamp((1.0 - glm::dot(lookup_dir / lp, sigma / ls)) * 0.5, 0.0, 1.0);
+}
+
+double error_parallax(const glm::dvec3& found_point, const glm::dvec3& w, const glm::dvec3& r) {
+  const glm::dvec3 x = found_point - w;
+  const double lx = glm::length(x), lr = glm::length(r);
+  ABCUBE_CHECK(lx > 0.0 && lr > 0.0, "error_parallax needs found_point != W and R != 0, got |X' - W| = " +
+                                         std::to_string(lx) + ", |R| = " + std::to_string(lr));
+  // thesis 9.3, eq. 7: Error_Parallax = (1 - [[X' - W]] . R) / 2
+  return std::clamp((1.0 - glm::dot(x / lx, r / lr)) * 0.5, 0.0, 1.0);
+}
+
+void ErrorStats::merge(const ErrorStats& other) {
+  values_.insert(values_.end(), other.values_.begin(), other.values_.end());
+  misses_ += other.misses_;
+}
+
+double ErrorStats::mean() const {
+  if (values_.empty()) return 0.0;
+  double s = 0;
+  for (double v : values_) s += v;
+  return s / static_cast<double>(values_.size());
+}
+
+double ErrorStats::max() const {
+  return values_.empty() ? 0.0 : *std::max_element(values_.begin(), values_.end());
+}
+
+double ErrorStats::percentile(double q) const {
+  if (values_.empty()) return 0.0;
+  const double n = static_cast<double>(values_.size());
+  const size_t rank = static_cast<size_t>(std::max(1.0, std::ceil(std::clamp(q, 0.0, 1.0) * n)));
+  std::vector<double> v(values_);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(rank - 1), v.end());
+  return v[rank - 1];
+}
+
+double ErrorStats::share_within(double bound) const {
+  if (values_.empty()) return 0.0;
+  size_t within = 0;
+  for (double v : values_) within += v <= bound;
+  return static_cast<double>(within) / static_cast<double>(values_.size());
+}
+
+double ErrorStats::miss_share() const {
+  const uint64_t n = total();
+  return n == 0 ? 0.0 : static_cast<double>(misses_) / static_cast<double>(n);
+}
+
+}  // namespace abcube

@@ -1,0 +1,153 @@
+// The rasterizer: one triangle -> per-pixel 4x8 coverage masks and fragment geometry,
+// for a cube face or the camera view (thesis 5.2: "un fragmento es un polígono cortado
+// en los límites del pixel"). One implementation serves both: a RasterView is three
+// basis rows, a centre and a pixel grid.
+//
+// THE RULES
+//
+// Projection. For a world point P, r = P - centre; the view has rows (row_x, row_y, row_w),
+// row_w unit: w = dot(row_w, r), pixel coordinates x = dot(row_x, r)/w, y = dot(row_y, r)/w.
+// Pixel (px, py) covers [px, px+1) x [py, py+1). A cube face (cube_map.hpp) has
+// row_w = forward, x = N s, y = N t (column i, row j); the camera view (camera.hpp) has
+// x right and y down, row 0 at the top.
+//
+// Coverage (homogeneous rasterisation, Olano & Greer 1997). Sample k of pixel (px, py) is
+// the direction d = to_direction * (px + sample_dx(k), py + sample_dy(k), 1) (samples.hpp).
+// Each edge (r_a, r_b) of a triangle spans a plane through the centre with normal
+// cross(r_a, r_b), turned (by the sign of the triangle's orientation seen from the centre)
+// to point at the triangle's inside; in pixel coordinates it is the linear edge function
+// E(x, y) = a x + b y + c = dot(normal, to_direction * (x, y, 1)). A sample is covered
+// iff every edge function is > 0 at it, or == 0 under the TIE RULE: an edge owns the
+// samples exactly on it iff a > 0, or a == 0 and b > 0 (D3D's top-left rule: left edges
+// and top edges, with y down; on a cube face "top" is smaller t). The rule is the limit
+// of moving every sample by (+eps, +eps^2), so in exact arithmetic a vertex shared by a
+// closed fan has exactly one owner too. The near line keeps its ties (w == near is kept).
+// Watertight: the two triangles on either side of a shared edge compute the edge plane
+// normals n and -n exactly (cross products and their dot products negate exactly in IEEE
+// arithmetic), so every sample is owned by exactly one of them, whatever the winding of
+// the mesh; this holds in floating point, not only in exact arithmetic. (Only a sample
+// within rounding, ~1e-16 relative, of a vertex shared by three or more triangles could be
+// owned by none or two.) No vertex is ever moved by clipping, so clipping cannot open a
+// crack.
+//
+// Near plane. The part of a triangle with w < near is cut away by a fourth edge function
+// (the line where the triangle's plane meets w = near, in the same homogeneous form), so
+// triangles that surround or straddle the centre are normal: each face gets the part in
+// front of it, and what lies behind the centre on one face appears on the opposite face.
+// A triangle with every vertex at w < near is culled on that view.
+//
+// Dropped triangles (never a crash): non-finite vertices, zero area (cross product exactly
+// zero), and edge-on triangles whose plane passes within 1e-9 * (farthest vertex) of the
+// centre (zero area in every view of this centre). They are counted, not rasterised.
+//
+// Fragment geometry. zmin and zmax are Euclidean distances |P - centre| over the
+// triangle clipped to the pixel's frustum (and to w >= near): the exact 3D polygon, so the
+// GPU prepass distance at the texel centre (perspective-correct |P - centre| there) lies
+// in [zmin, zmax] whenever the triangle covers the texel centre. zmax is the farthest
+// polygon vertex; zmin is the plane distance when the foot of the perpendicular from the
+// centre lies in the polygon, else the nearest point of the polygon's boundary. The
+// normal is the vertex normals' perspective-correct (3D barycentric) interpolation at the
+// centroid of the covered samples.
+#pragma once
+#include <array>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "scene/camera.hpp"
+#include "raster/samples.hpp"
+#include "scene/scene.hpp"
+
+namespace abcube {
+
+struct RasterView {
+  glm::dvec3 centre{0.0};
+  glm::dvec3 row_x{1, 0, 0}, row_y{0, 1, 0}, row_w{0, 0, 1};  // row_w unit
+  glm::dmat3 to_direction{1.0};  // inverse of the rows: (x, y, 1) -> unnormalised r
+  int width = 1, height = 1;
+  double near_distance = 1e-4;
+
+  // Unnormalised direction from the centre through pixel point (x, y).
+  glm::dvec3 direction(double x, double y) const { return to_direction * glm::dvec3(x, y, 1.0); }
+  // Pixel coordinates of r = P - centre (w must be > 0).
+  glm::dvec2 project(const glm::dvec3& r) const {
+    const double w = glm::dot(row_w, r);
+    return {glm::dot(row_x, r) / w, glm::dot(row_y, r) / w};
+  }
+  size_t pixel_count() const { return static_cast<size_t>(width) * static_cast<size_t>(height); }
+};
+
+// Face `face` (cube_map.hpp order and frames) of an n x n cube centred at `centre`.
+RasterView cube_face_view(int face, const glm::dvec3& centre, int n, double near_distance);
+// The camera image (camera.hpp: x right, y down), centred at the eye.
+RasterView camera_view(const CameraFrame& frame, double near_distance);
+
+enum class SetupResult { visible, culled, degenerate, edge_on };
+
+// One triangle prepared for one view: edge functions in pixel coordinates, its plane,
+// its part in front of the near plane, and the pixel rows and columns it may cover.
+struct TriangleSetup {
+  uint32_t triangle = 0;
+  std::array<glm::dvec3, 3> r{};          // vertices minus the view centre
+  std::array<glm::dvec3, 3> normal{};     // vertex normals
+  std::array<glm::dvec3, 4> edge{};       // (a, b, c) per edge (edge k: r_k -> r_k+1), then near
+  std::array<glm::dvec3, 4> edge_3d{};    // the same edges as inward plane normals (through the centre)
+  std::array<bool, 4> owns_ties{};        // tie rule per edge
+  int edge_count = 3;                     // 4 when the near plane cuts the triangle
+  std::array<glm::dvec3, 4> polygon{};    // the triangle clipped to w >= near (3D, minus centre)
+  int polygon_size = 0;
+  glm::dvec3 plane_normal{0.0};           // cross(r1 - r0, r2 - r0), the geometric normal
+  double plane_offset = 0;                // dot(plane_normal, r0): < 0 front face, > 0 back face
+  double plane_distance = 0;              // |plane_offset| / |plane_normal|
+  int foot_x = -1, foot_y = -1;           // pixel holding the foot of the perpendicular, if covered
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;     // pixel bounds [x0, x1) x [y0, y1), clamped to the view
+  bool back_face() const { return plane_offset > 0; }
+  bool near_clipped() const { return edge_count == 4; }
+};
+
+// Prepares triangle `index` of `soup` for `view`; `setup` is valid only for `visible`.
+SetupResult setup_triangle(const RasterView& view, const TriangleSoup& soup, uint32_t index,
+                           TriangleSetup* setup);
+
+// Columns [*x_begin, *x_end) of row y that may hold covered samples (a conservative span
+// inside the setup's bounds); empty when *x_begin >= *x_end.
+void row_span(const TriangleSetup& setup, int y, int* x_begin, int* x_end);
+
+// The samples of pixel (x, y) that the triangle covers (the rules above).
+CoverageMask pixel_mask(const TriangleSetup& setup, int x, int y);
+
+// Calls visit(x, y, mask) for every pixel of rows [y_begin, y_end) with a non-empty mask,
+// row by row, left to right.
+template <class Visit>
+void rasterize_rows(const TriangleSetup& setup, int y_begin, int y_end, Visit&& visit) {
+  const int yb = y_begin > setup.y0 ? y_begin : setup.y0;
+  const int ye = y_end < setup.y1 ? y_end : setup.y1;
+  for (int y = yb; y < ye; ++y) {
+    int xb = 0, xe = 0;
+    row_span(setup, y, &xb, &xe);
+    for (int x = xb; x < xe; ++x) {
+      const CoverageMask m = pixel_mask(setup, x, y);
+      if (m != 0) visit(x, y, m);
+    }
+  }
+}
+
+// Offsets (dx, dy) from the pixel corner of the centroid of the samples in `mask`
+// (the pixel centre (0.5, 0.5) for an empty mask).
+glm::dvec2 mask_centroid(CoverageMask mask);
+
+struct FragmentGeometry {
+  double zmin = 0, zmax = 0;  // Euclidean distance from the centre over the clipped polygon
+  glm::dvec3 normal{0.0};     // unit interpolated vertex normal at the covered samples' centroid
+};
+
+// The geometry of the triangle's fragment in pixel (x, y) with coverage `mask` (non-empty).
+FragmentGeometry fragment_geometry(const RasterView& view, const TriangleSetup& setup, int x, int y,
+                                   CoverageMask mask);
+
+// The point of triangle `index`'s plane seen from the view centre along pixel point (x, y)
+// (world space); the centre itself if that ray is parallel to the plane.
+glm::dvec3 point_on_triangle_plane(const RasterView& view, const TriangleSoup& soup, uint32_t index,
+                                   double x, double y);
+
+}  // namespace abcube

@@ -1,0 +1,159 @@
+// The exact reference: a Whitted ray tracer (Whitted 1980) over the scene's triangles,
+// in double precision, against which every other method's images and searches are
+// measured (design.md, "Error measures"; thesis ch. 9).
+//
+// THE RULES (shared by every method; the per-rule functions live in shading.hpp)
+//
+// Camera rays. Sample k of pixel (px, py) goes through image point
+//   (px + sample_dx(k), py + sample_dy(k)),  k = 0..31   (samples.hpp, the A-buffer's 4x8)
+// along CameraFrame::direction (camera.hpp), from the eye; the pixel is the plain mean of
+// its samples (box filter). samples_per_pixel = 1 shoots the pixel centre (px+.5, py+.5).
+//
+// A ray that hits nothing returns Scene::background (primary and secondary rays alike).
+//
+// Hit shading, at the nearest hit with t > 0 of ray (o, d), d unit, depth k:
+//   N_g  unit geometric normal cross(b-a, c-a) (outward for closed objects)
+//   N_s  barycentric interpolation of TriangleSoup::normals, renormalised (N_g if that
+//        interpolation vanishes)
+//   V = -d,  N = face_forward(N_s, V)  (two-sided lighting, as phong_local)
+//   C_surface = phong_ambient + sum_l S_l * phong_light(N, V, L_l)       (shading.hpp)
+//             + kr * trace(reflected, k+1)                    if kr > 0 and k < max_depth
+//             + kt * trace(transmitted, k+1)                  if kt > 0 and k < max_depth
+//   C = blend_coverage(opacity, C_surface, trace(continued straight on, k))  if opacity < 1
+//   reflected: reflect_dir(d, N_s). transmitted: transmission() in shading.hpp: entering
+//   iff dot(N_g, d) < 0, eta = 1/ior entering and ior leaving (air on the far side of every
+//   interface: no medium stack), bent about N_s flipped to the incoming side of N_g; on
+//   total internal reflection the kt weight follows the mirror direction instead.
+//   A direction bent by an interpolated N_s may cross to the other side of the triangle's
+//   plane (near silhouettes of coarse meshes); it is traced as it is, from the side it
+//   travels into (no correction).
+//
+// Depth. Primary rays have depth 0; reflected and refracted rays depth k+1. At depth
+// max_depth (Scene::render.max_depth) no reflected or refracted ray is spawned: those
+// terms contribute nothing (black), not the background. The opacity continuation keeps
+// the depth of the ray it continues (it is the same ray), so it never runs out.
+//
+// Shadows. For a light with cast_shadows, S_l is the product, over every surface the
+// segment from P to the light crosses, of blocker_transmittance = (1-op) + op*kt*Od
+// (opaque: 0, glass: kt*Od, veil: 1-op); shadow rays go straight (no refraction). Two
+// crossings of one object at the same distance with the same facing (a ray through a
+// shared edge) count once. Lights with cast_shadows false: S_l = 1. S_l is only
+// evaluated where phong_light is non-zero.
+//
+// Self-intersection. Every secondary ray (reflected, transmitted, continued, shadow)
+// starts at the hit point moved by self_intersection_offset(P, scene_scale) =
+// 1e-9 * (max|P_i| + scene_scale) along N_g, to the side the new ray travels into
+// (offset_origin in shading.hpp); there is no t_min besides t > 0. The hit point is the
+// barycentric combination of the double vertices, so it lies on the triangle's plane to
+// within rounding and the offset ray cannot see that plane again, grazing or not.
+//
+// Exactness. RayTracer::intersect is the double-precision watertight test (Woop et al.
+// 2013) on the float vertex data, through a BVH that returns the same first hit as a
+// loop over all triangles (bvh.hpp). Later methods measure Error_Parallax against it.
+//
+// Determinism. Pixels are independent and shaded in a fixed order, rows are handed to
+// threads dynamically, so the image is bit-identical for any number of threads.
+#pragma once
+#include <cstdint>
+#include <functional>
+
+#include <glm/glm.hpp>
+
+#include "reference/bvh.hpp"
+#include "io/image.hpp"
+#include "scene/scene.hpp"
+
+namespace abcube {
+
+struct RaytraceOptions {
+  int threads = 0;              // 0 = std::thread::hardware_concurrency()
+  int samples_per_pixel = 32;   // 32 (the 4x8 A-buffer samples) or 1 (pixel centre)
+  // Called now and then on the calling thread with the share of rows done, in [0, 1].
+  std::function<void(double)> progress;
+};
+
+struct RaytraceStats {
+  uint64_t primary_rays = 0;
+  uint64_t secondary_rays = 0;  // reflected, transmitted and opacity-continued rays
+  uint64_t shadow_rays = 0;
+  double build_ms = 0;          // BVH construction
+  double trace_ms = 0;          // all rays of the image
+  uint64_t triangles = 0;
+  uint64_t bvh_nodes = 0;
+  int bvh_depth = 0;
+  int threads = 0;              // threads actually used
+};
+
+// Per-thread ray counters (RaytraceStats sums them).
+struct RayCounts {
+  uint64_t primary = 0, secondary = 0, shadow = 0;
+};
+
+// Everything about the first surface a ray meets.
+struct Hit {
+  double t = 0;                        // origin + t * dir (t in units of |dir|)
+  glm::dvec3 point{0.0};               // on the triangle: barycentric combination of its vertices
+  uint32_t triangle = 0;               // index into Scene::triangles
+  glm::dvec3 barycentric{0.0};         // weights of the triangle's vertices 0, 1, 2
+  glm::dvec3 geometric_normal{0.0};    // unit, cross(b-a, c-a) direction
+  glm::dvec3 shading_normal{0.0};      // unit, interpolated vertex normal (not face-forwarded)
+  uint32_t object_id = 0;              // index into Scene::objects
+  uint32_t material_id = 0;            // index into Scene::materials
+  bool front_face = true;              // dot(geometric_normal, dir) < 0
+};
+
+// A secondary ray: origin already offset off the surface, unit direction.
+struct Ray {
+  glm::dvec3 origin{0.0}, dir{0.0};
+};
+
+class RayTracer {
+ public:
+  // Builds the BVH. The scene must outlive the tracer (it is referenced, not copied).
+  explicit RayTracer(const Scene& scene);
+  explicit RayTracer(Scene&&) = delete;
+
+  // The first hit with 0 < t < tmax along origin + t*dir (dir non-zero, need not be unit).
+  bool intersect(const glm::dvec3& origin, const glm::dvec3& dir, double tmax, Hit* hit) const;
+  bool intersect(const glm::dvec3& origin, const glm::dvec3& dir, Hit* hit) const;
+
+  // The colour seen along a ray of depth `depth` (dir need not be unit). Counts rays into
+  // `counts` when given (the ray itself is counted by the caller: see render_raytrace).
+  glm::dvec3 trace(const glm::dvec3& origin, const glm::dvec3& dir, int depth,
+                   RayCounts* counts = nullptr) const;
+
+  // The colour of a hit seen along unit dir, at depth `depth` (the rules above).
+  glm::dvec3 shade(const Hit& hit, const glm::dvec3& dir, int depth, RayCounts* counts) const;
+
+  // S_l: the light's visibility from surface point `hit` (1 when it casts no shadows).
+  glm::dvec3 light_visibility(const Hit& hit, const PointLight& light, RayCounts* counts) const;
+
+  // The secondary rays of a hit seen along unit dir (rules above).
+  Ray reflected_ray(const Hit& hit, const glm::dvec3& dir) const;
+  Ray transmitted_ray(const Hit& hit, const glm::dvec3& dir, bool* total_internal_reflection) const;
+  Ray continued_ray(const Hit& hit, const glm::dvec3& dir) const;
+
+  // The hit point offset off its surface towards the side `dir` travels into.
+  glm::dvec3 offset_point(const Hit& hit, const glm::dvec3& dir) const;
+
+  // Largest absolute vertex coordinate plus the diagonal of the vertex bounds.
+  double scene_scale() const { return scene_scale_; }
+  const Bvh& bvh() const { return bvh_; }
+  const Scene& scene() const { return *scene_; }
+  double build_ms() const { return build_ms_; }
+
+ private:
+  Hit make_hit(const TriangleHit& th, const glm::dvec3& dir) const;
+
+  const Scene* scene_;
+  double build_ms_ = 0;  // before bvh_: the BVH's construction writes it
+  Bvh bvh_;
+  double scene_scale_ = 0;
+};
+
+// Renders the scene's camera view with the rules above. Throws InputError for a bad
+// option (samples_per_pixel not 1 or 32, negative threads).
+Image render_raytrace(const Scene& scene, const RaytraceOptions& options = {},
+                      RaytraceStats* stats = nullptr);
+
+}  // namespace abcube

@@ -1,0 +1,362 @@
+#include "scene/tessellate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <unordered_map>
+#include <utility>
+
+namespace abcube {
+
+namespace {
+
+constexpr double PI = 3.14159265358979323846;
+
+// A triangle is zero-area when twice its area is below this share of its squared
+// longest edge (a relative test, so it does not depend on the scene's units).
+constexpr double ZERO_AREA_RELATIVE = 1e-12;
+
+void push_triangle(LocalMesh* m, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+  m->positions.push_back(a);
+  m->positions.push_back(b);
+  m->positions.push_back(c);
+}
+
+bool finite3(const glm::dvec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// Newell's method: twice the vector area of a polygon (Sutherland et al. 1974; Tampieri,
+// "Newell's Method for Computing the Plane Equation of a Polygon", Graphics Gems III).
+glm::dvec3 newell_normal(const glm::dvec3* v, size_t n) {
+  glm::dvec3 c(0.0);
+  for (size_t i = 0; i < n; ++i) c += v[i];
+  c /= static_cast<double>(n);
+  glm::dvec3 sum(0.0);
+  for (size_t i = 0; i < n; ++i) sum += glm::cross(v[i] - c, v[(i + 1) % n] - c);
+  return sum;
+}
+
+// cos and sin of an angle in degrees, exact at multiples of 90 so that quarter turns
+// keep axis-aligned geometry axis-aligned.
+void cos_sin_deg(double deg, double* c, double* s) {
+  const double quarters = deg / 90.0;
+  if (quarters == std::floor(quarters) && std::fabs(quarters) < 1e15) {
+    static const double COS[4] = {1, 0, -1, 0}, SIN[4] = {0, 1, 0, -1};
+    const int q = static_cast<int>(((static_cast<long long>(quarters) % 4) + 4) % 4);
+    *c = COS[q];
+    *s = SIN[q];
+    return;
+  }
+  const double r = deg * PI / 180.0;
+  *c = std::cos(r);
+  *s = std::sin(r);
+}
+
+// Point on the unit sphere at ring k (0 = +y pole, rings = -y pole) and segment j.
+glm::dvec3 sphere_direction(int k, int j, int rings, int segments) {
+  if (k == 0) return {0, 1, 0};
+  if (k == rings) return {0, -1, 0};
+  const double theta = PI * k / rings;
+  const double phi = 2.0 * PI * (j % segments) / segments;
+  return {std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi)};
+}
+
+// 2D cross product of (b - a) and (c - a).
+double cross2(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
+  return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
+
+bool inside_triangle(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b,
+                     const glm::dvec2& c) {
+  return cross2(a, b, p) > 0 && cross2(b, c, p) > 0 && cross2(c, a, p) > 0;
+}
+
+// Whether corner `i` of the remaining polygon `ring` is an ear: convex, and no other
+// remaining corner lies strictly inside the triangle it cuts off.
+bool is_ear(const std::vector<glm::dvec2>& p, const std::vector<int>& ring, size_t i) {
+  const size_t n = ring.size();
+  const int a = ring[(i + n - 1) % n], b = ring[i], c = ring[(i + 1) % n];
+  if (cross2(p[a], p[b], p[c]) <= 0) return false;
+  for (int k : ring) {
+    if (k == a || k == b || k == c) continue;
+    if (inside_triangle(p[k], p[a], p[b], p[c])) return false;
+  }
+  return true;
+}
+
+struct VertexKey {
+  uint32_t bits[3];
+  bool operator==(const VertexKey& o) const {
+    return bits[0] == o.bits[0] && bits[1] == o.bits[1] && bits[2] == o.bits[2];
+  }
+};
+struct VertexKeyHash {
+  size_t operator()(const VertexKey& k) const {
+    uint64_t h = 1469598103934665603ull;  // FNV-1a
+    for (uint32_t b : k.bits) h = (h ^ b) * 1099511628211ull;
+    return static_cast<size_t>(h);
+  }
+};
+
+VertexKey vertex_key(const glm::vec3& p) {
+  VertexKey k{};
+  for (int i = 0; i < 3; ++i) {
+    const float f = p[i] + 0.0f;  // -0 and +0 are one position
+    std::memcpy(&k.bits[i], &f, sizeof f);
+  }
+  return k;
+}
+
+}  // namespace
+
+LocalMesh tessellate_triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+  LocalMesh m;
+  push_triangle(&m, a, b, c);
+  return m;
+}
+
+double quad_planarity_error(const std::array<glm::dvec3, 4>& v) {
+  const double size = std::max(glm::length(v[2] - v[0]), glm::length(v[3] - v[1]));
+  const glm::dvec3 n = newell_normal(v.data(), 4);
+  const double len = glm::length(n);
+  if (!(size > 0) || !(len > ZERO_AREA_RELATIVE * size * size)) return 0;  // degenerate: no plane to miss
+  const glm::dvec3 unit = n / len;
+  const glm::dvec3 c = 0.25 * (v[0] + v[1] + v[2] + v[3]);
+  double worst = 0;
+  for (const glm::dvec3& p : v) worst = std::max(worst, std::fabs(glm::dot(p - c, unit)));
+  return worst / size;
+}
+
+bool tessellate_quad(const std::array<glm::dvec3, 4>& v, LocalMesh* out) {
+  glm::dvec3 n = newell_normal(v.data(), 4);
+  // A symmetric bow tie has no net area; measure its triangles against the first one.
+  if (glm::length(n) == 0.0) n = glm::cross(v[1] - v[0], v[2] - v[0]);
+  auto agrees = [&](int a, int b, int c) {
+    return glm::dot(glm::cross(v[b] - v[a], v[c] - v[a]), n) >= 0.0;
+  };
+  if (agrees(0, 1, 2) && agrees(0, 2, 3)) {
+    push_triangle(out, v[0], v[1], v[2]);
+    push_triangle(out, v[0], v[2], v[3]);
+    return true;
+  }
+  if (agrees(1, 2, 3) && agrees(1, 3, 0)) {
+    push_triangle(out, v[1], v[2], v[3]);
+    push_triangle(out, v[1], v[3], v[0]);
+    return true;
+  }
+  return false;
+}
+
+LocalMesh tessellate_box(const glm::dvec3& lo, const glm::dvec3& hi) {
+  auto corner = [&](int x, int y, int z) {
+    return glm::dvec3(x ? hi.x : lo.x, y ? hi.y : lo.y, z ? hi.z : lo.z);
+  };
+  // Each face's corners counter-clockwise seen from outside: cross(b-a, c-a) points out.
+  static const int FACES[6][4][3] = {
+      {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}},  // -x
+      {{1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1}},  // +x
+      {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}},  // -y
+      {{0, 1, 0}, {0, 1, 1}, {1, 1, 1}, {1, 1, 0}},  // +y
+      {{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}},  // -z
+      {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}},  // +z
+  };
+  LocalMesh m;
+  for (const auto& f : FACES) {
+    glm::dvec3 q[4];
+    for (int i = 0; i < 4; ++i) q[i] = corner(f[i][0], f[i][1], f[i][2]);
+    push_triangle(&m, q[0], q[1], q[2]);
+    push_triangle(&m, q[0], q[2], q[3]);
+  }
+  return m;
+}
+
+int sphere_rings(int segments) { return std::max(2, segments / 2); }
+
+size_t sphere_triangle_count(int segments) {
+  // Two pole caps of `segments` triangles, two triangles per cell of the other bands.
+  return 2 * static_cast<size_t>(segments) * static_cast<size_t>(sphere_rings(segments) - 1);
+}
+
+LocalMesh tessellate_sphere(const glm::dvec3& center, double radius, int segments) {
+  const int rings = sphere_rings(segments);
+  LocalMesh m;
+  m.positions.reserve(3 * sphere_triangle_count(segments));
+  m.normals.reserve(3 * sphere_triangle_count(segments));
+  auto corner = [&](int k, int j) {
+    const glm::dvec3 d = sphere_direction(k, j, rings, segments);
+    m.positions.push_back(center + radius * d);
+    m.normals.push_back(d);
+  };
+  // Around +x on the equator, j grows towards +z and k towards -y, so (k,j), (k,j+1),
+  // (k+1,j) winds counter-clockwise seen from outside.
+  for (int k = 0; k < rings; ++k) {
+    for (int j = 0; j < segments; ++j) {
+      if (k > 0) {  // the triangle touching ring k (absent at the +y pole)
+        corner(k, j);
+        corner(k, j + 1);
+        corner(k + 1, j);
+      }
+      if (k + 1 < rings) {  // the triangle touching ring k+1 (absent at the -y pole)
+        corner(k, j + 1);
+        corner(k + 1, j + 1);
+        corner(k + 1, j);
+      }
+    }
+  }
+  return m;
+}
+
+std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<glm::dvec3>& corners) {
+  const int n = static_cast<int>(corners.size());
+  std::vector<std::array<int, 3>> out;
+  if (n < 3) return out;
+  // Project onto the polygon's plane with a frame (u, v, normal), so it runs counter-clockwise.
+  const glm::dvec3 normal = newell_normal(corners.data(), corners.size());
+  std::vector<int> ring(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) ring[static_cast<size_t>(i)] = i;
+  if (n > 3 && glm::length(normal) > 0.0) {
+    const glm::dvec3 w = glm::normalize(normal);
+    const glm::dvec3 helper = std::fabs(w.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+    const glm::dvec3 u = glm::normalize(glm::cross(helper, w));
+    const glm::dvec3 v = glm::cross(w, u);
+    std::vector<glm::dvec2> p;
+    p.reserve(corners.size());
+    for (const glm::dvec3& c : corners) p.emplace_back(glm::dot(c, u), glm::dot(c, v));
+    while (ring.size() > 3) {
+      size_t ear = ring.size();
+      for (size_t i = 0; i < ring.size() && ear == ring.size(); ++i) {
+        if (is_ear(p, ring, i)) ear = i;
+      }
+      if (ear == ring.size()) break;  // no ear: numerically degenerate, fan the rest
+      const size_t m = ring.size();
+      out.push_back({ring[(ear + m - 1) % m], ring[ear], ring[(ear + 1) % m]});
+      ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(ear));
+    }
+  }
+  for (size_t i = 1; i + 1 < ring.size(); ++i) out.push_back({ring[0], ring[i], ring[i + 1]});
+  return out;
+}
+
+AffineMap make_affine_map(const Transform& t) {
+  double cx, sx, cy, sy, cz, sz;
+  cos_sin_deg(t.rotate_deg.x, &cx, &sx);
+  cos_sin_deg(t.rotate_deg.y, &cy, &sy);
+  cos_sin_deg(t.rotate_deg.z, &cz, &sz);
+  // Right-handed rotations, GLM column-major: each dmat3 argument triple is a column.
+  const glm::dmat3 rx(1, 0, 0, 0, cx, sx, 0, -sx, cx);
+  const glm::dmat3 ry(cy, 0, -sy, 0, 1, 0, sy, 0, cy);
+  const glm::dmat3 rz(cz, sz, 0, -sz, cz, 0, 0, 0, 1);
+  const glm::dmat3 s(t.scale.x, 0, 0, 0, t.scale.y, 0, 0, 0, t.scale.z);
+  AffineMap m;
+  m.linear = rz * ry * rx * s;  // scale first, then x, y, z
+  m.offset = t.translate;
+  // Normals transform by the inverse transpose (e.g. pbrt-v4 Transform::ApplyNormal).
+  m.normal_matrix = glm::transpose(glm::inverse(m.linear));
+  m.mirrors = glm::determinant(m.linear) < 0.0;
+  return m;
+}
+
+bool is_zero_area(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+  const double longest2 =
+      std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
+  const double twice_area = glm::length(glm::cross(b - a, c - a));
+  return !(twice_area > ZERO_AREA_RELATIVE * longest2) || !std::isfinite(longest2);
+}
+
+size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t object_id,
+                        uint32_t material, TriangleSoup* soup) {
+  // A mirroring transform reverses the winding; swapping b and c restores the sense of
+  // the geometric normal.
+  const int order[3] = {0, m.mirrors ? 2 : 1, m.mirrors ? 1 : 2};
+  size_t dropped = 0;
+  for (size_t t = 0; t < local.triangle_count(); ++t) {
+    glm::vec3 f[3];
+    glm::dvec3 p[3];
+    for (int k = 0; k < 3; ++k) {
+      f[k] = glm::vec3(m.point(local.positions[3 * t + static_cast<size_t>(order[k])]));
+      p[k] = glm::dvec3(f[k]);  // judge the triangle the renderer will see
+    }
+    if (!finite3(p[0]) || !finite3(p[1]) || !finite3(p[2]) || is_zero_area(p[0], p[1], p[2])) {
+      ++dropped;
+      continue;
+    }
+    const glm::dvec3 flat = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
+    glm::dvec3 n[3] = {flat, flat, flat};
+    if (!local.normals.empty()) {
+      bool smooth = true;
+      for (int k = 0; k < 3 && smooth; ++k) {
+        const glm::dvec3 w = m.normal_matrix * local.normals[3 * t + static_cast<size_t>(order[k])];
+        const double len = glm::length(w);
+        smooth = std::isfinite(len) && len > 0.0;
+        if (smooth) n[k] = w / len;
+      }
+      if (!smooth) n[0] = n[1] = n[2] = flat;
+    }
+    const int mat = local.material.empty() ? -1 : local.material[t];
+    for (int k = 0; k < 3; ++k) {
+      soup->positions.push_back(f[k]);
+      soup->normals.push_back(glm::vec3(n[k]));
+    }
+    soup->object_id.push_back(object_id);
+    soup->material_id.push_back(mat < 0 ? material : static_cast<uint32_t>(mat));
+  }
+  return dropped;
+}
+
+bool is_closed_surface(const TriangleSoup& soup, size_t first, size_t count) {
+  if (count == 0) return false;
+  std::unordered_map<VertexKey, uint32_t, VertexKeyHash> ids;
+  ids.reserve(count * 2);
+  auto id_of = [&](size_t corner) {
+    const auto it = ids.emplace(vertex_key(soup.positions[corner]), static_cast<uint32_t>(ids.size()));
+    return uint64_t{it.first->second};
+  };
+  // Each directed edge as (undirected key, +1 or -1 for its direction).
+  std::vector<std::pair<uint64_t, int>> edges;
+  edges.reserve(3 * count);
+  for (size_t t = first; t < first + count; ++t) {
+    const uint64_t v[3] = {id_of(3 * t), id_of(3 * t + 1), id_of(3 * t + 2)};
+    for (int k = 0; k < 3; ++k) {
+      const uint64_t a = v[k], b = v[(k + 1) % 3];
+      edges.emplace_back(std::min(a, b) << 32 | std::max(a, b), a < b ? 1 : -1);
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    int direction_sum = 0;
+    for (; j < edges.size() && edges[j].first == edges[i].first; ++j) direction_sum += edges[j].second;
+    if (j - i != 2 || direction_sum != 0) return false;
+    i = j;
+  }
+  return true;
+}
+
+double signed_volume(const TriangleSoup& soup, size_t first, size_t count) {
+  if (count == 0) return 0.0;
+  const glm::dvec3 o(soup.positions[3 * first]);  // any origin; near the mesh for precision
+  double six_v = 0;
+  for (size_t t = first; t < first + count; ++t) {
+    const glm::dvec3 a = glm::dvec3(soup.positions[3 * t]) - o;
+    const glm::dvec3 b = glm::dvec3(soup.positions[3 * t + 1]) - o;
+    const glm::dvec3 c = glm::dvec3(soup.positions[3 * t + 2]) - o;
+    six_v += glm::dot(a, glm::cross(b, c));
+  }
+  return six_v / 6.0;
+}
+
+void flip_winding(TriangleSoup* soup, size_t first, size_t count) {
+  for (size_t t = first; t < first + count; ++t) {
+    std::swap(soup->positions[3 * t + 1], soup->positions[3 * t + 2]);
+    std::swap(soup->normals[3 * t + 1], soup->normals[3 * t + 2]);
+    const glm::vec3 a = soup->positions[3 * t];
+    const glm::vec3 g = glm::cross(soup->positions[3 * t + 1] - a, soup->positions[3 * t + 2] - a);
+    for (int k = 0; k < 3; ++k) {
+      glm::vec3& n = soup->normals[3 * t + static_cast<size_t>(k)];
+      if (glm::dot(n, g) < 0.0f) n = -n;
+    }
+  }
+}
+
+}  // namespace abcube

@@ -1,0 +1,90 @@
+// Scene primitives as triangles, the object transform, and closed-surface tests
+// (scene-format.md "objects"). Winding: the geometric normal is cross(b-a, c-a); on a
+// closed object it points outward.
+#pragma once
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene/scene.hpp"
+
+namespace abcube {
+
+// One object's triangles in its own space, before the transform: corners 3i..3i+2 are
+// triangle i. `normals` is empty (flat shading) or holds one normal per corner, where a
+// zero normal anywhere in a triangle means "flat" for that triangle. `material` is empty
+// or holds one entry per triangle, -1 meaning the object's own material.
+struct LocalMesh {
+  std::vector<glm::dvec3> positions;
+  std::vector<glm::dvec3> normals;
+  std::vector<int> material;
+  size_t triangle_count() const { return positions.size() / 3; }
+};
+
+LocalMesh tessellate_triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
+
+// How far the four quad vertices are from their best plane, relative to the quad's size
+// (largest diagonal): 0 for a planar quad.
+double quad_planarity_error(const std::array<glm::dvec3, 4>& v);
+
+// Two triangles along a diagonal that keeps the quad's winding (either diagonal of a
+// convex quad, the inner one of a concave quad). False for a self-intersecting quad.
+bool tessellate_quad(const std::array<glm::dvec3, 4>& v, LocalMesh* out);
+
+// Closed axis-aligned box, 12 triangles, flat normals, outward winding. lo < hi.
+LocalMesh tessellate_box(const glm::dvec3& lo, const glm::dvec3& hi);
+
+// Latitude-longitude sphere: `segments` around the equator, sphere_rings(segments)
+// bands from pole (+y) to pole (-y); closed, outward winding, smooth normals.
+int sphere_rings(int segments);
+size_t sphere_triangle_count(int segments);
+LocalMesh tessellate_sphere(const glm::dvec3& center, double radius, int segments);
+
+// Splits a simple polygon (corners in order) into triangles of the same winding by ear
+// clipping in the plane of its Newell normal (Eberly 2002, "Triangulation by Ear
+// Clipping"). Corner index triples; what no ear can be cut from is fanned.
+std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<glm::dvec3>& corners);
+
+// Object to world: scale, then rotate about x, then y, then z (degrees), then translate.
+struct Transform {
+  glm::dvec3 translate{0.0};
+  glm::dvec3 rotate_deg{0.0};
+  glm::dvec3 scale{1.0};
+};
+
+struct AffineMap {
+  glm::dmat3 linear{1.0};
+  glm::dvec3 offset{0.0};
+  glm::dmat3 normal_matrix{1.0};  // inverse transpose of `linear`
+  bool mirrors = false;           // det(linear) < 0: winding must flip to keep normals
+  glm::dvec3 point(const glm::dvec3& p) const { return linear * p + offset; }
+};
+AffineMap make_affine_map(const Transform& t);
+
+// True when the triangle has no usable area: |cross(b-a, c-a)| <= 1e-12 * (longest
+// edge)^2, or non-finite corners.
+bool is_zero_area(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
+
+// Appends `local`, moved to world space by `m`, to `soup` as object `object_id`; triangles
+// without a material entry (or with -1) get `material`. Triangles that are zero-area or
+// non-finite once stored as floats are skipped; returns how many were.
+size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t object_id,
+                        uint32_t material, TriangleSoup* soup);
+
+// Whether triangles [first, first + count) of the soup form a closed, consistently
+// oriented surface: every edge (by exact vertex position) is shared by exactly two
+// triangles that run along it in opposite directions.
+bool is_closed_surface(const TriangleSoup& soup, size_t first, size_t count);
+
+// Signed volume enclosed by the triangles (divergence theorem, sum of tetrahedra
+// (o, a, b, c)); positive when a closed surface's normals point outward.
+double signed_volume(const TriangleSoup& soup, size_t first, size_t count);
+
+// Reverses the winding of the triangles (swaps corners b and c with their normals) and
+// turns every normal that then points against the new geometric normal (all flat ones).
+void flip_winding(TriangleSoup* soup, size_t first, size_t count);
+
+}  // namespace abcube

@@ -1,0 +1,128 @@
+// The texel walk: the texels of an n x n cube map (cube_map.hpp) that a ray's projection
+// crosses, in order of increasing ray parameter (thesis 7.4.1 "usar un algoritmo que dibuje
+// líneas para indexar el mapa", 7.5, 8.3).
+//
+// GEOMETRY. Coordinates are relative to the cube centre C. The ray is X(l) = W + l D, D unit,
+// l in [0, l_max]. Seen from C its points sweep the great-circle arc from [[W]] towards D
+// (thesis 7.4, theorem 1: [[X(l)]] = [[(1-t) D + t W]], t = 1/(1+l)). Every texel boundary is
+// a plane through C, so the ray crosses it at one exact parameter l; on a face the projection
+// (s(l), t(l)) is a straight segment whose s and t are monotone in l (ds/dl has the constant
+// sign of (F x S) . (W x D), F the face's forward axis and S its s axis).
+//
+// ALGORITHM (no 3D march, no fixed step).
+//  1. Faces. The face of X(l) is the argmax of the six linear functions F_k . X(l) =
+//     F_k . W + l F_k . D (their max is |X(l)|_inf). Their upper envelope is convex in l, so
+//     the faces follow in order of increasing slope F_k . D, each at most once; the switch
+//     from face k to face m is where the two lines meet. Ties at an l: the larger slope (the
+//     face the ray enters), then the lower face index (cube_map.hpp's x-before-y-before-z).
+//  2. Texels on a face: a 2D DDA (Amanatides & Woo 1987) on the face's (s, t) grid, the
+//     parameter of each crossing computed exactly from the boundary plane
+//     N (S . X) - (2k - N) (F . X) = 0 (integer coefficients on the axis-aligned frame).
+//     The entry texel is the projection of X(l) where the ray enters the face, clamped to
+//     the face. Only the interior boundaries 1..n-1 are stepped; the face's own edges are
+//     left by step 1, so a seam, edge or corner is crossed exactly once.
+//  3. TIE RULES. Two crossings at the same l (the ray through a texel corner): both indices
+//     step at once (a diagonal move; the two texels touching only the corner point are
+//     not visited). A crossing computed behind the current l (rounding on a boundary) is
+//     taken at the current l. Texels whose interval has zero length are not reported (a
+//     ray along a seam or exactly through a corner touches them at one point only). Each
+//     step moves i or j one way only and the faces never repeat, so a walk has at most
+//     6 * 2n texels; max_texels (default 16 n + 64) is a safety cap, `aborted` says when it
+//     was hit.
+//  4. THE CENTRE. A ray whose line passes within r of C (closest approach h = |W x D| < r)
+//     skips the part inside the ball |X| < r: l in (l_c - sqrt(r^2 - h^2), l_c +
+//     sqrt(r^2 - h^2)), l_c = -W . D. r = max(skip_radius, CENTRE_PASS_REL |W|). The searches
+//     pass the map's near distance as skip_radius (the map holds nothing closer to C); the
+//     relative floor is the degenerate case D . [[W]] = -1 (the ray through C: its direction
+//     jumps to the antipode D) and its neighbours, where the arc's sweep past C cannot be
+//     resolved in double precision. The first texel after a skip has `after_gap` set.
+//     D . [[W]] = +1 needs no rule: no boundary plane is crossed, the walk is one texel.
+//     W = 0 (the ray starts at C): the walk is the one texel of D.
+//
+// Each reported texel has the exact parameter interval [l0, l1] the ray spends in its
+// frustum (l1 = +inf for the last texel of an unbounded ray); consecutive intervals meet
+// (l1 of one = l0 of the next), except across a gap.
+#pragma once
+#include <cstdint>
+#include <limits>
+
+#include <glm/glm.hpp>
+
+#include "raster/cube_map.hpp"
+
+namespace abcube {
+
+// Below this closest approach, relative to |W|, a ray counts as passing through the centre.
+constexpr double CENTRE_PASS_REL = 1e-9;
+
+struct WalkTexel {
+  int face = 0, i = 0, j = 0;  // cube_map.hpp: face, column (s), row (t)
+  double l0 = 0, l1 = 0;       // the ray's parameter interval in the texel's frustum
+  bool after_gap = false;      // first texel after a skipped ball around the centre
+};
+
+class CubeWalk {
+ public:
+  // w: ray origin relative to the cube centre; d: unit direction; n: face resolution;
+  // l_max: end of the ray (+inf for a ray, |L - P| for a shadow segment);
+  // skip_radius: ball around the centre to skip (see 4.); max_texels: 0 = 16 n + 64.
+  CubeWalk(const glm::dvec3& w, const glm::dvec3& d, int n,
+           double l_max = std::numeric_limits<double>::infinity(), double skip_radius = 0.0,
+           uint32_t max_texels = 0);
+
+  // The next texel in order of increasing l; false when the walk is over (or aborted).
+  bool next(WalkTexel* texel);
+
+  // The DDA's direction on the current face per axis (0: s / column i, 1: t / row j): +1,
+  // -1 or 0; a face's texels are visited with i and j moving that way only.
+  int step(int axis) const { return step_[axis]; }
+  // Skips the rest of the current face segment: the next texel is on the next face (the
+  // caller knows that nothing it looks for lies on the rest of this face).
+  void leave_face() { face_active_ = false; }
+
+  bool aborted() const { return aborted_; }
+  uint32_t texels() const { return texels_; }  // reported so far
+  // The skipped parameter interval (gap_begin < gap_end) or an empty one.
+  double gap_begin() const { return gap_begin_; }
+  double gap_end() const { return gap_end_; }
+
+ private:
+  bool start_face();            // the next face segment of the current run; false at the end
+  void start_texel_on_face();   // entry texel and first crossings of the face segment
+  double crossing(int axis, int boundary) const;  // l where the ray crosses a boundary plane
+  void next_crossing(int axis);
+
+  glm::dvec3 w_, d_;
+  int n_;
+  double l_max_;
+  uint32_t cap_;
+  // Runs: [0, gap_begin] and [gap_end, l_max] (either may be empty).
+  double run_begin_[2] = {0, 0}, run_end_[2] = {0, 0};
+  int run_count_ = 0, run_ = -1;
+  double gap_begin_ = 0, gap_end_ = 0;
+  bool gap_pending_ = false;
+  // The current face segment [face_begin_, face_end_] and the envelope's next line.
+  int face_ = -1, next_face_ = -1;
+  double face_begin_ = 0, face_end_ = 0;
+  bool face_active_ = false;
+  // The DDA on the current face. A crossing's plane is N (A . X) - u (F . X) = 0, so its
+  // parameter needs only A . W, A . D (A the s or t axis) and F . W, F . D, fixed per face.
+  double axis_w_[2] = {0, 0}, axis_d_[2] = {0, 0}, forward_w_ = 0, forward_d_ = 0;
+  int ij_[2] = {0, 0};      // column i, row j
+  int step_[2] = {0, 0};    // +1, -1 or 0 per axis
+  double next_l_[2] = {0, 0};
+  double l_ = 0;
+  uint32_t texels_ = 0, iterations_ = 0;
+  bool aborted_ = false, done_ = false;
+};
+
+// The width of one texel of an n x n map at point x (relative to the centre): 2 |x|_inf / n,
+// the exact width of a texel in the plane through x perpendicular to its face's axis
+// (|x|_inf = F . x). At a face centre it is 2 |x| / n (the thesis 9.3.4 texel, the largest);
+// at a face corner 2 |x| / (sqrt(3) n). Tolerances and offsets in texel units use it.
+double texel_size_at(const glm::dvec3& x, int n);
+
+// [min, max] of |W + l D| over l in [l0, l1] (D unit; l1 may be +inf).
+glm::dvec2 ray_distance_range(const glm::dvec3& w, const glm::dvec3& d, double l0, double l1);
+
+}  // namespace abcube

@@ -1,0 +1,311 @@
+// The searches in the A-buffered cube map (thesis 7.4, 7.5, 8.3, 9.3.4; design.md
+// "Searches in the A-buffered cube map"): reflection, refraction exit and shadow rays
+// answered from ONE cube A-buffer (abuffer.hpp) centred on C, by walking the texels of the
+// ray's projection (cube_walk.hpp) in order of increasing ray parameter l.
+//
+// CANDIDATES. In each texel the walk gives the parameter interval [l0, l1] the ray spends
+// there, hence the ray's distance range [dmin, dmax] from C (thesis 7.5: "podemos descartar
+// totalmente una lista ... si la posición del rayo para ese pixel es mayor que la mayor
+// distancia guardada o menor que la menor"). A fragment is tested iff its [zmin, zmax]
+// overlaps [dmin, dmax]. Layers: SearchLayers::all tests every fragment of the list (the
+// A-buffer, thesis 7.5); SearchLayers::nearest tests only the fragment nearest_layer()
+// would keep (centre sample covered, nearest plane along the texel centre): the one-layer
+// Z-buffered map of Patow 1995 (thesis 7.4), same walk, same rules.
+//
+// MODE crossing (default). Each tested fragment is refined with its triangle's exact plane
+// (the fragment stores the triangle index): X' = X(l') where the ray meets the plane. Its
+// error is its distance e from the triangle (0 inside), in texels at X' (texel_size_at).
+// It is accepted iff X' lies in the texel holding the fragment (l' in [l0, l1]: the map's
+// evidence that a surface is there) and e <= tolerance_texels. e > 0 happens when the
+// fragment's triangle is a neighbour of the surface the ray really crosses there (merged
+// fragments; a triangle too thin to cover a sample of that texel). The hit is the first
+// crossing: after the first texel with an accepted candidate the walk goes on for
+// CROSSING_WINDOW_TEXELS more texels (and while l0 <= the best l'); the result is the
+// accepted candidate ON its triangle (e ~ 0) with the smallest l' if there is one, else the
+// accepted one with the smallest l'. So a surface's neighbouring triangle, whose extended
+// plane the ray meets a little before the triangle it really crosses, does not win over
+// it, and a silhouette missed by less than the tolerance only wins when no exact crossing
+// lies just behind it. The point X' is on the ray: Error_Parallax is 0 to rounding; the
+// error of this mode is the wrong surface within the tolerance of silhouettes. Tolerance
+// candidates closer to W than 2 * tolerance_texels texels are ignored: there the extended
+// planes of W's own neighbouring triangles (a tessellated convex mirror) pass within the
+// tolerance of the ray and cannot be told from another surface; exact crossings are kept.
+// MERGED MAPS: a merged fragment keeps one triangle's plane for a patch of several
+// (abuffer.hpp MERGE); a ray crossing the patch at a grazing angle meets that plane more
+// than the tolerance away from its triangle and the crossing is lost (a threshold
+// rejection): bench_search measures it on the terrain of scenes/bench/spheres_terrain.json
+// (--merge off for the unmerged map).
+//
+// MESH REFINEMENT (crossing mode, SearchRefine::mesh, the default; --refine mesh|plane; the
+// same flood moves camera fragments' shading points onto the mesh, map_shading.hpp).
+// The plane of one triangle says little near that triangle's edges: a ray passing within
+// the tolerance outside a silhouette, or crossing the extension of a box's top face just
+// beyond the crease, was accepted as a crossing (a false hit, a false shadow); and a
+// merged fragment's triangle is often not the one the ray crosses. So a candidate whose
+// ray does not cross its own triangle asks the mesh around it: the triangles
+// edge-connected to it (SearchContext::neighbour: same object, shared vertex positions
+// bit for bit) whose bounding spheres come within max(tolerance, 1) texel of the ray's
+// stretch in that texel (widened by the same), each tested for an exact crossing (on the
+// triangle to ON_TRIANGLE_TEXELS, anywhere on the ray past the self offset): first a
+// straight walk across the edge the ray's crossing of the current plane lies furthest
+// outside of (a smooth patch's crossing in a few steps), then, if that ends without one,
+// all of them breadth-first. A crossing found is an exact candidate (its triangle and facing replace
+// the fragment's); a flood that ends with none rejects the candidate (the ray passes by
+// that surface here); a flood that reaches REFINE_MAX_TRIANGLES, or a fragment triangle
+// whose sphere is not near the ray, leaves the plane rule above to decide. Plain meshes
+// without shared vertices (triangle soups) therefore behave as before. Measured on the
+// repository scenes (abuffer, N = 512): default 37.3 -> 41.3 dB, cornell 34.3 -> 39.4 dB
+// (the rest of the gain there is map_shading.hpp's per-quarter shading).
+//
+// MODE thesis (thesis 7.4.1 pseudo-code, 9.3.4). Each tested fragment gives the point
+// a V, V the texel-centre direction and a its distance to the fragment's plane along V
+// (the Z-buffer's alpha); the angle between R and (a V - W) is its error. The best
+// approximator is the smallest angle, accepted iff <= theta_max (default 2 degrees), else a
+// threshold rejection (the thesis reflects the background). OUR RESTRICTION: the thesis
+// takes the minimum over the whole arc, which can pick a surface hidden behind the first
+// one the ray meets; we take it over the first candidates: from the first texel holding a
+// candidate under theta_max to THESIS_WINDOW_TEXELS texels after it. Error_Parallax of an
+// accepted point is (1 - cos angle)/2 <= theta_max^2/4 (thesis 9.3.4); the 1/(2 N^2) bound
+// holds only where the angle seen from W is no larger than seen from C: the thesis takes
+// the half texel diagonal seen from C, atan(sqrt(2)/N), as the angle seen from W; seen from
+// W it is amplified by about |S - C| / (|S - W| cos(view angle on the hit plane)), S the
+// true point (tests/core/test_search.cpp measures it; bench_search reports it).
+//
+// SELF-HITS (rule "offset", in texel units instead of shading.hpp's absolute epsilon).
+// s = self_offset_texels * texel_size_at(W - C): one texel at W's distance is 2 |W - C|_inf / N
+// world units (cube_walk.hpp). Ignored: (1) W's own surface: a fragment whose plane passes
+// within s of W and that the ray leaves, runs along, or meets again within s (a ray cannot
+// meet the plane it leaves; a face near W that the ray crosses further on is kept); (2) any
+// found point closer than s to W. The default depends on the mode. Crossing mode:
+// SELF_OFFSET_CROSSING_TEXELS = 1e-3, far above the rounding of a W computed on its
+// triangle's plane (1e-16 |W|; even float rounding, 6e-8 |W|, is under 1e-3 texel up to
+// N = 16384), so a grazing ray never finds its own plane while a surface meeting W's
+// at a concave corner is found from 1e-3 texel on. Thesis mode: SELF_OFFSET_THESIS_TEXELS =
+// 0.5: its points a V are texel centres, and those of W's own surface or of its neighbours
+// within half a texel of W are at arbitrary angles from R; surfaces closer to W than that
+// (concave corners) are not found (with N = 512 and |W - C| = 5, s = 0.005 world units).
+//
+// ZERO-AREA SURFACES. A triangle whose plane contains C (within the raster's edge-on rule)
+// has no fragment: no search can find it. SearchContext lists them; when the exact ray
+// meets one before the found point (or when nothing was found), the result is a miss
+// with reason zero_area_surface (counted, never a silent wrong hit).
+//
+// THE CENTRE. The walk skips the ball |X| < near_distance around C (the map holds nothing
+// there). A ray through C (R . [[W]] = -1) jumps from the texel of [[W]] to the texel of
+// its antipode R; R . [[W]] = +1 is a walk of one texel (cube_walk.hpp).
+//
+// SHADOWS (thesis 8.3). The segment from P to the light: every accepted candidate with
+// s <= |X' - P| < |L - P| is a blocker (crossing mode: accepted as above; thesis mode: angle
+// under theta_max); blockers multiply the light by blocker_transmittance (shading.hpp); the
+// walk stops at the first opaque one. Shadow rays are not refracted. One triangle counts
+// once; so do crossings of one object with the same facing within (tolerance_texels + 1)
+// texels of each other (a ray through a shared edge, one surface found in two texels) or,
+// in thesis mode, anywhere on the segment (its points under theta_max spread along a grazing
+// surface; a concave transparent object crossed twice with one facing then counts once).
+// A blocker within the tolerance of a silhouette darkens (the crossing mode's silhouette
+// error, as for reflections).
+//
+// REFRACTION. The exit point of a ray inside a closed object is the first crossing of the
+// SAME object along the refracted direction (back faces are in the map):
+// refraction_exit_search. The caller bends the ray there (shading.hpp transmission; total
+// internal reflection gives a mirror direction, searched again with refraction_exit_search)
+// and searches what the emerging ray sees with reflection_search. With
+// SearchLayers::nearest the back faces are rarely the nearest layer: the one-layer map
+// finds few exits (its limitation, thesis 7.4.2).
+//
+// Every search is a pure function of its inputs (thread safe); stats are per caller.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "raster/abuffer.hpp"
+#include "raster/cube_map.hpp"
+#include "scene/scene.hpp"
+
+namespace abcube {
+
+enum class SearchMode { crossing, thesis };
+enum class SearchLayers { all, nearest };  // A-buffer (thesis 7.5) or Z-buffer (Patow 1995)
+enum class SearchRefine { mesh, plane };   // crossing mode: MESH REFINEMENT on or off
+const char* search_mode_name(SearchMode m);
+bool parse_search_mode(const std::string& s, SearchMode* out);  // "crossing" | "thesis"
+const char* search_refine_name(SearchRefine r);
+bool parse_search_refine(const std::string& s, SearchRefine* out);  // "mesh" | "plane"
+
+// Texels the crossing mode walks past its first accepted candidate, and the thesis mode
+// past its first candidate under theta_max.
+constexpr int CROSSING_WINDOW_TEXELS = 2;
+constexpr int THESIS_WINDOW_TEXELS = 2;
+// Default self offsets per mode, in texels at W (SELF-HITS above).
+constexpr double SELF_OFFSET_CROSSING_TEXELS = 1e-3;
+constexpr double SELF_OFFSET_THESIS_TEXELS = 0.5;
+// MESH REFINEMENT: the most triangles one refinement floods before it gives up (unknown).
+constexpr size_t REFINE_MAX_TRIANGLES = 32;
+
+struct SearchOptions {
+  SearchMode mode = SearchMode::crossing;
+  SearchLayers layers = SearchLayers::all;
+  double theta_max = 0.034906585039886591;  // thesis mode: 2 degrees, in radians
+  double tolerance_texels = 1.0;            // crossing mode: largest accepted e
+  SearchRefine refine = SearchRefine::mesh;  // MESH REFINEMENT (header)
+  double self_offset_texels = 0;            // W's own surface and points closer; 0 = the mode's default
+  uint32_t max_texels = 0;                  // walk cap; 0 = CubeWalk's default
+};
+
+// The self offset `options` gives, in texels at W (its own, or the mode's default).
+double self_offset_texels(const SearchOptions& options);
+
+enum class MissReason { none, no_crossing, threshold_rejection, zero_area_surface, aborted };
+const char* miss_reason_name(MissReason r);
+
+// The geometry a search needs, prepared once per cube map: per triangle its plane relative
+// to the centre, and the triangles the map cannot hold (plane through the centre).
+// Scene and cube must outlive it.
+class SearchContext {
+ public:
+  SearchContext(const Scene& scene, const CubeABuffer& cube);
+
+  const Scene& scene() const { return *scene_; }
+  const CubeABuffer& cube() const { return *cube_; }
+  const std::vector<uint32_t>& zero_area_triangles() const { return zero_area_; }
+
+  struct Plane {
+    glm::dvec3 normal{0.0};  // unit geometric normal, cross(b-a, c-a) direction
+    double offset = 0;       // normal . X for X on the plane, X relative to the centre
+  };
+  const Plane& plane(uint32_t triangle) const { return planes_[triangle]; }
+  // What the MESH REFINEMENT tests per triangle, relative to the centre: the in-plane
+  // inward unit normals of its edges (edge k from vertex k to k+1) with their offsets, and
+  // a bounding sphere (centroid, largest vertex distance). Zero for a degenerate triangle.
+  struct Bounds {
+    std::array<glm::dvec3, 3> edge_normal{};
+    std::array<double, 3> edge_offset{};
+    glm::dvec3 centroid{0.0};
+    double radius = 0;
+  };
+  const Bounds& bounds(uint32_t triangle) const { return bounds_[triangle]; }
+  // The vertices of a triangle relative to the centre.
+  glm::dvec3 vertex(uint32_t triangle, int k) const;
+  // The triangle across edge k (vertices k, k+1) of `triangle`: same object, the same two
+  // vertex positions bit for bit; NO_NEIGHBOUR on a border or a non-manifold edge.
+  static constexpr uint32_t NO_NEIGHBOUR = 0xffffffffu;
+  uint32_t neighbour(uint32_t triangle, int k) const { return neighbours_[triangle][static_cast<size_t>(k)]; }
+
+  // Whether every texel (i', j') of `face` with i' - i of the sign of step_i (or 0) and
+  // j' - j of the sign of step_j (or 0) holds an empty list: the rest of a walk on that
+  // face from (i, j) then meets no fragment (its indices only move that way).
+  bool empty_ahead(int face, int i, int j, int step_i, int step_j) const;
+
+  // BLOCK BOUNDS: per face and block of BOUNDS_BLOCK x BOUNDS_BLOCK texels, the smallest
+  // zmin and the largest zmax of its fragments. A texel whose block holds nothing in the
+  // ray's distance range [dmin, dmax] is passed without reading its list (no fragment of
+  // it could pass the z-interval test): a few hundred kilobytes that stay in cache where
+  // the lists do not.
+  static constexpr int BOUNDS_BLOCK = 8;
+  bool block_empty(int face, int i, int j) const { return block_bounds(face, i, j).x > block_bounds(face, i, j).y; }
+  // Given the squares of the ray's distance range.
+  bool block_misses2(int face, int i, int j, double dmin2, double dmax2) const {
+    const glm::vec2 z = block_bounds(face, i, j);
+    return static_cast<double>(z.y) * z.y < dmin2 || static_cast<double>(z.x) * z.x > dmax2;
+  }
+
+ private:
+  const Scene* scene_;
+  const CubeABuffer* cube_;
+  std::vector<Plane> planes_;
+  std::vector<Bounds> bounds_;
+  std::vector<uint32_t> zero_area_;
+  std::vector<std::array<uint32_t, 3>> neighbours_;
+  // Per face and row j: the smallest and largest column holding a fragment over rows
+  // <= j (prefix) and >= j (suffix), and in row j alone (n and -1 when none).
+  struct RowBounds {
+    std::vector<int> min_row, max_row, min_prefix, max_prefix, min_suffix, max_suffix;
+  };
+  std::array<RowBounds, 6> occupied_;
+  int blocks_per_row_ = 0;
+  std::array<std::vector<glm::vec2>, 6> block_z_;  // (min zmin, max zmax); empty: (+inf, -inf)
+  glm::vec2 block_bounds(int face, int i, int j) const {
+    return block_z_[static_cast<size_t>(face)][static_cast<size_t>(j / BOUNDS_BLOCK) * static_cast<size_t>(blocks_per_row_) +
+                                               static_cast<size_t>(i / BOUNDS_BLOCK)];
+  }
+  void build_neighbours();
+};
+
+struct SearchResult {
+  bool hit = false;
+  MissReason miss = MissReason::no_crossing;  // none when hit
+  uint32_t triangle = 0;       // the found fragment's triangle (index into Scene::triangles)
+  uint32_t object_id = 0, material_id = 0;
+  bool back_face = false;      // the fragment's facing as seen from the cube centre
+  glm::dvec3 point{0.0};       // X', world space
+  double distance = 0;         // |X' - W|
+  double angle = 0;            // angle between the ray and X' - W (radians; 0 in crossing mode)
+  double outside_texels = 0;   // crossing mode: X''s distance from its triangle, in texels
+  CubeTexel texel{0, 0, 0};    // where the fragment was found
+  uint32_t texels_visited = 0;
+  uint32_t fragments_tested = 0;  // z-interval tests
+  uint32_t candidates = 0;        // fragments refined (z overlap, not own surface)
+};
+
+struct ShadowResult {
+  glm::dvec3 transmittance{1.0};  // S_l: product of blocker_transmittance over blockers
+  bool blocked = false;           // an opaque blocker stopped the walk
+  uint32_t blockers = 0;          // distinct crossings counted
+  uint32_t first_blocker = 0;     // triangle of the nearest counted blocker (if blockers > 0)
+  bool aborted = false;
+  bool zero_area = false;         // the segment meets a surface the map cannot hold
+  uint32_t texels_visited = 0;
+  uint32_t fragments_tested = 0;
+  uint32_t candidates = 0;
+  uint32_t threshold_rejections = 0;  // candidates refused by the tolerance / theta_max
+};
+
+// Reflection (or any secondary ray seen from outside): the first surface along the ray
+// W + l R, l > 0 (W world space on the reflecting surface, R unit).
+SearchResult reflection_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& r,
+                               const SearchOptions& options = {});
+
+// The exit point of a ray inside object `object_id`: its first crossing of that object's
+// surface along W + l T (W world space, on the entry surface; T unit, refracted inwards).
+SearchResult refraction_exit_search(const SearchContext& ctx, const glm::dvec3& w,
+                                    const glm::dvec3& t, uint32_t object_id,
+                                    const SearchOptions& options = {});
+
+// The exact crossing of the ray W + l D (W world space, D unit) with the mesh around
+// `triangle`: the edge-connected triangles within `radius` of the stretch
+// [l_near - radius, l_near + radius] (MESH REFINEMENT). True with the triangle crossed and
+// its l (the smallest); false when none is crossed or the flood gave up.
+bool mesh_crossing(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& dir, uint32_t triangle,
+                   double l_near, double radius, uint32_t* crossed, double* l);
+
+// Visibility of point light `light_position` from surface point p (world space).
+ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p,
+                           const glm::dvec3& light_position, const SearchOptions& options = {});
+
+// Counters of one kind of search (issue item 10).
+struct SearchKindStats {
+  uint64_t rays = 0;
+  uint64_t texels = 0, max_texels = 0;  // texels visited: sum and max per ray
+  uint64_t fragments = 0;               // z-interval tests
+  uint64_t candidates = 0;              // fragments refined
+  uint64_t hits = 0;                    // shadows: rays with a blocker
+  uint64_t misses = 0;                  // every miss, whatever the reason; shadows: unblocked
+  uint64_t threshold_rejections = 0;    // misses whose best candidate failed the threshold
+  uint64_t zero_area = 0;               // misses on a surface through the centre
+  uint64_t aborted = 0;                 // walks stopped by the cap
+  double mean_texels() const { return rays ? static_cast<double>(texels) / static_cast<double>(rays) : 0.0; }
+  void add(const SearchResult& r);
+  void add(const ShadowResult& r);
+  void merge(const SearchKindStats& o);
+};
+
+struct SearchStats {
+  SearchKindStats reflection, refraction_exit, shadow;
+  void merge(const SearchStats& o);
+};
+
+}  // namespace abcube

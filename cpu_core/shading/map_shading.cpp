@@ -1,0 +1,390 @@
+#include "shading/map_shading.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <thread>
+#include <utility>
+
+#include "scene/camera.hpp"
+#include "raster/cube_map.hpp"
+#include "base/error.hpp"
+#include "io/image_io.hpp"
+#include "base/parallel.hpp"
+#include "raster/raster.hpp"
+#include "reference/raytrace.hpp"
+#include "shading/resolve.hpp"
+#include "shading/shading.hpp"
+
+namespace abcube {
+
+namespace {
+
+constexpr uint32_t OUTSIDE = UINT32_MAX;  // a ray in the open, not inside a closed object
+
+constexpr const char* LOOKUP_NAMES[] = {"R", "bisector", "position"};
+
+}  // namespace
+
+const char* envmap_lookup_name(EnvmapLookup l) { return LOOKUP_NAMES[static_cast<int>(l)]; }
+
+bool parse_envmap_lookup(const std::string& s, EnvmapLookup* out) {
+  for (int i = 0; i < 3; ++i) {
+    if (s == LOOKUP_NAMES[i]) {
+      *out = static_cast<EnvmapLookup>(i);
+      return true;
+    }
+  }
+  return false;
+}
+
+void RayErrors::merge(const RayErrors& o) {
+  error_cp.merge(o.error_cp);
+  error_parallax.merge(o.error_parallax);
+  false_hits += o.false_hits;
+  wrong_object += o.wrong_object;
+}
+
+void MapShadingStats::merge(const MapShadingStats& o) {
+  searches.merge(o.searches);
+  lens_transfers += o.lens_transfers;
+  lens_fallbacks += o.lens_fallbacks;
+  envmap_lookups += o.envmap_lookups;
+  errors.merge(o.errors);
+}
+
+SurfacePoint surface_point(const Scene& scene, uint32_t triangle, const glm::dvec3& point) {
+  const TriangleSoup& t = scene.triangles;
+  const size_t base = 3 * static_cast<size_t>(triangle);
+  const glm::dvec3 a(t.positions[base]), b(t.positions[base + 1]), c(t.positions[base + 2]);
+  SurfacePoint sp;
+  sp.point = point;
+  sp.triangle = triangle;
+  sp.object = t.object_id[triangle];
+  sp.material = t.material_id[triangle];
+  const glm::dvec3 ng = glm::cross(b - a, c - a);
+  const double area2 = glm::dot(ng, ng);
+  sp.geometric_normal = area2 > 0.0 ? ng / std::sqrt(area2) : glm::dvec3(0, 0, 1);
+  // Barycentric weights of the point's projection on the plane (Ericson 2005, 3.4).
+  const double wa = glm::dot(glm::cross(b - point, c - point), ng) / area2;
+  const double wb = glm::dot(glm::cross(c - point, a - point), ng) / area2;
+  const glm::dvec3 n = wa * glm::dvec3(t.normals[base]) + wb * glm::dvec3(t.normals[base + 1]) +
+                       (1.0 - wa - wb) * glm::dvec3(t.normals[base + 2]);
+  const double len = glm::length(n);
+  sp.shading_normal = len > 0.0 && std::isfinite(len) ? n / len : sp.geometric_normal;
+  return sp;
+}
+
+MapShader::MapShader(const Scene& scene, const CubeABuffer& cube, const MapShadingOptions& options,
+                     const RayTracer* reference)
+    : scene_(scene), cube_(cube), options_(options), reference_(reference) {
+  options_.search.layers = options.method == Method::zbuffer ? SearchLayers::nearest : SearchLayers::all;
+  ctx_ = std::make_unique<SearchContext>(scene, cube);
+  lens_of_object_.assign(scene.objects.size(), -1);
+  if (options_.refraction != RefractionMode::search) {
+    lenses_ = fit_lenses(scene);
+    for (size_t i = 0; i < lenses_.size(); ++i) {
+      if (lenses_[i].valid) lens_of_object_[lenses_[i].object] = static_cast<int>(i);
+    }
+  }
+  if (options_.method == Method::envmap) {
+    env_colour_ = CubeImage(cube.n, 3);
+    texel_state_ = std::make_unique<std::atomic<uint8_t>[]>(6 * static_cast<size_t>(cube.n) * static_cast<size_t>(cube.n));
+  }
+}
+
+MapShader::~MapShader() = default;
+
+// Which closed object a ray leaving sp along d runs inside of (N_g is outward).
+static uint32_t inside_after(const Scene& scene, const SurfacePoint& sp, const glm::dvec3& d) {
+  return scene.objects[sp.object].closed && glm::dot(sp.geometric_normal, d) < 0.0 ? sp.object : OUTSIDE;
+}
+
+glm::dvec3 MapShader::shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
+                            MapShadingStats* stats) const {
+  const Material& m = scene_.materials[sp.material];
+  // Coverage transparency of a found surface: the ray goes on behind it, same depth.
+  glm::dvec3 behind(0.0);
+  const bool blend = !primary && m.opacity < 1.0;
+  if (blend) {
+    behind = trace(sp.point, dir, depth, inside_after(scene_, sp, dir), stats, nullptr);
+    if (m.opacity <= 0.0) return behind;
+  }
+  const glm::dvec3 v = -dir;
+  const glm::dvec3 n = face_forward(sp.shading_normal, v);
+  glm::dvec3 c = phong_ambient(m, scene_.ambient) + lights(sp, v, n, stats);
+  const SecondaryWeights w =
+      secondary_weights(m, scene_.render.fresnel, dir,
+                        transmission(dir, sp.geometric_normal, sp.shading_normal, m.ior), sp.geometric_normal);
+  if (depth < scene_.render.max_depth && w.reflect > 0.0) c += w.reflect * reflected(sp, dir, depth, primary, stats);
+  if (depth < scene_.render.max_depth && w.transmit > 0.0) c += w.transmit * transmitted(sp, dir, depth, stats);
+  return blend ? blend_coverage(m.opacity, c, behind) : c;
+}
+
+// sum_l S_l phong_light, S_l from the shadow search (thesis 8.3).
+glm::dvec3 MapShader::visibility(const glm::dvec3& p, const PointLight& light, MapShadingStats* stats) const {
+  const ShadowResult s = shadow_search(*ctx_, p, light.position, options_.search);
+  if (stats) stats->searches.shadow.add(s);
+  return s.transmittance;
+}
+
+glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n,
+                             MapShadingStats* stats) const {
+  const Material& m = scene_.materials[sp.material];
+  glm::dvec3 c(0.0);
+  for (const PointLight& light : scene_.lights) {
+    const glm::dvec3 to_light = light.position - sp.point;
+    if (to_light == glm::dvec3(0.0)) continue;
+    const glm::dvec3 lit = phong_light(m, n, v, glm::normalize(to_light), light.color);
+    if (lit == glm::dvec3(0.0)) continue;
+    if (!light.cast_shadows) {
+      if (options_.walk_all_shadows) {
+        const ShadowResult unused = shadow_search(*ctx_, sp.point, light.position, options_.search);
+        if (stats) stats->searches.shadow.add(unused);
+      }
+      c += lit;
+      continue;
+    }
+    c += lit * visibility(sp.point, light, stats);
+  }
+  return c;
+}
+
+// What a ray from w along dir finds in the map, shaded one bounce deeper (or background).
+glm::dvec3 MapShader::trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, uint32_t inside,
+                            MapShadingStats* stats, SearchResult* found) const {
+  const SearchResult r = inside != OUTSIDE ? refraction_exit_search(*ctx_, w, dir, inside, options_.search)
+                                           : reflection_search(*ctx_, w, dir, options_.search);
+  if (stats) (inside != OUTSIDE ? stats->searches.refraction_exit : stats->searches.reflection).add(r);
+  if (found) *found = r;
+  if (!r.hit) return scene_.background;
+  return shade(surface_point(scene_, r.triangle, r.point), dir, depth, false, stats);
+}
+
+glm::dvec3 MapShader::reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
+                                MapShadingStats* stats) const {
+  const glm::dvec3 r = glm::normalize(reflect_dir(dir, sp.shading_normal));
+  if (options_.method == Method::envmap) {
+    if (stats) ++stats->envmap_lookups;
+    const glm::dvec3 lookup = envmap_direction(sp.point, r);
+    if (primary && reference_ && stats) measure(sp.point, r, nullptr, &lookup, stats);
+    return envmap_at(lookup);
+  }
+  SearchResult found;
+  const glm::dvec3 c = trace(sp.point, r, depth + 1, inside_after(scene_, sp, r), stats, &found);
+  if (primary && reference_ && stats) measure(sp.point, r, &found, nullptr, stats);
+  return c;
+}
+
+glm::dvec3 MapShader::transmitted(const SurfacePoint& sp, const glm::dvec3& dir, int depth,
+                                  MapShadingStats* stats) const {
+  const Material& m = scene_.materials[sp.material];
+  const Transmission tr = transmission(dir, sp.geometric_normal, sp.shading_normal, m.ior);
+  const glm::dvec3 t = glm::normalize(tr.dir);
+  if (options_.method == Method::envmap) {
+    if (stats) ++stats->envmap_lookups;
+    return envmap_at(envmap_direction(sp.point, t));
+  }
+  // Patow-Delrieux lens: entry to emergence in one paraxial transfer, no exit search.
+  const int lens = lens_of_object_[sp.object];
+  if (lens >= 0 && tr.entering) {
+    LensRay out;
+    if (lens_transfer(lenses_[static_cast<size_t>(lens)], options_.refraction, sp.point, dir, &out)) {
+      if (stats) ++stats->lens_transfers;
+      return trace(out.point, out.dir, depth + 1, OUTSIDE, stats, nullptr);
+    }
+    if (stats) ++stats->lens_fallbacks;
+  }
+  return trace(sp.point, t, depth + 1, inside_after(scene_, sp, t), stats, nullptr);
+}
+
+// The lookup direction of thesis 9.2: R, the bisector [[R + [[W]]]], or [[W]].
+glm::dvec3 MapShader::envmap_direction(const glm::dvec3& w, const glm::dvec3& r) const {
+  const glm::dvec3 wc = w - cube_.centre;
+  const double len = glm::length(wc);
+  const glm::dvec3 wu = len > 0.0 ? wc / len : r;
+  switch (options_.lookup) {
+    case EnvmapLookup::reflected:
+      return r;
+    case EnvmapLookup::bisector: {
+      const glm::dvec3 b = r + wu;
+      return glm::dot(b, b) > 1e-24 ? glm::normalize(b) : r;  // R = -[[W]]: no bisector
+    }
+    case EnvmapLookup::position:
+      return wu;
+  }
+  return r;
+}
+
+// The map as a picture (Blinn & Newell): a texel's list resolved by Pack_Under_Mask, each
+// fragment lit by local Phong and the shadow searches, seen from the centre. Computed on
+// first lookup and kept (texel_state_: 0 not yet, 1 being computed, 2 done): the picture
+// of all 6 N^2 texels, each with shadow walks of ~N texels, costs N^3 and is mostly never
+// looked at (cornell at N = 2048 ran for over 10 minutes before this).
+glm::dvec3 MapShader::envmap_at(const glm::dvec3& direction) const {
+  const int n = cube_.n;
+  const CubeTexel t = direction_to_texel(direction, n);
+  const size_t index = (static_cast<size_t>(t.face) * static_cast<size_t>(n) + static_cast<size_t>(t.j)) *
+                           static_cast<size_t>(n) + static_cast<size_t>(t.i);
+  std::atomic<uint8_t>& state = texel_state_[index];
+  uint8_t expected = 0;
+  if (state.compare_exchange_strong(expected, 1, std::memory_order_acq_rel)) {
+    env_colour_.faces[static_cast<size_t>(t.face)].set_rgb(t.i, t.j, glm::vec3(envmap_texel(t.face, t.i, t.j)));
+    state.store(2, std::memory_order_release);
+  } else {
+    while (state.load(std::memory_order_acquire) != 2) std::this_thread::yield();
+  }
+  return glm::dvec3(env_colour_.faces[static_cast<size_t>(t.face)].rgb(t.i, t.j));
+}
+
+glm::dvec3 MapShader::envmap_texel(int face, int i, int j) const {
+  const ABuffer& buffer = cube_.faces[static_cast<size_t>(face)];
+  const FragmentShader shade_fragment = [&](const Fragment& f) {
+    const glm::dvec3 p = fragment_point(buffer, scene_.triangles, f, i, j);
+    const SurfacePoint sp = surface_point(scene_, f.triangle(), p);
+    const Material& m = scene_.materials[sp.material];
+    const glm::dvec3 v = glm::normalize(cube_.centre - p);
+    const glm::dvec3 nn = face_forward(sp.shading_normal, v);
+    return ShadedFragment{phong_ambient(m, scene_.ambient) + lights(sp, v, nn, nullptr), m.opacity};
+  };
+  return pack_under_mask(buffer.list(i, j), FULL_MASK, shade_fragment, scene_.triangles, scene_.background);
+}
+
+// Error_CP and Error_Parallax of one reflection ray against the exact tracer (thesis 9).
+void MapShader::measure(const glm::dvec3& w, const glm::dvec3& r, const SearchResult* found,
+                        const glm::dvec3* lookup, MapShadingStats* stats) const {
+  RayErrors& e = stats->errors;
+  const glm::dvec3 origin = w + r * (1e-9 * reference_->scene_scale());
+  Hit exact;
+  const bool exact_hit = reference_->intersect(origin, r, &exact);
+  const glm::dvec3 c = cube_.centre;
+  // The method's found point X': the search's, or for a lookup the surface seen from C
+  // in the lookup direction.
+  bool has_point = false;
+  glm::dvec3 x(0.0);
+  uint32_t object = 0;
+  if (found && found->hit) {
+    has_point = true;
+    x = found->point;
+    object = found->object_id;
+  } else if (lookup) {
+    Hit seen;
+    if (reference_->intersect(c, *lookup, &seen)) {
+      has_point = true;
+      x = seen.point;
+      object = seen.object_id;
+    }
+  }
+  if (!exact_hit) {
+    if (has_point) ++e.false_hits;
+    return;
+  }
+  const glm::dvec3 sigma = exact.point - c;
+  if (lookup) {
+    e.error_cp.add(error_cp(*lookup, sigma));
+  } else if (has_point && glm::length(x - c) > 0.0) {
+    e.error_cp.add(error_cp(x - c, sigma));
+  } else {
+    e.error_cp.add_miss();
+  }
+  if (has_point && glm::length(x - w) > 0.0) {
+    e.error_parallax.add(error_parallax(x, w, r));
+    if (object != exact.object_id) ++e.wrong_object;
+  } else {
+    e.error_parallax.add_miss();
+  }
+}
+
+namespace {
+
+// Per-thread statistics for a parallel resolve: a thread finds its own slot once per call.
+class ThreadStats {
+ public:
+  MapShadingStats* slot() {
+    const std::thread::id me = std::this_thread::get_id();
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto& [id, s] : slots_) {
+      if (id == me) return s.get();
+    }
+    slots_.emplace_back(me, std::make_unique<MapShadingStats>());
+    return slots_.back().second.get();
+  }
+  void merge_into(MapShadingStats* out) const {
+    for (const auto& [id, s] : slots_) out->merge(*s);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::pair<std::thread::id, std::unique_ptr<MapShadingStats>>> slots_;
+};
+
+}  // namespace
+
+// The quarters of the 4x8 mask (samples.hpp): columns 0-3 / 4-7 of rows 0-1 / 2-3.
+static constexpr CoverageMask QUARTERS[4] = {0x00000f0fu, 0x0000f0f0u, 0x0f0f0000u, 0xf0f00000u};
+
+// Is the sRGB-encoded difference of two colours above QUARTER_SPLIT_SRGB in any channel?
+static bool differ(const glm::dvec3& a, const glm::dvec3& b) {
+  for (int k = 0; k < 3; ++k) {
+    const double ea = srgb_encode(static_cast<float>(std::clamp(a[k], 0.0, 1.0)));
+    const double eb = srgb_encode(static_cast<float>(std::clamp(b[k], 0.0, 1.0)));
+    if (std::fabs(ea - eb) > QUARTER_SPLIT_SRGB) return true;
+  }
+  return false;
+}
+
+Image render_with_map(const Scene& scene, const ABuffer& camera, const MapShader& shader, int threads,
+                      MapShadingStats* stats) {
+  ThreadStats per_thread;
+  // The fragment shaded at its covered quarters, adaptively (header, QUARTER_SPLIT_SRGB).
+  const PixelShader shade = [&](const Fragment& f, int x, int y) {
+    MapShadingStats* s = per_thread.slot();
+    const glm::dvec3 eye = scene.camera.position;
+    // One pixel's width seen from the eye, in radians (the mesh refinement's radius).
+    const double pixel = glm::length(glm::normalize(camera.view.direction(x + 1.5, y + 0.5)) -
+                                     glm::normalize(camera.view.direction(x + 0.5, y + 0.5)));
+    // A point of the fragment's plane, moved onto the surface the eye ray through it really
+    // crosses (a merged fragment keeps one triangle of several: abuffer.hpp MERGE).
+    const auto shade_at = [&](const glm::dvec3& p) {
+      const glm::dvec3 dir = glm::normalize(p - eye);
+      uint32_t tri = f.triangle();
+      glm::dvec3 on = p;
+      double l = 0;
+      const double dist = glm::length(p - eye);
+      if (shader.refines_on_mesh() && mesh_crossing(shader.context(), eye, dir, f.triangle(), dist, dist * pixel, &tri, &l)) {
+        on = eye + l * dir;
+      }
+      return shader.shade(surface_point(scene, tri, on), dir, 0, true, s);
+    };
+    glm::dvec3 point[4];
+    double weight[4];
+    int count = 0;
+    const double total = mask_count(f.mask);
+    for (CoverageMask q : QUARTERS) {
+      const CoverageMask m = f.mask & q;
+      if (!m) continue;
+      const glm::dvec2 c = mask_centroid(m);
+      point[count] = point_on_triangle_plane(camera.view, scene.triangles, f.triangle(), x + c.x, y + c.y);
+      weight[count] = mask_count(m) / total;
+      ++count;
+    }
+    glm::dvec3 c(0.0);
+    if (count <= 1) {
+      c = shade_at(fragment_point(camera, scene.triangles, f, x, y));
+    } else {
+      const glm::dvec3 first = shade_at(point[0]), last = shade_at(point[count - 1]);
+      c = weight[0] * first + weight[count - 1] * last;
+      const bool split = differ(first, last);
+      for (int k = 1; k + 1 < count; ++k) c += weight[k] * (split ? shade_at(point[k]) : 0.5 * (first + last));
+    }
+    return ShadedFragment{c, scene.materials[scene.triangles.material_id[f.triangle()]].opacity};
+  };
+  ResolveOptions ro;
+  ro.threads = threads;
+  Image image = resolve_image(camera, scene.triangles, shade, scene.background, ro);
+  if (stats) per_thread.merge_into(stats);
+  return image;
+}
+
+}  // namespace abcube

@@ -1,0 +1,154 @@
+// Shading with the cube map: the `abuffer`, `zbuffer` and `envmap` methods (thesis 7, 8.3,
+// 9; design.md). The SAME rules as the exact tracer (raytrace.hpp "THE RULES"), with every
+// ray query but the camera's answered from the one cube map centred on the camera:
+//
+//   C = phong_ambient + sum_l S_l phong_light(N, V, L_l) + kr C_reflected + kt C_transmitted
+//   (and, for a surface found by a search, the coverage blend with what lies behind it)
+//
+//   method    S_l                  C_reflected / C_transmitted
+//   abuffer   shadow_search, all   the surface found by the search (all layers), shaded
+//             layers               by these same rules one bounce deeper (multi-bounce,
+//                                  thesis 11.2.2), or the background on a miss
+//   zbuffer   same, nearest layer  same, nearest layer only (Patow 1995)
+//   envmap    shadow_search, all   the map's colour looked up in one direction (Blinn &
+//             layers               Newell 1976): R, the bisector [[R + [[W]]]] or [[W]]
+//                                  (--envmap-lookup, thesis 9.2); no bounce
+//
+// Secondary rays start on the surface (the searches keep W's own surface out by their
+// texel-unit offset, search.hpp). A ray leaving a closed object's surface into its inside
+// (dot(N_g, dir) < 0, N_g outward) is searched with refraction_exit_search restricted to
+// that object: back faces are in the map. Refraction bends by shading.hpp transmission()
+// (total internal reflection follows the mirror direction, bounded by max_depth). The
+// lens modes (--refraction thick_lens|thin_lens, lens.hpp) replace the entry-exit pair of
+// a closed transparent object by the paraxial lens transfer, then search from the
+// emerging ray.
+//
+// Which shadows the envmap method casts: the same shadow search as abuffer, so that
+// comparing the methods isolates the reflection and refraction lookups.
+#pragma once
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "raster/abuffer.hpp"
+#include "io/image.hpp"
+#include "search/lens.hpp"
+#include "io/metrics.hpp"
+#include "scene/scene.hpp"
+#include "search/search.hpp"
+
+namespace abcube {
+
+class RayTracer;
+
+enum class EnvmapLookup { reflected, bisector, position };  // R, [[R + [[W]]]], [[W]]
+const char* envmap_lookup_name(EnvmapLookup l);
+bool parse_envmap_lookup(const std::string& s, EnvmapLookup* out);  // "R" | "bisector" | "position"
+
+struct MapShadingOptions {
+  Method method = Method::abuffer;  // abuffer, zbuffer or envmap
+  SearchOptions search;             // layers are set from the method
+  RefractionMode refraction = RefractionMode::search;
+  EnvmapLookup lookup = EnvmapLookup::reflected;
+  int threads = 0;
+  // --plan everything: also walk the shadows of lights that cast none (result unused), to
+  // measure what the plan's skip saves. The image does not change.
+  bool walk_all_shadows = false;
+};
+
+// Ray-level error against the exact tracer (thesis ch. 9), for the reflection rays of
+// primary surfaces: Error_CP of the lookup direction and Error_Parallax of the found point.
+struct RayErrors {
+  ErrorStats error_cp, error_parallax;
+  uint64_t false_hits = 0;  // the method found a point, the exact ray meets nothing
+  uint64_t wrong_object = 0;
+  void merge(const RayErrors& o);
+};
+
+struct MapShadingStats {
+  SearchStats searches;
+  uint64_t lens_transfers = 0, lens_fallbacks = 0;  // fallbacks: transfer refused, searched
+  uint64_t envmap_lookups = 0;
+  RayErrors errors;  // filled only when a reference tracer is given
+  void merge(const MapShadingStats& o);
+};
+
+// A point on a triangle: what the rules need to shade it.
+// Where a camera fragment is shaded (render_with_map): at up to four points of its
+// triangle's plane, the centroids of its covered samples in each 4x2 quarter of the 4x8
+// mask, weighted by their sample counts. One shading point per fragment is the A-buffer's
+// design, but an edge through the pixel of anything the point's shading depends on (a hard
+// shadow, a silhouette seen in a mirror or through glass) is then all or nothing where
+// the tracer averages its 32 samples: on scenes/default.json the shadows alone cost 5 dB
+// (35.6 dB; 40.7 without shadows), on cornell.json the edges of the room seen in its mirror
+// made most of the remaining error. ADAPTIVE: the first and last covered quarters (the
+// diagonal when all four are) are shaded; only where their colours differ by more than
+// QUARTER_SPLIT_SRGB (sRGB-encoded, any channel) are the others shaded too, else they take
+// the mean of the two.
+constexpr double QUARTER_SPLIT_SRGB = 1.0 / 255.0;
+
+struct SurfacePoint {
+  glm::dvec3 point{0.0};
+  glm::dvec3 geometric_normal{0.0};  // unit, cross(b-a, c-a)
+  glm::dvec3 shading_normal{0.0};    // unit, interpolated vertex normals
+  uint32_t triangle = 0, object = 0, material = 0;
+};
+SurfacePoint surface_point(const Scene& scene, uint32_t triangle, const glm::dvec3& point);
+
+class MapShader {
+ public:
+  // `cube` is the map around scene.camera.position. `reference` (optional) is the exact
+  // tracer the ray errors are measured against. All must outlive the shader.
+  MapShader(const Scene& scene, const CubeABuffer& cube, const MapShadingOptions& options,
+            const RayTracer* reference = nullptr);
+  ~MapShader();
+
+  // The colour of surface point `sp` seen along unit `dir` at bounce `depth`. `primary`
+  // marks a camera fragment: its coverage transparency is the resolve's business, and
+  // its reflection rays are the ones measured against the reference.
+  glm::dvec3 shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
+                   MapShadingStats* stats) const;
+
+  const std::vector<LensFit>& lenses() const { return lenses_; }
+  const SearchContext& context() const { return *ctx_; }
+  // SearchRefine::mesh (search.hpp MESH REFINEMENT): besides the crossing searches' candidates,
+  // camera fragments' shading points are moved onto the surface the same way (any mode).
+  bool refines_on_mesh() const { return options_.search.refine == SearchRefine::mesh; }
+
+ private:
+  glm::dvec3 trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, uint32_t inside,
+                   MapShadingStats* stats, SearchResult* found) const;
+  glm::dvec3 lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n,
+                    MapShadingStats* stats) const;
+  glm::dvec3 visibility(const glm::dvec3& p, const PointLight& light, MapShadingStats* stats) const;
+  glm::dvec3 reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
+                       MapShadingStats* stats) const;
+  glm::dvec3 transmitted(const SurfacePoint& sp, const glm::dvec3& dir, int depth, MapShadingStats* stats) const;
+  glm::dvec3 envmap_direction(const glm::dvec3& w, const glm::dvec3& r) const;
+  glm::dvec3 envmap_at(const glm::dvec3& direction) const;
+  void measure(const glm::dvec3& w, const glm::dvec3& r, const SearchResult* found, const glm::dvec3* lookup,
+               MapShadingStats* stats) const;
+  glm::dvec3 envmap_texel(int face, int i, int j) const;
+
+  const Scene& scene_;
+  const CubeABuffer& cube_;
+  MapShadingOptions options_;
+  const RayTracer* reference_;
+  std::unique_ptr<SearchContext> ctx_;
+  std::vector<LensFit> lenses_;
+  std::vector<int> lens_of_object_;  // index into lenses_, -1 if none
+  // envmap: the resolved colour of each texel looked up so far (envmap_at).
+  mutable CubeImage env_colour_;
+  std::unique_ptr<std::atomic<uint8_t>[]> texel_state_;
+};
+
+// The camera view through the camera A-buffer, every fragment shaded by `shader`, resolved
+// by Pack_Under_Mask (resolve.hpp). Stats merged over threads.
+Image render_with_map(const Scene& scene, const ABuffer& camera, const MapShader& shader, int threads,
+                      MapShadingStats* stats);
+
+}  // namespace abcube

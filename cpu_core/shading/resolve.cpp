@@ -1,0 +1,104 @@
+#include "shading/resolve.hpp"
+
+#include <algorithm>
+
+#include "base/error.hpp"
+#include "base/parallel.hpp"
+
+namespace abcube {
+
+namespace {
+
+// Thesis 5.2.1.2, Vis_front = (zmax_next - zmin_front) / ((zmax-zmin)_front + (zmax-zmin)_next),
+// clamped to [0, 1]; 1 when both ranges are empty.
+double visible_fraction(const Fragment& front, const Fragment& next) {
+  const double denom = (double(front.zmax) - front.zmin) + (double(next.zmax) - next.zmin);
+  if (!(denom > 0.0)) return 1.0;
+  return std::clamp((double(next.zmax) - front.zmin) / denom, 0.0, 1.0);
+}
+
+// The first fragment at or after `i` whose mask meets `mask` (list.size() if none).
+size_t first_overlapping(FragmentList list, size_t i, CoverageMask mask) {
+  while (i < list.size() && (list[i].mask & mask) == 0) ++i;
+  return i;
+}
+
+// Pack_Under_Mask as a weighted sum (resolve.hpp): items (position, mask, weight) stand
+// for "weight * pack(list from position, mask)".
+template <class Shade>
+glm::dvec3 pack(FragmentList list, CoverageMask search, Shade&& shade, const TriangleSoup& triangles,
+                const glm::dvec3& background, PackScratch* sc) {
+  if (search == 0) return background;
+  const size_t n = list.size();
+  sc->shaded.resize(n);
+  sc->done.assign(n, 0);
+  sc->stack.clear();
+  const auto shaded = [&](size_t i) -> const ShadedFragment& {
+    if (!sc->done[i]) {
+      sc->shaded[i] = shade(list[i]);
+      sc->shaded[i].opacity = std::clamp(sc->shaded[i].opacity, 0.0, 1.0);
+      sc->done[i] = 1;
+    }
+    return sc->shaded[i];
+  };
+  glm::dvec3 colour(0.0);
+  sc->stack.push_back({0, search, 1.0});
+  while (!sc->stack.empty()) {
+    const PackScratch::Item item = sc->stack.back();
+    sc->stack.pop_back();
+    const size_t i = first_overlapping(list, item.position, item.mask);
+    if (i == n) {  // nothing left under this mask
+      colour += item.weight * background;
+      continue;
+    }
+    const Fragment& f = list[i];
+    // Thesis 5.2.1.1: M_in = M_search & M_f, M_out = M_search & ~M_f; areas from bit counts,
+    // C = (a_in C_in + a_out C_out) / (a_in + a_out).
+    const CoverageMask in = item.mask & f.mask, out = item.mask & ~f.mask;
+    const double total = mask_count(item.mask);
+    if (out != 0) sc->stack.push_back({i + 1, out, item.weight * (mask_count(out) / total)});
+    const double w_in = item.weight * (mask_count(in) / total);
+
+    const ShadedFragment& sf = shaded(i);
+    double alpha = sf.opacity;  // thesis 5.2.1.1: C_in = Op_f C_f + (1 - Op_f) C_behind
+    const size_t j = first_overlapping(list, i + 1, in);
+    if (j < n && list[j].zmin < f.zmax &&
+        triangles.object_id[list[j].triangle()] != triangles.object_id[f.triangle()]) {
+      // Thesis 5.2.1.2, intersecting surfaces: alpha_in = Vis Op_f + (1 - Vis)(1 - alpha_next),
+      // times Op_f for a transparent front fragment (resolve.hpp).
+      const double vis = visible_fraction(f, list[j]);
+      alpha = sf.opacity * (vis + (1.0 - vis) * (1.0 - shaded(j).opacity));
+    }
+    colour += (w_in * alpha) * sf.colour;
+    if (alpha < 1.0) sc->stack.push_back({i + 1, in, w_in * (1.0 - alpha)});
+  }
+  return colour;
+}
+
+}  // namespace
+
+glm::dvec3 pack_under_mask(FragmentList list, CoverageMask search, const FragmentShader& shade,
+                           const TriangleSoup& triangles, const glm::dvec3& background, PackScratch* scratch) {
+  PackScratch local;
+  return pack(list, search, shade, triangles, background, scratch ? scratch : &local);
+}
+
+Image resolve_image(const ABuffer& camera, const TriangleSoup& triangles, const PixelShader& shade,
+                    const glm::dvec3& background, const ResolveOptions& options) {
+  if (options.threads < 0) throw InputError("resolve: threads must be >= 0, got " + std::to_string(options.threads));
+  Image image(camera.width(), camera.height(), 3);
+  const int threads = thread_count(options.threads, static_cast<size_t>(camera.height()));
+  std::vector<PackScratch> scratch(static_cast<size_t>(threads));
+  parallel_for(static_cast<size_t>(camera.height()), threads, [&](size_t row, int worker) {
+    const int y = static_cast<int>(row);
+    for (int x = 0; x < camera.width(); ++x) {
+      const auto shade_here = [&](const Fragment& f) { return shade(f, x, y); };
+      const glm::dvec3 c = pack(camera.list(x, y), FULL_MASK, shade_here, triangles, background,
+                                &scratch[static_cast<size_t>(worker)]);
+      image.set_rgb(x, y, glm::vec3(c));
+    }
+  });
+  return image;
+}
+
+}  // namespace abcube

@@ -1,0 +1,81 @@
+// Resolving an A-buffer list into a pixel colour: Pack_Under_Mask (Carpenter 1984;
+// thesis 5.2.1.1 and 5.2.1.2, the pseudo-code at the end of 5.2.1.2).
+//
+// pack(list, search):
+//   no fragment of the list overlaps `search` (or search is empty) -> the background;
+//   f = the first fragment with f.mask & search != 0;
+//   in = search & f.mask, out = search & ~f.mask, a_in, a_out their bit counts;
+//   C_out = pack(rest after f, out)                                  (if out != 0)
+//   next  = the first fragment after f with next.mask & in != 0;
+//   intersecting = next exists, next's object differs from f's, and next.zmin < f.zmax
+//                  (thesis 5.2.1.2: "el identificador del objeto difiere y los fragmentos
+//                  se superponen en Z");
+//   alpha = op_f                                                     (thesis 5.2.1.1)
+//         = op_f * (Vis + (1 - Vis) * (1 - op_next)) if intersecting  (thesis 5.2.1.2)
+//     Vis = (zmax_next - zmin_f) / ((zmax - zmin)_f + (zmax - zmin)_next), clamped to [0, 1]
+//     (1 when the denominator is 0). For an opaque front fragment this is the thesis'
+//     alpha_in = Vis*Opacity_front + (1 - Vis)*(1 - alpha_next); the factor op_f extends
+//     it to a transparent front fragment, whose hidden part is seen through `next`.
+//   C_in  = alpha * C_f + (1 - alpha) * pack(rest after f, in)      (if alpha < 1)
+//         = C_f                                                       (if alpha == 1)
+//   return (a_in * C_in + a_out * C_out) / (a_in + a_out)
+//
+// Every result is a weighted sum of fragment colours and the background, so pack is
+// evaluated with an explicit stack of (list position, mask, weight) items instead of
+// recursion: no stack overflow on long lists, and each fragment is shaded at most once.
+// The work is bounded: the masks of the items at one list position are disjoint, so
+// there are at most 32 items per position.
+#pragma once
+#include <functional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "raster/abuffer.hpp"
+#include "io/image.hpp"
+#include "scene/scene.hpp"
+
+namespace abcube {
+
+// What the caller's shading says about a fragment.
+struct ShadedFragment {
+  glm::dvec3 colour{0.0};
+  double opacity = 1.0;  // material opacity in [0, 1]; < 1 blends with what is behind
+};
+
+// Shades one fragment of the list being packed.
+using FragmentShader = std::function<ShadedFragment(const Fragment&)>;
+
+// Reusable memory for pack_under_mask (one per thread); optional.
+struct PackScratch {
+  std::vector<ShadedFragment> shaded;
+  std::vector<unsigned char> done;
+  struct Item {
+    size_t position;
+    CoverageMask mask;
+    double weight;
+  };
+  std::vector<Item> stack;
+};
+
+// The colour of the part `search` of a pixel whose list is `list` (front to back).
+// `triangles` gives each fragment's object id (the intersection test).
+glm::dvec3 pack_under_mask(FragmentList list, CoverageMask search, const FragmentShader& shade,
+                           const TriangleSoup& triangles, const glm::dvec3& background,
+                           PackScratch* scratch = nullptr);
+
+// Shades fragment f of pixel (x, y) of the camera A-buffer.
+using PixelShader = std::function<ShadedFragment(const Fragment& f, int x, int y)>;
+
+struct ResolveOptions {
+  int threads = 0;  // 0 = std::thread::hardware_concurrency()
+};
+
+// The antialiased image (row 0 at the top): pack_under_mask(list, FULL_MASK) per pixel.
+// Rows go to threads dynamically; every pixel is computed the same way whatever the
+// thread, so the image is identical for any number of threads. `shade` is called from
+// several threads at once.
+Image resolve_image(const ABuffer& camera, const TriangleSoup& triangles, const PixelShader& shade,
+                    const glm::dvec3& background, const ResolveOptions& options = {});
+
+}  // namespace abcube

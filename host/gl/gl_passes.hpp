@@ -1,0 +1,90 @@
+// The GL passes: the six cube faces around the camera (distance prepass, Z-buffer colour)
+// and the camera view (Z-buffer Phong). All read back into cpu_core image types.
+#pragma once
+#include <glad/gl.h>
+
+#include <memory>
+#include <vector>
+
+#include "gl/gl_program.hpp"
+#include "io/image.hpp"
+#include "scene/scene.hpp"
+
+namespace abcube {
+
+// Wall milliseconds of GL work (glFinish-bracketed) and of reading it back.
+struct GpuTimings {
+  double upload_ms = 0;  // triangles and materials uploaded, shaders compiled
+  double cube_distance_ms = 0;
+  double cube_color_ms = 0;
+  double camera_ms = 0;
+  double readback_ms = 0;
+  double shadow_maps_ms = 0;
+  double environment_ms = 0;
+};
+
+// Shadow bias of the GPU cube shadow maps, in texels (common_shading.glsl).
+constexpr double SHADOW_BIAS_TEXELS = 1.5;
+
+// Value of a prepass texel that no surface covers.
+constexpr float NO_DISTANCE = INFINITY;
+constexpr uint32_t NO_OBJECT = 0xffffffffu;
+
+// The scene uploaded to the current GL context. Needs a current GL 4.5 context for its
+// whole life (gl_context.hpp).
+class GlScene {
+ public:
+  explicit GlScene(const Scene& scene);
+  ~GlScene();
+  GlScene(const GlScene&) = delete;
+  GlScene& operator=(const GlScene&) = delete;
+
+  // Distance prepass over the six faces around `center`: per texel the Euclidean distance
+  // to the nearest surface (NO_DISTANCE where none) and its object id (NO_OBJECT), faces
+  // as cube_map.hpp defines them. `ids` may be null. Faces of n_s x n_t texels; n_t = 0
+  // means square (a 8x, 4x supersampled face checks the 4x8 sample positions).
+  void cube_distance(const glm::dvec3& center, int n, CubeImage* distance, CubeIds* ids, int n_t = 0);
+
+  // Z-buffer Phong colour of the six faces seen from `center` (no shadows).
+  CubeImage cube_color(const glm::dvec3& center, int n);
+
+  // Z-buffer Phong image of the camera view (aliased: one sample per pixel centre). Uses
+  // the shadow maps and the environment map when they have been built.
+  Image camera_color(const Camera& camera);
+
+  // One cube shadow map (distance prepass from the light) per light with cast_shadows, at
+  // n x n per face; later colour passes are shadowed by them. Returns how many.
+  int build_shadow_maps(int n);
+
+  // The Z-buffer colour of the six faces around `center` (with shadows if built) kept on
+  // the GPU as a cube texture; later camera passes look it up for kr and kt (Blinn & Newell
+  // 1976, the `gpu` method's reflections).
+  void build_environment(const glm::dvec3& center, int n);
+
+  const GpuTimings& timings() const { return timings_; }
+  double near_distance() const { return near_; }
+  int max_size() const { return max_size_; }
+
+ private:
+  struct Target;
+  void draw(const GlProgram& program, const glm::mat4& clip, const glm::dvec3& center);
+  void bind_lookups(const GlProgram& program, bool with_environment);
+  void bind_lookup_target(int n);
+  void clear_lookup_target(int n, bool distance);
+  void upload_lights(const glm::dvec3& center);
+  Target& target(int width, int height, bool distance_pass);
+
+  const Scene& scene_;
+  GLuint vao_ = 0, vbo_ = 0, materials_ = 0, lights_ = 0;
+  GLuint shadow_maps_ = 0, environment_ = 0, lookup_fbo_ = 0, lookup_depth_ = 0;
+  int shadow_n_ = 0;
+  std::vector<int> shadow_layer_;  // per light, -1 when it casts no shadows
+  GLsizei vertex_count_ = 0;
+  double near_ = 1e-4;
+  int max_size_ = 0;
+  std::unique_ptr<GlProgram> distance_program_, phong_program_;
+  std::unique_ptr<Target> target_;
+  GpuTimings timings_;
+};
+
+}  // namespace abcube

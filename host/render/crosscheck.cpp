@@ -1,0 +1,167 @@
+#include "render/crosscheck.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "raster/abuffer.hpp"
+#include "scene/camera.hpp"
+#include "raster/cube_map.hpp"
+#include "io/image_io.hpp"
+#include "shading/resolve.hpp"
+#include "shading/shading.hpp"
+#include "base/timer.hpp"
+
+namespace abcube {
+
+namespace {
+
+double percentile(std::vector<double>& v, double q) {
+  if (v.empty()) return 0;
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+// Local Phong of a camera A-buffer fragment at the point it stands for (shading.hpp).
+PixelShader local_phong_shader(const Scene& scene, const ABuffer& buffer) {
+  return [&scene, &buffer](const Fragment& f, int x, int y) {
+    const Material& m = scene.materials[scene.triangles.material_id[f.triangle()]];
+    const glm::dvec3 p = fragment_point(buffer, scene.triangles, f, x, y);
+    return ShadedFragment{phong_local(m, p, f.shading_normal(), scene.camera.position, scene.ambient, scene.lights),
+                          m.opacity};
+  };
+}
+
+// A pixel whose colour is one surface's alone: its front fragment covers all 32 samples,
+// is opaque, and no fragment behind it reaches into its depth range.
+bool interior_pixel(const Scene& scene, const FragmentList& list) {
+  if (list.empty() || list[0].mask != FULL_MASK) return false;
+  if (scene.materials[scene.triangles.material_id[list[0].triangle()]].opacity < 1.0) return false;
+  return list.size() < 2 || list[1].zmin >= list[0].zmax;
+}
+
+void compare_cube(const Scene& scene, int n, int threads, GlScene& gl, CrosscheckResult* r) {
+  CubeImage gpu;
+  CubeIds gpu_ids;
+  const double before = gl.timings().cube_distance_ms;
+  gl.cube_distance(scene.camera.position, n, &gpu, &gpu_ids);
+  r->gpu_ms = gl.timings().cube_distance_ms - before;
+
+  ABufferOptions options;
+  options.threads = threads;
+  options.near_distance = gl.near_distance();
+  ABufferStats stats;
+  const Clock::time_point t0 = Clock::now();
+  const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, n, options, &stats);
+  r->cpu_ms = ms_since(t0);
+  r->fragments = stats.fragments;
+  const NearestLayer cpu = nearest_layer(cube, scene.triangles);
+
+  std::vector<double> rel;
+  size_t same = 0;
+  for (int face = 0; face < CUBE_FACES; ++face) {
+    for (size_t t = 0; t < static_cast<size_t>(n) * n; ++t) {
+      const float g = gpu.faces[face].data[t], c = cpu.distance.faces[face].data[t];
+      const bool gc = std::isfinite(g), cc = std::isfinite(c);
+      ++r->texels;
+      if (gc && !cc) ++r->gpu_only;
+      if (cc && !gc) ++r->cpu_only;
+      if (!gc || !cc) continue;
+      rel.push_back(std::abs(double(g) - double(c)) / double(c));
+      same += gpu_ids.faces[face][t] == cpu.object.faces[face][t];
+    }
+  }
+  r->both_covered = rel.size();
+  if (!rel.empty()) {
+    r->distance_max_rel = *std::max_element(rel.begin(), rel.end());
+    r->distance_p99_rel = percentile(rel, 0.99);
+    r->distance_median_rel = percentile(rel, 0.5);
+    r->same_object = static_cast<double>(same) / static_cast<double>(rel.size());
+  }
+}
+
+void compare_camera(const Scene& scene, int threads, GlScene& gl, CrosscheckResult* r) {
+  const Image gpu = gl.camera_color(scene.camera);
+  ABufferOptions options;
+  options.threads = threads;
+  options.near_distance = gl.near_distance();
+  const ABuffer camera = build_camera_abuffer(scene, options);
+  ResolveOptions ro;
+  ro.threads = threads;
+  const Image cpu = resolve_image(camera, scene.triangles, local_phong_shader(scene, camera), scene.background, ro);
+  double sum_sq = 0;
+  for (int y = 0; y < camera.height(); ++y) {
+    for (int x = 0; x < camera.width(); ++x) {
+      ++r->pixels;
+      if (!interior_pixel(scene, camera.list(x, y))) continue;
+      ++r->interior_pixels;
+      const glm::vec3 a = gpu.rgb(x, y), b = cpu.rgb(x, y);
+      for (int c = 0; c < 3; ++c) {
+        const double d = std::abs(double(srgb_encode(a[c])) - double(srgb_encode(b[c])));
+        sum_sq += d * d;
+        r->interior_max_abs = std::max(r->interior_max_abs, d);
+      }
+    }
+  }
+  if (r->interior_pixels > 0) r->interior_rmse = std::sqrt(sum_sq / (3.0 * double(r->interior_pixels)));
+}
+
+}  // namespace
+
+CrosscheckResult crosscheck(const Scene& scene, int n, int threads, const CrosscheckTolerances& tol) {
+  CrosscheckResult r;
+  GlScene gl(scene);
+  compare_cube(scene, n, threads, gl, &r);
+  compare_camera(scene, threads, gl, &r);
+  const double mismatch =
+      r.texels ? static_cast<double>(r.gpu_only + r.cpu_only) / static_cast<double>(r.texels) : 0.0;
+  auto fail = [&r](bool bad, const std::string& what) {
+    if (bad) r.failures += (r.failures.empty() ? "" : "; ") + what;
+  };
+  fail(r.distance_median_rel > tol.distance_median_rel, "distance median");
+  fail(r.distance_p99_rel > tol.distance_p99_rel, "distance p99");
+  fail(r.both_covered > 0 && r.same_object < tol.same_object_min, "same object share");
+  fail(mismatch > tol.coverage_mismatch_max, "coverage mismatch");
+  fail(r.interior_rmse > tol.interior_rmse, "camera interior RMSE");
+  fail(r.interior_max_abs > tol.interior_max_abs, "camera interior max abs");
+  r.pass = r.failures.empty();
+  return r;
+}
+
+nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolerances& tol) {
+  using nlohmann::json;
+  return json{
+      {"cube", {{"texels", r.texels}, {"both_covered", r.both_covered}, {"gpu_only", r.gpu_only},
+                {"cpu_only", r.cpu_only}, {"distance_rel_median", r.distance_median_rel},
+                {"distance_rel_p99", r.distance_p99_rel}, {"distance_rel_max", r.distance_max_rel},
+                {"same_object", r.same_object}, {"gpu_prepass_ms", r.gpu_ms}, {"cpu_abuffer_ms", r.cpu_ms},
+                {"fragments", r.fragments}}},
+      {"camera", {{"pixels", r.pixels}, {"interior_pixels", r.interior_pixels}, {"interior_rmse", r.interior_rmse},
+                  {"interior_max_abs", r.interior_max_abs}}},
+      {"tolerances", {{"distance_rel_median", tol.distance_median_rel}, {"distance_rel_p99", tol.distance_p99_rel},
+                      {"same_object_min", tol.same_object_min}, {"coverage_mismatch_max", tol.coverage_mismatch_max},
+                      {"interior_rmse", tol.interior_rmse}, {"interior_max_abs", tol.interior_max_abs}}},
+      {"pass", r.pass},
+      {"failures", r.failures}};
+}
+
+Image render_abuffer_local(const Scene& scene, const ABufferOptions& options, nlohmann::json* stats) {
+  ABufferStats s;
+  Clock::time_point t0 = Clock::now();
+  const ABuffer camera = build_camera_abuffer(scene, options, &s);
+  const double build_ms = ms_since(t0);
+  ResolveOptions ro;
+  ro.threads = options.threads;
+  t0 = Clock::now();
+  Image image = resolve_image(camera, scene.triangles, local_phong_shader(scene, camera), scene.background, ro);
+  (*stats)["timings_ms"]["camera_abuffer"] = build_ms;
+  (*stats)["timings_ms"]["resolve"] = ms_since(t0);
+  (*stats)["abuffer"] = {{"fragments", s.fragments}, {"raw_fragments", s.raw_fragments},
+                         {"max_list_length", s.max_list_length}, {"bytes_per_fragment", s.bytes_per_fragment},
+                         {"bytes_total", s.bytes_total}, {"dropped_by_cap", s.dropped_by_cap},
+                         {"triangles_degenerate", s.triangles_degenerate},
+                         {"triangles_clipped", s.triangles_clipped}, {"triangles_culled", s.triangles_culled}};
+  return image;
+}
+
+}  // namespace abcube
