@@ -62,7 +62,7 @@ Options parse(int argc, char** argv) {
 }
 
 // One configuration, in this process: `size` 0 means the camera view.
-Result measure(const Scene& scene, int size, const Options& o) {
+Result measure(const SceneData& scene, int size, const Options& o) {
   Result r;
   ABufferOptions ao;
   ao.threads = o.threads;

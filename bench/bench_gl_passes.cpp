@@ -40,7 +40,7 @@ struct PrepassError {
 };
 
 // Exact first hit along random texel-centre directions against what the prepass stored.
-PrepassError prepass_error(const Scene& scene, const RayTracer& rt, const CubeImage& dist,
+PrepassError prepass_error(const SceneData& scene, const RayTracer& rt, const CubeImage& dist,
                            const CubeIds& ids, int samples) {
   const int n = dist.n;
   std::mt19937 rng(1234);
@@ -70,7 +70,7 @@ PrepassError prepass_error(const Scene& scene, const RayTracer& rt, const CubeIm
 int run(const std::vector<std::string>& words) {
   const Args args(words, {"--sizes", "--runs", "--gl", "--error-samples"}, {});
   args.expect_positional(1, "SCENE.json");
-  const Scene scene = load_scene(args.positional()[0]);
+  const SceneData scene = load_scene(args.positional()[0]);
   const int runs = args.get_int("--runs", 5, 1, 1000);
   const int samples = args.get_int("--error-samples", 20000, 0, 100000000);
   GlChoice choice = GlChoice::automatic;

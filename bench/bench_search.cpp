@@ -90,7 +90,7 @@ struct ReflectionRay {
 };
 
 // Up to `count` reflection rays from camera-visible reflective points (random pixel samples).
-std::vector<ReflectionRay> reflection_rays(const Scene& scene, const RayTracer& tracer, int count, unsigned seed) {
+std::vector<ReflectionRay> reflection_rays(const SceneData& scene, const RayTracer& tracer, int count, unsigned seed) {
   const CameraFrame frame = make_camera_frame(scene.camera);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> x(0.0, frame.width), y(0.0, frame.height);
@@ -180,7 +180,7 @@ int run(int argc, char** argv) {
               o.runs, o.layers == SearchLayers::all ? "all" : "nearest", o.merge ? "on" : "off");
   print_header();
   for (const std::string& path : o.scenes) {
-    const Scene scene = load_scene(path);
+    const SceneData scene = load_scene(path);
     const RayTracer tracer(scene);
     const std::vector<ReflectionRay> rays = reflection_rays(scene, tracer, o.rays, o.seed);
     if (rays.empty()) {

@@ -40,7 +40,7 @@ std::string comment_safe(const std::string& s) {
   return out;
 }
 
-void write_header(std::ostringstream& os, const Scene& scene) {
+void write_header(std::ostringstream& os, const SceneData& scene) {
   os << "// Exported by abcube from " << comment_safe(scene.file.empty() ? "(memory)" : scene.file) << "\n"
      << "// z is mirrored: POV-Ray is left-handed (cpu_core/io/pov_export.hpp).\n"
      << "#version 3.7;\n"
@@ -67,7 +67,7 @@ void write_camera(std::ostringstream& os, const Camera& c) {
      << "}\n";
 }
 
-void write_lights(std::ostringstream& os, const Scene& scene) {
+void write_lights(std::ostringstream& os, const SceneData& scene) {
   for (const PointLight& l : scene.lights) {
     os << "light_source { " << vec(l.position) << " color rgb " << rgb(l.color)
        << (l.cast_shadows ? "" : " shadowless") << " }\n";
@@ -110,7 +110,7 @@ void write_mesh(std::ostringstream& os, const TriangleSoup& soup, const std::vec
 
 }  // namespace
 
-std::string export_pov(const Scene& scene) {
+std::string export_pov(const SceneData& scene) {
   const TriangleSoup& soup = scene.triangles;
   ABCUBE_CHECK(soup.positions.size() == 3 * soup.triangle_count() && soup.normals.size() == soup.positions.size(),
                "triangle soup with 3 positions and 3 normals per triangle");

@@ -1,4 +1,4 @@
-// Writing a Scene as a POV-Ray 3.7 scene, so an independent ray tracer can check ours.
+// Writing a scene as a POV-Ray 3.7 scene, so an independent ray tracer can check ours.
 //
 // MAPPING (ours -> POV-Ray 3.7)
 // - Coordinates: POV-Ray is left-handed, we are right-handed. Every point and vector is
@@ -46,11 +46,11 @@
 #pragma once
 #include <string>
 
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 namespace abcube {
 
 // The scene as POV-Ray 3.7 scene description text (see the mapping above).
-std::string export_pov(const Scene& scene);
+std::string export_pov(const SceneData& scene);
 
 }  // namespace abcube

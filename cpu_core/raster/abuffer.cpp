@@ -294,7 +294,7 @@ ABufferStats summarise(const std::vector<ViewBuild>& views, const std::vector<AB
   return st;
 }
 
-std::vector<ABuffer> build_views(const Scene& scene, std::vector<RasterView> rasters, const char* what,
+std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView> rasters, const char* what,
                                  const ABufferOptions& options, ABufferStats* stats) {
   const Clock::time_point start = Clock::now();
   const TriangleSoup& soup = scene.triangles;
@@ -352,14 +352,14 @@ std::vector<ABuffer> build_views(const Scene& scene, std::vector<RasterView> ras
   return out;
 }
 
-double near_for(const Scene& scene, const glm::dvec3& centre, const ABufferOptions& options) {
+double near_for(const SceneData& scene, const glm::dvec3& centre, const ABufferOptions& options) {
   check_options(options);
   return options.near_distance > 0.0 ? options.near_distance : default_near_distance(max_distance_from(scene, centre));
 }
 
 }  // namespace
 
-CubeABuffer build_cube_abuffer(const Scene& scene, const glm::dvec3& centre, int n, const ABufferOptions& options,
+CubeABuffer build_cube_abuffer(const SceneData& scene, const glm::dvec3& centre, int n, const ABufferOptions& options,
                                ABufferStats* stats) {
   if (n < 1) throw InputError("cube A-buffer: resolution must be >= 1, got " + std::to_string(n));
   if (!std::isfinite(centre.x) || !std::isfinite(centre.y) || !std::isfinite(centre.z)) {
@@ -377,7 +377,7 @@ CubeABuffer build_cube_abuffer(const Scene& scene, const glm::dvec3& centre, int
   return cube;
 }
 
-ABuffer build_camera_abuffer(const Scene& scene, const ABufferOptions& options, ABufferStats* stats) {
+ABuffer build_camera_abuffer(const SceneData& scene, const ABufferOptions& options, ABufferStats* stats) {
   const CameraFrame frame = make_camera_frame(scene.camera);
   const double near = near_for(scene, frame.eye, options);
   std::vector<ABuffer> one = build_views(scene, {camera_view(frame, near)}, "camera A-buffer", options, stats);

@@ -50,7 +50,7 @@
 #include "io/image.hpp"
 #include "raster/raster.hpp"
 #include "raster/samples.hpp"
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 namespace abcube {
 
@@ -144,11 +144,11 @@ struct ABufferStats {
 // The cube A-buffer of `scene` around `centre` (the environment map; design.md), n x n
 // per face. Throws InputError for n < 1, a bad option, or when the estimate exceeds the
 // budget: "cube A-buffer needs N MiB (F fragments at 20 bytes), above --max-memory M MiB".
-CubeABuffer build_cube_abuffer(const Scene& scene, const glm::dvec3& centre, int n,
+CubeABuffer build_cube_abuffer(const SceneData& scene, const glm::dvec3& centre, int n,
                                const ABufferOptions& options = {}, ABufferStats* stats = nullptr);
 
 // The camera view's A-buffer (scene.camera, its width x height), same rules.
-ABuffer build_camera_abuffer(const Scene& scene, const ABufferOptions& options = {},
+ABuffer build_camera_abuffer(const SceneData& scene, const ABufferOptions& options = {},
                              ABufferStats* stats = nullptr);
 
 // The four samples nearest the pixel centre (columns 3-4 of rows 1-2): there is no sample

@@ -56,7 +56,7 @@
 
 #include "scene/camera.hpp"
 #include "raster/samples.hpp"
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 namespace abcube {
 

@@ -26,7 +26,7 @@ Bvh timed_build(const TriangleSoup& soup, double* ms) {
   return bvh;
 }
 
-double compute_scene_scale(const Scene& scene) {
+double compute_scene_scale(const SceneData& scene) {
   const Bounds b = scene.bounds();
   if (b.empty()) return 0.0;
   const glm::dvec3 m = glm::max(glm::abs(b.lo), glm::abs(b.hi));
@@ -47,7 +47,7 @@ struct Crossing {
 
 }  // namespace
 
-RayTracer::RayTracer(const Scene& scene)
+RayTracer::RayTracer(const SceneData& scene)
     : scene_(&scene),
       bvh_(timed_build(scene.triangles, &build_ms_)),
       scene_scale_(compute_scene_scale(scene)) {
@@ -225,7 +225,7 @@ void render_row(const RayTracer& tracer, const CameraFrame& frame, int spp, int 
 
 }  // namespace
 
-Image render_raytrace(const Scene& scene, const RaytraceOptions& options, RaytraceStats* stats) {
+Image render_raytrace(const SceneData& scene, const RaytraceOptions& options, RaytraceStats* stats) {
   if (options.samples_per_pixel != 1 && options.samples_per_pixel != MASK_SAMPLES) {
     throw InputError("raytrace: samples per pixel must be 1 or " + std::to_string(MASK_SAMPLES) + ", got " +
                      std::to_string(options.samples_per_pixel));

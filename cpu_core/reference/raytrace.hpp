@@ -9,7 +9,7 @@
 // along CameraFrame::direction (camera.hpp), from the eye; the pixel is the plain mean of
 // its samples (box filter). samples_per_pixel = 1 shoots the pixel centre (px+.5, py+.5).
 //
-// A ray that hits nothing returns Scene::background (primary and secondary rays alike).
+// A ray that hits nothing returns SceneData::background (primary and secondary rays alike).
 //
 // Hit shading, at the nearest hit with t > 0 of ray (o, d), d unit, depth k:
 //   N_g  unit geometric normal cross(b-a, c-a) (outward for closed objects)
@@ -29,7 +29,7 @@
 //   travels into (no correction).
 //
 // Depth. Primary rays have depth 0; reflected and refracted rays depth k+1. At depth
-// max_depth (Scene::render.max_depth) no reflected or refracted ray is spawned: those
+// max_depth (SceneData::render.max_depth) no reflected or refracted ray is spawned: those
 // terms contribute nothing (black), not the background. The opacity continuation keeps
 // the depth of the ray it continues (it is the same ray), so it never runs out.
 //
@@ -61,7 +61,7 @@
 
 #include "reference/bvh.hpp"
 #include "io/image.hpp"
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 namespace abcube {
 
@@ -93,12 +93,12 @@ struct RayCounts {
 struct Hit {
   double t = 0;                        // origin + t * dir (t in units of |dir|)
   glm::dvec3 point{0.0};               // on the triangle: barycentric combination of its vertices
-  uint32_t triangle = 0;               // index into Scene::triangles
+  uint32_t triangle = 0;               // index into SceneData::triangles
   glm::dvec3 barycentric{0.0};         // weights of the triangle's vertices 0, 1, 2
   glm::dvec3 geometric_normal{0.0};    // unit, cross(b-a, c-a) direction
   glm::dvec3 shading_normal{0.0};      // unit, interpolated vertex normal (not face-forwarded)
-  uint32_t object_id = 0;              // index into Scene::objects
-  uint32_t material_id = 0;            // index into Scene::materials
+  uint32_t object_id = 0;              // index into SceneData::objects
+  uint32_t material_id = 0;            // index into SceneData::materials
   bool front_face = true;              // dot(geometric_normal, dir) < 0
 };
 
@@ -110,8 +110,8 @@ struct Ray {
 class RayTracer {
  public:
   // Builds the BVH. The scene must outlive the tracer (it is referenced, not copied).
-  explicit RayTracer(const Scene& scene);
-  explicit RayTracer(Scene&&) = delete;
+  explicit RayTracer(const SceneData& scene);
+  explicit RayTracer(SceneData&&) = delete;
 
   // The first hit with 0 < t < tmax along origin + t*dir (dir non-zero, need not be unit).
   bool intersect(const glm::dvec3& origin, const glm::dvec3& dir, double tmax, Hit* hit) const;
@@ -139,13 +139,13 @@ class RayTracer {
   // Largest absolute vertex coordinate plus the diagonal of the vertex bounds.
   double scene_scale() const { return scene_scale_; }
   const Bvh& bvh() const { return bvh_; }
-  const Scene& scene() const { return *scene_; }
+  const SceneData& scene() const { return *scene_; }
   double build_ms() const { return build_ms_; }
 
  private:
   Hit make_hit(const TriangleHit& th, const glm::dvec3& dir) const;
 
-  const Scene* scene_;
+  const SceneData* scene_;
   double build_ms_ = 0;  // before bvh_: the BVH's construction writes it
   Bvh bvh_;
   double scene_scale_ = 0;
@@ -153,7 +153,7 @@ class RayTracer {
 
 // Renders the scene's camera view with the rules above. Throws InputError for a bad
 // option (samples_per_pixel not 1 or 32, negative threads).
-Image render_raytrace(const Scene& scene, const RaytraceOptions& options = {},
+Image render_raytrace(const SceneData& scene, const RaytraceOptions& options = {},
                       RaytraceStats* stats = nullptr);
 
 }  // namespace abcube

@@ -2,7 +2,7 @@
 #pragma once
 #include <glm/glm.hpp>
 
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 namespace abcube {
 

@@ -10,7 +10,7 @@ int resolution_for_error(double target) {
 
 double parallax_bound(int n) { return 1.0 / (2.0 * static_cast<double>(n) * static_cast<double>(n)); }
 
-RenderPlan make_plan(const Scene& scene, bool everything) {
+RenderPlan make_plan(const SceneData& scene, bool everything) {
   RenderPlan p;
   bool reflect = false, transmit = false;
   for (const Material& m : scene.materials) {

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 namespace abcube {
 
@@ -28,6 +28,6 @@ struct RenderPlan {
   bool reflection_searches = true, refraction_searches = true;
   std::vector<PlanStep> steps;
 };
-RenderPlan make_plan(const Scene& scene, bool everything);
+RenderPlan make_plan(const SceneData& scene, bool everything);
 
 }  // namespace abcube

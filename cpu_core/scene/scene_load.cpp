@@ -1,4 +1,4 @@
-// Scene file (scene-format.md, version 1) -> Scene. Every value is checked where it is
+// Scene file (scene-format.md, version 1) -> SceneData. Every value is checked where it is
 // read, and every message names its place: "FILE:LINE:COL: ..." for JSON syntax (from the
 // parser's byte offset, as nori does), "FILE: objects[3].radius: ..." for values.
 //
@@ -436,7 +436,7 @@ RenderSettings read_render(const Fields& f) {
 // materials already made from MTL files (keyed by resolved OBJ path and MTL name).
 struct LoadState {
   const Source& src;
-  Scene& scene;
+  SceneData& scene;
   std::map<std::string, uint32_t> material_by_name;
   std::map<std::string, uint32_t> mtl_materials;
   int default_material = -1;
@@ -746,14 +746,14 @@ const Json& read_array(const Source& src, const Json& v, const std::string& path
   return v;
 }
 
-Scene read_scene(const Json& doc, const Source& src) {
+SceneData read_scene(const Json& doc, const Source& src) {
   const Fields top(src, doc, "",
                    {"version", "camera", "background", "ambient", "lights", "materials", "objects", "render"});
   const Json& version = top.need("version");
   if (!version.is_number() || version.get<double>() != 1.0) {
     fail(src, "version", "must be 1 (the only version this program reads), got " + describe(version));
   }
-  Scene scene;
+  SceneData scene;
   scene.file = src.name;
   scene.camera = read_camera(Fields(src, top.need("camera"), "camera",
                                     {"position", "look_at", "up", "fov_y", "width", "height"}));
@@ -789,12 +789,12 @@ constexpr uint64_t TRIANGLE_BYTES = 6 * sizeof(glm::vec3) + 2 * sizeof(uint32_t)
 
 }  // namespace
 
-Scene load_scene_text(const std::string& text, const std::string& name, const std::string& base_dir) {
+SceneData load_scene_text(const std::string& text, const std::string& name, const std::string& base_dir) {
   const Source src{name, base_dir.empty() ? "." : base_dir};
   return read_scene(parse_document(text, src), src);
 }
 
-Scene load_scene(const std::string& path) {
+SceneData load_scene(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw InputError(one_line(path + ": cannot read scene: is a directory"));
@@ -807,13 +807,13 @@ Scene load_scene(const std::string& path) {
   return load_scene_text(text.str(), path, dir.empty() ? "." : dir);
 }
 
-uint64_t estimate_render_bytes(const Scene& scene) {
+uint64_t estimate_render_bytes(const SceneData& scene) {
   const uint64_t pixels = static_cast<uint64_t>(scene.camera.width) * static_cast<uint64_t>(scene.camera.height);
   const uint64_t n = static_cast<uint64_t>(scene.render.cube_resolution);
   return pixels * PIXEL_BYTES + 6 * n * n * TEXEL_BYTES + scene.triangles.triangle_count() * TRIANGLE_BYTES;
 }
 
-void check_render_size(const Scene& scene, uint64_t budget_bytes) {
+void check_render_size(const SceneData& scene, uint64_t budget_bytes) {
   const uint64_t need = estimate_render_bytes(scene);
   if (need <= budget_bytes) return;
   constexpr uint64_t MIB = uint64_t{1} << 20;

@@ -9,7 +9,7 @@
 
 #include <glm/glm.hpp>
 
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 namespace abcube {
 

@@ -83,7 +83,7 @@ void sort_unique(std::vector<glm::dvec3>* points) {
 }
 
 // One surface's points in the lens frame: u = (x^2 + y^2) / 2 and the height z.
-struct SurfacePoint {
+struct LensSurfacePoint {
   double u, z;
 };
 
@@ -98,9 +98,9 @@ struct NormalEquations {
   double cost = 0, jtj[2][2] = {{0, 0}, {0, 0}}, jtr[2] = {0, 0};
 };
 
-NormalEquations normal_equations(const std::vector<SurfacePoint>& pts, double rho, double z0) {
+NormalEquations normal_equations(const std::vector<LensSurfacePoint>& pts, double rho, double z0) {
   NormalEquations ne;
-  for (const SurfacePoint& p : pts) {
+  for (const LensSurfacePoint& p : pts) {
     const double w = p.z - z0, q = p.u + 0.5 * w * w;
     const double f = w - rho * q;
     const double j0 = -q, j1 = -1.0 + rho * w;  // dF/drho, dF/dz0
@@ -117,17 +117,17 @@ NormalEquations normal_equations(const std::vector<SurfacePoint>& pts, double rh
 
 // Least squares of F over (rho, z0) by Levenberg-Marquardt (Marquardt 1963), in units where
 // the object's size is 1, from z0 = z_start and the linear least-squares rho for it.
-SurfaceFit fit_surface(const std::vector<SurfacePoint>& pts_world, double z_start, double scale) {
+SurfaceFit fit_surface(const std::vector<LensSurfacePoint>& pts_world, double z_start, double scale) {
   SurfaceFit fit;
   if (pts_world.size() < MIN_SURFACE_POINTS) return fit;
-  std::vector<SurfacePoint> pts(pts_world.size());
+  std::vector<LensSurfacePoint> pts(pts_world.size());
   for (size_t i = 0; i < pts.size(); ++i) {
     pts[i] = {pts_world[i].u / (scale * scale), pts_world[i].z / scale};
   }
   double z0 = z_start / scale;
   // Linear least squares in rho for fixed z0: (z - z0) = rho q.
   double sqw = 0, sqq = 0;
-  for (const SurfacePoint& p : pts) {
+  for (const LensSurfacePoint& p : pts) {
     const double w = p.z - z0, q = p.u + 0.5 * w * w;
     sqw += q * w;
     sqq += q * q;
@@ -169,7 +169,7 @@ struct LensPoints {
   std::vector<glm::dvec3> all, upper, lower;
 };
 
-LensPoints surface_points(const Scene& scene, const SceneObject& obj, const LensFit& frame,
+LensPoints surface_points(const SceneData& scene, const SceneObject& obj, const LensFit& frame,
                           LensSplit split, const std::vector<glm::dvec3>& all) {
   LensPoints pts;
   if (split == LensSplit::side_of_plane) {
@@ -196,8 +196,8 @@ LensPoints surface_points(const Scene& scene, const SceneObject& obj, const Lens
   return pts;
 }
 
-std::vector<SurfacePoint> in_lens_frame(const std::vector<glm::dvec3>& pts, const LensFit& f) {
-  std::vector<SurfacePoint> out;
+std::vector<LensSurfacePoint> in_lens_frame(const std::vector<glm::dvec3>& pts, const LensFit& f) {
+  std::vector<LensSurfacePoint> out;
   out.reserve(pts.size());
   for (const glm::dvec3& p : pts) {
     const glm::dvec3 r = p - f.centroid;
@@ -255,7 +255,7 @@ bool parse_refraction_mode(const std::string& s, RefractionMode* out) {
   return false;
 }
 
-LensFit fit_lens(const Scene& scene, uint32_t object, const LensFitOptions& options) {
+LensFit fit_lens(const SceneData& scene, uint32_t object, const LensFitOptions& options) {
   ABCUBE_CHECK(object < scene.objects.size(),
                "object " + std::to_string(object) + " of " + std::to_string(scene.objects.size()));
   const SceneObject& obj = scene.objects[object];
@@ -276,15 +276,15 @@ LensFit fit_lens(const Scene& scene, uint32_t object, const LensFitOptions& opti
   if (!fit_principal_plane(all, &f)) return invalid(f, obj.path + ": vertices do not span a plane");
 
   double scale = 0;
-  for (const SurfacePoint& p : in_lens_frame(all, f)) {
+  for (const LensSurfacePoint& p : in_lens_frame(all, f)) {
     f.radius = std::max(f.radius, std::sqrt(2.0 * p.u));
     scale = std::max(scale, std::sqrt(2.0 * p.u + p.z * p.z));
   }
 
   // Curvature of each surface (Patow-Delrieux sec. 2, F(u, z) over rho and z0).
   const LensPoints pts = surface_points(scene, obj, f, options.split, all);
-  const std::vector<SurfacePoint> upper = in_lens_frame(pts.upper, f);
-  const std::vector<SurfacePoint> lower = in_lens_frame(pts.lower, f);
+  const std::vector<LensSurfacePoint> upper = in_lens_frame(pts.upper, f);
+  const std::vector<LensSurfacePoint> lower = in_lens_frame(pts.lower, f);
   f.points1 = static_cast<uint32_t>(upper.size());
   f.points2 = static_cast<uint32_t>(lower.size());
   if (upper.size() < MIN_SURFACE_POINTS || lower.size() < MIN_SURFACE_POINTS) {
@@ -292,8 +292,8 @@ LensFit fit_lens(const Scene& scene, uint32_t object, const LensFitOptions& opti
                           " above, " + std::to_string(lower.size()) + " below the principal plane)");
   }
   double top = -std::numeric_limits<double>::infinity(), bottom = std::numeric_limits<double>::infinity();
-  for (const SurfacePoint& p : upper) top = std::max(top, p.z);
-  for (const SurfacePoint& p : lower) bottom = std::min(bottom, p.z);
+  for (const LensSurfacePoint& p : upper) top = std::max(top, p.z);
+  for (const LensSurfacePoint& p : lower) bottom = std::min(bottom, p.z);
   const SurfaceFit s1 = fit_surface(upper, top, scale);
   const SurfaceFit s2 = fit_surface(lower, bottom, scale);
   if (!s1.ok || !s2.ok) return invalid(f, obj.path + ": the curvature fit failed (degenerate points)");
@@ -315,7 +315,7 @@ LensFit fit_lens(const Scene& scene, uint32_t object, const LensFitOptions& opti
   return f;
 }
 
-std::vector<LensFit> fit_lenses(const Scene& scene, const LensFitOptions& options) {
+std::vector<LensFit> fit_lenses(const SceneData& scene, const LensFitOptions& options) {
   std::vector<LensFit> fits;
   for (uint32_t i = 0; i < scene.objects.size(); ++i) {
     const uint32_t m = scene.objects[i].material;

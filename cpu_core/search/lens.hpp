@@ -84,7 +84,7 @@
 
 #include <glm/glm.hpp>
 
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 namespace abcube {
 
@@ -121,7 +121,7 @@ struct LensFit {
   glm::dvec3 spread{0.0};      // variance of the points along axis, v_axis, u_axis
   uint32_t points1 = 0;        // points fitted for surface 1
   uint32_t points2 = 0;
-  uint32_t object = 0;         // index into Scene::objects
+  uint32_t object = 0;         // index into SceneData::objects
   bool valid = false;
   std::string why_invalid;     // empty when valid
 };
@@ -130,11 +130,11 @@ struct LensFit {
 // material's ior). Invalid, with the reason, for an open object, too few points, a
 // degenerate spread, a surface without enough points, a fit that fails, or vertices in the
 // wrong order. Throws nothing for bad geometry; `object` must be in range (checked).
-LensFit fit_lens(const Scene& scene, uint32_t object, const LensFitOptions& options = {});
+LensFit fit_lens(const SceneData& scene, uint32_t object, const LensFitOptions& options = {});
 
 // One fit per object whose material (SceneObject::material) has transmit > 0, in object
 // order, valid or not.
-std::vector<LensFit> fit_lenses(const Scene& scene, const LensFitOptions& options = {});
+std::vector<LensFit> fit_lenses(const SceneData& scene, const LensFitOptions& options = {});
 
 // The Gaussian transfer of eq. 12 from the entry reference plane to the exit one.
 // alpha delta - beta gamma = 1 (the text's Property 2 prints "+", a slip: the product of

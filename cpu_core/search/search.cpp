@@ -24,7 +24,7 @@ constexpr double INF = std::numeric_limits<double>::infinity();
 constexpr double ON_TRIANGLE_TEXELS = 1e-6;
 
 // One search's ray, relative to the cube centre.
-struct RayQuery {
+struct SearchRay {
   glm::dvec3 w{0.0}, d{0.0};  // origin and unit direction
   double l_max = INF;         // end of the ray (shadow segments)
   double self = 0;            // self offset in world units (header, SELF-HITS)
@@ -82,7 +82,7 @@ const Fragment* nearest_fragment(const SearchContext& ctx, FragmentList list, co
 // W's own surface (header, SELF-HITS): a plane passing within the self offset of W that the
 // ray leaves, runs along, or crosses again within the offset. A neighbouring face near W
 // that the ray really crosses further on is not.
-bool own_surface(const SearchContext::Plane& p, const RayQuery& q) {
+bool own_surface(const SearchContext::Plane& p, const SearchRay& q) {
   const double delta = glm::dot(p.normal, q.w) - p.offset;
   if (!(std::fabs(delta) <= q.self)) return false;
   const double den = glm::dot(p.normal, q.d);
@@ -128,7 +128,7 @@ class SquaredDistanceRange {
 // texels counted as visited. Only while may_skip() holds: the crossing and thesis windows
 // count texels once they have a candidate.
 template <class OnFragment, class AfterTexel, class MaySkip>
-ScanCounts scan(const SearchContext& ctx, const RayQuery& q, const SearchOptions& o, OnFragment&& on_fragment,
+ScanCounts scan(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o, OnFragment&& on_fragment,
                 AfterTexel&& after_texel, MaySkip&& may_skip) {
   const CubeABuffer& cube = ctx.cube();
   const TriangleSoup& soup = ctx.scene().triangles;
@@ -193,7 +193,7 @@ struct PlaneCrossing {
   int outside_edge = -1;
 };
 
-PlaneCrossing plane_crossing(const SearchContext& ctx, const RayQuery& q, uint32_t tri) {
+PlaneCrossing plane_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri) {
   PlaneCrossing c;
   const SearchContext::Plane& p = ctx.plane(tri);
   const SearchContext::Bounds& b = ctx.bounds(tri);
@@ -214,7 +214,7 @@ PlaneCrossing plane_crossing(const SearchContext& ctx, const RayQuery& q, uint32
 
 // The exact crossing of the ray with triangle `tri` (on the triangle, l in [self, l_max]):
 // its parameter l, or INF.
-double exact_crossing(const SearchContext& ctx, const RayQuery& q, uint32_t tri) {
+double exact_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri) {
   const PlaneCrossing c = plane_crossing(ctx, q, tri);
   return c.outside_edge < 0 && c.l >= q.self && c.l <= q.l_max ? c.l : INF;
 }
@@ -229,7 +229,7 @@ struct MeshAnswer {
 };
 
 // Does a triangle's bounding sphere come within `radius` of the ray's stretch [l_lo, l_hi]?
-bool near_ray(const SearchContext::Bounds& b, const RayQuery& q, double l_lo, double l_hi, double radius) {
+bool near_ray(const SearchContext::Bounds& b, const SearchRay& q, double l_lo, double l_hi, double radius) {
   const double along = std::clamp(glm::dot(b.centroid - q.w, q.d), l_lo, l_hi);
   const glm::dvec3 off = b.centroid - (q.w + along * q.d);
   const double reach = b.radius + radius;
@@ -240,7 +240,7 @@ bool near_ray(const SearchContext::Bounds& b, const RayQuery& q, double l_lo, do
 // stretch [l_lo, l_hi] (bounding spheres), testing each for an exact crossing: hit (the
 // smallest l), miss (the flood ended with none), or unknown (more than
 // REFINE_MAX_TRIANGLES triangles were near: the caller falls back on the plane tolerance).
-MeshAnswer refine_on_mesh(const SearchContext& ctx, const RayQuery& q, uint32_t start, double l_lo, double l_hi,
+MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t start, double l_lo, double l_hi,
                           double radius) {
   MeshAnswer a;
   // A start triangle away from the ray: the mesh near the ray may be elsewhere in the
@@ -298,7 +298,7 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const RayQuery& q, uint32_t 
 
 // Crossing mode (header): the ray meets the fragment's triangle plane at X(l'); refined on
 // the mesh around that triangle unless the ray crosses the triangle itself there.
-Candidate crossing_candidate(const SearchContext& ctx, const RayQuery& q, const SearchOptions& o, const WalkTexel& t,
+Candidate crossing_candidate(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o, const WalkTexel& t,
                              const Fragment& f) {
   Candidate c;
   const uint32_t tri = f.triangle();
@@ -348,7 +348,7 @@ Candidate crossing_candidate(const SearchContext& ctx, const RayQuery& q, const 
 }
 
 // Thesis mode (thesis 7.4.1, 9.3.4): the point a V of the texel centre on the fragment's plane.
-Candidate thesis_candidate(const SearchContext& ctx, const RayQuery& q, const WalkTexel& t, const Fragment& f,
+Candidate thesis_candidate(const SearchContext& ctx, const SearchRay& q, const WalkTexel& t, const Fragment& f,
                            const glm::dvec3& v) {
   Candidate c;
   const SearchContext::Plane& p = ctx.plane(f.triangle());
@@ -371,7 +371,7 @@ Candidate thesis_candidate(const SearchContext& ctx, const RayQuery& q, const Wa
 }
 
 // Does the exact ray meet a triangle the map cannot hold before parameter l_end?
-bool meets_zero_area(const SearchContext& ctx, const RayQuery& q, double l_end) {
+bool meets_zero_area(const SearchContext& ctx, const SearchRay& q, double l_end) {
   for (const uint32_t tri : ctx.zero_area_triangles()) {
     if (q.restrict_object && ctx.scene().triangles.object_id[tri] != q.object) continue;
     // Moller & Trumbore 1997.
@@ -389,7 +389,7 @@ bool meets_zero_area(const SearchContext& ctx, const RayQuery& q, double l_end) 
   return false;
 }
 
-SearchResult make_result(const SearchContext& ctx, const RayQuery& q, const Candidate& c) {
+SearchResult make_result(const SearchContext& ctx, const SearchRay& q, const Candidate& c) {
   SearchResult r;
   r.hit = true;
   r.miss = MissReason::none;
@@ -407,7 +407,7 @@ SearchResult make_result(const SearchContext& ctx, const RayQuery& q, const Cand
 
 // The answer: the chosen candidate or a miss (`miss` unless the walk was aborted); a surface
 // the map cannot hold met before it turns it into a zero-area miss.
-SearchResult finish(const SearchContext& ctx, const RayQuery& q, const Candidate* best, MissReason miss,
+SearchResult finish(const SearchContext& ctx, const SearchRay& q, const Candidate* best, MissReason miss,
                     const ScanCounts& counts) {
   SearchResult r;
   if (best) r = make_result(ctx, q, *best);
@@ -423,7 +423,7 @@ SearchResult finish(const SearchContext& ctx, const RayQuery& q, const Candidate
 }
 
 // Crossing mode: the first crossing, exact ones first (header).
-SearchResult search_crossing(const SearchContext& ctx, const RayQuery& q, const SearchOptions& o) {
+SearchResult search_crossing(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o) {
   Candidate exact, near;
   bool rejected = false;
   int64_t first = -1;
@@ -449,7 +449,7 @@ SearchResult search_crossing(const SearchContext& ctx, const RayQuery& q, const 
 }
 
 // Thesis mode: the smallest angle over the first candidates under theta_max (header).
-SearchResult search_thesis(const SearchContext& ctx, const RayQuery& q, const SearchOptions& o) {
+SearchResult search_thesis(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o) {
   Candidate best;
   int64_t first = -1;
   const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v) {
@@ -468,10 +468,10 @@ SearchResult search_thesis(const SearchContext& ctx, const RayQuery& q, const Se
   return r;
 }
 
-RayQuery make_query(const SearchContext& ctx, const glm::dvec3& w_world, const glm::dvec3& dir,
+SearchRay make_query(const SearchContext& ctx, const glm::dvec3& w_world, const glm::dvec3& dir,
                     const SearchOptions& o) {
   ABCUBE_CHECK(std::fabs(glm::length(dir) - 1.0) < 1e-6, "search direction must be unit");
-  RayQuery q;
+  SearchRay q;
   q.w = w_world - ctx.cube().centre;
   q.d = dir;
   const double texel = texel_size_at(q.w, ctx.cube().n);
@@ -480,7 +480,7 @@ RayQuery make_query(const SearchContext& ctx, const glm::dvec3& w_world, const g
   return q;
 }
 
-SearchResult search_ray(const SearchContext& ctx, const RayQuery& q, const SearchOptions& o) {
+SearchResult search_ray(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o) {
   return o.mode == SearchMode::thesis ? search_thesis(ctx, q, o) : search_crossing(ctx, q, o);
 }
 
@@ -520,7 +520,7 @@ const char* miss_reason_name(MissReason r) {
   return "?";
 }
 
-SearchContext::SearchContext(const Scene& scene, const CubeABuffer& cube) : scene_(&scene), cube_(&cube) {
+SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube) : scene_(&scene), cube_(&cube) {
   const TriangleSoup& soup = scene.triangles;
   const uint32_t count = static_cast<uint32_t>(soup.triangle_count());
   planes_.resize(count);
@@ -667,7 +667,7 @@ glm::dvec3 SearchContext::vertex(uint32_t triangle, int k) const {
 
 bool mesh_crossing(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& dir, uint32_t triangle,
                    double l_near, double radius, uint32_t* crossed, double* l) {
-  RayQuery q;
+  SearchRay q;
   q.w = w - ctx.cube().centre;
   q.d = dir;
   q.self = -INF;
@@ -685,7 +685,7 @@ SearchResult reflection_search(const SearchContext& ctx, const glm::dvec3& w, co
 
 SearchResult refraction_exit_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& t,
                                     uint32_t object_id, const SearchOptions& options) {
-  RayQuery q = make_query(ctx, w, t, options);
+  SearchRay q = make_query(ctx, w, t, options);
   q.restrict_object = true;
   q.object = object_id;
   return search_ray(ctx, q, options);
@@ -728,7 +728,7 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
   const glm::dvec3 seg = light_position - p;
   const double len = glm::length(seg);
   if (!(len > 0.0)) return res;
-  RayQuery q = make_query(ctx, p, seg / len, options);
+  SearchRay q = make_query(ctx, p, seg / len, options);
   q.l_max = len;
   std::vector<ShadowCrossing> counted;
   const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v) {

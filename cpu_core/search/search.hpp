@@ -124,7 +124,7 @@
 
 #include "raster/abuffer.hpp"
 #include "raster/cube_map.hpp"
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 namespace abcube {
 
@@ -164,12 +164,12 @@ const char* miss_reason_name(MissReason r);
 
 // The geometry a search needs, prepared once per cube map: per triangle its plane relative
 // to the centre, and the triangles the map cannot hold (plane through the centre).
-// Scene and cube must outlive it.
+// The scene and cube must outlive it.
 class SearchContext {
  public:
-  SearchContext(const Scene& scene, const CubeABuffer& cube);
+  SearchContext(const SceneData& scene, const CubeABuffer& cube);
 
-  const Scene& scene() const { return *scene_; }
+  const SceneData& scene() const { return *scene_; }
   const CubeABuffer& cube() const { return *cube_; }
   const std::vector<uint32_t>& zero_area_triangles() const { return zero_area_; }
 
@@ -214,7 +214,7 @@ class SearchContext {
   }
 
  private:
-  const Scene* scene_;
+  const SceneData* scene_;
   const CubeABuffer* cube_;
   std::vector<Plane> planes_;
   std::vector<Bounds> bounds_;
@@ -238,7 +238,7 @@ class SearchContext {
 struct SearchResult {
   bool hit = false;
   MissReason miss = MissReason::no_crossing;  // none when hit
-  uint32_t triangle = 0;       // the found fragment's triangle (index into Scene::triangles)
+  uint32_t triangle = 0;       // the found fragment's triangle (index into SceneData::triangles)
   uint32_t object_id = 0, material_id = 0;
   bool back_face = false;      // the fragment's facing as seen from the cube centre
   glm::dvec3 point{0.0};       // X', world space

@@ -54,7 +54,7 @@ void MapShadingStats::merge(const MapShadingStats& o) {
   errors.merge(o.errors);
 }
 
-SurfacePoint surface_point(const Scene& scene, uint32_t triangle, const glm::dvec3& point) {
+SurfacePoint surface_point(const SceneData& scene, uint32_t triangle, const glm::dvec3& point) {
   const TriangleSoup& t = scene.triangles;
   const size_t base = 3 * static_cast<size_t>(triangle);
   const glm::dvec3 a(t.positions[base]), b(t.positions[base + 1]), c(t.positions[base + 2]);
@@ -76,7 +76,7 @@ SurfacePoint surface_point(const Scene& scene, uint32_t triangle, const glm::dve
   return sp;
 }
 
-MapShader::MapShader(const Scene& scene, const CubeABuffer& cube, const MapShadingOptions& options,
+MapShader::MapShader(const SceneData& scene, const CubeABuffer& cube, const MapShadingOptions& options,
                      const RayTracer* reference)
     : scene_(scene), cube_(cube), options_(options), reference_(reference) {
   options_.search.layers = options.method == Method::zbuffer ? SearchLayers::nearest : SearchLayers::all;
@@ -97,7 +97,7 @@ MapShader::MapShader(const Scene& scene, const CubeABuffer& cube, const MapShadi
 MapShader::~MapShader() = default;
 
 // Which closed object a ray leaving sp along d runs inside of (N_g is outward).
-static uint32_t inside_after(const Scene& scene, const SurfacePoint& sp, const glm::dvec3& d) {
+static uint32_t inside_after(const SceneData& scene, const SurfacePoint& sp, const glm::dvec3& d) {
   return scene.objects[sp.object].closed && glm::dot(sp.geometric_normal, d) < 0.0 ? sp.object : OUTSIDE;
 }
 
@@ -334,7 +334,7 @@ static bool differ(const glm::dvec3& a, const glm::dvec3& b) {
   return false;
 }
 
-Image render_with_map(const Scene& scene, const ABuffer& camera, const MapShader& shader, int threads,
+Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
                       MapShadingStats* stats) {
   ThreadStats per_thread;
   // The fragment shaded at its covered quarters, adaptively (header, QUARTER_SPLIT_SRGB).

@@ -38,7 +38,7 @@
 #include "io/image.hpp"
 #include "search/lens.hpp"
 #include "io/metrics.hpp"
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 #include "search/search.hpp"
 
 namespace abcube {
@@ -97,13 +97,13 @@ struct SurfacePoint {
   glm::dvec3 shading_normal{0.0};    // unit, interpolated vertex normals
   uint32_t triangle = 0, object = 0, material = 0;
 };
-SurfacePoint surface_point(const Scene& scene, uint32_t triangle, const glm::dvec3& point);
+SurfacePoint surface_point(const SceneData& scene, uint32_t triangle, const glm::dvec3& point);
 
 class MapShader {
  public:
   // `cube` is the map around scene.camera.position. `reference` (optional) is the exact
   // tracer the ray errors are measured against. All must outlive the shader.
-  MapShader(const Scene& scene, const CubeABuffer& cube, const MapShadingOptions& options,
+  MapShader(const SceneData& scene, const CubeABuffer& cube, const MapShadingOptions& options,
             const RayTracer* reference = nullptr);
   ~MapShader();
 
@@ -134,7 +134,7 @@ class MapShader {
                MapShadingStats* stats) const;
   glm::dvec3 envmap_texel(int face, int i, int j) const;
 
-  const Scene& scene_;
+  const SceneData& scene_;
   const CubeABuffer& cube_;
   MapShadingOptions options_;
   const RayTracer* reference_;
@@ -148,7 +148,7 @@ class MapShader {
 
 // The camera view through the camera A-buffer, every fragment shaded by `shader`, resolved
 // by Pack_Under_Mask (resolve.hpp). Stats merged over threads.
-Image render_with_map(const Scene& scene, const ABuffer& camera, const MapShader& shader, int threads,
+Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
                       MapShadingStats* stats);
 
 }  // namespace abcube

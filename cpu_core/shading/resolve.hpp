@@ -33,7 +33,7 @@
 
 #include "raster/abuffer.hpp"
 #include "io/image.hpp"
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 namespace abcube {
 

@@ -25,7 +25,7 @@ int cmd_crosscheck(const std::vector<std::string>& words) {
   const int device = args.get_int("--gl-device", -1, 0, 1024);
   const int threads = args.get_int("--threads", 0, 0, 4096);
   const std::string stats_path = args.get("--stats");
-  Scene scene = load_scene(args.positional()[0]);
+  SceneData scene = load_scene(args.positional()[0]);
   scene.render.cube_resolution = args.get_int("--cube-res", scene.render.cube_resolution, 1, 16384);
   check_render_size(scene, available_memory_bytes());
 

@@ -13,7 +13,7 @@ int cmd_export_pov(const std::vector<std::string>& words) {
   args.expect_positional(1, "SCENE.json");
   const std::string out = args.has("-o") ? args.get("-o") : args.get("--output");
   if (out.empty()) throw InputError("-o OUT.pov: an output file is required");
-  const Scene scene = load_scene(args.positional()[0]);
+  const SceneData scene = load_scene(args.positional()[0]);
   write_text_atomic(out, export_pov(scene));
   return 0;
 }

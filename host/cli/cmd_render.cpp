@@ -41,7 +41,7 @@ struct RenderRequest {
 };
 
 // Parses the command line and applies its overrides to the scene (cli.md).
-RenderRequest parse_request(const std::vector<std::string>& words, Scene* scene) {
+RenderRequest parse_request(const std::vector<std::string>& words, SceneData* scene) {
   const Args args(words,
                   {"-o", "--output", "--method", "--cube-res", "--max-depth", "--threads", "--gl",
                    "--gl-device", "--stats", "--max-memory", "--max-layers", "--search", "--refine", "--theta-max",
@@ -125,7 +125,7 @@ json gl_json(const GlContext* ctx) {
 }
 
 // The Z-buffer raster on the GPU: camera view only, Phong, aliased (--method gpu).
-Image render_gpu(const Scene& scene, const RenderRequest& r, json* stats) {
+Image render_gpu(const SceneData& scene, const RenderRequest& r, json* stats) {
   std::string log;
   Clock::time_point t0 = Clock::now();
   std::unique_ptr<GlContext> ctx = open_gl_context(r.gl, r.gl_device, &log);
@@ -177,7 +177,7 @@ std::function<void(double)> progress_printer(const char* label) {
 }
 
 // The exact Whitted tracer (--method raytrace, and the --reference image).
-Image render_reference(const Scene& scene, const RenderRequest& r, json* stats, const char* key) {
+Image render_reference(const SceneData& scene, const RenderRequest& r, json* stats, const char* key) {
   RaytraceOptions options;
   options.threads = r.threads;
   options.progress = progress_printer(key);
@@ -205,7 +205,7 @@ json error_stats_json(const ErrorStats& e) {
 
 // The cube-map methods (abuffer, zbuffer, envmap; map_shading.hpp). The map is built only
 // when something needs it: a reflecting or refracting material, or a shadow-casting light.
-Image render_map_method(const Scene& scene, const RenderRequest& r, json* stats) {
+Image render_map_method(const SceneData& scene, const RenderRequest& r, json* stats) {
   const RenderPlan plan = make_plan(scene, r.plan_everything);
   json passes = json::array(), skipped = json::array();
   for (const PlanStep& s : plan.steps) (s.run ? passes : skipped).push_back({{"pass", s.pass}, {"why", s.why}});
@@ -269,7 +269,7 @@ json image_error_json(const ImageError& e) {
 
 int cmd_render(const std::vector<std::string>& words) {
   const Clock::time_point start = Clock::now();
-  Scene scene;
+  SceneData scene;
   const RenderRequest r = parse_request(words, &scene);
   json stats;
   stats["scene"] = r.scene_path;

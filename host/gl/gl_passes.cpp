@@ -106,7 +106,7 @@ struct GlScene::Target {
   }
 };
 
-GlScene::GlScene(const Scene& scene) : scene_(scene) {
+GlScene::GlScene(const SceneData& scene) : scene_(scene) {
   const Clock::time_point t0 = Clock::now();
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size_);
   const double radius = max_distance_from(scene, scene.camera.position);

@@ -8,7 +8,7 @@
 
 #include "gl/gl_program.hpp"
 #include "io/image.hpp"
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 namespace abcube {
 
@@ -34,7 +34,7 @@ constexpr uint32_t NO_OBJECT = 0xffffffffu;
 // whole life (gl_context.hpp).
 class GlScene {
  public:
-  explicit GlScene(const Scene& scene);
+  explicit GlScene(const SceneData& scene);
   ~GlScene();
   GlScene(const GlScene&) = delete;
   GlScene& operator=(const GlScene&) = delete;
@@ -74,7 +74,7 @@ class GlScene {
   void upload_lights(const glm::dvec3& center);
   Target& target(int width, int height, bool distance_pass);
 
-  const Scene& scene_;
+  const SceneData& scene_;
   GLuint vao_ = 0, vbo_ = 0, materials_ = 0, lights_ = 0;
   GLuint shadow_maps_ = 0, environment_ = 0, lookup_fbo_ = 0, lookup_depth_ = 0;
   int shadow_n_ = 0;

@@ -23,7 +23,7 @@ double percentile(std::vector<double>& v, double q) {
 }
 
 // Local Phong of a camera A-buffer fragment at the point it stands for (shading.hpp).
-PixelShader local_phong_shader(const Scene& scene, const ABuffer& buffer) {
+PixelShader local_phong_shader(const SceneData& scene, const ABuffer& buffer) {
   return [&scene, &buffer](const Fragment& f, int x, int y) {
     const Material& m = scene.materials[scene.triangles.material_id[f.triangle()]];
     const glm::dvec3 p = fragment_point(buffer, scene.triangles, f, x, y);
@@ -34,13 +34,13 @@ PixelShader local_phong_shader(const Scene& scene, const ABuffer& buffer) {
 
 // A pixel whose colour is one surface's alone: its front fragment covers all 32 samples,
 // is opaque, and no fragment behind it reaches into its depth range.
-bool interior_pixel(const Scene& scene, const FragmentList& list) {
+bool interior_pixel(const SceneData& scene, const FragmentList& list) {
   if (list.empty() || list[0].mask != FULL_MASK) return false;
   if (scene.materials[scene.triangles.material_id[list[0].triangle()]].opacity < 1.0) return false;
   return list.size() < 2 || list[1].zmin >= list[0].zmax;
 }
 
-void compare_cube(const Scene& scene, int n, int threads, GlScene& gl, CrosscheckResult* r) {
+void compare_cube(const SceneData& scene, int n, int threads, GlScene& gl, CrosscheckResult* r) {
   CubeImage gpu;
   CubeIds gpu_ids;
   const double before = gl.timings().cube_distance_ms;
@@ -80,7 +80,7 @@ void compare_cube(const Scene& scene, int n, int threads, GlScene& gl, Crosschec
   }
 }
 
-void compare_camera(const Scene& scene, int threads, GlScene& gl, CrosscheckResult* r) {
+void compare_camera(const SceneData& scene, int threads, GlScene& gl, CrosscheckResult* r) {
   const Image gpu = gl.camera_color(scene.camera);
   ABufferOptions options;
   options.threads = threads;
@@ -108,7 +108,7 @@ void compare_camera(const Scene& scene, int threads, GlScene& gl, CrosscheckResu
 
 }  // namespace
 
-CrosscheckResult crosscheck(const Scene& scene, int n, int threads, const CrosscheckTolerances& tol) {
+CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const CrosscheckTolerances& tol) {
   CrosscheckResult r;
   GlScene gl(scene);
   compare_cube(scene, n, threads, gl, &r);
@@ -145,7 +145,7 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
       {"failures", r.failures}};
 }
 
-Image render_abuffer_local(const Scene& scene, const ABufferOptions& options, nlohmann::json* stats) {
+Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options, nlohmann::json* stats) {
   ABufferStats s;
   Clock::time_point t0 = Clock::now();
   const ABuffer camera = build_camera_abuffer(scene, options, &s);

@@ -8,7 +8,7 @@
 
 #include "raster/abuffer.hpp"
 #include "gl/gl_passes.hpp"
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 namespace abcube {
 
@@ -47,12 +47,12 @@ struct CrosscheckResult {
 };
 
 // Runs both paths on `scene` (a GL context must be current) with n x n faces.
-CrosscheckResult crosscheck(const Scene& scene, int n, int threads, const CrosscheckTolerances& tol = {});
+CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const CrosscheckTolerances& tol = {});
 
 nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolerances& tol);
 
 // The camera view through the CPU A-buffer with local Phong (no searches yet).
 // Options: threads, layer cap, memory budget (abuffer.hpp).
-Image render_abuffer_local(const Scene& scene, const ABufferOptions& options, nlohmann::json* stats);
+Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options, nlohmann::json* stats);
 
 }  // namespace abcube

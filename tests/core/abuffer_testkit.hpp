@@ -9,21 +9,21 @@
 #include <glm/glm.hpp>
 
 #include "raster/abuffer.hpp"
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 // Scene builders, defined in test_raytrace.cpp.
 namespace abcube::testkit {
-Scene empty_scene(const glm::dvec3& eye, const glm::dvec3& look_at, double fov_y_deg, int width, int height);
-uint32_t add_material(Scene& s, const Material& m);
+SceneData empty_scene(const glm::dvec3& eye, const glm::dvec3& look_at, double fov_y_deg, int width, int height);
+uint32_t add_material(SceneData& s, const Material& m);
 Material emissive(const glm::dvec3& color);
-uint32_t begin_object(Scene& s, const std::string& type, uint32_t material, bool closed);
-void add_triangle(Scene& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& na,
+uint32_t begin_object(SceneData& s, const std::string& type, uint32_t material, bool closed);
+void add_triangle(SceneData& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& na,
                   const glm::dvec3& nb, const glm::dvec3& nc);
-void add_flat_triangle(Scene& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
-uint32_t add_quad(Scene& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& d,
+void add_flat_triangle(SceneData& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
+uint32_t add_quad(SceneData& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& d,
                   uint32_t material);
-uint32_t add_box(Scene& s, const glm::dvec3& lo, const glm::dvec3& hi, uint32_t material);
-uint32_t add_sphere(Scene& s, const glm::dvec3& center, double radius, int segments, uint32_t material);
+uint32_t add_box(SceneData& s, const glm::dvec3& lo, const glm::dvec3& hi, uint32_t material);
+uint32_t add_sphere(SceneData& s, const glm::dvec3& center, double radius, int segments, uint32_t material);
 }  // namespace abcube::testkit
 
 namespace abcube::abtest {

@@ -27,16 +27,16 @@ using glm::dvec3;
 using namespace testkit;
 using namespace abtest;
 
-Scene facing_camera(int w = 24, int h = 24) { return empty_scene({0, 0, 0}, {0, 0, -1}, 60, w, h); }
+SceneData facing_camera(int w = 24, int h = 24) { return empty_scene({0, 0, 0}, {0, 0, -1}, 60, w, h); }
 
 // Quad in the plane z = -depth, corners (+-half, +-half), wound to face the camera (+z).
-uint32_t add_square(Scene& s, double depth, double half, uint32_t material) {
+uint32_t add_square(SceneData& s, double depth, double half, uint32_t material) {
   return add_quad(s, {-half, -half, -depth}, {half, -half, -depth}, {half, half, -depth}, {-half, half, -depth},
                   material);
 }
 
 TEST(ABuffer, ListsRunFrontToBackWithEveryLayer) {
-  Scene s = facing_camera();
+  SceneData s = facing_camera();
   const uint32_t m = add_material(s, Material{});
   for (double depth : {5.0, 2.0, 3.5}) add_square(s, depth, 10.0, m);
   const ABuffer b = build_camera_abuffer(s, test_options(true));
@@ -61,7 +61,7 @@ TEST(ABuffer, ListsRunFrontToBackWithEveryLayer) {
 // Two triangles sharing the diagonal of a square: the pixels along the diagonal hold two
 // fragments without merging and one with it, whose fields follow the merge rule.
 TEST(ABuffer, MergeJoinsOneSurfaceAcrossItsSharedEdge) {
-  Scene s = facing_camera();
+  SceneData s = facing_camera();
   add_square(s, 3.0, 0.8, add_material(s, Material{}));
   const ABuffer raw = build_camera_abuffer(s, test_options(false));
   const ABuffer merged = build_camera_abuffer(s, test_options(true));
@@ -89,7 +89,7 @@ TEST(ABuffer, MergeJoinsOneSurfaceAcrossItsSharedEdge) {
 
 // What must not merge: other objects, other materials, other facing, separate depths.
 TEST(ABuffer, MergeNeedsSameObjectMaterialFacingAndDepth) {
-  const auto diagonal_pixels_with_two = [](const Scene& s) {
+  const auto diagonal_pixels_with_two = [](const SceneData& s) {
     const ABuffer b = build_camera_abuffer(s, test_options(true));
     int two = 0;
     for (int y = 0; y < b.height(); ++y) {
@@ -98,17 +98,17 @@ TEST(ABuffer, MergeNeedsSameObjectMaterialFacingAndDepth) {
     return two;
   };
   const dvec3 a(-0.8, -0.8, -3), b(0.8, -0.8, -3), c(0.8, 0.8, -3), d(-0.8, 0.8, -3);
-  Scene base = facing_camera();
+  SceneData base = facing_camera();
   const uint32_t m0 = add_material(base, Material{}), m1 = add_material(base, Material{});
   {
-    Scene s = base;  // same object, same material: merges
+    SceneData s = base;  // same object, same material: merges
     begin_object(s, "mesh", m0, false);
     add_flat_triangle(s, a, b, c);
     add_flat_triangle(s, a, c, d);
     EXPECT_EQ(diagonal_pixels_with_two(s), 0);
   }
   {
-    Scene s = base;  // two objects
+    SceneData s = base;  // two objects
     begin_object(s, "t", m0, false);
     add_flat_triangle(s, a, b, c);
     begin_object(s, "t", m0, false);
@@ -116,7 +116,7 @@ TEST(ABuffer, MergeNeedsSameObjectMaterialFacingAndDepth) {
     EXPECT_GE(diagonal_pixels_with_two(s), 8);
   }
   {
-    Scene s = base;  // one object, two materials
+    SceneData s = base;  // one object, two materials
     begin_object(s, "mesh", m0, false);
     add_flat_triangle(s, a, b, c);
     add_flat_triangle(s, a, c, d);
@@ -124,14 +124,14 @@ TEST(ABuffer, MergeNeedsSameObjectMaterialFacingAndDepth) {
     EXPECT_GE(diagonal_pixels_with_two(s), 8);
   }
   {
-    Scene s = base;  // one object, the second triangle wound backwards (a back face)
+    SceneData s = base;  // one object, the second triangle wound backwards (a back face)
     begin_object(s, "mesh", m0, false);
     add_flat_triangle(s, a, b, c);
     add_flat_triangle(s, a, d, c);
     EXPECT_GE(diagonal_pixels_with_two(s), 8);
   }
   {
-    Scene s = base;  // one object, same facing, disjoint depths: two layers everywhere
+    SceneData s = base;  // one object, same facing, disjoint depths: two layers everywhere
     begin_object(s, "mesh", m0, false);
     add_flat_triangle(s, a, b, c);
     add_flat_triangle(s, 2.0 * a, 2.0 * b, 2.0 * c);  // the same projection, twice as far
@@ -149,7 +149,7 @@ TEST(ABuffer, MergeNeedsSameObjectMaterialFacingAndDepth) {
 }
 
 TEST(ABuffer, FrontAndBackFacesOfAClosedBoxAreBothKept) {
-  Scene s = facing_camera();
+  SceneData s = facing_camera();
   add_box(s, {-0.5, -0.5, -4}, {0.5, 0.5, -3}, add_material(s, Material{}));
   const ABuffer b = build_camera_abuffer(s, test_options(true));
   const FragmentList l = b.list(12, 12);  // straight through the box
@@ -166,7 +166,7 @@ TEST(ABuffer, EachDirectionLandsInItsCubeTexel) {
   const int n = 16;
   for (const dvec3& d : {dvec3(0.3, 0.2, 1), dvec3(-1, 0.1, -0.4), dvec3(0.2, -1, 0.6), dvec3(0.1, 0.7, -1),
                          dvec3(0.6, 1, 0.2), dvec3(1, -0.3, 0.5)}) {
-    Scene s = facing_camera();
+    SceneData s = facing_camera();
     add_material(s, Material{});
     begin_object(s, "dot", 0, false);
     const dvec3 p = 5.0 * glm::normalize(d);
@@ -190,7 +190,7 @@ TEST(ABuffer, EachDirectionLandsInItsCubeTexel) {
 // Thesis fig. 11.3: where the red triangle is in front as seen from the centre, the green
 // triangle it hides is still in the list, behind it. (hidden_point.json: 0 mirror, 1 red, 2 green)
 TEST(ABuffer, HiddenGreenTriangleStaysBehindTheRedOne) {
-  const Scene s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/hidden_point.json");
+  const SceneData s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/hidden_point.json");
   ASSERT_EQ(s.objects.size(), 3u);
   const int n = 96;
   const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, n, test_options(true));
@@ -218,7 +218,7 @@ TEST(ABuffer, HiddenGreenTriangleStaysBehindTheRedOne) {
 }
 
 TEST(ABuffer, BytesAreIdenticalForAnyThreadCount) {
-  Scene s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/default.json");
+  SceneData s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/default.json");
   s.camera.width = 64;
   s.camera.height = 48;
   const auto same = [](const ABuffer& a, const ABuffer& b) {
@@ -237,7 +237,7 @@ TEST(ABuffer, BytesAreIdenticalForAnyThreadCount) {
 }
 
 TEST(ABuffer, StatsCountWhatIsStored) {
-  Scene s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/default.json");
+  SceneData s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/default.json");
   ABufferStats st;
   const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, 32, test_options(true), &st);
   EXPECT_EQ(st.bytes_per_fragment, 20u);
@@ -265,7 +265,7 @@ TEST(ABuffer, StatsCountWhatIsStored) {
 }
 
 TEST(ABuffer, RefusesAboveTheMemoryBudgetWithTheEstimate) {
-  const Scene s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/default.json");
+  const SceneData s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/default.json");
   ABufferOptions o = test_options(true);
   ABufferStats st;
   build_cube_abuffer(s, s.camera.position, 64, o, &st);
@@ -287,7 +287,7 @@ TEST(ABuffer, RefusesAboveTheMemoryBudgetWithTheEstimate) {
 }
 
 TEST(ABuffer, LayerCapKeepsTheFrontAndCountsTheRest) {
-  Scene s = facing_camera(16, 16);
+  SceneData s = facing_camera(16, 16);
   for (int i = 0; i < 5; ++i) add_square(s, 2.0 + i, 10.0, add_material(s, Material{}));
   ABufferOptions o = test_options(true);
   o.max_layers = 2;
@@ -308,7 +308,7 @@ TEST(ABuffer, LayerCapKeepsTheFrontAndCountsTheRest) {
 // What a one-layer distance prepass holds at texel centres: the plane z = 2 in front of
 // face +Z gives 2 |d| / d.z, its object id, and nothing elsewhere.
 TEST(ABuffer, NearestLayerIsThePrepassAtTexelCentres) {
-  Scene s = facing_camera();
+  SceneData s = facing_camera();
   const uint32_t m = add_material(s, Material{});
   add_square(s, 9.0, 1.0, m);  // far, behind the next one
   add_quad(s, {-5, -5, 2}, {5, -5, 2}, {5, 5, 2}, {-5, 5, 2}, m);
@@ -340,7 +340,7 @@ TEST(ABuffer, NearestLayerIsThePrepassAtTexelCentres) {
 // edge passes between the centre and the four centre samples, or where the hit triangle
 // is a sliver between samples (no fragment), may differ: at most 5% of them.
 TEST(ABuffer, NearestLayerMatchesTheExactTracer) {
-  const Scene s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/default.json");
+  const SceneData s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/default.json");
   const RayTracer tracer(s);
   const int n = 32;
   const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, n, test_options(false));
@@ -374,7 +374,7 @@ TEST(ABuffer, NearestLayerMatchesTheExactTracer) {
 // the fragments stay separate, each with its own normal; along a flat shared edge they
 // still merge (MergeJoinsOneSurfaceAcrossItsSharedEdge).
 TEST(ABuffer, CreaseKeepsItsTwoFaces) {
-  Scene s = facing_camera();
+  SceneData s = facing_camera();
   const uint32_t m = add_material(s, Material{});
   begin_object(s, "crease", m, false);
   // A roof ridge along x at y = 0.03 (inside a pixel row, not on a pixel border), z = -2.5,

@@ -51,7 +51,7 @@ TEST(Fresnel, GrazingAndReciprocity) {
 // The tracer follows the option: through a glass sheet (y = 0) the transmitted ray sees the
 // red background, the reflected one a green ceiling (y = 5, ambient only). Off: no green.
 // On: green = F kt, red = (1 - F) kt, with F from Schlick at the incidence angle.
-void add_quad(Scene& s, float y, uint32_t material, bool facing_down) {
+void add_quad(SceneData& s, float y, uint32_t material, bool facing_down) {
   SceneObject o;
   o.type = "quad";
   o.first_triangle = static_cast<uint32_t>(s.triangles.triangle_count());
@@ -70,7 +70,7 @@ void add_quad(Scene& s, float y, uint32_t material, bool facing_down) {
 }
 
 TEST(Fresnel, TracerUsesTheWeights) {
-  Scene s;
+  SceneData s;
   s.background = glm::dvec3(1, 0, 0);
   s.ambient = glm::dvec3(1);
   Material g = glass();
@@ -86,7 +86,7 @@ TEST(Fresnel, TracerUsesTheWeights) {
   add_quad(s, 5.f, 1, true);
   const glm::dvec3 origin(0, 1, 0), d = glm::normalize(glm::dvec3(1, -0.3, 0));
   const glm::dvec3 c_off = RayTracer(s).trace(origin, d, 0);
-  Scene s2 = s;
+  SceneData s2 = s;
   s2.render.fresnel = true;
   const glm::dvec3 c_on = RayTracer(s2).trace(origin, d, 0);
   const double cos_i = 0.3 / std::sqrt(1.09), f0 = 0.04;

@@ -15,13 +15,13 @@
 
 // Scene builders, defined in test_raytrace.cpp.
 namespace abcube::testkit {
-Scene empty_scene(const glm::dvec3& eye, const glm::dvec3& look_at, double fov_y_deg, int width, int height);
-uint32_t add_material(Scene& s, const Material& m);
-uint32_t begin_object(Scene& s, const std::string& type, uint32_t material, bool closed);
-void add_triangle(Scene& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& na,
+SceneData empty_scene(const glm::dvec3& eye, const glm::dvec3& look_at, double fov_y_deg, int width, int height);
+uint32_t add_material(SceneData& s, const Material& m);
+uint32_t begin_object(SceneData& s, const std::string& type, uint32_t material, bool closed);
+void add_triangle(SceneData& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& na,
                   const glm::dvec3& nb, const glm::dvec3& nc);
-uint32_t add_box(Scene& s, const glm::dvec3& lo, const glm::dvec3& hi, uint32_t material);
-uint32_t add_sphere(Scene& s, const glm::dvec3& center, double radius, int segments, uint32_t material);
+uint32_t add_box(SceneData& s, const glm::dvec3& lo, const glm::dvec3& hi, uint32_t material);
+uint32_t add_sphere(SceneData& s, const glm::dvec3& center, double radius, int segments, uint32_t material);
 }  // namespace abcube::testkit
 
 namespace abcube {
@@ -60,9 +60,9 @@ LensPlacement tilted_placement() {
   return pl;
 }
 
-Scene lens_scene() { return empty_scene({0, 0, 10}, {0, 0, 0}, 40, 8, 8); }
+SceneData lens_scene() { return empty_scene({0, 0, 10}, {0, 0, 0}, 40, 8, 8); }
 
-uint32_t glass(Scene& s, double ior) {
+uint32_t glass(SceneData& s, double ior) {
   Material m;
   m.transmit = 1;
   m.diffuse = 0;
@@ -72,7 +72,7 @@ uint32_t glass(Scene& s, double ior) {
 
 // Polar grid on both faces, `rings` rings and `segments` segments, outward winding, the
 // faces' exact normals at the corners. Rim corners are computed once, so the mesh is closed.
-uint32_t add_lens(Scene& s, const LensShape& shape, const LensPlacement& pl, int rings, int segments,
+uint32_t add_lens(SceneData& s, const LensShape& shape, const LensPlacement& pl, int rings, int segments,
                   uint32_t material) {
   const uint32_t id = begin_object(s, "mesh", material, true);
   auto corner = [&](int face, int ring, int seg, dvec3* p, dvec3* n) {
@@ -199,7 +199,7 @@ TEST(LensMatrix, Equation14AndThinLimit) {
 // A biconvex lens R1 = 2, R2 = 3 (a = 1.2) tilted in space: rho1 = 1/R1, rho2 = -1/R2,
 // d = sag1 + sag2, the axis and the vertices where they are.
 TEST(LensFit, BiconvexRecoversCurvaturesAndThickness) {
-  Scene s = lens_scene();
+  SceneData s = lens_scene();
   const LensShape shape{1.0 / 2.0, 1.0 / 3.0, 1.2};
   const LensPlacement pl = tilted_placement();
   add_lens(s, shape, pl, 64, 128, glass(s, 1.5));
@@ -226,7 +226,7 @@ TEST(LensFit, BiconvexRecoversCurvaturesAndThickness) {
 // words read literally (points below the plane) put the curved face's rim into the flat
 // face's fit; the facing split does not.
 TEST(LensFit, PlanoConvexHasFlatBack) {
-  Scene s = lens_scene();
+  SceneData s = lens_scene();
   const LensShape shape{1.0 / 2.0, 0.0, 1.2};
   const LensPlacement pl = tilted_placement();
   add_lens(s, shape, pl, 64, 128, glass(s, 1.5));
@@ -251,7 +251,7 @@ TEST(LensFit, PlanoConvexHasFlatBack) {
 // The project's lat-long sphere: rho1 = 1/r, rho2 = -1/r, d = 2r, whatever axis the
 // (nearly isotropic) spread picks.
 TEST(LensFit, SphereIsALensOfEqualRadii) {
-  Scene s = lens_scene();
+  SceneData s = lens_scene();
   const dvec3 c(0.3, -1.1, 0.8);
   const double r = 0.75;
   add_sphere(s, c, r, 96, glass(s, 1.5));
@@ -269,7 +269,7 @@ TEST(LensFit, SphereIsALensOfEqualRadii) {
 // largest spread, its normal the optical axis. A 4 x 0.2 x 2 box: normal y, u_axis x, and
 // flat faces 0.2 apart.
 TEST(LensFit, PrincipalPlaneIsThePlaneOfLargestSpread) {
-  Scene s = lens_scene();
+  SceneData s = lens_scene();
   const LensPlacement pl = tilted_placement();
   add_lens(s, LensShape{0.1, 0.1, 1.0}, pl, 32, 64, glass(s, 1.5));
   add_box(s, dvec3(-2, -0.1, -1), dvec3(2, 0.1, 1), s.objects[0].material);
@@ -293,7 +293,7 @@ TEST(LensFit, PrincipalPlaneIsThePlaneOfLargestSpread) {
 // fit_lenses takes the objects whose material transmits, valid or not; an open one is
 // invalid with the reason.
 TEST(LensFit, FitsTransparentObjectsAndNamesWhatIsNotALens) {
-  Scene s = lens_scene();
+  SceneData s = lens_scene();
   const uint32_t opaque = add_material(s, Material{});
   const uint32_t glass_mat = glass(s, 1.5);
   add_box(s, dvec3(-3, -3, -3), dvec3(-2, -2, -2), opaque);
@@ -333,7 +333,7 @@ TEST(LensTransfer, ParaxialFocusMatchesLensmakerAndThickLensFormulas) {
   const double nu = 1.5;
   for (const bool from_top : {true, false}) {
     // Thin lens R1 = 8, R2 = 12, a = 1: f = 1 / ((nu-1)(rho1 - rho2)) = 9.6 from either side.
-    Scene thin = lens_scene();
+    SceneData thin = lens_scene();
     const LensShape thin_shape{1.0 / 8.0, 1.0 / 12.0, 1.0};
     const LensPlacement pl = tilted_placement();
     add_lens(thin, thin_shape, pl, 48, 96, glass(thin, nu));
@@ -350,7 +350,7 @@ TEST(LensTransfer, ParaxialFocusMatchesLensmakerAndThickLensFormulas) {
     }
 
     // Thick lens R1 = 2, R2 = 3, a = 1.2 (d = 0.65): the mirrored lens from below.
-    Scene thick = lens_scene();
+    SceneData thick = lens_scene();
     const LensShape shape{1.0 / 2.0, 1.0 / 3.0, 1.2};
     add_lens(thick, shape, pl, 64, 128, glass(thick, nu));
     const LensFit f = fit_lens(thick, 0);
@@ -434,7 +434,7 @@ TEST(LensTransfer, AgainstExactTracer) {
   const double heights[] = {0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9};
   const LensPlacement pl = tilted_placement();
   for (const Case& c : cases) {
-    Scene s = lens_scene();
+    SceneData s = lens_scene();
     add_lens(s, c.shape, pl, 64, 128, glass(s, 1.5));
     const LensFit f = fit_lens(s, 0);
     ASSERT_TRUE(f.valid) << f.why_invalid;

@@ -15,8 +15,8 @@
 namespace abcube {
 namespace {
 
-Scene small_scene(const char* name, int width, int cube_n) {
-  Scene s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/" + name);
+SceneData small_scene(const char* name, int width, int cube_n) {
+  SceneData s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/" + name);
   const double aspect = static_cast<double>(s.camera.width) / s.camera.height;
   s.camera.width = width;
   s.camera.height = static_cast<int>(width / aspect + 0.5);
@@ -29,7 +29,7 @@ struct Rendered {
   MapShadingStats stats;
 };
 
-Rendered render_method(const Scene& s, Method method, const RayTracer* reference = nullptr,
+Rendered render_method(const SceneData& s, Method method, const RayTracer* reference = nullptr,
                        SearchMode mode = SearchMode::crossing, SearchRefine refine = SearchRefine::mesh) {
   const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, s.render.cube_resolution);
   MapShadingOptions o;
@@ -48,7 +48,7 @@ Rendered render_method(const Scene& s, Method method, const RayTracer* reference
 // shows green and the one-layer Z-buffered map does not. The pixel set comes from the
 // exact tracer's geometry; only pixels whose 3x3 neighbourhood is in the set are judged.
 TEST(MapShading, HiddenPointIsFoundOnlyWithAllLayers) {
-  const Scene s = small_scene("hidden_point.json", 192, 256);
+  const SceneData s = small_scene("hidden_point.json", 192, 256);
   const RayTracer rt(s);
   uint32_t green = UINT32_MAX, mirror = UINT32_MAX;
   for (uint32_t o = 0; o < s.objects.size(); ++o) {
@@ -116,7 +116,7 @@ class MethodsAgainstReference : public ::testing::TestWithParam<MethodCase> {};
 
 TEST_P(MethodsAgainstReference, AbufferIsClosestToTheExactImage) {
   const MethodCase& c = GetParam();
-  const Scene s = small_scene(c.scene, c.width, 256);
+  const SceneData s = small_scene(c.scene, c.width, 256);
   const RayTracer rt(s);
   const Image ref = render_raytrace(s);
   const Rendered ab = render_method(s, Method::abuffer, &rt);

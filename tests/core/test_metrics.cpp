@@ -149,7 +149,7 @@ TEST(Metrics, ErrorStatsAccumulates) {
 TEST(Metrics, ExactTracerHasZeroParallaxError) {
   // Reflect a camera ray off a mirror and find the true point Sigma with the exact tracer:
   // measured against itself, Error_Parallax is 0 to rounding (the later methods' yardstick).
-  Scene s;
+  SceneData s;
   s.materials.push_back(Material{});
   auto add_tri = [&](const dvec3& a, const dvec3& b, const dvec3& c) {
     const glm::vec3 n(glm::normalize(glm::cross(b - a, c - a)));

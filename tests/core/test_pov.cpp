@@ -28,13 +28,13 @@
 
 // Scene builders, defined in test_raytrace.cpp.
 namespace abcube::testkit {
-Scene empty_scene(const glm::dvec3& eye, const glm::dvec3& look_at, double fov_y_deg, int width, int height);
-uint32_t add_material(Scene& s, const Material& m);
+SceneData empty_scene(const glm::dvec3& eye, const glm::dvec3& look_at, double fov_y_deg, int width, int height);
+uint32_t add_material(SceneData& s, const Material& m);
 Material emissive(const glm::dvec3& color);
-uint32_t add_quad(Scene& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& d,
+uint32_t add_quad(SceneData& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& d,
                   uint32_t material);
-uint32_t add_box(Scene& s, const glm::dvec3& lo, const glm::dvec3& hi, uint32_t material);
-uint32_t add_sphere(Scene& s, const glm::dvec3& center, double radius, int segments, uint32_t material);
+uint32_t add_box(SceneData& s, const glm::dvec3& lo, const glm::dvec3& hi, uint32_t material);
+uint32_t add_sphere(SceneData& s, const glm::dvec3& center, double radius, int segments, uint32_t material);
 }  // namespace abcube::testkit
 
 namespace abcube {
@@ -130,7 +130,7 @@ double pov_trace_seconds(const std::string& log_path) {
 }
 
 // Renders the scene with POV-Ray at our 32 samples per pixel; returns the wall time.
-Image render_pov(const Scene& scene, const std::string& name, int threads, double* seconds) {
+Image render_pov(const SceneData& scene, const std::string& name, int threads, double* seconds) {
   const std::string dir = work_dir();
   {
     std::ofstream pov(dir + "/" + name + ".pov");
@@ -147,7 +147,7 @@ Image render_pov(const Scene& scene, const std::string& name, int threads, doubl
   return box_downsample(read_ppm(dir + "/" + name + ".ppm"));
 }
 
-Image render_ours(const Scene& scene, int threads, double* seconds, RaytraceStats* stats = nullptr) {
+Image render_ours(const SceneData& scene, int threads, double* seconds, RaytraceStats* stats = nullptr) {
   RaytraceOptions opt;
   opt.threads = threads;
   const Clock::time_point start = Clock::now();
@@ -172,7 +172,7 @@ std::string describe(const ImageError& e) {
 }
 
 TEST(Pov, ExportWritesTheSceneAsMesh2) {
-  Scene s = empty_scene({0, 1, 5}, {0, 0, 0}, 45, 64, 32);
+  SceneData s = empty_scene({0, 1, 5}, {0, 0, 0}, 45, 64, 32);
   s.render.max_depth = 3;
   PointLight shadowless;
   shadowless.position = {1, 2, 3};
@@ -201,7 +201,7 @@ TEST(Pov, ExportWritesTheSceneAsMesh2) {
 
 TEST(Pov, FlatColourRoundTrip) {
   if (!povray_available()) GTEST_SKIP() << "povray not on PATH";
-  Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 8, 8);
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 8, 8);
   s.ambient = dvec3(1.0);
   add_quad(s, {-9, -9, -2}, {9, -9, -2}, {9, 9, -2}, {-9, 9, -2}, add_material(s, emissive({0.2, 0.5, 0.8})));
   double t_pov = 0, t_ours = 0;
@@ -217,7 +217,7 @@ TEST(Pov, FlatColourRoundTrip) {
 TEST(Pov, ImageIsNotMirrored) {
   if (!povray_available()) GTEST_SKIP() << "povray not on PATH";
   // Red square upper left, green lower right, seen from a tilted camera off the axes.
-  Scene s = empty_scene({1, 2, 6}, {0, 0, 0}, 40, 48, 32);
+  SceneData s = empty_scene({1, 2, 6}, {0, 0, 0}, 40, 48, 32);
   s.camera.up = glm::normalize(dvec3(0.2, 1, 0));
   s.ambient = dvec3(1.0);
   s.background = {0, 0, 0.2};
@@ -246,8 +246,8 @@ TEST(Pov, ImageIsNotMirrored) {
 // Everything both tracers model identically: ambient + Lambert, mirrors, glass with
 // ka = kd = 0 and white Od, total internal reflection, hard shadows through opaque and
 // transmitting blockers, a veil (kt = ks = kr = 0), a shadowless light.
-Scene shared_model_scene(int w, int h) {
-  Scene s = empty_scene({0.5, 2.2, 5.5}, {0, 0.3, 0}, 45, w, h);
+SceneData shared_model_scene(int w, int h) {
+  SceneData s = empty_scene({0.5, 2.2, 5.5}, {0, 0.3, 0}, 45, w, h);
   s.ambient = dvec3(0.1);
   s.background = {0.05, 0.1, 0.2};
   s.render.max_depth = 5;
@@ -281,7 +281,7 @@ Scene shared_model_scene(int w, int h) {
 TEST(Pov, MatchesOurTracerOnTheSharedModel) {
   if (!povray_available()) GTEST_SKIP() << "povray not on PATH";
   const int w = 160, h = 120, threads = 2;
-  const Scene s = shared_model_scene(w, h);
+  const SceneData s = shared_model_scene(w, h);
   double t_pov = 0, t_ours = 0;
   RaytraceStats st;
   const Image pov = render_pov(s, "shared_model", threads, &t_pov);
@@ -303,7 +303,7 @@ TEST(Pov, MatchesOurTracerOnTheSharedModel) {
 
 // Keeps a loaded scene inside what both tracers model identically (pov_export.hpp):
 // no phong highlights; glass with ka = kd = 0 and white Od; veils without mirror terms.
-void restrict_to_shared_model(Scene* s) {
+void restrict_to_shared_model(SceneData* s) {
   for (Material& m : s->materials) {
     m.specular = 0.0;
     if (m.transmit > 0.0) {
@@ -324,7 +324,7 @@ TEST(Pov, RepositoryScenesMatchOnTheSharedModel) {
   std::sort(files.begin(), files.end());
   int compared = 0;
   for (const fs::path& file : files) {
-    Scene s = load_scene(file.string());
+    SceneData s = load_scene(file.string());
     restrict_to_shared_model(&s);
     const int w = POV_SCENE_WIDTH;
     s.camera.height = std::max(1, static_cast<int>(std::lround(static_cast<double>(w) * s.camera.height / s.camera.width)));

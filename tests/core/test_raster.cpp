@@ -60,7 +60,7 @@ TEST(Raster, ViewsFollowTheCubeAndCameraConventions) {
 
 // Star-shaped closed mesh around `c`: a sphere whose radius varies with direction (the same
 // function of each shared vertex, so the mesh stays closed).
-void add_bumpy_sphere(Scene& s, const dvec3& c, int segments, uint32_t material) {
+void add_bumpy_sphere(SceneData& s, const dvec3& c, int segments, uint32_t material) {
   const size_t first = s.triangles.positions.size();
   add_sphere(s, c, 1.0, segments, material);
   for (size_t i = first; i < s.triangles.positions.size(); ++i) {
@@ -89,7 +89,7 @@ void expect_each_sample_once(const ABuffer& b, const char* what) {
 }
 
 TEST(Raster, ClosedMeshesAroundTheCentreCoverEverySampleOnce) {
-  Scene s = empty_scene({0.05, 0.1, -0.02}, {0, 0, -1}, 90, 24, 20);
+  SceneData s = empty_scene({0.05, 0.1, -0.02}, {0, 0, -1}, 90, 24, 20);
   const uint32_t m = add_material(s, Material{});
   add_box(s, {-1.0, -0.7, -1.3}, {1.4, 0.9, 0.8}, m);
   add_sphere(s, {0.1, -0.05, 0.07}, 3.0, 24, m);
@@ -97,7 +97,7 @@ TEST(Raster, ClosedMeshesAroundTheCentreCoverEverySampleOnce) {
   const dvec3 centre = s.camera.position;
   // Each closed surface alone: one layer per sample, whatever the face and the clipping.
   for (uint32_t object = 0; object < 3; ++object) {
-    Scene one = s;
+    SceneData one = s;
     one.triangles = TriangleSoup{};
     for (size_t t = 0; t < s.triangles.triangle_count(); ++t) {
       if (s.triangles.object_id[t] != object) continue;
@@ -127,7 +127,7 @@ TEST(Raster, SharedEdgesThroughSamplesCoverEachSampleOnce) {
   const RasterView v = cube_face_view(POS_Z, dvec3(0.0), n, 1e-4);
   // Pixel point (x, y) of face +Z at distance 1: direction (x/4 - 1, 1 - y/4, 1), exact.
   const auto at = [&](double x, double y) { return v.direction(x, y); };
-  Scene s = empty_scene({0, 0, 0}, {0, 0, 1}, 60, 8, 8);
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, 1}, 60, 8, 8);
   const uint32_t m = add_material(s, Material{});
   begin_object(s, "grid", m, false);
   const double x0 = 1 + 1.0 / 16, y0 = 1 + 1.0 / 8, step_x = 5.0 / 8, step_y = 3.0 / 4;
@@ -173,7 +173,7 @@ TEST(Raster, SharedEdgesThroughSamplesCoverEachSampleOnce) {
 TEST(Raster, PixelMasksFollowThePerSampleRuleExactly) {
   std::mt19937 rng(19);
   std::uniform_real_distribution<double> u(-2.0, 2.0);
-  Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 8, 8);
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 8, 8);
   add_material(s, Material{});
   begin_object(s, "random", 0, false);
   for (int t = 0; t < 60; ++t) add_flat_triangle(s, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
@@ -212,10 +212,10 @@ TEST(Raster, PixelMasksFollowThePerSampleRuleExactly) {
 TEST(Raster, OneTriangleCoverageMatchesItsProjectedArea) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-0.7, 0.7), z(2.0, 6.0);
-  Scene base = empty_scene({0, 0, 0}, {0, 0, -1}, 70, 48, 40);
+  SceneData base = empty_scene({0, 0, 0}, {0, 0, -1}, 70, 48, 40);
   const uint32_t m = add_material(base, Material{});
   for (int trial = 0; trial < 12; ++trial) {
-    Scene s = base;
+    SceneData s = base;
     begin_object(s, "triangle", m, false);
     std::array<dvec3, 3> p;
     for (dvec3& q : p) q = dvec3(u(rng), u(rng), -1.0) * z(rng);
@@ -248,7 +248,7 @@ TEST(Raster, OneTriangleCoverageMatchesItsProjectedArea) {
 // gives them in closed form; and for random triangles they bracket the exact distance at
 // every covered texel centre (what the GPU prepass stores).
 TEST(Raster, DistanceRangeIsTheClippedPolygonsRange) {
-  Scene s = empty_scene({0, 0, 0}, {0, 0, 1}, 60, 8, 8);
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, 1}, 60, 8, 8);
   const uint32_t m = add_material(s, Material{});
   add_quad(s, {-5, -5, 2}, {5, -5, 2}, {5, 5, 2}, {-5, 5, 2}, m);
   const int n = 15;  // odd: the foot is inside texel (7, 7), so nearest points lie on texel edges
@@ -278,7 +278,7 @@ TEST(Raster, DistanceRangeIsTheClippedPolygonsRange) {
 
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-3.0, 3.0);
-  Scene r = empty_scene({0, 0, 0}, {0, 0, 1}, 60, 8, 8);
+  SceneData r = empty_scene({0, 0, 0}, {0, 0, 1}, 60, 8, 8);
   add_material(r, Material{});
   begin_object(r, "random", 0, false);
   for (int t = 0; t < 40; ++t) add_flat_triangle(r, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
@@ -316,7 +316,7 @@ TEST(Raster, DistanceRangeIsTheClippedPolygonsRange) {
 // A triangle cut by a (deliberately large) near plane: a sample is covered iff its ray
 // meets the triangle at w >= near.
 TEST(Raster, NearPlaneCutsTheTriangleWhereItIsNearer) {
-  Scene s = empty_scene({0, 0, 0}, {0, 0, 1}, 60, 8, 8);
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, 1}, 60, 8, 8);
   add_material(s, Material{});
   begin_object(s, "slanted", 0, false);
   // Plane y = z/2 - 0.1, passing 0.09 from the centre: its part with w = z < 0.5 is on face +Z.
@@ -356,7 +356,7 @@ TEST(Raster, NearPlaneCutsTheTriangleWhereItIsNearer) {
 }
 
 TEST(Raster, NormalIsPerspectiveCorrectAtTheCoveredCentroid) {
-  Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 16, 16);
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 16, 16);
   add_material(s, Material{});
   begin_object(s, "tilted", 0, false);
   const dvec3 a(-2, -2, -2), b(3, -2, -8), c(-2, 3, -3);
@@ -396,7 +396,7 @@ TEST(Raster, OctahedralNormalsRoundTrip) {
 }
 
 TEST(Raster, DegenerateTrianglesAreCountedNotRasterised) {
-  Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 16, 16);
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 16, 16);
   add_material(s, Material{});
   begin_object(s, "junk", 0, false);
   const double nan = std::nan("");

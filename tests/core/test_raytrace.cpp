@@ -23,8 +23,8 @@ namespace abcube::testkit {
 
 using glm::dvec3;
 
-Scene empty_scene(const dvec3& eye, const dvec3& look_at, double fov_y_deg, int width, int height) {
-  Scene s;
+SceneData empty_scene(const dvec3& eye, const dvec3& look_at, double fov_y_deg, int width, int height) {
+  SceneData s;
   s.file = "(test scene)";
   s.camera.position = eye;
   s.camera.look_at = look_at;
@@ -39,7 +39,7 @@ Scene empty_scene(const dvec3& eye, const dvec3& look_at, double fov_y_deg, int 
   return s;
 }
 
-uint32_t add_material(Scene& s, const Material& m) {
+uint32_t add_material(SceneData& s, const Material& m) {
   s.materials.push_back(m);
   if (s.materials.back().name.empty()) s.materials.back().name = "m" + std::to_string(s.materials.size() - 1);
   return static_cast<uint32_t>(s.materials.size() - 1);
@@ -54,7 +54,7 @@ Material emissive(const dvec3& color) {
   return m;
 }
 
-uint32_t begin_object(Scene& s, const std::string& type, uint32_t material, bool closed) {
+uint32_t begin_object(SceneData& s, const std::string& type, uint32_t material, bool closed) {
   SceneObject o;
   o.type = type;
   o.path = "objects[" + std::to_string(s.objects.size()) + "]";
@@ -66,7 +66,7 @@ uint32_t begin_object(Scene& s, const std::string& type, uint32_t material, bool
 }
 
 // Appends a triangle with corner normals to the last object begun.
-void add_triangle(Scene& s, const dvec3& a, const dvec3& b, const dvec3& c, const dvec3& na, const dvec3& nb,
+void add_triangle(SceneData& s, const dvec3& a, const dvec3& b, const dvec3& c, const dvec3& na, const dvec3& nb,
                   const dvec3& nc) {
   TriangleSoup& t = s.triangles;
   for (const dvec3& p : {a, b, c}) t.positions.emplace_back(p);
@@ -76,13 +76,13 @@ void add_triangle(Scene& s, const dvec3& a, const dvec3& b, const dvec3& c, cons
   ++s.objects.back().triangle_count;
 }
 
-void add_flat_triangle(Scene& s, const dvec3& a, const dvec3& b, const dvec3& c) {
+void add_flat_triangle(SceneData& s, const dvec3& a, const dvec3& b, const dvec3& c) {
   const dvec3 n = glm::normalize(glm::cross(b - a, c - a));
   add_triangle(s, a, b, c, n, n, n);
 }
 
 // A flat triangle wound so that its geometric normal points along `outward`.
-void add_oriented(Scene& s, const dvec3& a, const dvec3& b, const dvec3& c, const dvec3& outward) {
+void add_oriented(SceneData& s, const dvec3& a, const dvec3& b, const dvec3& c, const dvec3& outward) {
   if (glm::dot(glm::cross(b - a, c - a), outward) >= 0) {
     add_flat_triangle(s, a, b, c);
   } else {
@@ -90,7 +90,7 @@ void add_oriented(Scene& s, const dvec3& a, const dvec3& b, const dvec3& c, cons
   }
 }
 
-uint32_t add_quad(Scene& s, const dvec3& a, const dvec3& b, const dvec3& c, const dvec3& d, uint32_t material) {
+uint32_t add_quad(SceneData& s, const dvec3& a, const dvec3& b, const dvec3& c, const dvec3& d, uint32_t material) {
   const uint32_t id = begin_object(s, "quad", material, false);
   add_flat_triangle(s, a, b, c);
   add_flat_triangle(s, a, c, d);
@@ -98,7 +98,7 @@ uint32_t add_quad(Scene& s, const dvec3& a, const dvec3& b, const dvec3& c, cons
 }
 
 // Closed axis-aligned box, outward winding, flat normals.
-uint32_t add_box(Scene& s, const dvec3& lo, const dvec3& hi, uint32_t material) {
+uint32_t add_box(SceneData& s, const dvec3& lo, const dvec3& hi, uint32_t material) {
   const uint32_t id = begin_object(s, "box", material, true);
   for (int axis = 0; axis < 3; ++axis) {
     const int u = (axis + 1) % 3, v = (axis + 2) % 3;
@@ -121,7 +121,7 @@ uint32_t add_box(Scene& s, const dvec3& lo, const dvec3& hi, uint32_t material) 
 
 // Latitude-longitude sphere (poles on y), segments/2 bands, smooth normals, outward winding;
 // shared vertices are computed once so the mesh is closed exactly.
-uint32_t add_sphere(Scene& s, const dvec3& center, double radius, int segments, uint32_t material) {
+uint32_t add_sphere(SceneData& s, const dvec3& center, double radius, int segments, uint32_t material) {
   const uint32_t id = begin_object(s, "sphere", material, true);
   const int rings = segments / 2;
   const double pi = 3.14159265358979323846;
@@ -192,7 +192,7 @@ void save_failure(const std::string& name, const Image& actual, const Image& exp
 TEST(Raytrace, BvhMatchesBruteForce) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Scene s = empty_scene({0, 0, 5}, {0, 0, 0}, 60, 8, 8);
+  SceneData s = empty_scene({0, 0, 5}, {0, 0, 0}, 60, 8, 8);
   const uint32_t mat = add_material(s, Material{});
   begin_object(s, "mesh", mat, false);
   for (int i = 0; i < 3000; ++i) {
@@ -233,7 +233,7 @@ TEST(Raytrace, BvhMatchesBruteForce) {
 }
 
 TEST(Raytrace, WatertightClosedSphere) {
-  Scene s = empty_scene({0, 0, 5}, {0, 0, 0}, 60, 8, 8);
+  SceneData s = empty_scene({0, 0, 5}, {0, 0, 0}, 60, 8, 8);
   const dvec3 c(0.1, 0.2, 0.3);
   add_sphere(s, c, 1.0, 48, add_material(s, Material{}));
   const RayTracer tracer(s);
@@ -266,7 +266,7 @@ TEST(Raytrace, WatertightClosedSphere) {
 }
 
 TEST(Raytrace, HitCarriesExactGeometry) {
-  Scene s = empty_scene({0, 0, 5}, {0, 0, 0}, 60, 8, 8);
+  SceneData s = empty_scene({0, 0, 5}, {0, 0, 0}, 60, 8, 8);
   add_material(s, Material{});
   const uint32_t mat = add_material(s, Material{});
   const uint32_t obj = begin_object(s, "triangle", mat, false);
@@ -295,7 +295,7 @@ TEST(Raytrace, HitCarriesExactGeometry) {
 TEST(Raytrace, MirrorAt45SendsMarkerToComputedPixel) {
   // Camera at the origin looking down -z; a mirror in the plane x + z = -5 (45 degrees);
   // a red square at x = 3, out of the camera's view, seen only in the mirror.
-  Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 64, 64);
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 64, 64);
   s.ambient = dvec3(1.0);
   s.render.max_depth = 1;
   Material mirror;
@@ -343,7 +343,7 @@ TEST(Raytrace, GlassSlabShiftsRayLaterally) {
   const double ior = 1.5, d = 1.0, theta = 30.0 * PI / 180.0;
   const double theta_t = std::asin(std::sin(theta) / ior);
   const double expect_shift = d * std::sin(theta - theta_t) / std::cos(theta_t);
-  Scene s = empty_scene({0, 0, 3}, {0, 0, 0}, 60, 8, 8);
+  SceneData s = empty_scene({0, 0, 3}, {0, 0, 0}, 60, 8, 8);
   s.ambient = dvec3(1.0);
   Material glass;
   glass.color = dvec3(1.0);
@@ -389,7 +389,7 @@ TEST(Raytrace, GlassSlabShiftsRayLaterally) {
 
 TEST(Raytrace, TotalInternalReflectionBeyondCriticalAngle) {
   const double ior = 1.5, critical = std::asin(1.0 / ior);
-  Scene s = empty_scene({0, 0, 3}, {0, 0, 0}, 60, 8, 8);
+  SceneData s = empty_scene({0, 0, 3}, {0, 0, 0}, 60, 8, 8);
   s.ambient = dvec3(1.0);
   s.render.max_depth = 6;
   Material glass;
@@ -428,7 +428,7 @@ TEST(Raytrace, TotalInternalReflectionBeyondCriticalAngle) {
 
 TEST(Raytrace, SphereUnderPointLightIsLambert) {
   const dvec3 center(0, 0, -5), light_pos(5, 5, 0), od(0.8, 0.6, 0.4);
-  Scene s = empty_scene({0, 0, 0}, center, 30, 48, 48);
+  SceneData s = empty_scene({0, 0, 0}, center, 30, 48, 48);
   s.ambient = dvec3(0.1);
   PointLight l;
   l.position = light_pos;
@@ -468,7 +468,7 @@ TEST(Raytrace, SphereUnderPointLightIsLambert) {
 // Renders a floor lit from (0, 4, 0) with a square blocker at height 2; checks every pixel
 // against the similar-triangles shadow [-1, 1]^2 scaled by the blocker's transmittance.
 void check_shadow(const Material& blocker, const dvec3& shadow_factor, const std::string& name) {
-  Scene s = empty_scene({0, 6, 6}, {0, 0, 0}, 50, 64, 64);
+  SceneData s = empty_scene({0, 6, 6}, {0, 0, 0}, 50, 64, 64);
   s.ambient = dvec3(0.1);
   PointLight l;
   l.position = {0, 4, 0};
@@ -525,7 +525,7 @@ glm::dmat3 rotation(const dvec3& axis, double angle) {
 
 // Moves a whole scene rigidly; every shading value is unchanged, but the hit points no
 // longer have exactly representable coordinates.
-void move_scene(Scene& s, const glm::dmat3& rot, const dvec3& shift) {
+void move_scene(SceneData& s, const glm::dmat3& rot, const dvec3& shift) {
   for (glm::vec3& p : s.triangles.positions) p = glm::vec3(rot * dvec3(p) + shift);
   for (glm::vec3& n : s.triangles.normals) n = glm::vec3(rot * dvec3(n));
   s.camera.position = rot * s.camera.position + shift;
@@ -537,7 +537,7 @@ void move_scene(Scene& s, const glm::dmat3& rot, const dvec3& shift) {
 TEST(Raytrace, GrazingHitsDoNotSelfShadowOrSelfReflect) {
   // A floor seen and lit at grazing angles, moved off the axes: every floor pixel must get
   // the full Lambert term (no self-shadowing) and the background in its reflection.
-  Scene s = empty_scene({0, 0.01, 10}, {0, 0, -100}, 10, 64, 64);
+  SceneData s = empty_scene({0, 0.01, 10}, {0, 0, -100}, 10, 64, 64);
   s.ambient = dvec3(0.1);
   s.background = {0.2, 0.3, 0.4};
   PointLight l;
@@ -577,7 +577,7 @@ TEST(Raytrace, GrazingHitsDoNotSelfShadowOrSelfReflect) {
 TEST(Raytrace, DepthLimitTruncatesMirrorSeries) {
   // Two facing mirrors, a ray perpendicular to both: C = a (1 + kr + ... + kr^D).
   for (int depth : {0, 1, 2, 5}) {
-    Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 8, 8);
+    SceneData s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 8, 8);
     s.ambient = dvec3(0.2);
     s.render.max_depth = depth;
     Material m;
@@ -595,7 +595,7 @@ TEST(Raytrace, DepthLimitTruncatesMirrorSeries) {
 }
 
 TEST(Raytrace, OpacityBlendsWithWhatIsBehind) {
-  Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 8, 8);
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 8, 8);
   s.ambient = dvec3(1.0);
   s.render.max_depth = 0;  // the continuation does not consume depth
   Material veil = emissive({0, 0, 1});
@@ -616,7 +616,7 @@ TEST(Raytrace, SamplesAreTheABufferPositions) {
   // pixel column 5 has 6 of 8 sample columns inside (dx = (c + 0.5)/8 > 0.28), pixel
   // row 9 has 3 of 4 sample rows inside (dy = (r + 0.5)/4 > 0.3). Mirrored sample
   // positions would give 2/8 and 1/4.
-  Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 90, 16, 16);
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, -1}, 90, 16, 16);
   s.ambient = dvec3(1.0);
   const double left = 2.0 * 5.28 / 16 - 1.0, top = 1.0 - 2.0 * 9.3 / 16;  // at z = -1, tan = 1
   add_quad(s, {left, -5, -1}, {5, -5, -1}, {5, top, -1}, {left, top, -1}, add_material(s, emissive(dvec3(1.0))));
@@ -635,8 +635,8 @@ TEST(Raytrace, SamplesAreTheABufferPositions) {
 }
 
 // Floor, glass sphere in a glass box, mirror box, veil, two lights.
-Scene mixed_scene(int w, int h) {
-  Scene s = empty_scene({0.3, 1.5, 4}, {0, 0.2, 0}, 50, w, h);
+SceneData mixed_scene(int w, int h) {
+  SceneData s = empty_scene({0.3, 1.5, 4}, {0, 0.2, 0}, 50, w, h);
   s.ambient = dvec3(0.1);
   s.background = {0.1, 0.2, 0.3};
   PointLight a, b;
@@ -668,7 +668,7 @@ Scene mixed_scene(int w, int h) {
 }
 
 TEST(Raytrace, NestedGlassAndGrazingRaysStayFinite) {
-  const Scene s = mixed_scene(48, 48);
+  const SceneData s = mixed_scene(48, 48);
   RaytraceOptions opt;
   opt.threads = 2;
   const Image img = render_raytrace(s, opt);
@@ -694,7 +694,7 @@ TEST(Raytrace, NestedGlassAndGrazingRaysStayFinite) {
 }
 
 TEST(Raytrace, ImageIdenticalForAnyThreadCount) {
-  const Scene s = mixed_scene(40, 30);
+  const SceneData s = mixed_scene(40, 30);
   RaytraceOptions one, three;
   one.threads = 1;
   three.threads = 3;
@@ -718,7 +718,7 @@ TEST(Raytrace, ImageIdenticalForAnyThreadCount) {
 }
 
 TEST(Raytrace, RejectsBadOptions) {
-  const Scene s = mixed_scene(4, 4);
+  const SceneData s = mixed_scene(4, 4);
   RaytraceOptions opt;
   opt.samples_per_pixel = 4;
   EXPECT_THROW(render_raytrace(s, opt), InputError);

@@ -128,7 +128,7 @@ TEST(Resolve, EachFragmentIsShadedOnceAndLongListsNeedNoRecursion) {
 }
 
 // Material colour and opacity, no lighting: what the resolve tests shade with.
-PixelShader material_shader(const Scene& s) {
+PixelShader material_shader(const SceneData& s) {
   return [&s](const Fragment& f, int, int) {
     const Material& m = s.materials[s.triangles.material_id[f.triangle()]];
     return ShadedFragment{m.color, m.opacity};
@@ -136,7 +136,7 @@ PixelShader material_shader(const Scene& s) {
 }
 
 TEST(Resolve, VeilOverAQuadInTheImage) {
-  Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 16, 12);
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 16, 12);
   Material veil = emissive(RED);
   veil.opacity = 0.25;
   const uint32_t mv = add_material(s, veil), mb = add_material(s, emissive(BLUE));
@@ -154,7 +154,7 @@ TEST(Resolve, VeilOverAQuadInTheImage) {
 // Two quads crossing along x = 0, mirror images of each other (planes z = -3 +- x/2): in
 // the pixel column centred on x = 0 their z ranges coincide, so Vis = 1/2.
 TEST(Resolve, IntersectingQuadsMeetHalfAndHalf) {
-  Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 40, 15, 9);
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, -1}, 40, 15, 9);
   const uint32_t mr = add_material(s, emissive(RED)), mg = add_material(s, emissive(GREEN));
   add_quad(s, {-1, -1, -3.5}, {1, -1, -2.5}, {1, 1, -2.5}, {-1, 1, -3.5}, mr);
   add_quad(s, {-1, -1, -2.5}, {1, -1, -3.5}, {1, 1, -3.5}, {-1, 1, -2.5}, mg);
@@ -176,7 +176,7 @@ TEST(Resolve, IntersectingQuadsMeetHalfAndHalf) {
 // Thesis figures 11.1-11.2: a white triangle on black; edge pixels take the covered share
 // of their 32 samples, which follows the exact covered area.
 TEST(Resolve, AntialiasedEdgesFollowTheCoveredArea) {
-  Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 50, 40, 32);
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, -1}, 50, 40, 32);
   const uint32_t m = add_material(s, emissive(dvec3(1.0)));
   begin_object(s, "triangle", m, false);
   const dvec3 a(-1.3, -0.9, -3), b(1.4, -0.5, -3), c(-0.2, 1.2, -3);
@@ -210,7 +210,7 @@ TEST(Resolve, AntialiasedEdgesFollowTheCoveredArea) {
 }
 
 TEST(Resolve, ImageIdenticalForAnyThreadCount) {
-  Scene s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/default.json");
+  SceneData s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/default.json");
   s.camera.width = 64;
   s.camera.height = 48;
   const ABuffer b = build_camera_abuffer(s, test_options(true));

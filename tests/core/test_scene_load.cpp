@@ -119,7 +119,7 @@ SceneText with_objects(const std::string& objects) {
   return s;
 }
 
-Scene load_text(const std::string& text, const std::string& dir = ".") {
+SceneData load_text(const std::string& text, const std::string& dir = ".") {
   return load_scene_text(text, "scene.json", dir);
 }
 
@@ -143,17 +143,17 @@ std::string load_error(const std::string& text, const std::string& dir = ".") {
     EXPECT_NE(message_.find(place), std::string::npos) << message_;   \
   } while (0)
 
-glm::dvec3 corner(const Scene& s, size_t triangle, int k) {
+glm::dvec3 corner(const SceneData& s, size_t triangle, int k) {
   return glm::dvec3(s.triangles.positions[3 * triangle + static_cast<size_t>(k)]);
 }
 
-glm::dvec3 geometric_normal(const Scene& s, size_t t) {
+glm::dvec3 geometric_normal(const SceneData& s, size_t t) {
   return glm::normalize(glm::cross(corner(s, t, 1) - corner(s, t, 0), corner(s, t, 2) - corner(s, t, 0)));
 }
 
 // Every edge of the object used exactly twice, once in each direction (checked here
 // independently of is_closed_surface, with an ordered map of corner positions).
-bool edges_shared_twice(const Scene& s, const SceneObject& o) {
+bool edges_shared_twice(const SceneData& s, const SceneObject& o) {
   using Point = std::tuple<float, float, float>;
   std::map<std::pair<Point, Point>, int> directed;
   for (uint32_t t = o.first_triangle; t < o.first_triangle + o.triangle_count; ++t) {
@@ -170,7 +170,7 @@ bool edges_shared_twice(const Scene& s, const SceneObject& o) {
   return !directed.empty();
 }
 
-double object_volume(const Scene& s, const SceneObject& o) {
+double object_volume(const SceneData& s, const SceneObject& o) {
   return signed_volume(s.triangles, o.first_triangle, o.triangle_count);
 }
 
@@ -180,7 +180,7 @@ TEST(SceneLoad, FormatExampleLoads) {
   TempDir dir;
   dir.write("meshes/knot.obj", CUBE_OBJ);
   const std::string path = dir.write("scene.json", FORMAT_EXAMPLE);
-  const Scene s = load_scene(path);
+  const SceneData s = load_scene(path);
 
   EXPECT_EQ(s.file, path);
   EXPECT_EQ(s.camera.width, 512);
@@ -455,7 +455,7 @@ TEST(SceneLoadErrors, MissingSceneFileNamesIt) {
 // ---- Geometry --------------------------------------------------------------------------
 
 TEST(SceneLoadGeometry, ZeroAreaTrianglesAreDroppedAndCounted) {
-  const Scene s = load_text(with_objects(R"([
+  const SceneData s = load_text(with_objects(R"([
       {"type": "triangle", "vertices": [[0,0,0],[1,1,1],[2,2,2]]},
       {"type": "triangle", "vertices": [[0,0,0],[0,0,0],[1,0,0]]},
       {"type": "quad", "vertices": [[0,0,0],[1,0,0],[2,0,0],[0,1,0]]},
@@ -471,7 +471,7 @@ TEST(SceneLoadGeometry, ZeroAreaTrianglesAreDroppedAndCounted) {
 }
 
 TEST(SceneLoadGeometry, BoxIsClosedWithOutwardFlatNormals) {
-  const Scene s = load_text(with_objects(R"([{"type": "box", "min": [-1,0,2], "max": [0,2,5]}])").str());
+  const SceneData s = load_text(with_objects(R"([{"type": "box", "min": [-1,0,2], "max": [0,2,5]}])").str());
   const SceneObject& box = s.objects[0];
   EXPECT_EQ(box.triangle_count, 12u);
   EXPECT_TRUE(box.closed);
@@ -493,7 +493,7 @@ TEST(SceneLoadGeometry, SphereIsClosedWithOutwardSmoothNormals) {
   for (int segments : {3, 7, 32, 65}) {
     const std::string objects = R"([{"type": "sphere", "center": [1,2,3], "radius": 2, "segments": )" +
                                 std::to_string(segments) + "}]";
-    const Scene s = load_text(with_objects(objects).str());
+    const SceneData s = load_text(with_objects(objects).str());
     const SceneObject& o = s.objects[0];
     const int rings = std::max(2, segments / 2);
     EXPECT_EQ(o.triangle_count, static_cast<uint32_t>(2 * segments * (rings - 1))) << segments;
@@ -522,7 +522,7 @@ TEST(SceneLoadGeometry, SphereIsClosedWithOutwardSmoothNormals) {
 TEST(SceneLoadGeometry, TransformScalesThenRotatesXYZThenTranslates) {
   // (1,2,3) scaled by (2,3,4) is (2,6,12); 90 degrees about x: (2,-12,6); about y: (6,-12,-2);
   // about z: (12,6,-2); translated by (10,20,30): (22,26,28).
-  const Scene s = load_text(with_objects(R"([{"type": "triangle", "vertices": [[1,2,3],[2,2,3],[1,3,3]],
+  const SceneData s = load_text(with_objects(R"([{"type": "triangle", "vertices": [[1,2,3],[2,2,3],[1,3,3]],
       "transform": {"scale": [2,3,4], "rotate_deg": [90,90,90], "translate": [10,20,30]}}])").str());
   ASSERT_EQ(s.triangles.triangle_count(), 1u);
   const glm::dvec3 p = corner(s, 0, 0);
@@ -536,7 +536,7 @@ TEST(SceneLoadGeometry, TransformScalesThenRotatesXYZThenTranslates) {
 }
 
 TEST(SceneLoadGeometry, MirroringTransformKeepsNormalsOutward) {
-  const Scene s = load_text(with_objects(R"([
+  const SceneData s = load_text(with_objects(R"([
       {"type": "box", "min": [0,0,0], "max": [1,2,3], "transform": {"scale": [-1,1,1]}},
       {"type": "triangle", "vertices": [[0,0,0],[1,0,0],[0,1,0]], "transform": {"scale": [1,1,-2]}},
       {"type": "sphere", "center": [0,0,0], "radius": 1, "transform": {"scale": [2,-1,1]}}])").str());
@@ -559,7 +559,7 @@ TEST(SceneLoadGeometry, MirroringTransformKeepsNormalsOutward) {
 }
 
 TEST(SceneLoadGeometry, QuarterTurnsKeepBoxesAxisAligned) {
-  const Scene s = load_text(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,2,3],
+  const SceneData s = load_text(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,2,3],
       "transform": {"rotate_deg": [0,90,0]}}])").str());
   const Bounds b = s.bounds();
   EXPECT_EQ(b.lo, glm::dvec3(0, 0, -1));
@@ -570,7 +570,7 @@ TEST(SceneLoadGeometry, QuarterTurnsKeepBoxesAxisAligned) {
 
 TEST(SceneLoadMesh, MtlMaterialsAreUsedWithoutObjectMaterial) {
   const std::string dir = std::string(ABCUBE_SOURCE_DIR) + "/scenes";
-  const Scene s = load_text(with_objects(R"([{"type": "mesh", "file": "meshes/octahedron.obj"}])").str(), dir);
+  const SceneData s = load_text(with_objects(R"([{"type": "mesh", "file": "meshes/octahedron.obj"}])").str(), dir);
   const SceneObject& o = s.objects[0];
   EXPECT_EQ(o.triangle_count, 8u);
   EXPECT_TRUE(o.closed);
@@ -595,7 +595,7 @@ TEST(SceneLoadMesh, MtlMaterialsAreUsedWithoutObjectMaterial) {
               mid.y > 0 ? "meshes/octahedron.obj:red" : "meshes/octahedron.obj:blue");
   }
   // An object material overrides the MTL, which then adds no materials.
-  const Scene named = load_text(
+  const SceneData named = load_text(
       with_objects(R"([{"type": "mesh", "file": "meshes/octahedron.obj", "material": "m"}])").str(), dir);
   EXPECT_EQ(named.materials.size(), 2u);
   for (uint32_t id : named.triangles.material_id) EXPECT_EQ(named.materials[id].name, "m");
@@ -604,7 +604,7 @@ TEST(SceneLoadMesh, MtlMaterialsAreUsedWithoutObjectMaterial) {
 TEST(SceneLoadMesh, MeshWithoutMaterialsGetsTheDefault) {
   TempDir dir;
   dir.write("cube.obj", CUBE_OBJ);
-  const Scene s = load_text(with_objects(R"([{"type": "mesh", "file": "cube.obj"}])").str(), dir.path().string());
+  const SceneData s = load_text(with_objects(R"([{"type": "mesh", "file": "cube.obj"}])").str(), dir.path().string());
   const Material& m = s.materials[s.objects[0].material];
   EXPECT_EQ(m.name, "(default)");
   EXPECT_DOUBLE_EQ(m.color.r, 0.8);
@@ -630,7 +630,7 @@ f 4//1 1//1 5//1
 )");
   // An L-shaped hexagon (concave): ear clipping must cover exactly its area, 3 units.
   dir.write("ell.obj", "v 0 0 0\nv 2 0 0\nv 2 0 1\nv 1 0 1\nv 1 0 2\nv 0 0 2\nf 6 5 4 3 2 1\n");
-  const Scene s = load_text(with_objects(R"([{"type": "mesh", "file": "pyramid.obj"},
+  const SceneData s = load_text(with_objects(R"([{"type": "mesh", "file": "pyramid.obj"},
       {"type": "mesh", "file": "ell.obj", "transform": {"translate": [5, 0, 0]}}])").str(), dir.path().string());
   const SceneObject& pyramid = s.objects[0];
   EXPECT_EQ(pyramid.triangle_count, 6u);
@@ -677,7 +677,7 @@ TEST(SceneLoadMesh, BadObjIndicesAreErrors) {
 // ---- Tessellation helpers --------------------------------------------------------------
 
 TEST(Tessellate, ClosedSurfaceNeedsConsistentOrientation) {
-  Scene s = load_text(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1]}])").str());
+  SceneData s = load_text(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1]}])").str());
   EXPECT_TRUE(is_closed_surface(s.triangles, 0, 12));
   EXPECT_FALSE(is_closed_surface(s.triangles, 0, 11));  // a hole
   std::swap(s.triangles.positions[1], s.triangles.positions[2]);  // one face turned over
@@ -689,7 +689,7 @@ TEST(Tessellate, ClosedSurfaceNeedsConsistentOrientation) {
 TEST(SceneLoadMemory, EstimateAndBudget) {
   SceneText text;
   text.render = R"({"cube_resolution": 100})";
-  const Scene s = load_text(text.str());
+  const SceneData s = load_text(text.str());
   const uint64_t bytes = estimate_render_bytes(s);
   // 64x48 pixels, 6 faces of 100x100 texels, 960 triangles, each with some headroom.
   EXPECT_GT(bytes, 64u * 48 * 12 + 6u * 100 * 100 * 4 + 960u * 80);
@@ -717,7 +717,7 @@ TEST(RepositoryScenes, AllLoad) {
     for (const auto& entry : fs::directory_iterator(dir)) {
       if (entry.path().extension() != ".json") continue;
       SCOPED_TRACE(entry.path().string());
-      Scene s;
+      SceneData s;
       EXPECT_NO_THROW(s = load_scene(entry.path().string()));
       EXPECT_GT(s.triangles.triangle_count(), 0u);
       EXPECT_FALSE(s.lights.empty());
@@ -726,7 +726,7 @@ TEST(RepositoryScenes, AllLoad) {
     }
   }
   EXPECT_GE(count, 5);
-  const Scene bench = load_scene((root / "bench/spheres_terrain.json").string());
+  const SceneData bench = load_scene((root / "bench/spheres_terrain.json").string());
   EXPECT_GE(bench.triangles.triangle_count(), 100000u);
 }
 
@@ -746,7 +746,7 @@ double hit_triangle(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3& 
 // hidden_point.json (thesis fig. 11.3) does what scenes/README.md says: some points of the
 // green triangle are hidden from the camera by the red one, yet seen in the mirror.
 TEST(RepositoryScenes, HiddenPointSeenOnlyInTheMirror) {
-  const Scene s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/hidden_point.json");
+  const SceneData s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/hidden_point.json");
   ASSERT_EQ(s.objects.size(), 3u);  // mirror, red, green: one triangle each
   auto tri = [&](size_t i, int k) { return corner(s, i, k); };
   const glm::dvec3 eye = s.camera.position;

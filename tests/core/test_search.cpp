@@ -29,14 +29,14 @@ using namespace testkit;
 
 // A scene, its exact tracer and its cube map around the camera.
 struct World {
-  Scene scene;
+  SceneData scene;
   std::unique_ptr<RayTracer> tracer;
   CubeABuffer cube;
   std::unique_ptr<SearchContext> ctx;
   int n = 0;
 };
 
-std::unique_ptr<World> make_world(Scene scene, int n, bool merge = false) {
+std::unique_ptr<World> make_world(SceneData scene, int n, bool merge = false) {
   auto w = std::make_unique<World>();
   w->scene = std::move(scene);
   w->n = n;
@@ -93,15 +93,15 @@ std::vector<SurfaceRay> mirror_rays(const World& world, int cols, int rows) {
 }
 
 // A perfect mirror material added to s.
-uint32_t add_mirror(Scene& s) {
+uint32_t add_mirror(SceneData& s) {
   Material mirror;
   mirror.reflect = 1.0;
   return add_material(s, mirror);
 }
 
 // Mirror floor and back wall, a box, a sphere, a tilted triangle, and a box behind the camera.
-Scene reflection_scene() {
-  Scene s = empty_scene({0.3, 1.6, 4.2}, {0, 0.3, 0}, 60, 320, 240);
+SceneData reflection_scene() {
+  SceneData s = empty_scene({0.3, 1.6, 4.2}, {0, 0.3, 0}, 60, 320, 240);
   const uint32_t m = add_mirror(s);
   const uint32_t red = add_material(s, emissive({1, 0, 0}));
   const uint32_t blue = add_material(s, emissive({0, 0, 1}));
@@ -274,8 +274,8 @@ TEST(Search, HiddenPointFoundOnlyWithAllLayers) {
 }
 
 // Glass sphere and glass box in front of a wall.
-Scene glass_scene() {
-  Scene s = empty_scene({0.2, 1.2, 4.0}, {0, 0.6, 0}, 50, 320, 240);
+SceneData glass_scene() {
+  SceneData s = empty_scene({0.2, 1.2, 4.0}, {0, 0.6, 0}, 50, 320, 240);
   Material glass;
   glass.transmit = 0.9;
   glass.ior = 1.5;
@@ -349,8 +349,8 @@ TEST(Search, TotalInternalReflectionIsSearchedAgain) {
 }
 
 // Floor, an opaque slab and a glass slab floating above it, one light above.
-Scene shadow_scene() {
-  Scene s = empty_scene({0, 3, 6}, {0, 0, 0}, 50, 320, 240);
+SceneData shadow_scene() {
+  SceneData s = empty_scene({0, 3, 6}, {0, 0, 0}, 50, 320, 240);
   Material floor;
   floor.color = {0.8, 0.8, 0.8};
   Material glass;
@@ -428,8 +428,8 @@ TEST(Search, OwnSurfaceNeverShadowsGrazingLight) {
 
 // A room around the camera at the origin, with a mirror, boxes, and a quad in the plane
 // y = 0 that contains the centre (zero area in the map).
-Scene room_scene() {
-  Scene s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 64, 64);
+SceneData room_scene() {
+  SceneData s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 64, 64);
   const uint32_t m = add_mirror(s);
   const uint32_t a = add_material(s, emissive({1, 0.5, 0}));
   const uint32_t b = add_material(s, emissive({0, 0.5, 1}));
@@ -468,7 +468,7 @@ Scene room_scene() {
 TEST(Search, TessellatedMirrorSphereDoesNotFindItself) {
   // A coarse mirror sphere: near W the extended planes of its neighbouring triangles pass
   // within the tolerance of every reflected ray; only an exact crossing may be found there.
-  Scene s = room_scene();
+  SceneData s = room_scene();
   add_sphere(s, {0.2, -0.3, -2.6}, 0.5, 16, add_mirror(s));
   const auto world = make_world(std::move(s), 64);
   const uint32_t sphere = static_cast<uint32_t>(world->scene.objects.size() - 1);
@@ -633,7 +633,7 @@ SearchOptions with_refine(SearchRefine r) {
 }
 
 TEST(MeshRefine, ClosedMeshesAreLinkedAcrossEveryEdgeAndObjectsAreNot) {
-  Scene s = empty_scene({0, 0, 5}, {0, 0, 0}, 50, 32, 32);
+  SceneData s = empty_scene({0, 0, 5}, {0, 0, 0}, 50, 32, 32);
   const uint32_t m = add_material(s, Material{});
   add_sphere(s, {0, 0, 0}, 1.0, 24, m);
   add_box(s, {1.0, -0.5, -0.5}, {2.0, 0.5, 0.5}, m);  // touches the sphere at (1, 0, 0)
@@ -663,7 +663,7 @@ TEST(MeshRefine, ClosedMeshesAreLinkedAcrossEveryEdgeAndObjectsAreNot) {
 // Rays from a mirror floor aimed at points within half a texel of a sphere's silhouette,
 // inside and outside it: what they meet first, against the exact tracer.
 TEST(MeshRefine, RaysGrazingASilhouetteMeetWhatTheExactRayMeets) {
-  Scene s = empty_scene({0, 1.2, 4}, {0, 0.5, 0}, 50, 64, 48);
+  SceneData s = empty_scene({0, 1.2, 4}, {0, 0.5, 0}, 50, 64, 48);
   const uint32_t mm = add_mirror(s);
   const uint32_t red = add_material(s, emissive({1, 0, 0}));
   const uint32_t blue = add_material(s, emissive({0, 0, 1}));
@@ -713,7 +713,7 @@ TEST(MeshRefine, RaysGrazingASilhouetteMeetWhatTheExactRayMeets) {
 // from the point than the 2 texels within which tolerance candidates are ignored. No
 // false shadow.
 TEST(MeshRefine, ACreaseDoesNotShadowItsOwnFace) {
-  Scene s = empty_scene({0.3, 1.1, 3}, {0, 0.5, 0}, 50, 64, 48);
+  SceneData s = empty_scene({0.3, 1.1, 3}, {0, 0.5, 0}, 50, 64, 48);
   const uint32_t white = add_material(s, Material{});
   add_box(s, {-0.5, 0, -0.5}, {0.5, 1.0, 0.5}, white);
   const int n = 128;

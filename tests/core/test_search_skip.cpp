@@ -29,7 +29,7 @@ bool occupied_ahead(const ABuffer& b, int n, int i, int j, int si, int sj) {
 }
 
 TEST(SearchSkip, EmptyAheadNeverHidesAFragment) {
-  const Scene scene = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/default.json");
+  const SceneData scene = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/default.json");
   const int n = 24;
   ABufferOptions options;
   options.threads = 2;

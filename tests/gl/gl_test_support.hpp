@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "gl/gl_context.hpp"
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 namespace abcube::test {
 
@@ -26,7 +26,7 @@ inline GlContext& test_context() {
   return *ctx;
 }
 
-inline uint32_t add_material(Scene& s, glm::dvec3 color, double ambient = 1.0) {
+inline uint32_t add_material(SceneData& s, glm::dvec3 color, double ambient = 1.0) {
   Material m;
   m.name = "m" + std::to_string(s.materials.size());
   m.color = color;
@@ -35,7 +35,7 @@ inline uint32_t add_material(Scene& s, glm::dvec3 color, double ambient = 1.0) {
   return static_cast<uint32_t>(s.materials.size() - 1);
 }
 
-inline uint32_t new_object(Scene& s, const char* type, uint32_t material = 0) {
+inline uint32_t new_object(SceneData& s, const char* type, uint32_t material = 0) {
   if (s.materials.empty()) add_material(s, glm::dvec3(0.8));
   SceneObject o;
   o.type = type;
@@ -46,7 +46,7 @@ inline uint32_t new_object(Scene& s, const char* type, uint32_t material = 0) {
 }
 
 // Appends one flat triangle to object `object` (the last one created).
-inline void push_triangle(Scene& s, uint32_t object, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+inline void push_triangle(SceneData& s, uint32_t object, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
   const glm::vec3 n = glm::normalize(glm::cross(glm::vec3(b - a), glm::vec3(c - a)));
   for (const glm::dvec3& p : {a, b, c}) {
     s.triangles.positions.push_back(glm::vec3(p));
@@ -57,13 +57,13 @@ inline void push_triangle(Scene& s, uint32_t object, glm::dvec3 a, glm::dvec3 b,
   s.objects[object].triangle_count++;
 }
 
-inline uint32_t add_triangle(Scene& s, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, uint32_t material = 0) {
+inline uint32_t add_triangle(SceneData& s, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, uint32_t material = 0) {
   const uint32_t id = new_object(s, "triangle", material);
   push_triangle(s, id, a, b, c);
   return id;
 }
 
-inline uint32_t add_quad(Scene& s, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d, uint32_t material = 0) {
+inline uint32_t add_quad(SceneData& s, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d, uint32_t material = 0) {
   const uint32_t id = new_object(s, "quad", material);
   push_triangle(s, id, a, b, c);
   push_triangle(s, id, a, c, d);
@@ -71,7 +71,7 @@ inline uint32_t add_quad(Scene& s, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm
 }
 
 // Axis-aligned box [lo, hi] as 12 triangles (6 quads).
-inline void add_box(Scene& s, glm::dvec3 lo, glm::dvec3 hi, uint32_t material = 0) {
+inline void add_box(SceneData& s, glm::dvec3 lo, glm::dvec3 hi, uint32_t material = 0) {
   auto p = [&](int x, int y, int z) { return glm::dvec3(x ? hi.x : lo.x, y ? hi.y : lo.y, z ? hi.z : lo.z); };
   add_quad(s, p(0, 0, 0), p(0, 1, 0), p(1, 1, 0), p(1, 0, 0), material);
   add_quad(s, p(0, 0, 1), p(1, 0, 1), p(1, 1, 1), p(0, 1, 1), material);

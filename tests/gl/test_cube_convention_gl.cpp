@@ -16,7 +16,7 @@ using test::add_triangle;
 
 // An equilateral triangle centred on `center`, in the plane normal to `normal`,
 // with inradius `inradius` (circumradius twice that).
-void add_marker(Scene& s, glm::dvec3 center, glm::dvec3 normal, glm::dvec3 hint, double inradius) {
+void add_marker(SceneData& s, glm::dvec3 center, glm::dvec3 normal, glm::dvec3 hint, double inradius) {
   const glm::dvec3 n = glm::normalize(normal);
   const glm::dvec3 u = glm::normalize(glm::cross(n, hint));
   const glm::dvec3 v = glm::cross(n, u);
@@ -30,7 +30,7 @@ void add_marker(Scene& s, glm::dvec3 center, glm::dvec3 normal, glm::dvec3 hint,
 TEST(CubeConventionGl, EveryTexelCentreLandsOnItsTexel) {
   test::test_context();
   const int n = 12;
-  Scene s;
+  SceneData s;
   for (int face = 0; face < CUBE_FACES; ++face) {
     const CubeFaceBasis& b = cube_face_basis(face);
     for (int j = 0; j < n; ++j) {
@@ -77,7 +77,7 @@ TEST(CubeConventionGl, GridDirectionsIncludingSeamsAndCorners) {
     }
   }
   ASSERT_EQ(dirs.size(), 98u);  // 6 * 9 interior + 12 * 3 edge + 8 corner directions
-  Scene s;
+  SceneData s;
   for (const glm::dvec3& d : dirs) {
     // One texel spans 2/n of the face plane at |ma| = 1; d has |ma| = 1 here.
     const glm::dvec3 hint = std::abs(d.y) < 0.9 * glm::length(d) ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
@@ -101,7 +101,7 @@ TEST(CubeConventionGl, GridDirectionsIncludingSeamsAndCorners) {
 TEST(CubeConventionGl, SubpixelSamplesMatchSupersampledRaster) {
   test::test_context();
   const int n = 4;
-  Scene s;
+  SceneData s;
   std::vector<std::tuple<int, int, int, int>> where;  // face, i, j, k
   for (int face = 0; face < CUBE_FACES; ++face) {
     const CubeFaceBasis& b = cube_face_basis(face);

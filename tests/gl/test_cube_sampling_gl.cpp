@@ -42,7 +42,7 @@ TEST(CubeConventionGl, GlCubeSamplingPicksCpuTexel) {
   test::test_context();
   const int n = 8;
   // One marker per texel centre, each its own object id (as in the texel test).
-  Scene s;
+  SceneData s;
   for (int face = 0; face < CUBE_FACES; ++face) {
     const CubeFaceBasis& b = cube_face_basis(face);
     for (int j = 0; j < n; ++j) {

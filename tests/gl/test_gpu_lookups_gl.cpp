@@ -16,7 +16,7 @@ namespace {
 // edge, where a shadow-map texel straddles it) are counted.
 TEST(GpuLookupsGl, CubeShadowMapMatchesExactShadows) {
   test::test_context();
-  Scene s;
+  SceneData s;
   s.ambient = glm::dvec3(0.2);
   s.camera.position = {0, 3, 4};
   s.camera.look_at = {0, 0, 0};
@@ -67,7 +67,7 @@ TEST(GpuLookupsGl, CubeShadowMapMatchesExactShadows) {
 // colour is the exact one except within a texel or two of a wall's edge.
 TEST(GpuLookupsGl, EnvironmentReflectionMatchesExactForFarWalls) {
   test::test_context();
-  Scene s;
+  SceneData s;
   s.ambient = glm::dvec3(1);
   s.camera.position = {0, 0, 0};
   s.camera.look_at = {0, 0, -1};

@@ -24,7 +24,7 @@ double box_exit_distance(glm::dvec3 c, glm::dvec3 u, glm::dvec3 lo, glm::dvec3 h
 }
 
 void expect_box_distances(glm::dvec3 center, glm::dvec3 lo, glm::dvec3 hi, int n) {
-  Scene s;
+  SceneData s;
   test::add_box(s, lo, hi);
   GlScene gl(s);
   CubeImage dist;
@@ -59,7 +59,7 @@ TEST(PrepassGl, DistanceOffCentre) {
 // Nothing beyond the near plane is clipped, however far: a wall 1e6 away is in the map.
 TEST(PrepassGl, NoFarClipping) {
   test::test_context();
-  Scene s;
+  SceneData s;
   test::add_box(s, glm::dvec3(-1e6), glm::dvec3(1e6));
   GlScene gl(s);
   CubeImage dist;
@@ -73,7 +73,7 @@ TEST(PrepassGl, NoFarClipping) {
 // material colour (ambient only), the rest the background; exact but for the edge rows.
 TEST(ZbufferGl, QuadCoversKnownRectangle) {
   test::test_context();
-  Scene s;
+  SceneData s;
   s.ambient = glm::dvec3(1);
   s.background = glm::dvec3(0.0, 0.0, 1.0);
   s.camera.position = glm::dvec3(0);
@@ -116,7 +116,7 @@ TEST(ZbufferGl, QuadCoversKnownRectangle) {
 // The GLSL Phong (common_shading.glsl) equals cpu_core phong_local at pixel centres.
 TEST(ZbufferGl, PhongMatchesCpuShading) {
   test::test_context();
-  Scene s;
+  SceneData s;
   s.ambient = glm::dvec3(0.1, 0.15, 0.2);
   s.background = glm::dvec3(0);
   s.camera.position = glm::dvec3(0, 1, 3);
@@ -163,7 +163,7 @@ namespace {
 // intermediate values matching the covered area, is in tests/core).
 TEST(ZbufferGl, WhiteTriangleEdgesAreAliased) {
   test::test_context();
-  Scene s;
+  SceneData s;
   s.ambient = glm::dvec3(1);
   s.background = glm::dvec3(0);
   s.camera.position = glm::dvec3(0, 0, 3);
@@ -193,7 +193,7 @@ namespace {
 // computes for the exact point of a box wall seen from the centre.
 TEST(ZbufferGl, CubeColourMatchesCpuShading) {
   test::test_context();
-  Scene s;
+  SceneData s;
   s.ambient = glm::dvec3(0.2);
   s.lights.push_back({glm::dvec3(0.3, 0.5, -0.2), glm::dvec3(0.8, 0.7, 0.6), true});
   const uint32_t m = test::add_material(s, glm::dvec3(0.3, 0.6, 0.9), 0.7);

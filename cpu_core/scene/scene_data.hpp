@@ -45,7 +45,7 @@ struct Material {
 struct SceneObject {
   std::string type;              // triangle, quad, box, sphere, mesh
   std::string path;              // "objects[3]" (for messages)
-  uint32_t material = 0;         // index into Scene::materials (per-triangle ids may differ for meshes)
+  uint32_t material = 0;         // index into SceneData::materials (per-triangle ids may differ for meshes)
   bool closed = false;           // has an inside (box, sphere, closed mesh)
   uint32_t first_triangle = 0;   // range in TriangleSoup
   uint32_t triangle_count = 0;
@@ -57,8 +57,8 @@ struct SceneObject {
 struct TriangleSoup {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;
-  std::vector<uint32_t> object_id;    // per triangle, index into Scene::objects
-  std::vector<uint32_t> material_id;  // per triangle, index into Scene::materials
+  std::vector<uint32_t> object_id;    // per triangle, index into SceneData::objects
+  std::vector<uint32_t> material_id;  // per triangle, index into SceneData::materials
   size_t triangle_count() const { return object_id.size(); }
 };
 
@@ -76,7 +76,7 @@ struct Bounds {
   void extend(const glm::dvec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
 };
 
-struct Scene {
+struct SceneData {
   std::string file;  // path as given, for messages
   Camera camera;
   glm::dvec3 background{0};
@@ -92,6 +92,6 @@ struct Scene {
 };
 
 // Largest Euclidean distance from p to any scene vertex (0 for an empty scene).
-double max_distance_from(const Scene& scene, const glm::dvec3& p);
+double max_distance_from(const SceneData& scene, const glm::dvec3& p);
 
 }  // namespace abcube

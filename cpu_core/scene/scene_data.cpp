@@ -1,4 +1,4 @@
-#include "scene/scene.hpp"
+#include "scene/scene_data.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -21,13 +21,13 @@ bool parse_method(const std::string& s, Method* out) {
   return false;
 }
 
-Bounds Scene::bounds() const {
+Bounds SceneData::bounds() const {
   Bounds b;
   for (const glm::vec3& p : triangles.positions) b.extend(glm::dvec3(p));
   return b;
 }
 
-double max_distance_from(const Scene& scene, const glm::dvec3& p) {
+double max_distance_from(const SceneData& scene, const glm::dvec3& p) {
   double d = 0;
   for (const glm::vec3& v : scene.triangles.positions) d = std::max(d, glm::length(glm::dvec3(v) - p));
   return d;
