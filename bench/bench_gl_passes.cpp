@@ -83,7 +83,7 @@ int run(const std::vector<std::string>& words) {
   const RayTracer rt(scene);
   GlScene gl(scene);
   std::printf("scene: %s (%zu triangles)\nrenderer: %s\nruns: %d (median [min, max] ms)\n\n",
-              args.positional()[0].c_str(), scene.triangles.triangle_count(), describe_gl(ctx.get()).c_str(),
+              args.positional()[0].c_str(), scene.triangles->triangle_count(), describe_gl(ctx.get()).c_str(),
               runs);
   std::printf("| N | prepass 6 faces ms | readback ms | camera %dx%d raster ms | prepass rel. distance error "
               "vs exact: median / p99 / max | same object | texels checked | CPU cube A-buffer ms | fragments | "

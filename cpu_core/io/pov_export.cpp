@@ -111,7 +111,7 @@ void write_mesh(std::ostringstream& os, const TriangleSoup& soup, const std::vec
 }  // namespace
 
 std::string export_pov(const SceneData& scene) {
-  const TriangleSoup& soup = scene.triangles;
+  const TriangleSoup& soup = *scene.triangles;
   ABCUBE_CHECK(soup.positions.size() == 3 * soup.triangle_count() && soup.normals.size() == soup.positions.size(),
                "triangle soup with 3 positions and 3 normals per triangle");
   std::ostringstream os;

@@ -297,7 +297,7 @@ ABufferStats summarise(const std::vector<ViewBuild>& views, const std::vector<AB
 std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView> rasters, const char* what,
                                  const ABufferOptions& options, ABufferStats* stats) {
   const Clock::time_point start = Clock::now();
-  const TriangleSoup& soup = scene.triangles;
+  const TriangleSoup& soup = *scene.triangles;
   const uint64_t budget = options.max_memory_bytes > 0 ? options.max_memory_bytes : default_max_memory_bytes();
   std::vector<ViewBuild> views(rasters.size());
   std::vector<Band> bands;

@@ -19,9 +19,10 @@ namespace abcube {
 
 namespace {
 
-Bvh timed_build(const TriangleSoup& soup, double* ms) {
+std::shared_ptr<const Bvh> timed_build(const TriangleSoup& soup, std::shared_ptr<const Bvh> given, double* ms) {
+  if (given) return given;
   const Clock::time_point start = Clock::now();
-  Bvh bvh(soup);
+  auto bvh = std::make_shared<const Bvh>(soup);
   *ms = ms_since(start);
   return bvh;
 }
@@ -47,21 +48,21 @@ struct Crossing {
 
 }  // namespace
 
-RayTracer::RayTracer(const SceneData& scene)
+RayTracer::RayTracer(const SceneData& scene, std::shared_ptr<const Bvh> bvh)
     : scene_(&scene),
-      bvh_(timed_build(scene.triangles, &build_ms_)),
+      bvh_(timed_build(*scene.triangles, std::move(bvh), &build_ms_)),
       scene_scale_(compute_scene_scale(scene)) {
-  ABCUBE_CHECK(scene.triangles.normals.size() == scene.triangles.positions.size(),
+  ABCUBE_CHECK(scene.triangles->normals.size() == scene.triangles->positions.size(),
                "one normal per triangle vertex");
-  ABCUBE_CHECK(scene.triangles.material_id.size() == scene.triangles.triangle_count(),
+  ABCUBE_CHECK(scene.triangles->material_id.size() == scene.triangles->triangle_count(),
                "one material id per triangle");
-  for (uint32_t id : scene.triangles.material_id) {
+  for (uint32_t id : scene.triangles->material_id) {
     ABCUBE_CHECK(id < scene.materials.size(), "material id " + std::to_string(id) + " out of range");
   }
 }
 
 Hit RayTracer::make_hit(const TriangleHit& th, const glm::dvec3& dir) const {
-  const TriangleSoup& soup = scene_->triangles;
+  const TriangleSoup& soup = *scene_->triangles;
   const glm::dvec3 a = vertex(soup, th.triangle, 0);
   const glm::dvec3 b = vertex(soup, th.triangle, 1);
   const glm::dvec3 c = vertex(soup, th.triangle, 2);
@@ -87,7 +88,7 @@ Hit RayTracer::make_hit(const TriangleHit& th, const glm::dvec3& dir) const {
 bool RayTracer::intersect(const glm::dvec3& origin, const glm::dvec3& dir, double tmax, Hit* hit) const {
   ABCUBE_CHECK(dir != glm::dvec3(0.0), "ray direction must not be zero");
   TriangleHit th;
-  if (!bvh_.closest_hit(RayQuery(origin, dir), tmax, &th)) return false;
+  if (!bvh_->closest_hit(RayQuery(origin, dir), tmax, &th)) return false;
   *hit = make_hit(th, dir);
   return true;
 }
@@ -126,10 +127,10 @@ glm::dvec3 RayTracer::light_visibility(const Hit& hit, const PointLight& light, 
   if (!(dist > 0.0)) return glm::dvec3(1.0);
   const glm::dvec3 dir = seg / dist;
   if (counts) ++counts->shadow;
-  const TriangleSoup& soup = scene_->triangles;
+  const TriangleSoup& soup = *scene_->triangles;
   bool opaque = false;
   std::vector<Crossing> crossings;
-  bvh_.for_each_hit(RayQuery(origin, dir), dist, [&](const TriangleHit& th) {
+  bvh_->for_each_hit(RayQuery(origin, dir), dist, [&](const TriangleHit& th) {
     const glm::dvec3 tr = blocker_transmittance(scene_->materials[soup.material_id[th.triangle]]);
     if (tr == glm::dvec3(0.0)) {
       opaque = true;
@@ -231,7 +232,7 @@ Image render_raytrace(const SceneData& scene, const RaytraceOptions& options, Ra
                      std::to_string(options.samples_per_pixel));
   }
   if (options.threads < 0) throw InputError("raytrace: threads must be >= 0, got " + std::to_string(options.threads));
-  const RayTracer tracer(scene);
+  const RayTracer tracer(scene, options.bvh);
   const CameraFrame frame = make_camera_frame(scene.camera);
   Image image(frame.width, frame.height, 3);
   const int threads = thread_count(options.threads, static_cast<size_t>(frame.height));
@@ -257,7 +258,7 @@ Image render_raytrace(const SceneData& scene, const RaytraceOptions& options, Ra
     }
     stats->build_ms = tracer.build_ms();
     stats->trace_ms = ms_since(start);
-    stats->triangles = scene.triangles.triangle_count();
+    stats->triangles = scene.triangles->triangle_count();
     stats->bvh_nodes = tracer.bvh().node_count();
     stats->bvh_depth = tracer.bvh().depth();
     stats->threads = threads;

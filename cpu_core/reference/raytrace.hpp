@@ -56,6 +56,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <memory>
 
 #include <glm/glm.hpp>
 
@@ -70,6 +71,8 @@ struct RaytraceOptions {
   int samples_per_pixel = 32;   // 32 (the 4x8 A-buffer samples) or 1 (pixel centre)
   // Called now and then on the calling thread with the share of rows done, in [0, 1].
   std::function<void(double)> progress;
+  // The scene's BVH when already built (SceneCache); null: built for this render.
+  std::shared_ptr<const Bvh> bvh;
 };
 
 struct RaytraceStats {
@@ -109,8 +112,9 @@ struct Ray {
 
 class RayTracer {
  public:
-  // Builds the BVH. The scene must outlive the tracer (it is referenced, not copied).
-  explicit RayTracer(const SceneData& scene);
+  // Builds the BVH, or uses `bvh` (built on the same triangles, shared by every render of
+  // a scene: SceneCache). The scene must outlive the tracer (referenced, not copied).
+  explicit RayTracer(const SceneData& scene, std::shared_ptr<const Bvh> bvh = nullptr);
   explicit RayTracer(SceneData&&) = delete;
 
   // The first hit with 0 < t < tmax along origin + t*dir (dir non-zero, need not be unit).
@@ -138,7 +142,7 @@ class RayTracer {
 
   // Largest absolute vertex coordinate plus the diagonal of the vertex bounds.
   double scene_scale() const { return scene_scale_; }
-  const Bvh& bvh() const { return bvh_; }
+  const Bvh& bvh() const { return *bvh_; }
   const SceneData& scene() const { return *scene_; }
   double build_ms() const { return build_ms_; }
 
@@ -146,8 +150,8 @@ class RayTracer {
   Hit make_hit(const TriangleHit& th, const glm::dvec3& dir) const;
 
   const SceneData* scene_;
-  double build_ms_ = 0;  // before bvh_: the BVH's construction writes it
-  Bvh bvh_;
+  double build_ms_ = 0;  // 0 when the BVH was given
+  std::shared_ptr<const Bvh> bvh_;
   double scene_scale_ = 0;
 };
 

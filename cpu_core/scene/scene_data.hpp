@@ -1,6 +1,7 @@
 // The scene after loading: validated, triangulated, in world space (scene-format.md).
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,24 @@ struct TriangleSoup {
   size_t triangle_count() const { return object_id.size(); }
 };
 
+// The scene's triangles, shared between copies of a SceneData: a render with another camera
+// or other settings copies the SceneData (lights, materials, objects) but not its triangles.
+// Reading is through -> and *; edit() gives the triangles to change, copying them first
+// when another SceneData shares them (copy on write).
+class SharedTriangles {
+ public:
+  SharedTriangles() : soup_(std::make_shared<TriangleSoup>()) {}
+  const TriangleSoup* operator->() const { return soup_.get(); }
+  const TriangleSoup& operator*() const { return *soup_; }
+  TriangleSoup& edit() {
+    if (soup_.use_count() > 1) soup_ = std::make_shared<TriangleSoup>(*soup_);
+    return *soup_;
+  }
+
+ private:
+  std::shared_ptr<TriangleSoup> soup_;
+};
+
 struct RenderSettings {
   Method method = Method::abuffer;
   int cube_resolution = 512;
@@ -84,7 +103,7 @@ struct SceneData {
   std::vector<PointLight> lights;
   std::vector<Material> materials;
   std::vector<SceneObject> objects;
-  TriangleSoup triangles;
+  SharedTriangles triangles;
   RenderSettings render;
   size_t dropped_triangles = 0;  // zero-area or non-finite triangles dropped at load
 

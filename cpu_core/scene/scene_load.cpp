@@ -651,7 +651,7 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
                                                                          : static_cast<int>(default_material(st));
       }
       add_obj_face(a, corners, n, material, &m);
-      if (st.scene.triangles.triangle_count() + m.triangle_count() > MAX_TRIANGLES) {
+      if (st.scene.triangles->triangle_count() + m.triangle_count() > MAX_TRIANGLES) {
         fail(st.src, path, "the scene would exceed " + std::to_string(MAX_TRIANGLES) + " triangles");
       }
     }
@@ -667,7 +667,7 @@ LocalMesh read_geometry(LoadState& st, const Fields& f, const std::string& type,
   }
   if (type == "quad") return read_quad(f);
   if (type == "box") return read_box(f);
-  if (type == "sphere") return read_sphere(f, st.scene.triangles.triangle_count());
+  if (type == "sphere") return read_sphere(f, st.scene.triangles->triangle_count());
   return read_obj(st, f, !has_material);
 }
 
@@ -710,11 +710,11 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   const LocalMesh local = read_geometry(st, f, type, material != nullptr);
   // Without a "material", a primitive gets the default and a mesh its per-face MTL ones.
   if (!material && local.material.empty()) obj.material = default_material(st);
-  if (st.scene.triangles.triangle_count() + local.triangle_count() > MAX_TRIANGLES) {
+  if (st.scene.triangles->triangle_count() + local.triangle_count() > MAX_TRIANGLES) {
     fail(st.src, path, "the scene would exceed " + std::to_string(MAX_TRIANGLES) + " triangles");
   }
 
-  TriangleSoup& soup = st.scene.triangles;
+  TriangleSoup& soup = st.scene.triangles.edit();
   const uint32_t id = static_cast<uint32_t>(st.scene.objects.size());
   obj.first_triangle = static_cast<uint32_t>(soup.triangle_count());
   st.scene.dropped_triangles += append_triangles(local, make_affine_map(transform), id, obj.material, &soup);
@@ -810,7 +810,7 @@ SceneData load_scene(const std::string& path) {
 uint64_t estimate_render_bytes(const SceneData& scene) {
   const uint64_t pixels = static_cast<uint64_t>(scene.camera.width) * static_cast<uint64_t>(scene.camera.height);
   const uint64_t n = static_cast<uint64_t>(scene.render.cube_resolution);
-  return pixels * PIXEL_BYTES + 6 * n * n * TEXEL_BYTES + scene.triangles.triangle_count() * TRIANGLE_BYTES;
+  return pixels * PIXEL_BYTES + 6 * n * n * TEXEL_BYTES + scene.triangles->triangle_count() * TRIANGLE_BYTES;
 }
 
 void check_render_size(const SceneData& scene, uint64_t budget_bytes) {

@@ -180,7 +180,7 @@ LensPoints surface_points(const SceneData& scene, const SceneObject& obj, const 
     }
     return pts;
   }
-  const TriangleSoup& soup = scene.triangles;
+  const TriangleSoup& soup = *scene.triangles;
   for (uint32_t t = obj.first_triangle; t < obj.first_triangle + obj.triangle_count; ++t) {
     const glm::dvec3 a(soup.positions[3 * t]), b(soup.positions[3 * t + 1]), c(soup.positions[3 * t + 2]);
     const glm::dvec3 n = glm::cross(b - a, c - a);
@@ -269,7 +269,7 @@ LensFit fit_lens(const SceneData& scene, uint32_t object, const LensFitOptions& 
   std::vector<glm::dvec3> all;
   all.reserve(3 * size_t{obj.triangle_count});
   for (uint32_t t = obj.first_triangle; t < obj.first_triangle + obj.triangle_count; ++t) {
-    for (int k = 0; k < 3; ++k) all.emplace_back(scene.triangles.positions[3 * size_t{t} + k]);
+    for (int k = 0; k < 3; ++k) all.emplace_back(scene.triangles->positions[3 * size_t{t} + k]);
   }
   sort_unique(&all);
   if (all.size() < 4) return invalid(f, obj.path + ": fewer than 4 distinct vertices");

@@ -131,7 +131,7 @@ template <class OnFragment, class AfterTexel, class MaySkip>
 ScanCounts scan(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o, OnFragment&& on_fragment,
                 AfterTexel&& after_texel, MaySkip&& may_skip) {
   const CubeABuffer& cube = ctx.cube();
-  const TriangleSoup& soup = ctx.scene().triangles;
+  const TriangleSoup& soup = *ctx.scene().triangles;
   CubeWalk walk(q.w, q.d, cube.n, q.l_max, cube.near_distance, o.max_texels);
   SquaredDistanceRange distances2(q.w, q.d);
   // Only the thesis mode and the nearest layer look at the texel-centre direction.
@@ -373,7 +373,7 @@ Candidate thesis_candidate(const SearchContext& ctx, const SearchRay& q, const W
 // Does the exact ray meet a triangle the map cannot hold before parameter l_end?
 bool meets_zero_area(const SearchContext& ctx, const SearchRay& q, double l_end) {
   for (const uint32_t tri : ctx.zero_area_triangles()) {
-    if (q.restrict_object && ctx.scene().triangles.object_id[tri] != q.object) continue;
+    if (q.restrict_object && ctx.scene().triangles->object_id[tri] != q.object) continue;
     // Moller & Trumbore 1997.
     const glm::dvec3 a = ctx.vertex(tri, 0), e1 = ctx.vertex(tri, 1) - a, e2 = ctx.vertex(tri, 2) - a;
     const glm::dvec3 pv = glm::cross(q.d, e2);
@@ -394,8 +394,8 @@ SearchResult make_result(const SearchContext& ctx, const SearchRay& q, const Can
   r.hit = true;
   r.miss = MissReason::none;
   r.triangle = c.triangle;
-  r.object_id = ctx.scene().triangles.object_id[r.triangle];
-  r.material_id = ctx.scene().triangles.material_id[r.triangle];
+  r.object_id = ctx.scene().triangles->object_id[r.triangle];
+  r.material_id = ctx.scene().triangles->material_id[r.triangle];
   r.back_face = c.back_face;
   r.point = ctx.cube().centre + c.x;
   r.distance = glm::length(c.x - q.w);
@@ -520,8 +520,10 @@ const char* miss_reason_name(MissReason r) {
   return "?";
 }
 
-SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube) : scene_(&scene), cube_(&cube) {
-  const TriangleSoup& soup = scene.triangles;
+SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube,
+                             std::shared_ptr<const MeshNeighbours> neighbours)
+    : scene_(&scene), cube_(&cube), neighbours_(std::move(neighbours)) {
+  const TriangleSoup& soup = *scene.triangles;
   const uint32_t count = static_cast<uint32_t>(soup.triangle_count());
   planes_.resize(count);
   bounds_.resize(count);
@@ -547,7 +549,7 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube) : 
     }
     if (setup_triangle(view, soup, k, &setup) == SetupResult::edge_on) zero_area_.push_back(k);
   }
-  build_neighbours();
+  if (!neighbours_) neighbours_ = std::make_shared<const MeshNeighbours>(build_mesh_neighbours(soup));
   // Where each face holds fragments, row by row (empty_ahead), and BLOCK BOUNDS.
   const int n = cube.n;
   blocks_per_row_ = (std::max(n, 0) + BOUNDS_BLOCK - 1) / BOUNDS_BLOCK;
@@ -598,10 +600,10 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube) : 
 
 // Vertices are the same when their object and float position are (bit for bit, -0 = +0);
 // an edge links the two triangles that have it, in either direction.
-void SearchContext::build_neighbours() {
-  const TriangleSoup& soup = scene_->triangles;
+MeshNeighbours build_mesh_neighbours(const TriangleSoup& soup) {
+  constexpr uint32_t NO_NEIGHBOUR = SearchContext::NO_NEIGHBOUR;
   const size_t count = soup.triangle_count();
-  neighbours_.assign(count, {NO_NEIGHBOUR, NO_NEIGHBOUR, NO_NEIGHBOUR});
+  MeshNeighbours neighbours(count, {NO_NEIGHBOUR, NO_NEIGHBOUR, NO_NEIGHBOUR});
   struct Corner {
     uint32_t object;
     std::array<uint32_t, 3> bits;
@@ -642,11 +644,12 @@ void SearchContext::build_neighbours() {
     while (end < edges.size() && edges[end].first == edges[e].first) ++end;
     if (end - e == 2) {  // manifold edge; a border (1) or a non-manifold edge (> 2) links nothing
       const uint32_t x = edges[e].second, y = edges[e + 1].second;
-      neighbours_[x / 3][x % 3] = y / 3;
-      neighbours_[y / 3][y % 3] = x / 3;
+      neighbours[x / 3][x % 3] = y / 3;
+      neighbours[y / 3][y % 3] = x / 3;
     }
     e = end;
   }
+  return neighbours;
 }
 
 bool SearchContext::empty_ahead(int face, int i, int j, int step_i, int step_j) const {
@@ -661,7 +664,7 @@ bool SearchContext::empty_ahead(int face, int i, int j, int step_i, int step_j) 
 }
 
 glm::dvec3 SearchContext::vertex(uint32_t triangle, int k) const {
-  return glm::dvec3(scene_->triangles.positions[3 * static_cast<size_t>(triangle) + static_cast<size_t>(k)]) -
+  return glm::dvec3(scene_->triangles->positions[3 * static_cast<size_t>(triangle) + static_cast<size_t>(k)]) -
          cube_->centre;
 }
 
@@ -710,7 +713,7 @@ struct ShadowCrossing {
 bool already_counted(const std::vector<ShadowCrossing>& counted, const SearchContext& ctx, const SearchOptions& o,
                      const Candidate& c) {
   const uint32_t tri = c.triangle;
-  const uint32_t object = ctx.scene().triangles.object_id[tri];
+  const uint32_t object = ctx.scene().triangles->object_id[tri];
   const double near = (o.tolerance_texels + 1.0) * texel_size_at(c.x, ctx.cube().n);
   for (const ShadowCrossing& k : counted) {
     if (k.triangle == tri) return true;
@@ -744,9 +747,9 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
     }
     if (already_counted(counted, ctx, options, c)) return;
     const uint32_t tri = c.triangle;
-    counted.push_back({tri, ctx.scene().triangles.object_id[tri], c.back_face, c.x, c.l});
+    counted.push_back({tri, ctx.scene().triangles->object_id[tri], c.back_face, c.x, c.l});
     // thesis 8.3; rule "shadows" (shading.hpp): S_l is the product over the blockers.
-    res.transmittance *= blocker_transmittance(ctx.scene().materials[ctx.scene().triangles.material_id[tri]]);
+    res.transmittance *= blocker_transmittance(ctx.scene().materials[ctx.scene().triangles->material_id[tri]]);
     res.blocked = res.transmittance == glm::dvec3(0.0);
   };
   const auto after_texel = [&](const WalkTexel&, uint32_t) { return !res.blocked; };

@@ -117,6 +117,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -127,6 +128,12 @@
 #include "scene/scene_data.hpp"
 
 namespace abcube {
+
+// Per triangle, the triangle across each edge k (vertices k, k+1): same object, the same
+// two vertex positions bit for bit; SearchContext::NO_NEIGHBOUR on a border or a
+// non-manifold edge. Depends on the triangles only: one per scene.
+using MeshNeighbours = std::vector<std::array<uint32_t, 3>>;
+MeshNeighbours build_mesh_neighbours(const TriangleSoup& soup);
 
 enum class SearchMode { crossing, thesis };
 enum class SearchLayers { all, nearest };  // A-buffer (thesis 7.5) or Z-buffer (Patow 1995)
@@ -167,7 +174,10 @@ const char* miss_reason_name(MissReason r);
 // The scene and cube must outlive it.
 class SearchContext {
  public:
-  SearchContext(const SceneData& scene, const CubeABuffer& cube);
+  // `neighbours` (optional): the scene's edge adjacency, built once per scene and shared
+  // by every map of it (SceneCache); built here when null.
+  SearchContext(const SceneData& scene, const CubeABuffer& cube,
+                std::shared_ptr<const MeshNeighbours> neighbours = nullptr);
 
   const SceneData& scene() const { return *scene_; }
   const CubeABuffer& cube() const { return *cube_; }
@@ -193,7 +203,7 @@ class SearchContext {
   // The triangle across edge k (vertices k, k+1) of `triangle`: same object, the same two
   // vertex positions bit for bit; NO_NEIGHBOUR on a border or a non-manifold edge.
   static constexpr uint32_t NO_NEIGHBOUR = 0xffffffffu;
-  uint32_t neighbour(uint32_t triangle, int k) const { return neighbours_[triangle][static_cast<size_t>(k)]; }
+  uint32_t neighbour(uint32_t triangle, int k) const { return (*neighbours_)[triangle][static_cast<size_t>(k)]; }
 
   // Whether every texel (i', j') of `face` with i' - i of the sign of step_i (or 0) and
   // j' - j of the sign of step_j (or 0) holds an empty list: the rest of a walk on that
@@ -219,7 +229,7 @@ class SearchContext {
   std::vector<Plane> planes_;
   std::vector<Bounds> bounds_;
   std::vector<uint32_t> zero_area_;
-  std::vector<std::array<uint32_t, 3>> neighbours_;
+  std::shared_ptr<const MeshNeighbours> neighbours_;
   // Per face and row j: the smallest and largest column holding a fragment over rows
   // <= j (prefix) and >= j (suffix), and in row j alone (n and -1 when none).
   struct RowBounds {
@@ -232,7 +242,6 @@ class SearchContext {
     return block_z_[static_cast<size_t>(face)][static_cast<size_t>(j / BOUNDS_BLOCK) * static_cast<size_t>(blocks_per_row_) +
                                                static_cast<size_t>(i / BOUNDS_BLOCK)];
   }
-  void build_neighbours();
 };
 
 struct SearchResult {

@@ -1,4 +1,5 @@
 #include "shading/map_shading.hpp"
+#include "shading/scene_cache.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -55,7 +56,7 @@ void MapShadingStats::merge(const MapShadingStats& o) {
 }
 
 SurfacePoint surface_point(const SceneData& scene, uint32_t triangle, const glm::dvec3& point) {
-  const TriangleSoup& t = scene.triangles;
+  const TriangleSoup& t = *scene.triangles;
   const size_t base = 3 * static_cast<size_t>(triangle);
   const glm::dvec3 a(t.positions[base]), b(t.positions[base + 1]), c(t.positions[base + 2]);
   SurfacePoint sp;
@@ -77,13 +78,13 @@ SurfacePoint surface_point(const SceneData& scene, uint32_t triangle, const glm:
 }
 
 MapShader::MapShader(const SceneData& scene, const CubeABuffer& cube, const MapShadingOptions& options,
-                     const RayTracer* reference)
+                     const RayTracer* reference, const SceneCache* cache)
     : scene_(scene), cube_(cube), options_(options), reference_(reference) {
   options_.search.layers = options.method == Method::zbuffer ? SearchLayers::nearest : SearchLayers::all;
-  ctx_ = std::make_unique<SearchContext>(scene, cube);
+  ctx_ = std::make_unique<SearchContext>(scene, cube, cache ? cache->neighbours() : nullptr);
   lens_of_object_.assign(scene.objects.size(), -1);
   if (options_.refraction != RefractionMode::search) {
-    lenses_ = fit_lenses(scene);
+    lenses_ = cache ? *cache->lenses() : fit_lenses(scene);
     for (size_t i = 0; i < lenses_.size(); ++i) {
       if (lenses_[i].valid) lens_of_object_[lenses_[i].object] = static_cast<int>(i);
     }
@@ -241,14 +242,14 @@ glm::dvec3 MapShader::envmap_at(const glm::dvec3& direction) const {
 glm::dvec3 MapShader::envmap_texel(int face, int i, int j) const {
   const ABuffer& buffer = cube_.faces[static_cast<size_t>(face)];
   const FragmentShader shade_fragment = [&](const Fragment& f) {
-    const glm::dvec3 p = fragment_point(buffer, scene_.triangles, f, i, j);
+    const glm::dvec3 p = fragment_point(buffer, *scene_.triangles, f, i, j);
     const SurfacePoint sp = surface_point(scene_, f.triangle(), p);
     const Material& m = scene_.materials[sp.material];
     const glm::dvec3 v = glm::normalize(cube_.centre - p);
     const glm::dvec3 nn = face_forward(sp.shading_normal, v);
     return ShadedFragment{phong_ambient(m, scene_.ambient) + lights(sp, v, nn, nullptr), m.opacity};
   };
-  return pack_under_mask(buffer.list(i, j), FULL_MASK, shade_fragment, scene_.triangles, scene_.background);
+  return pack_under_mask(buffer.list(i, j), FULL_MASK, shade_fragment, *scene_.triangles, scene_.background);
 }
 
 // Error_CP and Error_Parallax of one reflection ray against the exact tracer (thesis 9).
@@ -365,24 +366,24 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
       const CoverageMask m = f.mask & q;
       if (!m) continue;
       const glm::dvec2 c = mask_centroid(m);
-      point[count] = point_on_triangle_plane(camera.view, scene.triangles, f.triangle(), x + c.x, y + c.y);
+      point[count] = point_on_triangle_plane(camera.view, *scene.triangles, f.triangle(), x + c.x, y + c.y);
       weight[count] = mask_count(m) / total;
       ++count;
     }
     glm::dvec3 c(0.0);
     if (count <= 1) {
-      c = shade_at(fragment_point(camera, scene.triangles, f, x, y));
+      c = shade_at(fragment_point(camera, *scene.triangles, f, x, y));
     } else {
       const glm::dvec3 first = shade_at(point[0]), last = shade_at(point[count - 1]);
       c = weight[0] * first + weight[count - 1] * last;
       const bool split = differ(first, last);
       for (int k = 1; k + 1 < count; ++k) c += weight[k] * (split ? shade_at(point[k]) : 0.5 * (first + last));
     }
-    return ShadedFragment{c, scene.materials[scene.triangles.material_id[f.triangle()]].opacity};
+    return ShadedFragment{c, scene.materials[scene.triangles->material_id[f.triangle()]].opacity};
   };
   ResolveOptions ro;
   ro.threads = threads;
-  Image image = resolve_image(camera, scene.triangles, shade, scene.background, ro);
+  Image image = resolve_image(camera, *scene.triangles, shade, scene.background, ro);
   if (stats) per_thread.merge_into(stats);
   return image;
 }

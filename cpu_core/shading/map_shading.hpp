@@ -44,6 +44,7 @@
 namespace abcube {
 
 class RayTracer;
+class SceneCache;
 
 enum class EnvmapLookup { reflected, bisector, position };  // R, [[R + [[W]]]], [[W]]
 const char* envmap_lookup_name(EnvmapLookup l);
@@ -103,8 +104,10 @@ class MapShader {
  public:
   // `cube` is the map around scene.camera.position. `reference` (optional) is the exact
   // tracer the ray errors are measured against. All must outlive the shader.
+  // `cache` (optional) holds the per-scene data (mesh neighbours, lens fits) built once
+  // for every render of the scene; without it they are built here.
   MapShader(const SceneData& scene, const CubeABuffer& cube, const MapShadingOptions& options,
-            const RayTracer* reference = nullptr);
+            const RayTracer* reference = nullptr, const SceneCache* cache = nullptr);
   ~MapShader();
 
   // The colour of surface point `sp` seen along unit `dir` at bounce `depth`. `primary`

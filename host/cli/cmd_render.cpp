@@ -275,7 +275,7 @@ int cmd_render(const std::vector<std::string>& words) {
   stats["scene"] = r.scene_path;
   stats["method"] = method_name(scene.render.method);
   stats["timings_ms"]["load"] = ms_since(start);
-  stats["counts"] = {{"triangles", scene.triangles.triangle_count()},
+  stats["counts"] = {{"triangles", scene.triangles->triangle_count()},
                      {"dropped_triangles", scene.dropped_triangles},
                      {"objects", scene.objects.size()},
                      {"lights", scene.lights.size()}};

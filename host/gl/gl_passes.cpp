@@ -112,7 +112,7 @@ GlScene::GlScene(const SceneData& scene) : scene_(scene) {
   const double radius = max_distance_from(scene, scene.camera.position);
   near_ = default_near_distance(radius);
 
-  const TriangleSoup& t = scene.triangles;
+  const TriangleSoup& t = *scene.triangles;
   std::vector<Vertex> vertices(t.positions.size());
   for (size_t v = 0; v < vertices.size(); ++v) {
     Vertex& o = vertices[v];

@@ -25,8 +25,8 @@ double percentile(std::vector<double>& v, double q) {
 // Local Phong of a camera A-buffer fragment at the point it stands for (shading.hpp).
 PixelShader local_phong_shader(const SceneData& scene, const ABuffer& buffer) {
   return [&scene, &buffer](const Fragment& f, int x, int y) {
-    const Material& m = scene.materials[scene.triangles.material_id[f.triangle()]];
-    const glm::dvec3 p = fragment_point(buffer, scene.triangles, f, x, y);
+    const Material& m = scene.materials[scene.triangles->material_id[f.triangle()]];
+    const glm::dvec3 p = fragment_point(buffer, *scene.triangles, f, x, y);
     return ShadedFragment{phong_local(m, p, f.shading_normal(), scene.camera.position, scene.ambient, scene.lights),
                           m.opacity};
   };
@@ -36,7 +36,7 @@ PixelShader local_phong_shader(const SceneData& scene, const ABuffer& buffer) {
 // is opaque, and no fragment behind it reaches into its depth range.
 bool interior_pixel(const SceneData& scene, const FragmentList& list) {
   if (list.empty() || list[0].mask != FULL_MASK) return false;
-  if (scene.materials[scene.triangles.material_id[list[0].triangle()]].opacity < 1.0) return false;
+  if (scene.materials[scene.triangles->material_id[list[0].triangle()]].opacity < 1.0) return false;
   return list.size() < 2 || list[1].zmin >= list[0].zmax;
 }
 
@@ -55,7 +55,7 @@ void compare_cube(const SceneData& scene, int n, int threads, GlScene& gl, Cross
   const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, n, options, &stats);
   r->cpu_ms = ms_since(t0);
   r->fragments = stats.fragments;
-  const NearestLayer cpu = nearest_layer(cube, scene.triangles);
+  const NearestLayer cpu = nearest_layer(cube, *scene.triangles);
 
   std::vector<double> rel;
   size_t same = 0;
@@ -88,7 +88,7 @@ void compare_camera(const SceneData& scene, int threads, GlScene& gl, Crosscheck
   const ABuffer camera = build_camera_abuffer(scene, options);
   ResolveOptions ro;
   ro.threads = threads;
-  const Image cpu = resolve_image(camera, scene.triangles, local_phong_shader(scene, camera), scene.background, ro);
+  const Image cpu = resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera), scene.background, ro);
   double sum_sq = 0;
   for (int y = 0; y < camera.height(); ++y) {
     for (int x = 0; x < camera.width(); ++x) {
@@ -153,7 +153,7 @@ Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options
   ResolveOptions ro;
   ro.threads = options.threads;
   t0 = Clock::now();
-  Image image = resolve_image(camera, scene.triangles, local_phong_shader(scene, camera), scene.background, ro);
+  Image image = resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera), scene.background, ro);
   (*stats)["timings_ms"]["camera_abuffer"] = build_ms;
   (*stats)["timings_ms"]["resolve"] = ms_since(t0);
   (*stats)["abuffer"] = {{"fragments", s.fragments}, {"raw_fragments", s.raw_fragments},

@@ -44,9 +44,9 @@ TEST(ABuffer, ListsRunFrontToBackWithEveryLayer) {
     for (int x = 0; x < b.width(); ++x) {
       const FragmentList l = b.list(x, y);
       ASSERT_EQ(l.size(), 3u) << x << ", " << y;
-      EXPECT_EQ(s.triangles.object_id[l[0].triangle()], 1u);
-      EXPECT_EQ(s.triangles.object_id[l[1].triangle()], 2u);
-      EXPECT_EQ(s.triangles.object_id[l[2].triangle()], 0u);
+      EXPECT_EQ(s.triangles->object_id[l[0].triangle()], 1u);
+      EXPECT_EQ(s.triangles->object_id[l[1].triangle()], 2u);
+      EXPECT_EQ(s.triangles->object_id[l[2].triangle()], 0u);
       for (size_t i = 0; i < 3; ++i) {
         EXPECT_EQ(l[i].mask, FULL_MASK);  // each square's two triangles merged
         EXPECT_FALSE(l[i].back_face());
@@ -120,7 +120,7 @@ TEST(ABuffer, MergeNeedsSameObjectMaterialFacingAndDepth) {
     begin_object(s, "mesh", m0, false);
     add_flat_triangle(s, a, b, c);
     add_flat_triangle(s, a, c, d);
-    s.triangles.material_id[1] = m1;
+    s.triangles.edit().material_id[1] = m1;
     EXPECT_GE(diagonal_pixels_with_two(s), 8);
   }
   {
@@ -199,10 +199,10 @@ TEST(ABuffer, HiddenGreenTriangleStaysBehindTheRedOne) {
     for (int y = 0; y < n; ++y) {
       for (int x = 0; x < n; ++x) {
         const FragmentList l = b->list(x, y);
-        if (l.empty() || s.triangles.object_id[l[0].triangle()] != 1 || l[0].mask != FULL_MASK) continue;
+        if (l.empty() || s.triangles->object_id[l[0].triangle()] != 1 || l[0].mask != FULL_MASK) continue;
         ++red_front;
         for (size_t i = 1; i < l.size(); ++i) {
-          if (s.triangles.object_id[l[i].triangle()] == 2) {
+          if (s.triangles->object_id[l[i].triangle()] == 2) {
             ++green_behind;
             EXPECT_GT(l[i].zmin, l[0].zmax);
             EXPECT_FALSE(l[i].back_face());  // green faces the camera
@@ -261,7 +261,7 @@ TEST(ABuffer, StatsCountWhatIsStored) {
   EXPECT_GE(st.raw_fragments, st.fragments);
   EXPECT_GE(st.estimated_bytes, st.raw_fragments * 20);
   EXPECT_EQ(st.dropped_by_cap, 0u);
-  EXPECT_GT(st.triangle_views, s.triangles.triangle_count() - 1);  // each seen by one face at least
+  EXPECT_GT(st.triangle_views, s.triangles->triangle_count() - 1);  // each seen by one face at least
 }
 
 TEST(ABuffer, RefusesAboveTheMemoryBudgetWithTheEstimate) {
@@ -297,8 +297,8 @@ TEST(ABuffer, LayerCapKeepsTheFrontAndCountsTheRest) {
     for (int x = 0; x < 16; ++x) {
       const FragmentList l = b.list(x, y);
       ASSERT_EQ(l.size(), 2u);
-      EXPECT_EQ(s.triangles.object_id[l[0].triangle()], 0u);
-      EXPECT_EQ(s.triangles.object_id[l[1].triangle()], 1u);
+      EXPECT_EQ(s.triangles->object_id[l[0].triangle()], 0u);
+      EXPECT_EQ(s.triangles->object_id[l[1].triangle()], 1u);
     }
   }
   EXPECT_EQ(st.dropped_by_cap, 3u * 16 * 16);
@@ -314,7 +314,7 @@ TEST(ABuffer, NearestLayerIsThePrepassAtTexelCentres) {
   add_quad(s, {-5, -5, 2}, {5, -5, 2}, {5, 5, 2}, {-5, 5, 2}, m);
   const int n = 16;
   const CubeABuffer cube = build_cube_abuffer(s, dvec3(0.0), n, test_options(true));
-  const NearestLayer nl = nearest_layer(cube, s.triangles);
+  const NearestLayer nl = nearest_layer(cube, *s.triangles);
   for (int y = 0; y < n; ++y) {
     for (int x = 0; x < n; ++x) {
       const dvec3 d = texel_center_direction(POS_Z, x, y, n);
@@ -322,7 +322,7 @@ TEST(ABuffer, NearestLayerIsThePrepassAtTexelCentres) {
       EXPECT_EQ(nl.object.faces[POS_Z][static_cast<size_t>(y * n + x)], 1u);
       const Fragment* f = centre_fragment(cube.faces[POS_Z], x, y);
       ASSERT_NE(f, nullptr);
-      EXPECT_EQ(s.triangles.object_id[f->triangle()], 1u);
+      EXPECT_EQ(s.triangles->object_id[f->triangle()], 1u);
       EXPECT_LE(f->zmin, nl.distance.faces[POS_Z].at(x, y)[0]);
       EXPECT_GE(f->zmax, nl.distance.faces[POS_Z].at(x, y)[0]);
     }
@@ -344,7 +344,7 @@ TEST(ABuffer, NearestLayerMatchesTheExactTracer) {
   const RayTracer tracer(s);
   const int n = 32;
   const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, n, test_options(false));
-  const NearestLayer nl = nearest_layer(cube, s.triangles);
+  const NearestLayer nl = nearest_layer(cube, *s.triangles);
   int hits = 0, same = 0, with_fragment = 0;
   for (int f = 0; f < CUBE_FACES; ++f) {
     for (int j = 0; j < n; ++j) {

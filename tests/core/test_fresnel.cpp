@@ -54,18 +54,18 @@ TEST(Fresnel, GrazingAndReciprocity) {
 void add_quad(SceneData& s, float y, uint32_t material, bool facing_down) {
   SceneObject o;
   o.type = "quad";
-  o.first_triangle = static_cast<uint32_t>(s.triangles.triangle_count());
+  o.first_triangle = static_cast<uint32_t>(s.triangles->triangle_count());
   o.triangle_count = 2;
   s.objects.push_back(o);
   const glm::vec3 q[4] = {{-50, y, -50}, {50, y, -50}, {50, y, 50}, {-50, y, 50}};
   const int tris[2][3] = {{0, 2, 1}, {0, 3, 2}};
   for (const auto& t : tris) {
     for (int k = 0; k < 3; ++k) {
-      s.triangles.positions.push_back(q[facing_down ? t[2 - k] : t[k]]);
-      s.triangles.normals.push_back({0, facing_down ? -1.f : 1.f, 0});
+      s.triangles.edit().positions.push_back(q[facing_down ? t[2 - k] : t[k]]);
+      s.triangles.edit().normals.push_back({0, facing_down ? -1.f : 1.f, 0});
     }
-    s.triangles.object_id.push_back(static_cast<uint32_t>(s.objects.size() - 1));
-    s.triangles.material_id.push_back(material);
+    s.triangles.edit().object_id.push_back(static_cast<uint32_t>(s.objects.size() - 1));
+    s.triangles.edit().material_id.push_back(material);
   }
 }
 

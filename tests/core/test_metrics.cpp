@@ -153,10 +153,10 @@ TEST(Metrics, ExactTracerHasZeroParallaxError) {
   s.materials.push_back(Material{});
   auto add_tri = [&](const dvec3& a, const dvec3& b, const dvec3& c) {
     const glm::vec3 n(glm::normalize(glm::cross(b - a, c - a)));
-    for (const dvec3& p : {a, b, c}) s.triangles.positions.emplace_back(p);
-    for (int k = 0; k < 3; ++k) s.triangles.normals.push_back(n);
-    s.triangles.object_id.push_back(static_cast<uint32_t>(s.triangles.object_id.size()));
-    s.triangles.material_id.push_back(0);
+    for (const dvec3& p : {a, b, c}) s.triangles.edit().positions.emplace_back(p);
+    for (int k = 0; k < 3; ++k) s.triangles.edit().normals.push_back(n);
+    s.triangles.edit().object_id.push_back(static_cast<uint32_t>(s.triangles->object_id.size()));
+    s.triangles.edit().material_id.push_back(0);
   };
   add_tri({-5, -1, -5}, {-5, -1, 5}, {5, -1, 5});  // floor mirror (one triangle)
   add_tri({-5, -1, -5}, {5, -1, 5}, {5, -1, -5});

@@ -61,12 +61,12 @@ TEST(Raster, ViewsFollowTheCubeAndCameraConventions) {
 // Star-shaped closed mesh around `c`: a sphere whose radius varies with direction (the same
 // function of each shared vertex, so the mesh stays closed).
 void add_bumpy_sphere(SceneData& s, const dvec3& c, int segments, uint32_t material) {
-  const size_t first = s.triangles.positions.size();
+  const size_t first = s.triangles->positions.size();
   add_sphere(s, c, 1.0, segments, material);
-  for (size_t i = first; i < s.triangles.positions.size(); ++i) {
-    const dvec3 d = dvec3(s.triangles.positions[i]) - c;
+  for (size_t i = first; i < s.triangles->positions.size(); ++i) {
+    const dvec3 d = dvec3(s.triangles->positions[i]) - c;
     const double k = 1.5 + 0.6 * std::sin(3.0 * d.x + 1.0) * std::cos(2.0 * d.y) + 0.3 * d.z;
-    s.triangles.positions[i] = glm::vec3(c + k * d);
+    s.triangles.edit().positions[i] = glm::vec3(c + k * d);
   }
 }
 
@@ -98,15 +98,15 @@ TEST(Raster, ClosedMeshesAroundTheCentreCoverEverySampleOnce) {
   // Each closed surface alone: one layer per sample, whatever the face and the clipping.
   for (uint32_t object = 0; object < 3; ++object) {
     SceneData one = s;
-    one.triangles = TriangleSoup{};
-    for (size_t t = 0; t < s.triangles.triangle_count(); ++t) {
-      if (s.triangles.object_id[t] != object) continue;
+    one.triangles = SharedTriangles{};
+    for (size_t t = 0; t < s.triangles->triangle_count(); ++t) {
+      if (s.triangles->object_id[t] != object) continue;
       for (size_t k = 0; k < 3; ++k) {
-        one.triangles.positions.push_back(s.triangles.positions[3 * t + k]);
-        one.triangles.normals.push_back(s.triangles.normals[3 * t + k]);
+        one.triangles.edit().positions.push_back(s.triangles->positions[3 * t + k]);
+        one.triangles.edit().normals.push_back(s.triangles->normals[3 * t + k]);
       }
-      one.triangles.object_id.push_back(object);
-      one.triangles.material_id.push_back(m);
+      one.triangles.edit().object_id.push_back(object);
+      one.triangles.edit().material_id.push_back(m);
     }
     for (bool merge : {false, true}) {
       ABufferStats st;
@@ -180,9 +180,9 @@ TEST(Raster, PixelMasksFollowThePerSampleRuleExactly) {
   int partial = 0, full = 0;
   for (int face = 0; face < CUBE_FACES; ++face) {
     const RasterView v = cube_face_view(face, dvec3(0.05, -0.1, 0.02), 20, 0.3);
-    for (uint32_t t = 0; t < s.triangles.triangle_count(); ++t) {
+    for (uint32_t t = 0; t < s.triangles->triangle_count(); ++t) {
       TriangleSetup st;
-      if (setup_triangle(v, s.triangles, t, &st) != SetupResult::visible) continue;
+      if (setup_triangle(v, *s.triangles, t, &st) != SetupResult::visible) continue;
       for (int y = 0; y < v.height; ++y) {
         int xb = 0, xe = 0;
         row_span(st, y, &xb, &xe);
@@ -290,9 +290,9 @@ TEST(Raster, DistanceRangeIsTheClippedPolygonsRange) {
         const dvec3 d = b->view.direction(x + 0.5, y + 0.5);
         for (const Fragment& f : b->list(x, y)) {
           const size_t t = f.triangle();
-          const dvec3 a = dvec3(r.triangles.positions[3 * t]) - rc.centre;
-          const dvec3 e1 = dvec3(r.triangles.positions[3 * t + 1]) - rc.centre - a;
-          const dvec3 e2 = dvec3(r.triangles.positions[3 * t + 2]) - rc.centre - a;
+          const dvec3 a = dvec3(r.triangles->positions[3 * t]) - rc.centre;
+          const dvec3 e1 = dvec3(r.triangles->positions[3 * t + 1]) - rc.centre - a;
+          const dvec3 e2 = dvec3(r.triangles->positions[3 * t + 2]) - rc.centre - a;
           // Moller-Trumbore from the centre along d: is the texel centre on the triangle?
           const dvec3 pv = glm::cross(d, e2);
           const double det = glm::dot(e1, pv);
@@ -367,7 +367,7 @@ TEST(Raster, NormalIsPerspectiveCorrectAtTheCoveredCentroid) {
   for (int y = 0; y < 16; ++y) {
     for (int x = 0; x < 16; ++x) {
       for (const Fragment& f : buf.list(x, y)) {
-        const dvec3 p = fragment_point(buf, s.triangles, f, x, y);
+        const dvec3 p = fragment_point(buf, *s.triangles, f, x, y);
         // Barycentrics of p in 3D: the perspective-correct weights.
         const dvec3 n = glm::cross(b - a, c - a);
         const double wa = glm::dot(glm::cross(c - b, p - b), n) / glm::dot(n, n);

@@ -60,7 +60,7 @@ uint32_t begin_object(SceneData& s, const std::string& type, uint32_t material, 
   o.path = "objects[" + std::to_string(s.objects.size()) + "]";
   o.material = material;
   o.closed = closed;
-  o.first_triangle = static_cast<uint32_t>(s.triangles.triangle_count());
+  o.first_triangle = static_cast<uint32_t>(s.triangles->triangle_count());
   s.objects.push_back(o);
   return static_cast<uint32_t>(s.objects.size() - 1);
 }
@@ -68,7 +68,7 @@ uint32_t begin_object(SceneData& s, const std::string& type, uint32_t material, 
 // Appends a triangle with corner normals to the last object begun.
 void add_triangle(SceneData& s, const dvec3& a, const dvec3& b, const dvec3& c, const dvec3& na, const dvec3& nb,
                   const dvec3& nc) {
-  TriangleSoup& t = s.triangles;
+  TriangleSoup& t = s.triangles.edit();
   for (const dvec3& p : {a, b, c}) t.positions.emplace_back(p);
   for (const dvec3& n : {na, nb, nc}) t.normals.emplace_back(n);
   t.object_id.push_back(static_cast<uint32_t>(s.objects.size() - 1));
@@ -210,7 +210,7 @@ TEST(Raytrace, BvhMatchesBruteForce) {
     bool brute_found = false;
     double tmax = INFINITY;
     int brute_all = 0;
-    for (uint32_t t = 0; t < s.triangles.triangle_count(); ++t) {
+    for (uint32_t t = 0; t < s.triangles->triangle_count(); ++t) {
       TriangleHit h;
       if (bvh.intersect_triangle(q, t, INFINITY, &h)) ++brute_all;
       if (bvh.intersect_triangle(q, t, tmax, &h)) {
@@ -237,7 +237,7 @@ TEST(Raytrace, WatertightClosedSphere) {
   const dvec3 c(0.1, 0.2, 0.3);
   add_sphere(s, c, 1.0, 48, add_material(s, Material{}));
   const RayTracer tracer(s);
-  const TriangleSoup& soup = s.triangles;
+  const TriangleSoup& soup = *s.triangles;
   int misses = 0, rays = 0;
   // Rays through every vertex and every edge midpoint: from inside points they must all
   // hit; from outside points, those aimed at a vertex or edge facing the origin too
@@ -526,8 +526,8 @@ glm::dmat3 rotation(const dvec3& axis, double angle) {
 // Moves a whole scene rigidly; every shading value is unchanged, but the hit points no
 // longer have exactly representable coordinates.
 void move_scene(SceneData& s, const glm::dmat3& rot, const dvec3& shift) {
-  for (glm::vec3& p : s.triangles.positions) p = glm::vec3(rot * dvec3(p) + shift);
-  for (glm::vec3& n : s.triangles.normals) n = glm::vec3(rot * dvec3(n));
+  for (glm::vec3& p : s.triangles.edit().positions) p = glm::vec3(rot * dvec3(p) + shift);
+  for (glm::vec3& n : s.triangles.edit().normals) n = glm::vec3(rot * dvec3(n));
   s.camera.position = rot * s.camera.position + shift;
   s.camera.look_at = rot * s.camera.look_at + shift;
   s.camera.up = rot * s.camera.up;
@@ -686,7 +686,7 @@ TEST(Raytrace, NestedGlassAndGrazingRaysStayFinite) {
     ++rays;
     bad += !(std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b) && glm::all(glm::greaterThanEqual(c, dvec3(0))));
   };
-  for (const glm::vec3& v : s.triangles.positions) check(eye, dvec3(v) - eye);
+  for (const glm::vec3& v : s.triangles->positions) check(eye, dvec3(v) - eye);
   check({-5, 1, 0}, {1, 0, 0});    // in the plane of the glass box's top face
   check({-5, -1, 0.3}, {1, 0, 0});  // in the floor's plane
   check({0, 0.9, 0}, {std::sin(std::asin(1 / 1.5)), std::cos(std::asin(1 / 1.5)), 0});  // inside, critical

@@ -130,7 +130,7 @@ TEST(Resolve, EachFragmentIsShadedOnceAndLongListsNeedNoRecursion) {
 // Material colour and opacity, no lighting: what the resolve tests shade with.
 PixelShader material_shader(const SceneData& s) {
   return [&s](const Fragment& f, int, int) {
-    const Material& m = s.materials[s.triangles.material_id[f.triangle()]];
+    const Material& m = s.materials[s.triangles->material_id[f.triangle()]];
     return ShadedFragment{m.color, m.opacity};
   };
 }
@@ -143,7 +143,7 @@ TEST(Resolve, VeilOverAQuadInTheImage) {
   add_quad(s, {-1, -1, -2}, {1, -1, -2}, {1, 1, -2}, {-1, 1, -2}, mv);
   add_quad(s, {-9, -9, -5}, {9, -9, -5}, {9, 9, -5}, {-9, 9, -5}, mb);
   const ABuffer b = build_camera_abuffer(s, test_options(true));
-  const Image img = resolve_image(b, s.triangles, material_shader(s), GREY);
+  const Image img = resolve_image(b, *s.triangles, material_shader(s), GREY);
   const dvec3 want = 0.25 * RED + 0.75 * BLUE;
   for (int c = 0; c < 3; ++c) {
     EXPECT_FLOAT_EQ(img.at(8, 6)[c], static_cast<float>(want[c]));  // under the veil
@@ -159,7 +159,7 @@ TEST(Resolve, IntersectingQuadsMeetHalfAndHalf) {
   add_quad(s, {-1, -1, -3.5}, {1, -1, -2.5}, {1, 1, -2.5}, {-1, 1, -3.5}, mr);
   add_quad(s, {-1, -1, -2.5}, {1, -1, -3.5}, {1, 1, -3.5}, {-1, 1, -2.5}, mg);
   const ABuffer b = build_camera_abuffer(s, test_options(true));
-  const Image img = resolve_image(b, s.triangles, material_shader(s), GREY);
+  const Image img = resolve_image(b, *s.triangles, material_shader(s), GREY);
   for (int y = 2; y < 7; ++y) {
     ASSERT_EQ(b.list(7, y).size(), 2u);
     EXPECT_NEAR(img.at(7, y)[0], 0.5, 1e-5) << "row " << y;
@@ -182,7 +182,7 @@ TEST(Resolve, AntialiasedEdgesFollowTheCoveredArea) {
   const dvec3 a(-1.3, -0.9, -3), b(1.4, -0.5, -3), c(-0.2, 1.2, -3);
   add_flat_triangle(s, a, b, c);
   const ABuffer buf = build_camera_abuffer(s, test_options(true));
-  const Image img = resolve_image(buf, s.triangles, material_shader(s), dvec3(0.0));
+  const Image img = resolve_image(buf, *s.triangles, material_shader(s), dvec3(0.0));
   std::vector<glm::dvec2> tri;
   for (const dvec3& p : {a, b, c}) tri.push_back(buf.view.project(p));
   int edge = 0, intermediate = 0;
@@ -215,15 +215,15 @@ TEST(Resolve, ImageIdenticalForAnyThreadCount) {
   s.camera.height = 48;
   const ABuffer b = build_camera_abuffer(s, test_options(true));
   const PixelShader shade = [&s](const Fragment& f, int x, int y) {
-    const Material& m = s.materials[s.triangles.material_id[f.triangle()]];
+    const Material& m = s.materials[s.triangles->material_id[f.triangle()]];
     const double lambert = std::fabs(glm::dot(f.shading_normal(), glm::normalize(dvec3(1, 2, 3))));
     return ShadedFragment{m.color * lambert + 0.01 * dvec3(x % 3, y % 5, 0), m.opacity};
   };
   ResolveOptions one, three;
   one.threads = 1;
   three.threads = 3;
-  const Image a = resolve_image(b, s.triangles, shade, GREY, one);
-  const Image c = resolve_image(b, s.triangles, shade, GREY, three);
+  const Image a = resolve_image(b, *s.triangles, shade, GREY, one);
+  const Image c = resolve_image(b, *s.triangles, shade, GREY, three);
   ASSERT_EQ(a.data.size(), c.data.size());
   EXPECT_EQ(std::memcmp(a.data.data(), c.data.data(), a.data.size() * sizeof(float)), 0);
 }

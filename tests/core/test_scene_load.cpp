@@ -144,7 +144,7 @@ std::string load_error(const std::string& text, const std::string& dir = ".") {
   } while (0)
 
 glm::dvec3 corner(const SceneData& s, size_t triangle, int k) {
-  return glm::dvec3(s.triangles.positions[3 * triangle + static_cast<size_t>(k)]);
+  return glm::dvec3(s.triangles->positions[3 * triangle + static_cast<size_t>(k)]);
 }
 
 glm::dvec3 geometric_normal(const SceneData& s, size_t t) {
@@ -158,8 +158,8 @@ bool edges_shared_twice(const SceneData& s, const SceneObject& o) {
   std::map<std::pair<Point, Point>, int> directed;
   for (uint32_t t = o.first_triangle; t < o.first_triangle + o.triangle_count; ++t) {
     for (int k = 0; k < 3; ++k) {
-      const glm::vec3 a = s.triangles.positions[3 * t + static_cast<size_t>(k)];
-      const glm::vec3 b = s.triangles.positions[3 * t + static_cast<size_t>((k + 1) % 3)];
+      const glm::vec3 a = s.triangles->positions[3 * t + static_cast<size_t>(k)];
+      const glm::vec3 b = s.triangles->positions[3 * t + static_cast<size_t>((k + 1) % 3)];
       ++directed[{Point(a.x, a.y, a.z), Point(b.x, b.y, b.z)}];
     }
   }
@@ -171,7 +171,7 @@ bool edges_shared_twice(const SceneData& s, const SceneObject& o) {
 }
 
 double object_volume(const SceneData& s, const SceneObject& o) {
-  return signed_volume(s.triangles, o.first_triangle, o.triangle_count);
+  return signed_volume(*s.triangles, o.first_triangle, o.triangle_count);
 }
 
 // ---- The format's example ---------------------------------------------------------------
@@ -215,14 +215,14 @@ TEST(SceneLoad, FormatExampleLoads) {
     EXPECT_EQ(o.triangle_count, expected_triangles[i]) << o.type;
     EXPECT_EQ(o.closed, expected_closed[i]) << o.type;
     for (uint32_t t = o.first_triangle; t < o.first_triangle + o.triangle_count; ++t) {
-      EXPECT_EQ(s.triangles.object_id[t], i);
-      EXPECT_EQ(s.triangles.material_id[t], o.material);
+      EXPECT_EQ(s.triangles->object_id[t], i);
+      EXPECT_EQ(s.triangles->material_id[t], o.material);
     }
     first += o.triangle_count;
   }
-  EXPECT_EQ(s.triangles.triangle_count(), first);
-  EXPECT_EQ(s.triangles.positions.size(), 3 * first);
-  EXPECT_EQ(s.triangles.normals.size(), 3 * first);
+  EXPECT_EQ(s.triangles->triangle_count(), first);
+  EXPECT_EQ(s.triangles->positions.size(), 3 * first);
+  EXPECT_EQ(s.triangles->normals.size(), 3 * first);
   EXPECT_EQ(s.dropped_triangles, 0u);
   EXPECT_EQ(s.objects[2].material, 1u);  // the box is the mirror
   // The knot stand-in: a unit cube scaled by 0.5 has volume 1/8, wherever it is turned.
@@ -466,7 +466,7 @@ TEST(SceneLoadGeometry, ZeroAreaTrianglesAreDroppedAndCounted) {
   EXPECT_EQ(s.dropped_triangles, 4u);  // collinear, repeated vertex, half the quad, overflow
   const uint32_t expected[6] = {0, 0, 1, 0, 1, 1};
   for (size_t i = 0; i < 6; ++i) EXPECT_EQ(s.objects[i].triangle_count, expected[i]) << i;
-  EXPECT_EQ(s.triangles.triangle_count(), 3u);
+  EXPECT_EQ(s.triangles->triangle_count(), 3u);
   EXPECT_FALSE(s.objects[0].closed);
 }
 
@@ -484,7 +484,7 @@ TEST(SceneLoadGeometry, BoxIsClosedWithOutwardFlatNormals) {
     EXPECT_GT(glm::dot(n, mid - center), 0.0) << t;                               // outward
     EXPECT_NEAR(std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z), 1.0, 1e-12);    // axis-aligned
     for (int k = 0; k < 3; ++k) {
-      EXPECT_NEAR(glm::length(glm::dvec3(s.triangles.normals[3 * t + static_cast<size_t>(k)]) - n), 0.0, 1e-6);
+      EXPECT_NEAR(glm::length(glm::dvec3(s.triangles->normals[3 * t + static_cast<size_t>(k)]) - n), 0.0, 1e-6);
     }
   }
 }
@@ -508,7 +508,7 @@ TEST(SceneLoadGeometry, SphereIsClosedWithOutwardSmoothNormals) {
       const glm::dvec3 g = geometric_normal(s, t);
       for (int k = 0; k < 3; ++k) {
         const glm::dvec3 p = corner(s, t, k);
-        const glm::dvec3 n(s.triangles.normals[3 * t + static_cast<size_t>(k)]);
+        const glm::dvec3 n(s.triangles->normals[3 * t + static_cast<size_t>(k)]);
         EXPECT_NEAR(glm::length(p - c), 2.0, 1e-5);
         EXPECT_NEAR(glm::length(n - glm::normalize(p - c)), 0.0, 1e-5);
         EXPECT_GT(glm::dot(n, g), 0.0);  // smooth and geometric normals agree on outside
@@ -524,13 +524,13 @@ TEST(SceneLoadGeometry, TransformScalesThenRotatesXYZThenTranslates) {
   // about z: (12,6,-2); translated by (10,20,30): (22,26,28).
   const SceneData s = load_text(with_objects(R"([{"type": "triangle", "vertices": [[1,2,3],[2,2,3],[1,3,3]],
       "transform": {"scale": [2,3,4], "rotate_deg": [90,90,90], "translate": [10,20,30]}}])").str());
-  ASSERT_EQ(s.triangles.triangle_count(), 1u);
+  ASSERT_EQ(s.triangles->triangle_count(), 1u);
   const glm::dvec3 p = corner(s, 0, 0);
   EXPECT_NEAR(p.x, 22, 1e-5);
   EXPECT_NEAR(p.y, 26, 1e-5);
   EXPECT_NEAR(p.z, 28, 1e-5);
   // The triangle's normal +z goes through the same rotations: z -> -y -> -y -> +x.
-  const glm::dvec3 n(s.triangles.normals[0]);
+  const glm::dvec3 n(s.triangles->normals[0]);
   EXPECT_NEAR(glm::length(n - glm::dvec3(1, 0, 0)), 0.0, 1e-6);
   EXPECT_NEAR(glm::length(geometric_normal(s, 0) - glm::dvec3(1, 0, 0)), 0.0, 1e-6);
 }
@@ -552,7 +552,7 @@ TEST(SceneLoadGeometry, MirroringTransformKeepsNormalsOutward) {
   for (size_t t = e.first_triangle; t < e.first_triangle + e.triangle_count; ++t) {
     for (int k = 0; k < 3; ++k) {
       const glm::dvec3 p = corner(s, t, k);
-      const glm::dvec3 n(s.triangles.normals[3 * t + static_cast<size_t>(k)]);
+      const glm::dvec3 n(s.triangles->normals[3 * t + static_cast<size_t>(k)]);
       EXPECT_NEAR(glm::length(n - glm::normalize(glm::dvec3(p.x / 4, p.y, p.z))), 0.0, 1e-5);
     }
   }
@@ -591,14 +591,14 @@ TEST(SceneLoadMesh, MtlMaterialsAreUsedWithoutObjectMaterial) {
   // Upper faces red, lower faces blue.
   for (uint32_t t = o.first_triangle; t < o.first_triangle + o.triangle_count; ++t) {
     const glm::dvec3 mid = (corner(s, t, 0) + corner(s, t, 1) + corner(s, t, 2)) / 3.0;
-    EXPECT_EQ(s.materials[s.triangles.material_id[t]].name,
+    EXPECT_EQ(s.materials[s.triangles->material_id[t]].name,
               mid.y > 0 ? "meshes/octahedron.obj:red" : "meshes/octahedron.obj:blue");
   }
   // An object material overrides the MTL, which then adds no materials.
   const SceneData named = load_text(
       with_objects(R"([{"type": "mesh", "file": "meshes/octahedron.obj", "material": "m"}])").str(), dir);
   EXPECT_EQ(named.materials.size(), 2u);
-  for (uint32_t id : named.triangles.material_id) EXPECT_EQ(named.materials[id].name, "m");
+  for (uint32_t id : named.triangles->material_id) EXPECT_EQ(named.materials[id].name, "m");
 }
 
 TEST(SceneLoadMesh, MeshWithoutMaterialsGetsTheDefault) {
@@ -641,7 +641,7 @@ f 4//1 1//1 5//1
   for (uint32_t t = pyramid.first_triangle; t < pyramid.first_triangle + pyramid.triangle_count; ++t) {
     const glm::dvec3 g = geometric_normal(s, t);
     for (int k = 0; k < 3; ++k) {
-      const glm::vec3 n = s.triangles.normals[3 * t + static_cast<size_t>(k)];
+      const glm::vec3 n = s.triangles->normals[3 * t + static_cast<size_t>(k)];
       EXPECT_EQ(n, glm::vec3(0, g.y > 0 ? 1 : -1, 0)) << t;
     }
   }
@@ -678,10 +678,10 @@ TEST(SceneLoadMesh, BadObjIndicesAreErrors) {
 
 TEST(Tessellate, ClosedSurfaceNeedsConsistentOrientation) {
   SceneData s = load_text(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1]}])").str());
-  EXPECT_TRUE(is_closed_surface(s.triangles, 0, 12));
-  EXPECT_FALSE(is_closed_surface(s.triangles, 0, 11));  // a hole
-  std::swap(s.triangles.positions[1], s.triangles.positions[2]);  // one face turned over
-  EXPECT_FALSE(is_closed_surface(s.triangles, 0, 12));
+  EXPECT_TRUE(is_closed_surface(*s.triangles, 0, 12));
+  EXPECT_FALSE(is_closed_surface(*s.triangles, 0, 11));  // a hole
+  std::swap(s.triangles.edit().positions[1], s.triangles.edit().positions[2]);  // one face turned over
+  EXPECT_FALSE(is_closed_surface(*s.triangles, 0, 12));
 }
 
 // ---- Memory estimate -------------------------------------------------------------------
@@ -719,7 +719,7 @@ TEST(RepositoryScenes, AllLoad) {
       SCOPED_TRACE(entry.path().string());
       SceneData s;
       EXPECT_NO_THROW(s = load_scene(entry.path().string()));
-      EXPECT_GT(s.triangles.triangle_count(), 0u);
+      EXPECT_GT(s.triangles->triangle_count(), 0u);
       EXPECT_FALSE(s.lights.empty());
       EXPECT_EQ(s.dropped_triangles, 0u);
       ++count;
@@ -727,7 +727,7 @@ TEST(RepositoryScenes, AllLoad) {
   }
   EXPECT_GE(count, 5);
   const SceneData bench = load_scene((root / "bench/spheres_terrain.json").string());
-  EXPECT_GE(bench.triangles.triangle_count(), 100000u);
+  EXPECT_GE(bench.triangles->triangle_count(), 100000u);
 }
 
 // Exact ray-triangle intersection (Moller-Trumbore 1997); returns the distance or -1.

@@ -562,7 +562,7 @@ TEST(SearchDegenerate, GrazingReflectionDoesNotFindItsOwnSurface) {
       for (const SearchOptions& o : {SearchOptions(), thesis}) {
         const SearchResult res = reflection_search(*world->ctx, w, r, o);
         EXPECT_TRUE(res.hit);
-        EXPECT_NE(world->scene.triangles.object_id[res.triangle], 1u) << angle << " " << k;
+        EXPECT_NE(world->scene.triangles->object_id[res.triangle], 1u) << angle << " " << k;
       }
       EXPECT_TRUE(matches_tracer(*world, {w, r, {0, 0, 1}})) << angle << " " << k;
     }
@@ -641,7 +641,7 @@ TEST(MeshRefine, ClosedMeshesAreLinkedAcrossEveryEdgeAndObjectsAreNot) {
   add_flat_triangle(s, {-3, -2, 0}, {-2, -2, 0}, {-2, -1, 0});
   add_flat_triangle(s, {-3, -2, 0}, {-2, -1, 0}, {-3, -1, 0});
   const auto w = make_world(s, 8, true);
-  const TriangleSoup& t = w->scene.triangles;
+  const TriangleSoup& t = *w->scene.triangles;
   size_t border = 0;
   for (uint32_t k = 0; k < t.triangle_count(); ++k) {
     for (int e = 0; e < 3; ++e) {

@@ -40,7 +40,7 @@ inline uint32_t new_object(SceneData& s, const char* type, uint32_t material = 0
   SceneObject o;
   o.type = type;
   o.material = material;
-  o.first_triangle = static_cast<uint32_t>(s.triangles.triangle_count());
+  o.first_triangle = static_cast<uint32_t>(s.triangles->triangle_count());
   s.objects.push_back(o);
   return static_cast<uint32_t>(s.objects.size() - 1);
 }
@@ -49,11 +49,11 @@ inline uint32_t new_object(SceneData& s, const char* type, uint32_t material = 0
 inline void push_triangle(SceneData& s, uint32_t object, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
   const glm::vec3 n = glm::normalize(glm::cross(glm::vec3(b - a), glm::vec3(c - a)));
   for (const glm::dvec3& p : {a, b, c}) {
-    s.triangles.positions.push_back(glm::vec3(p));
-    s.triangles.normals.push_back(n);
+    s.triangles.edit().positions.push_back(glm::vec3(p));
+    s.triangles.edit().normals.push_back(n);
   }
-  s.triangles.object_id.push_back(object);
-  s.triangles.material_id.push_back(s.objects[object].material);
+  s.triangles.edit().object_id.push_back(object);
+  s.triangles.edit().material_id.push_back(s.objects[object].material);
   s.objects[object].triangle_count++;
 }
 
