@@ -1,14 +1,10 @@
 #include "base/error.hpp"
 
-#include <cstdio>
-#include <cstdlib>
-
 namespace abcube {
 
 void check_failed(const char* expr, const char* file, int line, const std::string& detail) {
-  std::fprintf(stderr, "abcube: internal check failed: %s at %s:%d: %s\n", expr, file, line,
-               detail.c_str());
-  std::abort();
+  throw InternalError(std::string("internal check failed: ") + expr + " at " + file + ":" + std::to_string(line) +
+                      ": " + detail);
 }
 
 }  // namespace abcube
