@@ -6,21 +6,12 @@
 
 namespace abcube {
 
-// Writes atomically: a temporary file in the same folder, then rename, so a failure never
-// leaves a truncated file nor destroys an old one. Linear colour in; 8- and 16-bit
-// formats are written sRGB-encoded, float formats (EXR, HDR, float TIFF) linear.
-// Throws InputError for an extension no writer handles, RuntimeFailure for I/O errors.
-void write_image(const std::string& path, const Image& image);
-
-// Reads an image as linear float RGB(A) (sRGB-decoded when the file is 8/16-bit).
-// Throws InputError naming the file when it cannot be read.
-Image read_image(const std::string& path);
+// write_image, read_image and image_format_supported: <abcube/image.hpp> (included by
+// io/image.hpp). write_image throws InputError for an extension no writer handles,
+// RuntimeFailure for I/O errors.
 
 // Writes bytes to `path` atomically (temporary + rename). Throws RuntimeFailure.
 void write_text_atomic(const std::string& path, const std::string& text);
-
-// True if OpenImageIO has a writer for this file name's extension.
-bool image_format_supported(const std::string& path);
 
 float srgb_encode(float linear);
 float srgb_decode(float encoded);

@@ -29,16 +29,8 @@
 
 namespace abcube {
 
-struct ImageError {
-  double rmse = 0;
-  double psnr = 0;  // +inf when rmse == 0
-  double max_abs = 0;
-  double share_over_1 = 0;  // in [0, 1]
-  double share_over_2 = 0;
-};
-
-// Throws InputError when the sizes differ (naming both).
-ImageError image_error(const Image& a, const Image& b);
+// ImageError and image_error(a, b): <abcube/image.hpp>. Throws InputError when the
+// sizes differ (naming both).
 
 // Share of pixels whose largest displayed channel |d| exceeds `threshold` (idiff's
 // -fail; the same 1e-6 slack as share_over_1/2). Throws InputError when sizes differ.
