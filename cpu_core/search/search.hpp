@@ -191,13 +191,13 @@ class SearchContext {
   // What the MESH REFINEMENT tests per triangle, relative to the centre: the in-plane
   // inward unit normals of its edges (edge k from vertex k to k+1) with their offsets, and
   // a bounding sphere (centroid, largest vertex distance). Zero for a degenerate triangle.
-  struct Bounds {
+  struct TriangleBounds {
     std::array<glm::dvec3, 3> edge_normal{};
     std::array<double, 3> edge_offset{};
     glm::dvec3 centroid{0.0};
     double radius = 0;
   };
-  const Bounds& bounds(uint32_t triangle) const { return bounds_[triangle]; }
+  const TriangleBounds& triangle_bounds(uint32_t triangle) const { return bounds_[triangle]; }
   // The vertices of a triangle relative to the centre.
   glm::dvec3 vertex(uint32_t triangle, int k) const;
   // The triangle across edge k (vertices k, k+1) of `triangle`: same object, the same two
@@ -227,7 +227,7 @@ class SearchContext {
   const SceneData* scene_;
   const CubeABuffer* cube_;
   std::vector<Plane> planes_;
-  std::vector<Bounds> bounds_;
+  std::vector<TriangleBounds> bounds_;
   std::vector<uint32_t> zero_area_;
   std::shared_ptr<const MeshNeighbours> neighbours_;
   // Per face and row j: the smallest and largest column holding a fragment over rows

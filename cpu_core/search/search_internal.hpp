@@ -1,0 +1,95 @@
+// Internal to the search stage (search.hpp): what its files share. One search's ray,
+// the walk's counts, one fragment's answer (a candidate), the mesh refinement's answer, and
+// the functions one file defines for the others. Not part of the stage's API.
+#pragma once
+#include <cstdint>
+#include <limits>
+
+#include <glm/glm.hpp>
+
+#include "raster/abuffer.hpp"
+#include "search/cube_walk.hpp"
+#include "search/search.hpp"
+
+namespace abcube::detail {
+
+constexpr double INF = std::numeric_limits<double>::infinity();
+// A refined point this close to its triangle (in texels) is on it: rounding, not tolerance.
+constexpr double ON_TRIANGLE_TEXELS = 1e-6;
+
+// One search's ray, relative to the cube centre.
+struct SearchRay {
+  glm::dvec3 w{0.0}, d{0.0};  // origin and unit direction
+  double l_max = INF;         // end of the ray (shadow segments)
+  double self = 0;            // self offset in world units (header, SELF-HITS)
+  double self_tolerance = 0;  // nearest tolerance candidate accepted, world units (SELF-HITS)
+  bool restrict_object = false;
+  uint32_t object = 0;
+};
+
+// What the walk over the map saw of one ray.
+struct ScanCounts {
+  uint32_t texels = 0, fragments = 0, candidates = 0;
+  bool aborted = false;
+};
+
+// One fragment's answer for a ray.
+struct Candidate {
+  bool valid = false;
+  bool exact = false;   // crossing mode: the refined point is on the triangle
+  bool tested = false;  // crossing mode: a refined point in the texel was measured
+  double l = INF;       // crossing: ray parameter; thesis: projection of X' - W on the ray
+  double angle = INF;   // thesis: angle between the ray and X' - W
+  double outside = 0;   // crossing: distance from the triangle, in texels
+  glm::dvec3 x{0.0};    // X', relative to the centre
+  const Fragment* fragment = nullptr;
+  uint32_t triangle = 0;   // the surface found: the fragment's triangle or, refined on the mesh, the one crossed
+  bool back_face = false;  // its facing as seen from the centre (abuffer.hpp)
+  CubeTexel texel{0, 0, 0};
+};
+
+// Where the ray meets triangle `tri`'s plane: l (INF when parallel or degenerate) and the
+// edge whose line the point lies furthest outside of, in the plane, by more than
+// ON_TRIANGLE_TEXELS (-1: on the triangle; near a corner this admits up to the tolerance
+// times 1/sin(corner angle / 2)).
+struct PlaneCrossing {
+  double l = INF;
+  int outside_edge = -1;
+};
+
+// The crossing of the ray with triangle `tri`'s plane (search_refine.cpp).
+PlaneCrossing plane_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri);
+
+// MESH REFINEMENT (crossing mode; header). The answer of the mesh around a fragment's
+// triangle when the ray does not cross that triangle itself.
+enum class Refined { hit, miss, unknown };
+struct MeshAnswer {
+  Refined result = Refined::unknown;
+  uint32_t triangle = 0;
+  double l = INF;
+};
+
+// MESH REFINEMENT: the crossing of the ray with the mesh around `start` (search_refine.cpp).
+MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t start, double l_lo, double l_hi,
+                          double radius);
+
+// A fragment's candidate in crossing mode (header, MODE crossing) and in thesis mode
+// (thesis 7.4.1, 9.3.4) (search_candidates.cpp).
+Candidate crossing_candidate(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o, const WalkTexel& t,
+                             const Fragment& f);
+Candidate thesis_candidate(const SearchContext& ctx, const SearchRay& q, const WalkTexel& t, const Fragment& f,
+                           const glm::dvec3& v);
+
+// Does the exact ray meet a triangle the map cannot hold before parameter l_end?
+bool meets_zero_area(const SearchContext& ctx, const SearchRay& q, double l_end);
+
+// The answer: the chosen candidate or a miss (`miss` unless the walk was aborted); a surface
+// the map cannot hold met before it turns it into a zero-area miss.
+SearchResult finish(const SearchContext& ctx, const SearchRay& q, const Candidate* best, MissReason miss,
+                    const ScanCounts& counts);
+
+// The ray of a search from W (world space) along unit `dir`, with the self offsets of `o`.
+SearchRay make_query(const SearchContext& ctx, const glm::dvec3& w_world, const glm::dvec3& dir,
+                     const SearchOptions& o);
+
+}  // namespace abcube::detail

@@ -1,0 +1,150 @@
+// The three searches (search.hpp): reflection, refraction exit and shadow, each a walk of
+// the map (search_scan.hpp) with its own rule for which candidate answers.
+#include <algorithm>
+#include <vector>
+
+#include "search/search_scan.hpp"
+#include "shading/shading.hpp"
+
+namespace abcube {
+
+namespace {
+
+using namespace detail;
+
+// Crossing mode: the first crossing, exact ones first (header).
+SearchResult search_crossing(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o) {
+  Candidate exact, near;
+  bool rejected = false;
+  int64_t first = -1;
+  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3&) {
+    const Candidate c = crossing_candidate(ctx, q, o, t, f);
+    if (!c.valid) {
+      rejected = rejected || (c.tested && c.outside > o.tolerance_texels);
+      return;
+    }
+    Candidate& best = c.exact ? exact : near;
+    if (c.l < best.l) best = c;
+  };
+  const auto after_texel = [&](const WalkTexel& t, uint32_t index) {
+    const double best_l = std::min(exact.l, near.l);
+    if (best_l == INF) return true;
+    if (first < 0) first = index;
+    return index < first + CROSSING_WINDOW_TEXELS || t.l1 <= best_l;
+  };
+  const ScanCounts counts = scan(ctx, q, o, on_fragment, after_texel, [&] { return first < 0; });
+  const Candidate& best = exact.fragment ? exact : near;
+  return finish(ctx, q, best.fragment ? &best : nullptr,
+                rejected ? MissReason::threshold_rejection : MissReason::no_crossing, counts);
+}
+
+// Thesis mode: the smallest angle over the first candidates under theta_max (header).
+SearchResult search_thesis(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o) {
+  Candidate best;
+  int64_t first = -1;
+  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v) {
+    const Candidate c = thesis_candidate(ctx, q, t, f, v);
+    if (c.valid && c.angle < best.angle) best = c;
+  };
+  const auto after_texel = [&](const WalkTexel&, uint32_t index) {
+    if (first < 0 && best.angle <= o.theta_max) first = index;
+    return first < 0 || index < first + THESIS_WINDOW_TEXELS;
+  };
+  const ScanCounts counts = scan(ctx, q, o, on_fragment, after_texel, [&] { return first < 0; });
+  const bool accepted = best.fragment && best.angle <= o.theta_max;
+  SearchResult r = finish(ctx, q, accepted ? &best : nullptr,
+                          best.fragment ? MissReason::threshold_rejection : MissReason::no_crossing, counts);
+  if (!accepted) r.angle = best.angle;  // the best approximator's angle, for diagnostics
+  return r;
+}
+
+SearchResult search_ray(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o) {
+  return o.mode == SearchMode::thesis ? search_thesis(ctx, q, o) : search_crossing(ctx, q, o);
+}
+
+// A surface already counted on a shadow segment.
+struct ShadowCrossing {
+  uint32_t triangle, object;
+  bool back_face;
+  glm::dvec3 x;
+  double l;
+};
+
+// Is c the same surface crossing as one already counted? The same triangle always (a plane
+// is crossed once); in crossing mode the same object and facing within (tolerance + 1)
+// texels (a shared edge, or one surface found in two texels); in thesis mode the same
+// object and facing anywhere on the segment (its points under theta_max spread along a
+// grazing surface, so a concave transparent object crossed twice with one facing counts once).
+bool already_counted(const std::vector<ShadowCrossing>& counted, const SearchContext& ctx, const SearchOptions& o,
+                     const Candidate& c) {
+  const uint32_t tri = c.triangle;
+  const uint32_t object = ctx.scene().triangles->object_id[tri];
+  const double near = (o.tolerance_texels + 1.0) * texel_size_at(c.x, ctx.cube().n);
+  for (const ShadowCrossing& k : counted) {
+    if (k.triangle == tri) return true;
+    if (k.object != object || k.back_face != c.back_face) continue;
+    if (o.mode == SearchMode::thesis || glm::length(k.x - c.x) <= near) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+SearchResult reflection_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& r,
+                               const SearchOptions& options) {
+  return search_ray(ctx, make_query(ctx, w, r, options), options);
+}
+
+SearchResult refraction_exit_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& t,
+                                    uint32_t object_id, const SearchOptions& options) {
+  SearchRay q = make_query(ctx, w, t, options);
+  q.restrict_object = true;
+  q.object = object_id;
+  return search_ray(ctx, q, options);
+}
+
+ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const glm::dvec3& light_position,
+                           const SearchOptions& options) {
+  ShadowResult res;
+  const glm::dvec3 seg = light_position - p;
+  const double len = glm::length(seg);
+  if (!(len > 0.0)) return res;
+  SearchRay q = make_query(ctx, p, seg / len, options);
+  q.l_max = len;
+  std::vector<ShadowCrossing> counted;
+  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v) {
+    if (res.blocked) return;
+    const Candidate c = options.mode == SearchMode::thesis ? thesis_candidate(ctx, q, t, f, v)
+                                                           : crossing_candidate(ctx, q, options, t, f);
+    const bool accepted = options.mode == SearchMode::thesis ? c.valid && c.angle <= options.theta_max : c.valid;
+    if (!accepted || !(c.l < len)) {
+      if (c.l < len && (options.mode == SearchMode::thesis ? c.valid : c.tested)) {
+        ++res.threshold_rejections;
+      }
+      return;
+    }
+    if (already_counted(counted, ctx, options, c)) return;
+    const uint32_t tri = c.triangle;
+    counted.push_back({tri, ctx.scene().triangles->object_id[tri], c.back_face, c.x, c.l});
+    // thesis 8.3; rule "shadows" (shading.hpp): S_l is the product over the blockers.
+    res.transmittance *= blocker_transmittance(ctx.scene().materials[ctx.scene().triangles->material_id[tri]]);
+    res.blocked = res.transmittance == glm::dvec3(0.0);
+  };
+  const auto after_texel = [&](const WalkTexel&, uint32_t) { return !res.blocked; };
+  const ScanCounts counts = scan(ctx, q, options, on_fragment, after_texel, [] { return true; });
+  res.blockers = static_cast<uint32_t>(counted.size());
+  if (!counted.empty()) {
+    res.first_blocker = std::min_element(counted.begin(), counted.end(), [](const ShadowCrossing& a,
+                                                                            const ShadowCrossing& b) {
+                          return a.l < b.l;
+                        })->triangle;
+  }
+  res.aborted = counts.aborted;
+  res.zero_area = meets_zero_area(ctx, q, len);
+  res.texels_visited = counts.texels;
+  res.fragments_tested = counts.fragments;
+  res.candidates = counts.candidates;
+  return res;
+}
+
+}  // namespace abcube

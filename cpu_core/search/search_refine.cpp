@@ -1,0 +1,125 @@
+// MESH REFINEMENT (search.hpp): the exact crossing of a ray with the mesh around a
+// fragment's triangle, first straight across the edges, then breadth-first.
+#include <algorithm>
+#include <array>
+
+#include "search/search_internal.hpp"
+
+namespace abcube {
+namespace detail {
+
+PlaneCrossing plane_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri) {
+  PlaneCrossing c;
+  const SearchContext::Plane& p = ctx.plane(tri);
+  const SearchContext::TriangleBounds& b = ctx.triangle_bounds(tri);
+  const double den = glm::dot(p.normal, q.d);
+  if (den == 0.0 || !(b.radius > 0.0)) return c;
+  c.l = (p.offset - glm::dot(p.normal, q.w)) / den;
+  const glm::dvec3 x = q.w + c.l * q.d;
+  double worst = -ON_TRIANGLE_TEXELS * texel_size_at(x, ctx.cube().n);
+  for (int k = 0; k < 3; ++k) {
+    const double outside = glm::dot(b.edge_normal[static_cast<size_t>(k)], x) - b.edge_offset[static_cast<size_t>(k)];
+    if (outside < worst) {
+      worst = outside;
+      c.outside_edge = k;
+    }
+  }
+  return c;
+}
+
+namespace {
+
+// The exact crossing of the ray with triangle `tri` (on the triangle, l in [self, l_max]):
+// its parameter l, or INF.
+double exact_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri) {
+  const PlaneCrossing c = plane_crossing(ctx, q, tri);
+  return c.outside_edge < 0 && c.l >= q.self && c.l <= q.l_max ? c.l : INF;
+}
+
+// Does a triangle's bounding sphere come within `radius` of the ray's stretch [l_lo, l_hi]?
+bool near_ray(const SearchContext::TriangleBounds& b, const SearchRay& q, double l_lo, double l_hi, double radius) {
+  const double along = std::clamp(glm::dot(b.centroid - q.w, q.d), l_lo, l_hi);
+  const glm::dvec3 off = b.centroid - (q.w + along * q.d);
+  const double reach = b.radius + radius;
+  return glm::dot(off, off) <= reach * reach;
+}
+
+}  // namespace
+
+// Floods the edge-connected triangles of `start` that come within `radius` of the ray's
+// stretch [l_lo, l_hi] (bounding spheres), testing each for an exact crossing: hit (the
+// smallest l), miss (the flood ended with none), or unknown (more than
+// REFINE_MAX_TRIANGLES triangles were near: the caller falls back on the plane tolerance).
+MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t start, double l_lo, double l_hi,
+                          double radius) {
+  MeshAnswer a;
+  // A start triangle away from the ray: the mesh near the ray may be elsewhere in the
+  // fragment's patch (merged), the flood cannot say.
+  if (!near_ray(ctx.triangle_bounds(start), q, l_lo, l_hi, radius)) return a;
+  // First the straight way: from triangle to triangle across the edge the ray's crossing
+  // of the current plane lies furthest outside of, while the next is near the ray. On a
+  // smooth patch this reaches the triangle crossed in a few steps.
+  uint32_t walker = start;
+  for (size_t step = 0; step < REFINE_MAX_TRIANGLES; ++step) {
+    const PlaneCrossing c = plane_crossing(ctx, q, walker);
+    if (c.l == INF) break;
+    if (c.outside_edge < 0) {  // on this triangle
+      if (c.l >= q.self && c.l <= q.l_max) {
+        a.result = Refined::hit;
+        a.triangle = walker;
+        a.l = c.l;
+        return a;
+      }
+      break;
+    }
+    const uint32_t nb = ctx.neighbour(walker, c.outside_edge);
+    if (nb == SearchContext::NO_NEIGHBOUR || !near_ray(ctx.triangle_bounds(nb), q, l_lo, l_hi, radius)) break;
+    walker = nb;
+  }
+  // Then every triangle near the ray, breadth-first.
+  std::array<uint32_t, REFINE_MAX_TRIANGLES> seen{};
+  size_t count = 0, next = 0;
+  seen[count++] = start;
+  bool overflow = false;
+  while (next < count) {
+    const uint32_t tri = seen[next++];
+    const double l = exact_crossing(ctx, q, tri);
+    if (l < a.l) {
+      a.l = l;
+      a.triangle = tri;
+      if (tri == start) break;  // the ray crosses the start triangle itself
+    }
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t nb = ctx.neighbour(tri, k);
+      const auto seen_end = seen.begin() + static_cast<std::ptrdiff_t>(count);
+      if (nb == SearchContext::NO_NEIGHBOUR || std::find(seen.begin(), seen_end, nb) != seen_end) continue;
+      if (!near_ray(ctx.triangle_bounds(nb), q, l_lo, l_hi, radius)) continue;
+      if (count == seen.size()) {
+        overflow = true;
+        continue;
+      }
+      seen[count++] = nb;
+    }
+  }
+  if (a.l < INF) a.result = Refined::hit;
+  else a.result = overflow ? Refined::unknown : Refined::miss;
+  return a;
+}
+
+}  // namespace detail
+
+bool mesh_crossing(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& dir, uint32_t triangle,
+                   double l_near, double radius, uint32_t* crossed, double* l) {
+  using namespace detail;
+  SearchRay q;
+  q.w = w - ctx.cube().centre;
+  q.d = dir;
+  q.self = -INF;
+  const MeshAnswer m = refine_on_mesh(ctx, q, triangle, l_near - radius, l_near + radius, radius);
+  if (m.result != Refined::hit) return false;
+  *crossed = m.triangle;
+  *l = m.l;
+  return true;
+}
+
+}  // namespace abcube

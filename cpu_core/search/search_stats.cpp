@@ -1,0 +1,91 @@
+// Counters of the searches (search.hpp SearchKindStats, SearchStats), the options'
+// names and the self offset each mode defaults to.
+#include <algorithm>
+
+#include "search/search.hpp"
+
+namespace abcube {
+
+double self_offset_texels(const SearchOptions& o) {
+  if (o.self_offset_texels > 0.0) return o.self_offset_texels;
+  return o.mode == SearchMode::thesis ? SELF_OFFSET_THESIS_TEXELS : SELF_OFFSET_CROSSING_TEXELS;
+}
+
+const char* search_mode_name(SearchMode m) { return m == SearchMode::thesis ? "thesis" : "crossing"; }
+
+bool parse_search_mode(const std::string& s, SearchMode* out) {
+  if (s == "crossing") *out = SearchMode::crossing;
+  else if (s == "thesis") *out = SearchMode::thesis;
+  else return false;
+  return true;
+}
+
+const char* search_refine_name(SearchRefine r) { return r == SearchRefine::plane ? "plane" : "mesh"; }
+
+bool parse_search_refine(const std::string& s, SearchRefine* out) {
+  if (s == "mesh") *out = SearchRefine::mesh;
+  else if (s == "plane") *out = SearchRefine::plane;
+  else return false;
+  return true;
+}
+
+const char* miss_reason_name(MissReason r) {
+  switch (r) {
+    case MissReason::none: return "none";
+    case MissReason::no_crossing: return "no_crossing";
+    case MissReason::threshold_rejection: return "threshold_rejection";
+    case MissReason::zero_area_surface: return "zero_area_surface";
+    case MissReason::aborted: return "aborted";
+  }
+  return "?";
+}
+
+void SearchKindStats::add(const SearchResult& r) {
+  ++rays;
+  texels += r.texels_visited;
+  max_texels = std::max<uint64_t>(max_texels, r.texels_visited);
+  fragments += r.fragments_tested;
+  candidates += r.candidates;
+  if (r.hit) {
+    ++hits;
+    return;
+  }
+  ++misses;
+  threshold_rejections += r.miss == MissReason::threshold_rejection;
+  zero_area += r.miss == MissReason::zero_area_surface;
+  aborted += r.miss == MissReason::aborted;
+}
+
+void SearchKindStats::add(const ShadowResult& r) {
+  ++rays;
+  texels += r.texels_visited;
+  max_texels = std::max<uint64_t>(max_texels, r.texels_visited);
+  fragments += r.fragments_tested;
+  candidates += r.candidates;
+  if (r.blockers > 0) ++hits;
+  else ++misses;
+  threshold_rejections += r.blockers == 0 && r.threshold_rejections > 0;
+  zero_area += r.zero_area;
+  aborted += r.aborted;
+}
+
+void SearchKindStats::merge(const SearchKindStats& o) {
+  rays += o.rays;
+  texels += o.texels;
+  max_texels = std::max(max_texels, o.max_texels);
+  fragments += o.fragments;
+  candidates += o.candidates;
+  hits += o.hits;
+  misses += o.misses;
+  threshold_rejections += o.threshold_rejections;
+  zero_area += o.zero_area;
+  aborted += o.aborted;
+}
+
+void SearchStats::merge(const SearchStats& o) {
+  reflection.merge(o.reflection);
+  refraction_exit.merge(o.refraction_exit);
+  shadow.merge(o.shadow);
+}
+
+}  // namespace abcube
