@@ -7,16 +7,31 @@
 
 namespace abcube {
 
+// What a scene may ask of the machine that loads it (a server loading scenes it did not
+// write): where its files may be, and how many triangles it may hold.
+struct LoadLimits {
+  // Empty: any file. Otherwise every file the scene reads (the scene itself, OBJ meshes,
+  // the MTL files they name) must resolve, symbolic links and ".." included, inside this
+  // folder; one that does not is an InputError naming the field.
+  std::string root;
+  // 0: no cap (beyond the loader's own). Otherwise a scene with more triangles is refused
+  // with an InputError naming the count and the cap, before its triangles are made.
+  uint64_t max_triangles = 0;
+};
+
 // Parses, validates, tessellates and transforms. Throws InputError with one line that
 // names the place: "FILE:LINE:COL: ..." for JSON syntax, "FILE: objects[3].radius: ..."
 // for values. Unknown fields, NaN/inf, degenerate cameras, missing mesh files, unknown
 // materials and out-of-range weights are errors; zero-area triangles are dropped and
 // counted in SceneData::dropped_triangles.
 SceneData load_scene(const std::string& path);
+SceneData load_scene(const std::string& path, const LoadLimits& limits);
 
 // Same, from text already in memory; `name` stands for the file in messages and
 // `base_dir` resolves relative mesh paths.
 SceneData load_scene_text(const std::string& text, const std::string& name, const std::string& base_dir);
+SceneData load_scene_text(const std::string& text, const std::string& name, const std::string& base_dir,
+                          const LoadLimits& limits);
 
 // Bytes a render of this scene needs at its camera size and cube resolution (images,
 // cube faces, triangles); throws InputError naming the sizes when it exceeds

@@ -773,5 +773,119 @@ TEST(RepositoryScenes, HiddenPointSeenOnlyInTheMirror) {
   EXPECT_GT(hidden_but_reflected, seen_in_mirror / 5) << seen_in_mirror;
 }
 
+// ---- Load limits (LoadLimits: a root folder, a triangle cap) -----------------------------
+
+// The message of the InputError that loading the scene file `path` under `limits` raises.
+std::string limited_load_error(const std::string& path, const LoadLimits& limits) {
+  try {
+    load_scene(path, limits);
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    return m;
+  }
+  ADD_FAILURE() << "no InputError for " << path;
+  return "";
+}
+
+// A scene file in `root`/scenes/ whose one object is the mesh `file`.
+std::string mesh_scene(const TempDir& dir, const std::string& file) {
+  return dir.write("root/scenes/scene.json",
+                   with_objects(R"([{"type": "mesh", "file": ")" + file + R"(", "material": "white"}])").str());
+}
+
+TEST(SceneLoadLimits, MeshInsideTheRootIsAccepted) {
+  TempDir dir;
+  dir.write("root/meshes/cube.obj", CUBE_OBJ);
+  const std::string scene = mesh_scene(dir, "../meshes/cube.obj");
+  LoadLimits limits;
+  limits.root = (dir.path() / "root").string();
+  const SceneData s = load_scene(scene, limits);
+  EXPECT_EQ(s.objects.size(), 1u);
+  EXPECT_EQ(s.triangles->triangle_count(), 12u);
+}
+
+TEST(SceneLoadLimits, MeshOutsideTheRootIsRefusedWithItsField) {
+  TempDir dir;
+  dir.write("outside/cube.obj", CUBE_OBJ);
+  const std::string scene = mesh_scene(dir, "../../outside/cube.obj");
+  LoadLimits limits;
+  limits.root = (dir.path() / "root").string();
+  const std::string root = fs::canonical(limits.root).string();
+  EXPECT_EQ(limited_load_error(scene, limits),
+            scene + ": objects[0].file: '../../outside/cube.obj' resolves outside --root " + root);
+  // Without a root the same scene loads.
+  EXPECT_EQ(load_scene(scene).triangles->triangle_count(), 12u);
+}
+
+TEST(SceneLoadLimits, SymlinkEscapingTheRootIsRefused) {
+  TempDir dir;
+  dir.write("outside/cube.obj", CUBE_OBJ);
+  fs::create_directories(dir.path() / "root" / "meshes");
+  fs::create_symlink(dir.path() / "outside" / "cube.obj", dir.path() / "root" / "meshes" / "link.obj");
+  const std::string scene = mesh_scene(dir, "../meshes/link.obj");
+  LoadLimits limits;
+  limits.root = (dir.path() / "root").string();
+  EXPECT_NE(limited_load_error(scene, limits).find("objects[0].file: '../meshes/link.obj' resolves outside --root"),
+            std::string::npos);
+}
+
+TEST(SceneLoadLimits, MtllibOutsideTheRootIsRefusedBeforeItIsRead) {
+  TempDir dir;
+  dir.write("outside/secret.mtl", "newmtl red\nKd 1 0 0\n");
+  dir.write("root/meshes/cube.obj", "mtllib ../../outside/secret.mtl\nusemtl red\n" + std::string(CUBE_OBJ));
+  // No "material": the OBJ's own MTL materials are used.
+  const std::string scene = dir.write("root/scenes/scene.json",
+                                      with_objects(R"([{"type": "mesh", "file": "../meshes/cube.obj"}])").str());
+  LoadLimits limits;
+  limits.root = (dir.path() / "root").string();
+  const std::string m = limited_load_error(scene, limits);
+  EXPECT_NE(m.find(scene + ": objects[0].file: mtllib '../../outside/secret.mtl'"), std::string::npos) << m;
+  EXPECT_NE(m.find("resolves outside --root"), std::string::npos) << m;
+  // Without a root the MTL material is read.
+  const SceneData s = load_scene(scene);
+  EXPECT_EQ(s.materials[s.objects[0].material].color, glm::dvec3(1, 0, 0));
+}
+
+TEST(SceneLoadLimits, SceneFileOutsideTheRootIsRefused) {
+  TempDir dir;
+  const std::string scene = dir.write("elsewhere/scene.json", SceneText().str());
+  fs::create_directories(dir.path() / "root");
+  LoadLimits limits;
+  limits.root = (dir.path() / "root").string();
+  EXPECT_NE(limited_load_error(scene, limits).find("resolves outside --root"), std::string::npos);
+}
+
+TEST(SceneLoadLimits, TriangleCapNamesTheCountAndTheCap) {
+  // Two spheres of 32 segments (sphere_triangle_count each) against a cap between one and two.
+  const size_t one = sphere_triangle_count(32);
+  const std::string text = with_objects(R"([{"type": "sphere", "center": [0,0,0], "radius": 1},
+      {"type": "sphere", "center": [3,0,0], "radius": 1}])").str();
+  LoadLimits limits;
+  limits.max_triangles = one + 1;
+  try {
+    load_scene_text(text, "scene.json", ".", limits);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "scene.json: objects[1].segments: the scene would have " +
+                                         std::to_string(2 * one) + " triangles, over the cap of " +
+                                         std::to_string(one + 1) + " (max_triangles)");
+  }
+  limits.max_triangles = 2 * one;
+  EXPECT_EQ(load_scene_text(text, "scene.json", ".", limits).triangles->triangle_count(), 2 * one);
+  // A mesh is counted from its faces before its triangles are made.
+  TempDir dir;
+  dir.write("cube.obj", CUBE_OBJ);
+  limits.max_triangles = 11;
+  try {
+    load_scene_text(with_objects(R"([{"type": "mesh", "file": "cube.obj", "material": "white"}])").str(), "scene.json",
+                    dir.path().string(), limits);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "scene.json: objects[0].file: the scene would have 12 triangles, over the cap of 11 (max_triangles)");
+  }
+}
+
 }  // namespace
 }  // namespace abcube

@@ -1,0 +1,52 @@
+// Internal to scene loading (scene_load.hpp): what reading the objects shares between the
+// scene readers (scene_load.cpp) and the mesh loader (scene_mesh.cpp).
+#pragma once
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "scene/scene_data.hpp"
+#include "scene/scene_json.hpp"
+#include "scene/scene_load.hpp"
+#include "scene/tessellate.hpp"
+
+namespace abcube::detail {
+
+constexpr size_t MAX_TRIANGLES = size_t{1} << 26;  // 67M triangles, ~5 GiB of soup
+constexpr const char* DEFAULT_MATERIAL = "(default)";
+
+// What loading the objects shares: the scene being filled, the caller's limits (root
+// canonical, or empty), material names, and the materials already made from MTL files
+// (keyed by resolved OBJ path and MTL name).
+struct LoadState {
+  const Source& src;
+  SceneData& scene;
+  const LoadLimits& limits;
+  std::string root;
+  std::map<std::string, uint32_t> material_by_name;
+  std::map<std::string, uint32_t> mtl_materials;
+  int default_material = -1;
+};
+
+uint32_t add_material(LoadState& st, Material m);
+// The material "(default)", made on first use.
+uint32_t default_material(LoadState& st);
+
+// Refuses (InputError naming `path`, the count and the cap) a scene that would hold more
+// than LoadLimits::max_triangles once `adding` more triangles are appended. Called before
+// they are made.
+void check_triangle_cap(const LoadState& st, const std::string& path, uint64_t adding);
+
+// The canonical form of LoadLimits::root (InputError when it is not a folder).
+std::string canonical_root(const std::string& root);
+// Whether `file` (symbolic links and ".." resolved) lies inside the canonical `root`.
+bool inside_root(const std::string& root, const std::string& file);
+// Refuses `file` (as written at `path` of the scene) when it resolves outside the root.
+void check_inside_root(const LoadState& st, const std::string& path, const std::string& file,
+                       const std::string& resolved);
+
+// A mesh object's triangles from a Wavefront OBJ. With `use_mtl`, its MTL materials
+// become scene materials named "FILE:NAME", and faces without one get the default.
+LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl);
+
+}  // namespace abcube::detail

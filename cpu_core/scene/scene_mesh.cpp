@@ -1,0 +1,248 @@
+// Mesh objects: triangles from a Wavefront OBJ file, materials from the MTL files it
+// names, and the confinement of both to LoadLimits::root.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <tiny_obj_loader.h>
+
+#include "base/error.hpp"
+#include "scene/scene_load_state.hpp"
+#include "scene/tessellate.hpp"
+
+namespace abcube::detail {
+
+namespace {
+
+// The format's material from an MTL entry: Kd -> color, mean of Ks -> specular,
+// Ns -> shininess, d -> opacity, Ni -> ior (Ni below 1, which exporters write for
+// "unset", is taken as 1). `where` prefixes messages.
+Material convert_mtl(const LoadState& st, const std::string& path, const std::string& where,
+                     const tinyobj::material_t& in, const std::string& name) {
+  Material m;
+  m.name = name;
+  m.color = glm::dvec3(in.diffuse[0], in.diffuse[1], in.diffuse[2]);
+  m.specular = (static_cast<double>(in.specular[0]) + in.specular[1] + in.specular[2]) / 3.0;
+  m.shininess = in.shininess;
+  m.opacity = in.dissolve;
+  m.ior = std::max(1.0, static_cast<double>(in.ior));
+  auto bad = [&](const char* what, double x) {
+    fail(st.src, path, where + ": material \"" + in.name + "\": " + what + ", got " + format_number(x));
+  };
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(m.color[i]) || m.color[i] < 0) bad("Kd must be finite and >= 0", m.color[i]);
+  }
+  if (!(m.specular >= 0 && m.specular <= 1)) bad("mean Ks must be in [0, 1]", m.specular);
+  if (!(m.shininess >= 0 && std::isfinite(m.shininess))) bad("Ns must be finite and >= 0", m.shininess);
+  if (!(m.opacity >= 0 && m.opacity <= 1)) bad("d must be in [0, 1]", m.opacity);
+  if (!std::isfinite(m.ior)) bad("Ni must be finite", m.ior);
+  return m;
+}
+
+// Scene material index for each MTL material of an OBJ, made once per file.
+std::vector<uint32_t> mtl_material_ids(LoadState& st, const std::string& path, const std::string& file,
+                                       const std::string& resolved, const std::vector<tinyobj::material_t>& materials) {
+  std::vector<uint32_t> ids;
+  for (const tinyobj::material_t& mtl : materials) {
+    const std::string key = resolved + '\n' + mtl.name;
+    auto it = st.mtl_materials.find(key);
+    if (it == st.mtl_materials.end()) {
+      const uint32_t id = add_material(st, convert_mtl(st, path, resolved, mtl, file + ":" + mtl.name));
+      it = st.mtl_materials.emplace(key, id).first;
+    }
+    ids.push_back(it->second);
+  }
+  return ids;
+}
+
+// First line of a tinyobjloader message that contains `needle`, or "".
+std::string find_line(const std::string& text, const char* needle) {
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (line.find(needle) != std::string::npos) return line;
+  }
+  return "";
+}
+
+// Appends one OBJ face (already validated) to `out`, triangulating polygons.
+void add_obj_face(const tinyobj::attrib_t& a, const tinyobj::index_t* corners, size_t n, int material,
+                  LocalMesh* out) {
+  std::vector<glm::dvec3> p(n), nrm(n, glm::dvec3(0.0));
+  bool smooth = true;
+  for (size_t k = 0; k < n; ++k) {
+    const size_t v = static_cast<size_t>(corners[k].vertex_index);
+    p[k] = glm::dvec3(a.vertices[3 * v], a.vertices[3 * v + 1], a.vertices[3 * v + 2]);
+    const int ni = corners[k].normal_index;
+    smooth = smooth && ni >= 0;
+    if (ni >= 0) {
+      const size_t w = static_cast<size_t>(ni);
+      nrm[k] = glm::dvec3(a.normals[3 * w], a.normals[3 * w + 1], a.normals[3 * w + 2]);
+    }
+  }
+  if (!smooth) std::fill(nrm.begin(), nrm.end(), glm::dvec3(0.0));  // zero: flat
+  for (const auto& t : triangulate_polygon(p)) {
+    for (int k : t) {
+      out->positions.push_back(p[static_cast<size_t>(k)]);
+      out->normals.push_back(nrm[static_cast<size_t>(k)]);
+    }
+    out->material.push_back(material);
+  }
+}
+
+std::string resolve_mesh_path(const Source& src, const std::string& file) {
+  namespace fs = std::filesystem;
+  const fs::path p(file);
+  return (p.is_absolute() ? p : fs::path(src.base_dir) / p).lexically_normal().string();
+}
+
+// tinyobjloader's MaterialFileReader, refusing an MTL file outside the root before it is
+// opened: the first such path is kept in `escaped` and the reader reports failure.
+class ConfinedMaterialReader final : public tinyobj::MaterialReader {
+ public:
+  ConfinedMaterialReader(const std::string& base_dir, const std::string& root)
+      : files_(base_dir), base_dir_(base_dir), root_(root) {}
+  bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
+                  std::map<std::string, int>* by_name, std::string* warn, std::string* err) override {
+    // The paths MaterialFileReader tries: each ':'-separated folder joined with `name`.
+    std::vector<std::string> tried;
+    std::istringstream folders(base_dir_);
+    for (std::string folder; std::getline(folders, folder, ':');) {
+      tried.push_back(folder.empty() || folder.back() == '/' ? folder + name : folder + "/" + name);
+    }
+    if (base_dir_.empty()) tried.push_back(name);
+    for (const std::string& t : tried) {
+      if (!root_.empty() && !inside_root(root_, t)) {
+        if (escaped.empty()) escaped = name;
+        return false;
+      }
+    }
+    return files_(name, materials, by_name, warn, err);
+  }
+  std::string escaped;
+
+ private:
+  tinyobj::MaterialFileReader files_;
+  std::string base_dir_, root_;
+};
+
+// What tinyobjloader read of one OBJ file and its MTL files.
+struct ObjFile {
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> materials;
+  std::string warning, error;
+};
+
+// tinyobj::ObjReader::ParseFromFile (MTL files looked up in the OBJ's folder, no
+// triangulation, no vertex colours) with the MTL files confined to the root.
+ObjFile parse_obj(const LoadState& st, const std::string& path, const std::string& resolved) {
+  ObjFile obj;
+  std::ifstream in(resolved);
+  if (!in) fail(st.src, path, "cannot parse mesh \"" + resolved + "\": Cannot open file [" + resolved + "]");
+  const size_t slash = resolved.find_last_of("/\\");
+  const std::string base_dir = slash == std::string::npos || slash == 0 ? "" : resolved.substr(0, slash) + "/";
+  ConfinedMaterialReader mtl(base_dir, st.root);
+  const bool ok = tinyobj::LoadObj(&obj.attrib, &obj.shapes, &obj.materials, &obj.warning, &obj.error, &in, &mtl,
+                                   false /* triangulate: ear-clipped here, keeping the winding */, false);
+  if (!mtl.escaped.empty()) {
+    fail(st.src, path, "mtllib '" + mtl.escaped + "' of mesh \"" + resolved + "\" resolves outside --root " + st.root);
+  }
+  if (!ok) fail(st.src, path, "cannot parse mesh \"" + resolved + "\": " + obj.error);
+  return obj;
+}
+
+// Triangles the faces of an OBJ file become (ear clipping: n - 2 per polygon of n corners).
+uint64_t obj_triangle_count(const ObjFile& obj) {
+  uint64_t count = 0;
+  for (const tinyobj::shape_t& shape : obj.shapes) {
+    for (const auto n : shape.mesh.num_face_vertices) count += n >= 3 ? n - 2u : 0u;
+  }
+  return count;
+}
+
+}  // namespace
+
+std::string canonical_root(const std::string& root) {
+  std::error_code ec;
+  const std::filesystem::path p = std::filesystem::canonical(root, ec);
+  if (ec || !std::filesystem::is_directory(p, ec)) {
+    throw InputError(one_line("--root " + root + ": not a folder"));
+  }
+  return p.string();
+}
+
+bool inside_root(const std::string& root, const std::string& file) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path p = fs::weakly_canonical(fs::absolute(file, ec), ec);
+  if (ec) return false;
+  const fs::path r(root);
+  // Component by component: /a/bc is not inside /a/b.
+  auto pi = p.begin();
+  for (auto ri = r.begin(); ri != r.end(); ++ri, ++pi) {
+    if (ri->empty()) continue;  // a trailing separator
+    if (pi == p.end() || *pi != *ri) return false;
+  }
+  return true;
+}
+
+void check_inside_root(const LoadState& st, const std::string& path, const std::string& file,
+                       const std::string& resolved) {
+  if (!st.root.empty() && !inside_root(st.root, resolved)) {
+    fail(st.src, path, "'" + file + "' resolves outside --root " + st.root);
+  }
+}
+
+LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
+  const std::string path = f.at("file");
+  const std::string file = read_string(st.src, f.need("file"), path);
+  if (file.empty()) fail(st.src, path, "must name an OBJ file, got \"\"");
+  const std::string resolved = resolve_mesh_path(st.src, file);
+  check_inside_root(st, path, file, resolved);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(resolved, ec)) {
+    const bool exists = std::filesystem::exists(resolved, ec);
+    fail(st.src, path, "cannot read mesh \"" + resolved + "\": " + (exists ? "not a regular file" : "no such file"));
+  }
+  const ObjFile obj = parse_obj(st, path, resolved);
+  check_triangle_cap(st, path, obj_triangle_count(obj));
+  if (use_mtl) {
+    const std::string missing = find_line(obj.warning, "not found");
+    if (!missing.empty()) fail(st.src, path, "mesh \"" + resolved + "\": " + missing);
+  }
+  const std::vector<uint32_t> mtl_ids = use_mtl ? mtl_material_ids(st, path, file, resolved, obj.materials) : std::vector<uint32_t>{};
+  const tinyobj::attrib_t& a = obj.attrib;
+  const int vertex_count = static_cast<int>(a.vertices.size() / 3);
+  const int normal_count = static_cast<int>(a.normals.size() / 3);
+  LocalMesh m;
+  for (const tinyobj::shape_t& shape : obj.shapes) {
+    size_t offset = 0;
+    for (size_t face = 0; face < shape.mesh.num_face_vertices.size(); ++face) {
+      const size_t n = shape.mesh.num_face_vertices[face];
+      const tinyobj::index_t* corners = &shape.mesh.indices[offset];
+      offset += n;
+      for (size_t k = 0; k < n; ++k) {
+        if (corners[k].vertex_index < 0 || corners[k].vertex_index >= vertex_count ||
+            corners[k].normal_index >= normal_count) {
+          fail(st.src, path, "mesh \"" + resolved + "\": face of shape \"" + shape.name + "\" has an index out of range");
+        }
+      }
+      const int mtl = face < shape.mesh.material_ids.size() ? shape.mesh.material_ids[face] : -1;
+      int material = -1;  // the object's own
+      if (use_mtl) {
+        material = mtl >= 0 && static_cast<size_t>(mtl) < mtl_ids.size() ? static_cast<int>(mtl_ids[static_cast<size_t>(mtl)])
+                                                                         : static_cast<int>(default_material(st));
+      }
+      add_obj_face(a, corners, n, material, &m);
+      if (st.scene.triangles->triangle_count() + m.triangle_count() > MAX_TRIANGLES) {
+        fail(st.src, path, "the scene would exceed " + std::to_string(MAX_TRIANGLES) + " triangles");
+      }
+    }
+  }
+  return m;
+}
+
+}  // namespace abcube::detail
