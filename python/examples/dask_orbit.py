@@ -1,0 +1,156 @@
+#!/usr/bin/env python3
+"""Render an orbit of camera views across Dask worker processes, through the abcube module.
+
+A recipe for batches too big for one process: a Dask distributed LocalCluster (Debian 12:
+python3-distributed) of worker processes, each with its own abcube Renderer, renders
+chunks of views; the images are byte for byte those of the same views rendered in one
+process. Run it (from the repository, after the build):
+
+    PYTHONPATH=build/python /usr/bin/python3 python/examples/dask_orbit.py scenes/default.json \\
+        --views 64 --size 128 96 --cube-res 128 --workers 2 --out orbit/
+
+It prints the time of the batch in the cluster and in this process, checks that the images
+are equal, and with --out writes orbit/view_000.exr ... (float EXR, linear).
+
+How it works, and what to copy:
+  - Scenes do not travel between processes: send the scene's path (or its dict) and let
+    each task load it (a few ms for a small scene; cache it per process for big ones).
+  - Each task creates its own Renderer. The map methods (abuffer, zbuffer, envmap) and
+    raytrace need no GL: gl="none". A GL method ("gpu") needs the Renderer to be used on
+    the thread that opened it: with threads_per_worker=1 every task of a worker runs on
+    the same thread, so a Renderer kept per process (e.g. in a WorkerPlugin) is safe.
+  - threads_per_worker=1 and Renderer(threads=1): one render thread per worker process,
+    as many workers as cores; the process-level split costs no synchronisation.
+  - Workers are new processes (spawn): they get this process's environment, so PYTHONPATH
+    must name the folder of the abcube module (render_in_cluster adds it).
+"""
+import argparse
+import math
+import os
+import pathlib
+import sys
+import time
+
+import numpy as np
+
+import abcube
+
+GL_FREE_METHODS = ("abuffer", "zbuffer", "envmap", "raytrace")
+
+
+def orbit_cameras(count, center, radius, height, width, image_height, fov_y=None):
+    """`count` camera overrides evenly spaced on a circle of `radius` around `center`, at
+    `height` above it, each looking at `center`, with the image size given."""
+    cameras = []
+    for k in range(count):
+        angle = 2 * math.pi * k / count
+        camera = {
+            "position": [center[0] + radius * math.sin(angle), center[1] + height,
+                         center[2] + radius * math.cos(angle)],
+            "look_at": list(center),
+            "width": width,
+            "height": image_height,
+        }
+        if fov_y is not None:
+            camera["fov_y"] = fov_y
+        cameras.append(camera)
+    return cameras
+
+
+def load(scene_source):
+    """A scene from a path or a dict (what travels to the workers)."""
+    if isinstance(scene_source, dict):
+        return abcube.scene_from_dict(scene_source)
+    return abcube.load_scene(str(scene_source))
+
+
+def render_views(scene_source, cameras, method="abuffer", cube_res=None, max_depth=None,
+                 threads=1):
+    """Renders `cameras` (a list of camera overrides) of one scene with one Renderer; the
+    unit of work of a Dask task. Returns a list of float32 H x W x 3 arrays."""
+    scene = load(scene_source)
+    renderer = abcube.Renderer(gl="none" if method in GL_FREE_METHODS else "auto",
+                               threads=threads)
+    return [renderer.render(scene, method=method, cube_res=cube_res, max_depth=max_depth,
+                            camera=camera) for camera in cameras]
+
+
+def chunks(items, size):
+    return [items[k:k + size] for k in range(0, len(items), size)]
+
+
+def worker_environment():
+    """PYTHONPATH for spawned workers: the abcube module's folder and this file's."""
+    folders = [os.path.dirname(abcube.__file__), os.path.dirname(os.path.abspath(__file__))]
+    old = os.environ.get("PYTHONPATH", "")
+    folders += [p for p in old.split(os.pathsep) if p and p not in folders]
+    return os.pathsep.join(folders)
+
+
+def render_in_cluster(scene_source, cameras, method="abuffer", cube_res=None, max_depth=None,
+                      n_workers=2, chunk=8):
+    """The views rendered by a LocalCluster of `n_workers` processes, `chunk` views per
+    task, in the order of `cameras`. Returns (images, seconds of the batch without the
+    cluster's start-up, seconds of the start-up)."""
+    from dask.distributed import Client, LocalCluster
+
+    os.environ["PYTHONPATH"] = worker_environment()
+    started = time.perf_counter()
+    with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        # Every worker imports abcube once before the clock starts.
+        client.run(lambda: __import__("abcube").__version__)
+        startup = time.perf_counter() - started
+        begin = time.perf_counter()
+        futures = [client.submit(render_views, scene_source, part, method, cube_res, max_depth,
+                                 1, pure=False)
+                   for part in chunks(cameras, chunk)]
+        images = [image for part in client.gather(futures) for image in part]
+        batch = time.perf_counter() - begin
+    return images, batch, startup
+
+
+def render_in_process(scene_source, cameras, method="abuffer", cube_res=None, max_depth=None,
+                      threads=0):
+    """The same views in this process, one Renderer (threads=0: every core)."""
+    begin = time.perf_counter()
+    images = render_views(scene_source, cameras, method, cube_res, max_depth, threads)
+    return images, time.perf_counter() - begin
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("scene", help="scene JSON file")
+    parser.add_argument("--views", type=int, default=64)
+    parser.add_argument("--size", type=int, nargs=2, default=[128, 96], metavar=("W", "H"))
+    parser.add_argument("--method", default="abuffer")
+    parser.add_argument("--cube-res", type=int, default=None)
+    parser.add_argument("--max-depth", type=int, default=None)
+    parser.add_argument("--radius", type=float, default=6.0)
+    parser.add_argument("--height", type=float, default=2.0)
+    parser.add_argument("--center", type=float, nargs=3, default=[0, 0.8, 0])
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--chunk", type=int, default=8, help="views per Dask task")
+    parser.add_argument("--out", help="folder for view_NNN.exr")
+    args = parser.parse_args(argv)
+
+    cameras = orbit_cameras(args.views, args.center, args.radius, args.height, *args.size)
+    scene_path = str(pathlib.Path(args.scene).resolve())
+    options = dict(method=args.method, cube_res=args.cube_res, max_depth=args.max_depth)
+    in_cluster, batch, startup = render_in_cluster(scene_path, cameras, n_workers=args.workers,
+                                                   chunk=args.chunk, **options)
+    in_process, alone = render_in_process(scene_path, cameras, **options)
+    equal = all(a.tobytes() == b.tobytes() for a, b in zip(in_cluster, in_process))
+    print(f"{args.views} views {args.size[0]}x{args.size[1]} {args.method}: "
+          f"cluster of {args.workers} workers {batch:.2f} s (+ {startup:.2f} s start-up), "
+          f"one process {alone:.2f} s; images equal byte for byte: {equal}")
+    if args.out:
+        out = pathlib.Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        for k, image in enumerate(in_cluster):
+            abcube.write_image(str(out / f"view_{k:03d}.exr"), image)
+    return 0 if equal and len(in_cluster) == len(in_process) == args.views else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

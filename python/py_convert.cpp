@@ -1,0 +1,150 @@
+// Conversions between Python objects and the library's types (py_convert.hpp).
+#include "py_convert.hpp"
+
+#include <memory>
+#include <vector>
+
+#include <pybind11/stl.h>
+
+namespace abcube {
+
+py::array image_to_array(Image&& image) {
+  // The vector moves into a capsule that numpy frees with the array: no copy, no leak.
+  auto pixels = std::make_unique<std::vector<float>>(std::move(image.data));
+  const float* data = pixels->data();
+  py::capsule owner(pixels.get(), [](void* p) { delete static_cast<std::vector<float>*>(p); });
+  pixels.release();
+  std::vector<py::ssize_t> shape = {image.height, image.width};
+  if (image.channels != 1) shape.push_back(image.channels);
+  return py::array_t<float>(shape, data, owner);
+}
+
+Image array_to_image(const py::handle& array, const std::string& what) {
+  // Any numeric array-like, made a C-contiguous float32 array (a view when it already is one).
+  using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+  FloatArray pixels = FloatArray::ensure(array);
+  if (!pixels) {
+    throw InputError(what + ": must be a numeric array (H x W x C), got " + type_name(array));
+  }
+  const py::ssize_t ndim = pixels.ndim();
+  const py::ssize_t channels = ndim == 3 ? pixels.shape(2) : 1;
+  if ((ndim != 2 && ndim != 3) || channels < 1 || channels > 4 || pixels.shape(0) < 1 ||
+      pixels.shape(1) < 1) {
+    std::string shape;
+    for (py::ssize_t k = 0; k < ndim; ++k) shape += (k ? " x " : "") + std::to_string(pixels.shape(k));
+    throw InputError(what + ": must have shape H x W or H x W x C with C in 1..4, got (" +
+                     shape + ")");
+  }
+  Image image(static_cast<int>(pixels.shape(1)), static_cast<int>(pixels.shape(0)),
+              static_cast<int>(channels));
+  std::copy(pixels.data(), pixels.data() + pixels.size(), image.data.begin());
+  return image;
+}
+
+std::string type_name(const py::handle& value) {
+  return py::str(py::type::handle_of(value).attr("__name__"));
+}
+
+std::string path_arg(const py::handle& value, const std::string& what) {
+  // os.fspath accepts str and os.PathLike (pathlib.Path); bytes are refused.
+  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  if (!py::hasattr(value, "__fspath__")) {
+    throw InputError(what + ": must be a path (str or os.PathLike), got " + type_name(value));
+  }
+  py::object path = py::module_::import("os").attr("fspath")(value);
+  if (!py::isinstance<py::str>(path)) {
+    throw InputError(what + ": must be a str path, got " + type_name(path));
+  }
+  return path.cast<std::string>();
+}
+
+std::string string_arg(const py::handle& value, const std::string& what) {
+  if (!py::isinstance<py::str>(value)) {
+    throw InputError(what + ": must be a string, got " + type_name(value));
+  }
+  return value.cast<std::string>();
+}
+
+bool bool_arg(const py::handle& value, const std::string& what) {
+  // True/False (and numpy.bool_); 0 and 1 would hide a swapped argument.
+  if (py::isinstance<py::bool_>(value) || type_name(value) == "bool_") {
+    return value.cast<bool>();
+  }
+  throw InputError(what + ": must be True or False, got " + type_name(value));
+}
+
+int int_arg(const py::handle& value, const std::string& what) {
+  // Python int or numpy integer, in the range of a C int; never a float or a bool.
+  if (py::isinstance<py::bool_>(value) || !py::hasattr(value, "__index__")) {
+    throw InputError(what + ": must be an integer, got " + type_name(value));
+  }
+  try {
+    return py::int_(py::reinterpret_borrow<py::object>(value)).cast<int>();
+  } catch (const py::cast_error&) {
+    throw InputError(what + ": integer out of range, got " + std::string(py::str(value)));
+  }
+}
+
+uint64_t unsigned_arg(const py::handle& value, const std::string& what) {
+  if (py::isinstance<py::bool_>(value) || !py::hasattr(value, "__index__")) {
+    throw InputError(what + ": must be an integer >= 0, got " + type_name(value));
+  }
+  try {
+    return py::int_(py::reinterpret_borrow<py::object>(value)).cast<uint64_t>();
+  } catch (const py::cast_error&) {
+    throw InputError(what + ": must be an integer >= 0, got " + std::string(py::str(value)));
+  }
+}
+
+double float_arg(const py::handle& value, const std::string& what) {
+  // int or float (and numpy scalars); strings are not numbers here.
+  if (py::isinstance<py::bool_>(value) || py::isinstance<py::str>(value) ||
+      !py::hasattr(value, "__float__")) {
+    throw InputError(what + ": must be a number, got " + type_name(value));
+  }
+  return py::float_(py::reinterpret_borrow<py::object>(value)).cast<double>();
+}
+
+std::array<double, 3> vec3_arg(const py::handle& value, const std::string& what) {
+  // Any sequence of 3 numbers: a list, a tuple, a numpy array.
+  if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value) ||
+      py::len(value) != 3) {
+    throw InputError(what + ": must be 3 numbers [x, y, z], got " +
+                     std::string(py::str(py::repr(value))));
+  }
+  const py::sequence items = py::reinterpret_borrow<py::sequence>(value);
+  std::array<double, 3> v{};
+  for (size_t k = 0; k < 3; ++k) v[k] = float_arg(items[k], what + "[" + std::to_string(k) + "]");
+  return v;
+}
+
+CameraOverride camera_arg(const py::handle& value) {
+  // Only the keys given override the scene's camera; an unknown key is an error (a typo).
+  if (!py::isinstance<py::dict>(value)) {
+    throw InputError("camera: must be a dict with any of position, look_at, up, fov_y, width, "
+                     "height, got " + type_name(value));
+  }
+  CameraOverride camera;
+  for (const auto& item : py::reinterpret_borrow<py::dict>(value)) {
+    const std::string key = string_arg(item.first, "camera key");
+    const std::string what = "camera." + key;
+    if (key == "position") {
+      camera.position = vec3_arg(item.second, what);
+    } else if (key == "look_at") {
+      camera.look_at = vec3_arg(item.second, what);
+    } else if (key == "up") {
+      camera.up = vec3_arg(item.second, what);
+    } else if (key == "fov_y") {
+      camera.fov_y = float_arg(item.second, what);
+    } else if (key == "width") {
+      camera.width = int_arg(item.second, what);
+    } else if (key == "height") {
+      camera.height = int_arg(item.second, what);
+    } else {
+      throw InputError(what + ": unknown key (position, look_at, up, fov_y, width, height)");
+    }
+  }
+  return camera;
+}
+
+}  // namespace abcube

@@ -1,0 +1,94 @@
+"""Bad scenes raise abcube.SceneError (a ValueError) whose message names the place, as the
+CLI's one line does; nothing exits the interpreter."""
+import copy
+import math
+
+import pytest
+
+import abcube
+from conftest import small_scene_dict, write_scene
+
+
+def bad_dict(edit):
+    scene = small_scene_dict()
+    edit(scene)
+    return scene
+
+
+def sphere_index(scene):
+    return next(i for i, o in enumerate(scene["objects"]) if o["type"] == "sphere")
+
+
+def test_field_path_in_message():
+    def negative_radius(s):
+        s["objects"][0] = {"type": "sphere", "center": [0, 1, 0], "radius": -1}
+    with pytest.raises(abcube.SceneError) as error:
+        abcube.scene_from_dict(bad_dict(negative_radius))
+    assert isinstance(error.value, ValueError)
+    assert "objects[0].radius" in str(error.value)
+    assert str(error.value).startswith("<dict>")
+
+
+@pytest.mark.parametrize("edit,where", [
+    (lambda s: s["camera"].update(fov_y=0), "camera.fov_y"),
+    (lambda s: s["camera"].update(width=-4), "camera.width"),
+    (lambda s: s["camera"].update(up=[p - q for p, q in zip(s["camera"]["position"],
+                                                            s["camera"]["look_at"])]), "camera"),
+    (lambda s: s["objects"][1].update(material="nosuch"), "objects[1].material"),
+    (lambda s: s["objects"][1].update(colour=[1, 0, 0]), "objects[1].colour"),
+    (lambda s: s.update(lights=[{"type": "point", "position": [0, 1]}]), "lights[0].position"),
+    (lambda s: s["materials"]["glass"].update(ior=0.5), "materials.glass.ior"),
+    (lambda s: s["render"].update(method="nosuch"), "render.method"),
+    (lambda s: s["objects"].append({"type": "mesh", "file": "/nonexistent/x.obj"}), "x.obj"),
+])
+def test_bad_values(edit, where):
+    with pytest.raises(abcube.SceneError, match=r".*" + where.replace("[", r"\[").replace("]", r"\]")):
+        abcube.scene_from_dict(bad_dict(edit), name="bad.json")
+
+
+def test_nan_is_refused():
+    def nan_center(s):
+        s["objects"][sphere_index(s)]["center"] = [0, math.nan, 0]
+    with pytest.raises(abcube.SceneError):
+        abcube.scene_from_dict(bad_dict(nan_center))
+
+
+def test_not_a_dict():
+    with pytest.raises(abcube.SceneError):
+        abcube.scene_from_dict([1, 2, 3])
+    with pytest.raises(abcube.SceneError):
+        abcube.scene_from_dict({"objects": object()})
+
+
+def test_json_syntax_error_has_line_and_column(tmp_path):
+    path = tmp_path / "broken.json"
+    path.write_text('{\n  "version": 1,\n  "camera": {,\n}\n')
+    with pytest.raises(abcube.SceneError, match=r"broken\.json:3:\d+"):
+        abcube.load_scene(str(path))
+    with pytest.raises(abcube.SceneError, match=r"text:3:\d+"):
+        abcube.scene_from_json('{\n "version": 1,\n ]', name="text")
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(abcube.SceneError, match="missing.json"):
+        abcube.load_scene(str(tmp_path / "missing.json"))
+
+
+def test_mesh_relative_to_base_dir(tmp_path):
+    # A relative mesh path resolves against base_dir; a wrong base_dir names the file.
+    from conftest import SCENES
+    scene = small_scene_dict()
+    mesh = next(o for o in scene["objects"] if o["type"] == "mesh")
+    mesh["file"] = "meshes/octahedron.obj"
+    assert abcube.scene_from_dict(copy.deepcopy(scene), base_dir=str(SCENES)).triangle_count > 0
+    with pytest.raises(abcube.SceneError, match="octahedron.obj"):
+        abcube.scene_from_dict(scene, base_dir=str(tmp_path))
+
+
+def test_error_then_success(tmp_path):
+    # The interpreter and the module survive errors: a good scene still loads and renders.
+    for _ in range(20):
+        with pytest.raises(abcube.SceneError):
+            abcube.scene_from_dict({"version": 1, "objects": [{"type": "nosuch"}]})
+    scene = abcube.load_scene(str(write_scene(tmp_path / "ok.json", small_scene_dict())))
+    assert abcube.Renderer(gl="none").render(scene, method="raytrace").shape == (24, 32, 3)
