@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "bench_common.hpp"
+#include "base/statistics.hpp"
 #include "raster/abuffer.hpp"
 #include "cli/cli_common.hpp"
 #include "raster/cube_map.hpp"
@@ -30,8 +31,8 @@ struct Spread {
 };
 
 Spread spread(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return {v[v.size() / 2], v.front(), v.back()};
+  const double median = percentile(v, 0.5);
+  return {median, *std::min_element(v.begin(), v.end()), *std::max_element(v.begin(), v.end())};
 }
 
 struct PrepassError {
@@ -59,10 +60,9 @@ PrepassError prepass_error(const SceneData& scene, const RayTracer& rt, const Cu
   PrepassError e;
   e.texels = rel.size();
   if (rel.empty()) return e;
-  std::sort(rel.begin(), rel.end());
-  e.median_rel = rel[rel.size() / 2];
-  e.p99_rel = rel[std::min(rel.size() - 1, rel.size() * 99 / 100)];
-  e.max_rel = rel.back();
+  e.median_rel = percentile(rel, 0.5);
+  e.p99_rel = percentile(rel, 0.99);
+  e.max_rel = percentile(rel, 1.0);
   e.same_object = static_cast<double>(same) / static_cast<double>(rel.size());
   return e;
 }

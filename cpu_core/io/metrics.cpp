@@ -7,6 +7,7 @@
 #include <string>
 
 #include "base/error.hpp"
+#include "base/statistics.hpp"
 #include "io/image_io.hpp"
 
 namespace abcube {
@@ -144,12 +145,8 @@ double ErrorStats::max() const {
 }
 
 double ErrorStats::percentile(double q) const {
-  if (values_.empty()) return 0.0;
-  const double n = static_cast<double>(values_.size());
-  const size_t rank = static_cast<size_t>(std::max(1.0, std::ceil(std::clamp(q, 0.0, 1.0) * n)));
   std::vector<double> v(values_);
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(rank - 1), v.end());
-  return v[rank - 1];
+  return abcube::percentile(v, q);
 }
 
 double ErrorStats::share_within(double bound) const {
