@@ -24,17 +24,6 @@ constexpr double gamma_n(int n) {
 }
 constexpr double BOX_FAR_SCALE = 1.0 + 2.0 * gamma_n(3);  // Ize 2013, pbrt-v3 3.9.2
 
-struct Box {
-  glm::dvec3 lo{DBL_MAX}, hi{-DBL_MAX};
-  void extend(const glm::dvec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
-  void extend(const Box& b) { lo = glm::min(lo, b.lo); hi = glm::max(hi, b.hi); }
-  double area() const {
-    if (lo.x > hi.x) return 0.0;
-    const glm::dvec3 e = hi - lo;
-    return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
-  }
-};
-
 }  // namespace
 
 RayQuery::RayQuery(const glm::dvec3& o, const glm::dvec3& d) : origin(o), dir(d) {
@@ -53,7 +42,8 @@ RayQuery::RayQuery(const glm::dvec3& o, const glm::dvec3& d) : origin(o), dir(d)
 
 // A triangle during construction: its bounds and centroid.
 struct BvhBuildItem {
-  glm::dvec3 lo{0.0}, hi{0.0}, centroid{0.0};
+  Bounds box;
+  glm::dvec3 centroid{0.0};
   uint32_t triangle = 0;
 };
 
@@ -65,30 +55,29 @@ struct SahSplit {
   double cost = DBL_MAX;
 };
 
-int sah_bin(const BvhBuildItem& it, int axis, const Box& centroids) {
+int sah_bin(const BvhBuildItem& it, int axis, const Bounds& centroids) {
   const double scale = SAH_BINS / (centroids.hi[axis] - centroids.lo[axis]);
   return std::min(static_cast<int>((it.centroid[axis] - centroids.lo[axis]) * scale), SAH_BINS - 1);
 }
 
 // The cheapest binned-SAH split of items[begin, end) over the three axes (Wald 2007):
 // cost = TRAVERSAL_COST + (A_left N_left + A_right N_right) / A, in triangle tests.
-SahSplit best_sah_split(const std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t end, const Box& box,
-                        const Box& centroids) {
+SahSplit best_sah_split(const std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t end, const Bounds& box,
+                        const Bounds& centroids) {
   SahSplit best;
   for (int axis = 0; axis < 3; ++axis) {
     if (!(centroids.hi[axis] - centroids.lo[axis] > 0.0)) continue;
-    std::array<Box, SAH_BINS> bins;
+    std::array<Bounds, SAH_BINS> bins;
     std::array<uint32_t, SAH_BINS> counts{};
     for (uint32_t i = begin; i < end; ++i) {
       const int b = sah_bin(items[i], axis, centroids);
-      bins[b].extend(items[i].lo);
-      bins[b].extend(items[i].hi);
+      bins[b].extend(items[i].box);
       ++counts[b];
     }
     // Sweep from the right for the right-hand areas, then from the left.
     std::array<double, SAH_BINS> right_area{};
     std::array<uint32_t, SAH_BINS> right_count{};
-    Box acc;
+    Bounds acc;
     uint32_t acc_n = 0;
     for (int b = SAH_BINS - 1; b > 0; --b) {
       acc.extend(bins[b]);
@@ -96,7 +85,7 @@ SahSplit best_sah_split(const std::vector<BvhBuildItem>& items, uint32_t begin, 
       right_area[b] = acc.area();
       right_count[b] = acc_n;
     }
-    Box left;
+    Bounds left;
     uint32_t left_n = 0;
     for (int b = 1; b < SAH_BINS; ++b) {
       left.extend(bins[b - 1]);
@@ -129,9 +118,9 @@ Bvh::Bvh(const TriangleSoup& soup) {
   if (n == 0) return;
   std::vector<BvhBuildItem> items(n);
   for (size_t i = 0; i < n; ++i) {
-    Box b;
+    Bounds b;
     for (int k = 0; k < 3; ++k) b.extend(glm::dvec3(soup.positions[3 * i + k]));
-    items[i] = {b.lo, b.hi, 0.5 * (b.lo + b.hi), static_cast<uint32_t>(i)};
+    items[i] = {b, 0.5 * (b.lo + b.hi), static_cast<uint32_t>(i)};
   }
   nodes_.reserve(2 * n);
   order_.reserve(n);
@@ -149,10 +138,9 @@ uint32_t Bvh::build(std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t e
   const uint32_t index = static_cast<uint32_t>(nodes_.size());
   nodes_.emplace_back();
   depth_ = std::max(depth_, depth + 1);
-  Box box, centroids;
+  Bounds box, centroids;
   for (uint32_t i = begin; i < end; ++i) {
-    box.extend(items[i].lo);
-    box.extend(items[i].hi);
+    box.extend(items[i].box);
     centroids.extend(items[i].centroid);
   }
   nodes_[index].lo = box.lo;

@@ -7,6 +7,8 @@
 
 #include <glm/glm.hpp>
 
+#include "base/bounds.hpp"
+
 namespace abcube {
 
 enum class Method { abuffer, zbuffer, envmap, raytrace, gpu };
@@ -87,12 +89,6 @@ struct RenderSettings {
   int max_depth = 4;
   bool fresnel = false;  // Schlick weights for kr/kt (shading.hpp secondary_weights); off = thesis
   double error_target = 0;  // > 0: choose cube_resolution from the Error_Parallax bound (plan.hpp)
-};
-
-struct Bounds {
-  glm::dvec3 lo{1e300}, hi{-1e300};
-  bool empty() const { return lo.x > hi.x; }
-  void extend(const glm::dvec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
 };
 
 struct SceneData {
