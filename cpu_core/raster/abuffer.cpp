@@ -1,7 +1,6 @@
 #include "raster/abuffer.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -10,6 +9,7 @@
 #include "raster/cube_map.hpp"
 #include "base/error.hpp"
 #include "base/memory.hpp"
+#include "base/timer.hpp"
 #include "base/parallel.hpp"
 
 namespace abcube {
@@ -45,11 +45,6 @@ glm::dvec3 decode_octahedral(uint32_t code) {
 uint64_t default_max_memory_bytes() { return available_memory_bytes() / 2; }
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
 
 constexpr int BAND_ROWS = 32;
 constexpr uint64_t MIB = 1024 * 1024;

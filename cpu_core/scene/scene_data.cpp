@@ -3,23 +3,19 @@
 #include <algorithm>
 #include <cmath>
 
+#include "base/enum_names.hpp"
+
 namespace abcube {
 
 namespace {
-constexpr const char* METHOD_NAMES[] = {"abuffer", "zbuffer", "envmap", "raytrace", "gpu"};
+constexpr EnumName<Method> METHOD_NAMES[] = {{Method::abuffer, "abuffer"}, {Method::zbuffer, "zbuffer"},
+                                             {Method::envmap, "envmap"},   {Method::raytrace, "raytrace"},
+                                             {Method::gpu, "gpu"}};
 }
 
-const char* method_name(Method m) { return METHOD_NAMES[static_cast<int>(m)]; }
+const char* method_name(Method m) { return enum_name(METHOD_NAMES, m); }
 
-bool parse_method(const std::string& s, Method* out) {
-  for (int i = 0; i < 5; ++i) {
-    if (s == METHOD_NAMES[i]) {
-      *out = static_cast<Method>(i);
-      return true;
-    }
-  }
-  return false;
-}
+bool parse_method(const std::string& s, Method* out) { return parse_enum(METHOD_NAMES, s, out); }
 
 Bounds SceneData::bounds() const {
   Bounds b;

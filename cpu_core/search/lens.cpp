@@ -5,13 +5,16 @@
 #include <cmath>
 #include <limits>
 
+#include "base/enum_names.hpp"
 #include "base/error.hpp"
 
 namespace abcube {
 
 namespace {
 
-constexpr const char* REFRACTION_MODE_NAMES[] = {"search", "thick_lens", "thin_lens"};
+constexpr EnumName<RefractionMode> REFRACTION_MODE_NAMES[] = {{RefractionMode::search, "search"},
+                                                              {RefractionMode::thick_lens, "thick_lens"},
+                                                              {RefractionMode::thin_lens, "thin_lens"}};
 
 // Fewest points a surface fit accepts: two parameters, and a third point to overdetermine.
 constexpr size_t MIN_SURFACE_POINTS = 3;
@@ -242,17 +245,11 @@ bool fit_principal_plane(const std::vector<glm::dvec3>& all, LensFit* f) {
 }  // namespace
 
 const char* refraction_mode_name(RefractionMode m) {
-  return REFRACTION_MODE_NAMES[static_cast<int>(m)];
+  return enum_name(REFRACTION_MODE_NAMES, m);
 }
 
 bool parse_refraction_mode(const std::string& s, RefractionMode* out) {
-  for (int i = 0; i < 3; ++i) {
-    if (s == REFRACTION_MODE_NAMES[i]) {
-      *out = static_cast<RefractionMode>(i);
-      return true;
-    }
-  }
-  return false;
+  return parse_enum(REFRACTION_MODE_NAMES, s, out);
 }
 
 LensFit fit_lens(const SceneData& scene, uint32_t object, const LensFitOptions& options) {

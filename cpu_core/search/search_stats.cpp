@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "search/search.hpp"
+#include "base/enum_names.hpp"
 
 namespace abcube {
 
@@ -11,34 +12,28 @@ double self_offset_texels(const SearchOptions& o) {
   return o.mode == SearchMode::thesis ? SELF_OFFSET_THESIS_TEXELS : SELF_OFFSET_CROSSING_TEXELS;
 }
 
-const char* search_mode_name(SearchMode m) { return m == SearchMode::thesis ? "thesis" : "crossing"; }
+namespace {
 
-bool parse_search_mode(const std::string& s, SearchMode* out) {
-  if (s == "crossing") *out = SearchMode::crossing;
-  else if (s == "thesis") *out = SearchMode::thesis;
-  else return false;
-  return true;
-}
+constexpr EnumName<SearchMode> SEARCH_MODE_NAMES[] = {{SearchMode::crossing, "crossing"},
+                                                      {SearchMode::thesis, "thesis"}};
+constexpr EnumName<SearchRefine> SEARCH_REFINE_NAMES[] = {{SearchRefine::mesh, "mesh"}, {SearchRefine::plane, "plane"}};
+constexpr EnumName<MissReason> MISS_REASON_NAMES[] = {{MissReason::none, "none"},
+                                                      {MissReason::no_crossing, "no_crossing"},
+                                                      {MissReason::threshold_rejection, "threshold_rejection"},
+                                                      {MissReason::zero_area_surface, "zero_area_surface"},
+                                                      {MissReason::aborted, "aborted"}};
 
-const char* search_refine_name(SearchRefine r) { return r == SearchRefine::plane ? "plane" : "mesh"; }
+}  // namespace
 
-bool parse_search_refine(const std::string& s, SearchRefine* out) {
-  if (s == "mesh") *out = SearchRefine::mesh;
-  else if (s == "plane") *out = SearchRefine::plane;
-  else return false;
-  return true;
-}
+const char* search_mode_name(SearchMode m) { return enum_name(SEARCH_MODE_NAMES, m); }
 
-const char* miss_reason_name(MissReason r) {
-  switch (r) {
-    case MissReason::none: return "none";
-    case MissReason::no_crossing: return "no_crossing";
-    case MissReason::threshold_rejection: return "threshold_rejection";
-    case MissReason::zero_area_surface: return "zero_area_surface";
-    case MissReason::aborted: return "aborted";
-  }
-  return "?";
-}
+bool parse_search_mode(const std::string& s, SearchMode* out) { return parse_enum(SEARCH_MODE_NAMES, s, out); }
+
+const char* search_refine_name(SearchRefine r) { return enum_name(SEARCH_REFINE_NAMES, r); }
+
+bool parse_search_refine(const std::string& s, SearchRefine* out) { return parse_enum(SEARCH_REFINE_NAMES, s, out); }
+
+const char* miss_reason_name(MissReason r) { return enum_name(MISS_REASON_NAMES, r); }
 
 void SearchKindStats::add(const SearchResult& r) {
   ++rays;

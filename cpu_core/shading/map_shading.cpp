@@ -4,12 +4,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <mutex>
-#include <thread>
 #include <utility>
 
 #include "scene/camera.hpp"
 #include "raster/cube_map.hpp"
+#include "base/enum_names.hpp"
 #include "base/error.hpp"
 #include "io/image_io.hpp"
 #include "base/parallel.hpp"
@@ -24,21 +23,14 @@ namespace {
 
 constexpr uint32_t OUTSIDE = UINT32_MAX;  // a ray in the open, not inside a closed object
 
-constexpr const char* LOOKUP_NAMES[] = {"R", "bisector", "position"};
+constexpr EnumName<EnvmapLookup> LOOKUP_NAMES[] = {
+    {EnvmapLookup::reflected, "R"}, {EnvmapLookup::bisector, "bisector"}, {EnvmapLookup::position, "position"}};
 
 }  // namespace
 
-const char* envmap_lookup_name(EnvmapLookup l) { return LOOKUP_NAMES[static_cast<int>(l)]; }
+const char* envmap_lookup_name(EnvmapLookup l) { return enum_name(LOOKUP_NAMES, l); }
 
-bool parse_envmap_lookup(const std::string& s, EnvmapLookup* out) {
-  for (int i = 0; i < 3; ++i) {
-    if (s == LOOKUP_NAMES[i]) {
-      *out = static_cast<EnvmapLookup>(i);
-      return true;
-    }
-  }
-  return false;
-}
+bool parse_envmap_lookup(const std::string& s, EnvmapLookup* out) { return parse_enum(LOOKUP_NAMES, s, out); }
 
 void RayErrors::merge(const RayErrors& o) {
   error_cp.merge(o.error_cp);
@@ -297,31 +289,6 @@ void MapShader::measure(const glm::dvec3& w, const glm::dvec3& r, const SearchRe
   }
 }
 
-namespace {
-
-// Per-thread statistics for a parallel resolve: a thread finds its own slot once per call.
-class ThreadStats {
- public:
-  MapShadingStats* slot() {
-    const std::thread::id me = std::this_thread::get_id();
-    std::lock_guard<std::mutex> lock(mutex_);
-    for (auto& [id, s] : slots_) {
-      if (id == me) return s.get();
-    }
-    slots_.emplace_back(me, std::make_unique<MapShadingStats>());
-    return slots_.back().second.get();
-  }
-  void merge_into(MapShadingStats* out) const {
-    for (const auto& [id, s] : slots_) out->merge(*s);
-  }
-
- private:
-  std::mutex mutex_;
-  std::vector<std::pair<std::thread::id, std::unique_ptr<MapShadingStats>>> slots_;
-};
-
-}  // namespace
-
 // The quarters of the 4x8 mask (samples.hpp): columns 0-3 / 4-7 of rows 0-1 / 2-3.
 static constexpr CoverageMask QUARTERS[4] = {0x00000f0fu, 0x0000f0f0u, 0x0f0f0000u, 0xf0f00000u};
 
@@ -337,10 +304,13 @@ static bool differ(const glm::dvec3& a, const glm::dvec3& b) {
 
 Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
                       MapShadingStats* stats) {
-  ThreadStats per_thread;
+  ResolveOptions ro;
+  ro.threads = threads;
+  // Statistics per resolve worker, merged at the end: no lock while shading.
+  std::vector<MapShadingStats> per_worker(static_cast<size_t>(resolve_workers(camera, ro)));
   // The fragment shaded at its covered quarters, adaptively (header, QUARTER_SPLIT_SRGB).
-  const PixelShader shade = [&](const Fragment& f, int x, int y) {
-    MapShadingStats* s = per_thread.slot();
+  const WorkerPixelShader shade = [&](const Fragment& f, int x, int y, int worker) {
+    MapShadingStats* s = &per_worker[static_cast<size_t>(worker)];
     const glm::dvec3 eye = scene.camera.position;
     // One pixel's width seen from the eye, in radians (the mesh refinement's radius).
     const double pixel = glm::length(glm::normalize(camera.view.direction(x + 1.5, y + 0.5)) -
@@ -381,10 +351,10 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
     }
     return ShadedFragment{c, scene.materials[scene.triangles->material_id[f.triangle()]].opacity};
   };
-  ResolveOptions ro;
-  ro.threads = threads;
-  Image image = resolve_image(camera, *scene.triangles, shade, scene.background, ro);
-  if (stats) per_thread.merge_into(stats);
+  Image image = resolve_image_per_worker(camera, *scene.triangles, shade, scene.background, ro);
+  if (stats) {
+    for (const MapShadingStats& s : per_worker) stats->merge(s);
+  }
   return image;
 }
 

@@ -83,16 +83,26 @@ glm::dvec3 pack_under_mask(FragmentList list, CoverageMask search, const Fragmen
   return pack(list, search, shade, triangles, background, scratch ? scratch : &local);
 }
 
+int resolve_workers(const ABuffer& camera, const ResolveOptions& options) {
+  if (options.threads < 0) throw InputError("resolve: threads must be >= 0, got " + std::to_string(options.threads));
+  return thread_count(options.threads, static_cast<size_t>(camera.height()));
+}
+
 Image resolve_image(const ABuffer& camera, const TriangleSoup& triangles, const PixelShader& shade,
                     const glm::dvec3& background, const ResolveOptions& options) {
-  if (options.threads < 0) throw InputError("resolve: threads must be >= 0, got " + std::to_string(options.threads));
+  const WorkerPixelShader by_worker = [&shade](const Fragment& f, int x, int y, int) { return shade(f, x, y); };
+  return resolve_image_per_worker(camera, triangles, by_worker, background, options);
+}
+
+Image resolve_image_per_worker(const ABuffer& camera, const TriangleSoup& triangles, const WorkerPixelShader& shade,
+                               const glm::dvec3& background, const ResolveOptions& options) {
+  const int threads = resolve_workers(camera, options);
   Image image(camera.width(), camera.height(), 3);
-  const int threads = thread_count(options.threads, static_cast<size_t>(camera.height()));
   std::vector<PackScratch> scratch(static_cast<size_t>(threads));
   parallel_for(static_cast<size_t>(camera.height()), threads, [&](size_t row, int worker) {
     const int y = static_cast<int>(row);
     for (int x = 0; x < camera.width(); ++x) {
-      const auto shade_here = [&](const Fragment& f) { return shade(f, x, y); };
+      const auto shade_here = [&](const Fragment& f) { return shade(f, x, y, worker); };
       const glm::dvec3 c = pack(camera.list(x, y), FULL_MASK, shade_here, triangles, background,
                                 &scratch[static_cast<size_t>(worker)]);
       image.set_rgb(x, y, glm::vec3(c));

@@ -78,4 +78,11 @@ struct ResolveOptions {
 Image resolve_image(const ABuffer& camera, const TriangleSoup& triangles, const PixelShader& shade,
                     const glm::dvec3& background, const ResolveOptions& options = {});
 
+// Same, `shade` told which worker calls it (0 to resolve_workers() - 1; one worker never
+// runs two calls at once), so per-worker state (statistics) needs no lock.
+using WorkerPixelShader = std::function<ShadedFragment(const Fragment& f, int x, int y, int worker)>;
+int resolve_workers(const ABuffer& camera, const ResolveOptions& options);
+Image resolve_image_per_worker(const ABuffer& camera, const TriangleSoup& triangles, const WorkerPixelShader& shade,
+                               const glm::dvec3& background, const ResolveOptions& options = {});
+
 }  // namespace abcube
