@@ -11,7 +11,8 @@ PACKAGES=(
   libglm-dev python3-glad
   libopenimageio-dev openimageio-tools
   nlohmann-json3-dev libtinyobjloader-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-distributed
   povray
 )
 

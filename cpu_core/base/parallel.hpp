@@ -1,12 +1,17 @@
 // A plain parallel loop: items handed to std::threads dynamically, the calling thread
-// working too, the first exception rethrown after every thread has stopped.
+// working too, the first exception rethrown after every thread has stopped. A render's
+// time limit (RenderTimeout) is checked before every item: see ScopedDeadline.
 #pragma once
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <exception>
+#include <string>
 #include <thread>
 #include <vector>
+
+#include <abcube/error.hpp>
 
 namespace abcube {
 
@@ -17,14 +22,55 @@ inline int thread_count(int requested, size_t items) {
   return static_cast<int>(std::clamp<size_t>(static_cast<size_t>(n), 1, std::max<size_t>(items, 1)));
 }
 
+// A render's time limit. The thread that starts a render installs one for the render's
+// length (ScopedDeadline); every parallel_for started under it, on that thread or on its
+// workers, checks it before each item and throws RenderTimeout past it. The one piece of
+// per-thread state in the library, scoped to one render call.
+struct Deadline {
+  std::chrono::steady_clock::time_point at;
+  double seconds = 0;  // the limit as given, for the message
+  void check() const {
+    if (std::chrono::steady_clock::now() > at) {
+      throw RenderTimeout("render stopped: over its time limit of " + std::to_string(seconds) + " s");
+    }
+  }
+};
+
+inline const Deadline*& current_deadline() {
+  thread_local const Deadline* deadline = nullptr;
+  return deadline;
+}
+
+// Installs `d` (may be null) on this thread until the end of the scope.
+class ScopedDeadline {
+ public:
+  explicit ScopedDeadline(const Deadline* d) : previous_(current_deadline()) { current_deadline() = d; }
+  ~ScopedDeadline() { current_deadline() = previous_; }
+  ScopedDeadline(const ScopedDeadline&) = delete;
+  ScopedDeadline& operator=(const ScopedDeadline&) = delete;
+
+ private:
+  const Deadline* previous_;
+};
+
+// Throws RenderTimeout when this thread's render is over its limit (no-op without one).
+inline void check_deadline() {
+  if (const Deadline* d = current_deadline()) d->check();
+}
+
 // Calls fn(item, worker) for item in [0, count), worker in [0, threads).
 template <class Fn>
 void parallel_for(size_t count, int threads, Fn&& fn) {
   std::atomic<size_t> next{0};
   std::vector<std::exception_ptr> errors(static_cast<size_t>(threads));
+  const Deadline* deadline = current_deadline();
   auto work = [&](int worker) {
+    const ScopedDeadline scope(deadline);  // the workers inherit the caller's limit
     try {
-      for (size_t i = next++; i < count; i = next++) fn(i, worker);
+      for (size_t i = next++; i < count; i = next++) {
+        if (deadline) deadline->check();
+        fn(i, worker);
+      }
     } catch (...) {
       errors[static_cast<size_t>(worker)] = std::current_exception();
       next = count;  // stop the others early

@@ -71,6 +71,8 @@ void write_image(const std::string& path, const Image& image) {
   OIIO::ImageSpec spec(image.width, image.height, channels,
                        linear ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
   spec.attribute("oiio:ColorSpace", linear ? "linear" : "sRGB");
+  // The bytes depend on the pixels only: OpenEXR and TIFF otherwise stamp the time.
+  spec.attribute("DateTime", "");
   std::vector<float> pixels(image.data);
   if (!linear) {
     for (size_t k = 0; k < pixels.size(); ++k) {

@@ -5,9 +5,12 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 
 #include "base/error.hpp"
+#include "io/image_io.hpp"
 
 namespace abcube {
 
@@ -80,5 +83,54 @@ void Args::expect_positional(size_t count, const std::string& what) const {
 }
 
 bool stderr_is_terminal() { return isatty(STDERR_FILENO) == 1; }
+
+std::function<void(const std::string&, double)> progress_printer() {
+  if (!stderr_is_terminal()) return nullptr;
+  return [](const std::string& stage, double done) {
+    std::fprintf(stderr, "\r%s %3d%%%s", stage.c_str(), int(done * 100), done >= 1 ? "\n" : "");
+  };
+}
+
+RenderOptions render_options_from(const Args& args) {
+  RenderOptions o;
+  o.method = args.get("--method");
+  o.cube_resolution = args.get_int("--cube-res", 0, 1, 16384);
+  o.max_depth = args.get_int("--max-depth", -1, 0, 64);
+  o.error_target = args.get_double("--error-target", -1, 0.0, 0.5);
+  if (args.has("--fresnel")) o.fresnel = true;
+  o.reference_image = args.get("--reference-image");
+  o.reference = args.has("--reference");
+  const std::string plan = args.get("--plan", "needed");
+  if (plan != "needed" && plan != "everything") {
+    throw InputError("--plan: must be needed or everything, got '" + plan + "'");
+  }
+  o.plan_everything = plan == "everything";
+  o.search = args.get("--search", o.search);
+  o.refine = args.get("--refine", o.refine);
+  o.theta_max_deg = args.get_double("--theta-max", o.theta_max_deg, 1e-6, 90.0);
+  o.refraction = args.get("--refraction", o.refraction);
+  o.envmap_lookup = args.get("--envmap-lookup", o.envmap_lookup);
+  o.max_layers = static_cast<uint32_t>(args.get_int("--max-layers", 0, 0, 1 << 20));
+  o.max_memory_mib = static_cast<uint64_t>(args.get_int("--max-memory", 0, 0, 1 << 30));
+  o.max_pixels = static_cast<uint64_t>(args.get_double("--max-pixels", 0, 0, 1e15));
+  o.timeout_s = args.get_double("--timeout", 0, 0, 1e9);
+  const std::string aovs = args.get("--aovs");
+  for (size_t start = 0; start < aovs.size();) {
+    const size_t comma = std::min(aovs.find(',', start), aovs.size());
+    if (comma > start) o.aovs.push_back(aovs.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return o;
+}
+
+std::string aov_path(const std::string& output, const std::string& aov) {
+  const std::filesystem::path p(output);
+  return (p.parent_path() / (p.stem().string() + "." + aov + ".exr")).string();
+}
+
+void write_outputs(const std::string& output, const RenderResult& result) {
+  write_image(output, result.image);
+  for (const auto& [name, image] : result.aovs) write_image(aov_path(output, name), image);
+}
 
 }  // namespace abcube

@@ -1,9 +1,12 @@
 // Small pieces the abcube subcommands share: argument parsing, timing, progress.
 #pragma once
 #include <chrono>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
+
+#include <abcube/renderer.hpp>
 
 #include "base/timer.hpp"
 
@@ -35,6 +38,16 @@ class Args {
 
 // True when stderr is a terminal (progress is shown only then).
 bool stderr_is_terminal();
+
+// "stage NN%" on stderr when it is a terminal; null (quiet) otherwise (cli.md).
+std::function<void(const std::string&, double)> progress_printer();
+
+// The render options the command line gives (render's options; batch's shared ones).
+RenderOptions render_options_from(const Args& args);
+
+// The image, and each AOV beside it as OUT_STEM.NAME.exr (float), each written atomically.
+void write_outputs(const std::string& output, const RenderResult& result);
+std::string aov_path(const std::string& output, const std::string& aov);
 
 int cmd_render(const std::vector<std::string>& words);
 int cmd_info(const std::vector<std::string>& words);

@@ -1,5 +1,6 @@
 // abcube compare A B: image error figures and idiff-like thresholds (metrics.hpp).
 //   exit 0 within thresholds, 1 beyond, 2 for bad input (unreadable file, size mismatch).
+//   --exact: exit 0 only when every channel of every pixel holds the same float.
 #include <cmath>
 #include <cstdio>
 
@@ -11,7 +12,7 @@
 namespace abcube {
 
 int cmd_compare(const std::vector<std::string>& words) {
-  const Args args(words, {"--diff", "--fail", "--failpercent"}, {});
+  const Args args(words, {"--diff", "--fail", "--failpercent"}, {"--exact"});
   args.expect_positional(2, "images A and B");
   // A pixel fails when its largest channel differs by more than --fail (displayed values,
   // 0..1; default one 8-bit code); the comparison fails when more than --failpercent
@@ -28,6 +29,12 @@ int cmd_compare(const std::vector<std::string>& words) {
     throw InputError(args.positional()[0] + " is " + std::to_string(a.width) + "x" + std::to_string(a.height) +
                      ", " + args.positional()[1] + " is " + std::to_string(b.width) + "x" +
                      std::to_string(b.height) + ": sizes differ");
+  }
+  if (args.has("--exact")) {
+    // Bit for bit: the same channels and the same float in every one (before any encoding).
+    const bool same = a.channels == b.channels && a.data == b.data;
+    std::printf("%s\n", same ? "IDENTICAL" : "DIFFERENT");
+    return same ? 0 : 1;
   }
   const ImageError e = image_error(a, b);
   const double failing = share_over(a, b, fail);

@@ -229,6 +229,11 @@ void GlScene::bind_lookups(const GlProgram& program, bool with_environment) {
   glActiveTexture(GL_TEXTURE0);
 }
 
+void GlScene::drop_environment() {
+  glDeleteTextures(1, &environment_);
+  environment_ = 0;
+}
+
 int GlScene::build_shadow_maps(int n) {
   shadow_layer_.assign(scene_.lights.size(), -1);
   int layers = 0;
@@ -236,9 +241,12 @@ int GlScene::build_shadow_maps(int n) {
     if (scene_.lights[i].cast_shadows) shadow_layer_[i] = layers++;
   }
   if (layers == 0) return 0;
+  // The lights are the scene's: maps built at this size by an earlier render are kept.
+  if (shadow_maps_ != 0 && shadow_n_ == n) return layers;
   const Clock::time_point t0 = Clock::now();
   if (n > max_size_) throw RuntimeFailure("shadow map " + std::to_string(n) + " exceeds GL_MAX_TEXTURE_SIZE");
   shadow_n_ = n;
+  glDeleteTextures(1, &shadow_maps_);
   glGenTextures(1, &shadow_maps_);
   glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, shadow_maps_);
   glTexStorage3D(GL_TEXTURE_CUBE_MAP_ARRAY, 1, GL_R32F, n, n, 6 * layers);
@@ -265,7 +273,7 @@ int GlScene::build_shadow_maps(int n) {
 void GlScene::build_environment(const glm::dvec3& center, int n) {
   const Clock::time_point t0 = Clock::now();
   if (n > max_size_) throw RuntimeFailure("environment map " + std::to_string(n) + " exceeds GL_MAX_TEXTURE_SIZE");
-  glDeleteTextures(1, &environment_);
+  drop_environment();
   glGenTextures(1, &environment_);
   glBindTexture(GL_TEXTURE_CUBE_MAP, environment_);
   glTexStorage2D(GL_TEXTURE_CUBE_MAP, 1, GL_RGBA32F, n, n);

@@ -53,13 +53,16 @@ class GlScene {
   Image camera_color(const Camera& camera);
 
   // One cube shadow map (distance prepass from the light) per light with cast_shadows, at
-  // n x n per face; later colour passes are shadowed by them. Returns how many.
+  // n x n per face; later colour passes are shadowed by them. Returns how many. Maps of
+  // the same size built before are kept (the lights do not change).
   int build_shadow_maps(int n);
 
   // The Z-buffer colour of the six faces around `center` (with shadows if built) kept on
   // the GPU as a cube texture; later camera passes look it up for kr and kt (Blinn & Newell
   // 1976, the `gpu` method's reflections).
   void build_environment(const glm::dvec3& center, int n);
+  // Later camera passes look up no environment (max_depth 0, or nothing reflects).
+  void drop_environment();
 
   const GpuTimings& timings() const { return timings_; }
   double near_distance() const { return near_; }

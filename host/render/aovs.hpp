@@ -1,0 +1,17 @@
+// Arbitrary output variables beside the image (RenderOptions::aovs, renderer.hpp): what
+// the eye ray through each pixel centre meets, from the exact tracer on the same
+// triangles, whatever the method (so every method's AOVs agree by construction).
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+#include "render/render_methods.hpp"
+
+namespace abcube {
+
+bool aov_known(const std::string& name);
+std::string aov_names();  // "distance, normal, object_id"
+std::map<std::string, Image> render_aovs(MethodContext& mc, const std::vector<std::string>& names);
+
+}  // namespace abcube

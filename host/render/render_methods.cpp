@@ -1,0 +1,158 @@
+#include "render/render_methods.hpp"
+
+#include <cmath>
+#include <memory>
+
+#include <abcube/image.hpp>
+
+#include "base/error.hpp"
+#include "base/parallel.hpp"
+#include "base/timer.hpp"
+#include "io/metrics.hpp"
+#include "reference/raytrace.hpp"
+#include "render/crosscheck.hpp"
+#include "render/stats_json.hpp"
+#include "scene/plan.hpp"
+
+namespace abcube {
+
+using nlohmann::json;
+
+json gl_json(const GlContext* ctx) {
+  if (!ctx) return {{"path", "none"}, {"renderer", describe_gl(nullptr)}};
+  const GlInfo& i = ctx->info();
+  json j = {{"path", i.api}, {"renderer", i.gl_renderer}, {"gl_version", i.gl_version},
+            {"gl_vendor", i.gl_vendor}};
+  if (!i.egl_vendor.empty()) j["egl_vendor"] = i.egl_vendor;
+  if (i.device_index >= 0) j["egl_device"] = i.device_index;
+  return j;
+}
+
+Image render_gpu(MethodContext& mc) {
+  const SceneData& scene = mc.scene;
+  json& stats = mc.stats;
+  GlScene& gl = *mc.gl_scene;
+  const GpuTimings before = gl.timings();
+  // Model only what the scene needs: shadow maps for shadow-casting lights, the
+  // environment map for reflecting or refracting materials (none at max_depth 0).
+  json passes = json::array(), skipped = json::array();
+  const int n = scene.render.cube_resolution;
+  const int maps = gl.build_shadow_maps(n);
+  if (maps > 0) {
+    passes.push_back("shadow_maps");
+  } else {
+    skipped.push_back({{"pass", "shadow_maps"}, {"why", "no light casts shadows"}});
+  }
+  bool mirrors = false;
+  for (const Material& m : scene.materials) mirrors = mirrors || m.reflect > 0 || m.transmit > 0;
+  if (mirrors && scene.render.max_depth > 0) {
+    gl.build_environment(scene.camera.position, n);
+    passes.push_back("environment_map");
+  } else {
+    gl.drop_environment();
+    skipped.push_back({{"pass", "environment_map"},
+                       {"why", mirrors ? "max_depth 0: no reflected or refracted ray" : "no material reflects or transmits"}});
+    mirrors = false;
+  }
+  check_deadline();
+  Image image = gl.camera_color(scene.camera);
+  passes.push_back("camera_raster");
+  skipped.push_back({{"pass", "cube_distance"}, {"why", "method gpu does no map search"}});
+  const GpuTimings& t = gl.timings();
+  stats["timings_ms"]["upload"] = t.upload_ms - before.upload_ms;
+  if (maps > 0) stats["timings_ms"]["shadow_maps"] = t.shadow_maps_ms - before.shadow_maps_ms;
+  if (mirrors) stats["timings_ms"]["environment_map"] = t.environment_ms - before.environment_ms;
+  stats["timings_ms"]["camera_raster"] = t.camera_ms - before.camera_ms;
+  stats["timings_ms"]["readback"] = t.readback_ms - before.readback_ms;
+  stats["counts"]["shadow_maps"] = maps;
+  stats["plan"]["passes"] = passes;
+  stats["plan"]["skipped"] = skipped;
+  return image;
+}
+
+Image render_reference(MethodContext& mc, const char* key) {
+  RaytraceOptions options;
+  options.threads = mc.request.threads;
+  if (mc.progress) {
+    const std::string stage = key;
+    options.progress = [&mc, stage](double done) { mc.progress(stage, done); };
+  }
+  options.bvh = mc.cache.bvh();
+  RaytraceStats rs;
+  Image image = render_raytrace(mc.scene, options, &rs);
+  mc.stats[key].update(raytrace_json(rs));  // beside what the map method put there (ray_error)
+  return image;
+}
+
+Image render_map_method(MethodContext& mc) {
+  const SceneData& scene = mc.scene;
+  const RenderRequest& r = mc.request;
+  json& stats = mc.stats;
+  const RenderPlan plan = make_plan(scene, r.plan_everything);
+  json passes = json::array(), skipped = json::array();
+  for (const PlanStep& s : plan.steps) (s.run ? passes : skipped).push_back({{"pass", s.pass}, {"why", s.why}});
+  stats["plan"]["passes"] = passes;
+  stats["plan"]["skipped"] = skipped;
+  stats["plan"]["mode"] = r.plan_everything ? "everything" : "needed";
+  if (!plan.cube_map) return render_abuffer_local(scene, r.abuffer, &stats);
+  Clock::time_point t0 = Clock::now();
+  ABufferStats cs;
+  const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, scene.render.cube_resolution, r.abuffer, &cs);
+  stats["timings_ms"]["cube_abuffer"] = ms_since(t0);
+  stats["cube_abuffer"] = cube_abuffer_json(cs);
+  std::unique_ptr<RayTracer> reference;
+  if (r.reference) reference = std::make_unique<RayTracer>(scene, mc.cache.bvh());
+  MapShadingOptions options = r.map;
+  options.method = scene.render.method;
+  options.walk_all_shadows = r.plan_everything;
+  t0 = Clock::now();
+  const MapShader shader(scene, cube, options, reference.get(), &mc.cache);
+  stats["timings_ms"]["map_setup"] = ms_since(t0);
+  t0 = Clock::now();
+  ABufferStats as;
+  const ABuffer camera = build_camera_abuffer(scene, r.abuffer, &as);
+  stats["timings_ms"]["camera_abuffer"] = ms_since(t0);
+  t0 = Clock::now();
+  MapShadingStats ms;
+  Image image = render_with_map(scene, camera, shader, r.threads, &ms);
+  stats["timings_ms"]["shade_and_resolve"] = ms_since(t0);
+  stats["abuffer"] = abuffer_json(as, false);
+  stats["searches"] = map_shading_json(ms);
+  if (reference) {
+    const double bound = parallax_bound(scene.render.cube_resolution);
+    stats["reference"]["ray_error"] = {
+        {"rays", "reflection rays of camera-visible surfaces"},
+        {"error_cp", error_stats_json(ms.errors.error_cp)},
+        {"error_parallax", error_stats_json(ms.errors.error_parallax)},
+        {"false_hits", ms.errors.false_hits},
+        {"wrong_object", ms.errors.wrong_object},
+        {"bound_1_over_2n2", bound},
+        {"error_parallax_within_bound", ms.errors.error_parallax.share_within(bound)}};
+  }
+  return image;
+}
+
+double add_reference_error(MethodContext& mc, const Image& image) {
+  json& stats = mc.stats;
+  const RenderRequest& r = mc.request;
+  Image ref;
+  if (!r.reference_image.empty()) {
+    ref = read_image(r.reference_image);
+    if (ref.width != image.width || ref.height != image.height) {
+      throw InputError(r.reference_image + ": is " + std::to_string(ref.width) + "x" + std::to_string(ref.height) +
+                       ", the render is " + std::to_string(image.width) + "x" + std::to_string(image.height));
+    }
+    stats["reference"]["image"] = r.reference_image;
+  } else {
+    ref = mc.scene.render.method == Method::raytrace ? image : render_reference(mc, "reference");
+  }
+  const ImageError e = image_error(image, ref);
+  stats["reference"]["image_error"] = image_error_json(e);
+  if (!stats["reference"].contains("ray_error")) {
+    stats["reference"]["ray_error"] = std::string("n/a: method ") + method_name(mc.scene.render.method) +
+                                      " does no map search (Error_CP and Error_Parallax measure searches)";
+  }
+  return e.psnr;
+}
+
+}  // namespace abcube

@@ -1,0 +1,56 @@
+// The passes of each method, as the Renderer runs them (renderer.cpp): what the scene
+// needs and nothing more (the plan), with the per-scene data from the SceneCache.
+#pragma once
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "gl/gl_context.hpp"
+#include "gl/gl_passes.hpp"
+#include "raster/abuffer.hpp"
+#include "scene/scene_data.hpp"
+#include "shading/map_shading.hpp"
+#include "shading/scene_cache.hpp"
+
+namespace abcube {
+
+// One render's settings after validation (RenderOptions resolved against the scene).
+struct RenderRequest {
+  int threads = 0;
+  bool reference = false;
+  std::string reference_image;  // the exact image, rendered before
+  bool plan_everything = false;
+  ABufferOptions abuffer;       // threads, layer cap, memory budget
+  MapShadingOptions map;        // search mode, refinement, theta_max, refraction, envmap lookup
+  std::vector<std::string> aovs;
+};
+
+// What every method's passes read and write.
+struct MethodContext {
+  const SceneData& scene;       // with this render's camera and settings
+  const SceneCache& cache;
+  const RenderRequest& request;
+  nlohmann::json& stats;
+  const std::function<void(const std::string&, double)>& progress;
+  GlScene* gl_scene;            // the scene on the GPU (gpu method only)
+  // Filled by the map methods for the "fallback" AOV: per pixel, the share of secondary
+  // searches that found nothing.
+  Image* fallback;
+};
+
+// The Z-buffer raster on the GPU: camera view only, Phong, aliased.
+Image render_gpu(MethodContext& mc);
+// The cube-map methods (abuffer, zbuffer, envmap): the map is built only when something
+// needs it (a reflecting or refracting material, a shadow-casting light).
+Image render_map_method(MethodContext& mc);
+// The exact Whitted tracer; its stats go under `key` ("raytrace" or "reference").
+Image render_reference(MethodContext& mc, const char* key);
+// The image's error against the exact image (traced now, or --reference-image); PSNR.
+double add_reference_error(MethodContext& mc, const Image& image);
+
+nlohmann::json gl_json(const GlContext* ctx);
+
+}  // namespace abcube

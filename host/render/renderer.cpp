@@ -1,0 +1,315 @@
+// abcube::Renderer: the one render pipeline. The CLI's `render` and `batch`, the Python
+// module and the tests call it; each method's passes are in render_methods.cpp.
+#include <abcube/renderer.hpp>
+
+#include <cmath>
+#include <mutex>
+#include <thread>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "base/error.hpp"
+#include "base/memory.hpp"
+#include "base/parallel.hpp"
+#include "base/timer.hpp"
+#include "gl/gl_context.hpp"
+#include "render/aovs.hpp"
+#include "render/render_methods.hpp"
+#include "render/stats_json.hpp"
+#include "scene/plan.hpp"
+#include "scene/scene_load.hpp"
+#include "shading/scene_cache.hpp"
+
+#ifndef ABCUBE_VERSION
+#define ABCUBE_VERSION "0.0.0"
+#endif
+#ifndef ABCUBE_GIT_COMMIT
+#define ABCUBE_GIT_COMMIT ""
+#endif
+
+namespace abcube {
+
+using nlohmann::json;
+
+std::string version_string() {
+  const std::string commit = ABCUBE_GIT_COMMIT;
+  return std::string("abcube ") + ABCUBE_VERSION + (commit.empty() ? "" : " (git " + commit + ")");
+}
+
+namespace {
+
+// A finite 3-vector, or InputError naming the option.
+glm::dvec3 finite_vec3(const std::array<double, 3>& v, const char* name) {
+  for (double x : v) {
+    if (!std::isfinite(x)) throw InputError(std::string("camera.") + name + ": must be finite numbers");
+  }
+  return {v[0], v[1], v[2]};
+}
+
+// The scene's camera with the keys the override gives, validated as the scene file's is.
+Camera override_camera(Camera c, const CameraOverride& o) {
+  if (o.position) c.position = finite_vec3(*o.position, "position");
+  if (o.look_at) c.look_at = finite_vec3(*o.look_at, "look_at");
+  if (o.up) c.up = finite_vec3(*o.up, "up");
+  if (o.fov_y) {
+    if (!(*o.fov_y > 0 && *o.fov_y < 180)) {
+      throw InputError("camera.fov_y: must be > 0 and < 180 (degrees), got " + std::to_string(*o.fov_y));
+    }
+    c.fov_y_deg = *o.fov_y;
+  }
+  for (auto [value, name, out] : {std::tuple{o.width, "width", &c.width}, std::tuple{o.height, "height", &c.height}}) {
+    if (!value) continue;
+    if (*value < 1 || *value > 65536) {
+      throw InputError(std::string("camera.") + name + ": must be in [1, 65536], got " + std::to_string(*value));
+    }
+    *out = *value;
+  }
+  const glm::dvec3 view = c.look_at - c.position;
+  if (!(glm::length(view) > 0)) throw InputError("camera.look_at: must differ from camera.position");
+  if (!(glm::length(glm::cross(glm::normalize(view), c.up)) > 1e-9)) {
+    throw InputError("camera.up: must not be parallel to the view direction");
+  }
+  return c;
+}
+
+template <class Enum>
+Enum parse_named(const std::string& value, bool (*parse)(const std::string&, Enum*), const char* option,
+                 const char* what, const char* choices) {
+  Enum e{};
+  if (!parse(value, &e)) {
+    throw InputError(std::string(option) + ": unknown " + what + " '" + value + "' (" + choices + ")");
+  }
+  return e;
+}
+
+// The render request: the scene's settings with the options' overrides, validated.
+RenderRequest make_request(const SceneData& base, const RenderOptions& o, int renderer_threads, SceneData* view) {
+  RenderRequest r;
+  *view = base;  // shares the triangles (SharedTriangles)
+  RenderSettings& rs = view->render;
+  if (!o.method.empty()) {
+    rs.method = parse_named(o.method, parse_method, "method", "method", "abuffer, zbuffer, envmap, raytrace, gpu");
+  }
+  if (o.error_target >= 0) {
+    if (!(o.error_target <= 0.5)) throw InputError("error-target: must be in [0, 0.5], got " + std::to_string(o.error_target));
+    rs.error_target = o.error_target;
+  }
+  if (rs.error_target > 0 && o.cube_resolution == 0) {
+    // thesis 9.3.4: the N whose bound 1/(2 N^2) meets the target (plan.hpp).
+    rs.cube_resolution = resolution_for_error(rs.error_target);
+  }
+  if (o.cube_resolution != 0) {
+    if (o.cube_resolution < 1 || o.cube_resolution > 16384) {
+      throw InputError("cube-res: must be an integer in [1, 16384], got " + std::to_string(o.cube_resolution));
+    }
+    rs.cube_resolution = o.cube_resolution;
+  }
+  if (o.max_depth >= 0) {
+    if (o.max_depth > 64) throw InputError("max-depth: must be an integer in [0, 64], got " + std::to_string(o.max_depth));
+    rs.max_depth = o.max_depth;
+  }
+  if (o.fresnel) rs.fresnel = *o.fresnel;
+  view->camera = override_camera(view->camera, o.camera);
+  const uint64_t pixels = static_cast<uint64_t>(view->camera.width) * static_cast<uint64_t>(view->camera.height);
+  if (o.max_pixels > 0 && pixels > o.max_pixels) {
+    throw InputError(view->file + ": camera: " + std::to_string(view->camera.width) + "x" +
+                     std::to_string(view->camera.height) + " = " + std::to_string(pixels) +
+                     " pixels exceeds --max-pixels " + std::to_string(o.max_pixels));
+  }
+  if (o.threads < 0) throw InputError("threads: must be >= 0, got " + std::to_string(o.threads));
+  r.threads = o.threads > 0 ? o.threads : renderer_threads;
+  r.reference_image = o.reference_image;
+  r.reference = o.reference || !o.reference_image.empty();
+  r.plan_everything = o.plan_everything;
+  r.abuffer.threads = r.threads;
+  r.map.threads = r.threads;
+  r.map.search.mode = parse_named(o.search, parse_search_mode, "search", "mode", "crossing, thesis");
+  r.map.search.refine = parse_named(o.refine, parse_search_refine, "refine", "refinement", "mesh, plane");
+  if (!(o.theta_max_deg >= 1e-6 && o.theta_max_deg <= 90)) {
+    throw InputError("theta-max: must be a number in [1e-06, 90], got " + std::to_string(o.theta_max_deg));
+  }
+  r.map.search.theta_max = glm::radians(o.theta_max_deg);
+  r.map.refraction = parse_named(o.refraction, parse_refraction_mode, "refraction", "mode", "search, thick_lens, thin_lens");
+  r.map.lookup = parse_named(o.envmap_lookup, parse_envmap_lookup, "envmap-lookup", "lookup", "R, bisector, position");
+  r.abuffer.max_layers = o.max_layers;
+  if (o.max_memory_mib > (uint64_t{1} << 30)) throw InputError("max-memory: must be at most 2^30 MiB");
+  r.abuffer.max_memory_bytes = o.max_memory_mib << 20;
+  for (const std::string& a : o.aovs) {
+    if (!aov_known(a)) throw InputError("aovs: unknown AOV '" + a + "' (" + aov_names() + ")");
+  }
+  r.aovs = o.aovs;
+  check_render_size(*view, available_memory_bytes());
+  return r;
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  RendererOptions options;
+  GlChoice gl_choice = GlChoice::automatic;
+  std::mutex mutex;  // one render at a time per Renderer
+  uint64_t renders = 0;
+  // GL: opened on the first render that needs it, on that render's thread.
+  bool gl_tried = false;
+  std::unique_ptr<GlContext> gl;
+  std::string gl_log;
+  std::thread::id gl_thread;
+  // The scene uploaded to GL last, kept while the next render draws the same scene.
+  std::optional<Scene> gl_scene_owner;
+  std::unique_ptr<GlScene> gl_scene;
+
+  GlContext* open_gl() {
+    if (!gl_tried) {
+      gl_tried = true;
+      gl = open_gl_context(gl_choice, options.gl_device, &gl_log);
+      gl_thread = std::this_thread::get_id();
+    }
+    if (gl && std::this_thread::get_id() != gl_thread) {
+      throw RuntimeFailure("this Renderer opened GL on another thread; GL contexts are current per thread: "
+                           "use one Renderer per thread");
+    }
+    return gl.get();
+  }
+
+  GlScene& gl_scene_for(const Scene& scene) {
+    if (!gl_scene_owner || &gl_scene_owner->data() != &scene.data()) {
+      gl_scene.reset();
+      gl_scene_owner = scene;
+      gl_scene = std::make_unique<GlScene>(scene.data());
+    }
+    return *gl_scene;
+  }
+};
+
+Renderer::Renderer(const RendererOptions& options) : impl_(std::make_unique<Impl>()) {
+  impl_->options = options;
+  if (!parse_gl_choice(options.gl, &impl_->gl_choice)) {
+    throw InputError("gl: unknown path '" + options.gl + "' (auto, egl, egl-device, egl-surfaceless, osmesa, none)");
+  }
+  if (options.threads < 0) throw InputError("threads: must be >= 0, got " + std::to_string(options.threads));
+  if (options.gl_device < -1) throw InputError("gl-device: must be >= 0, got " + std::to_string(options.gl_device));
+}
+
+Renderer::~Renderer() {
+  // The GL objects go before the context they live in.
+  if (impl_) {
+    impl_->gl_scene.reset();
+    impl_->gl.reset();
+  }
+}
+
+std::string Renderer::gl_path() const {
+  if (!impl_->gl_tried) return "";
+  return impl_->gl ? impl_->gl->info().api : "none";
+}
+
+std::string Renderer::gl_renderer() const { return impl_->gl ? impl_->gl->info().gl_renderer : ""; }
+
+uint64_t Renderer::renders() const { return impl_->renders; }
+
+RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) {
+  const std::lock_guard<std::mutex> lock(impl_->mutex);
+  const Clock::time_point start = Clock::now();
+  Deadline deadline;
+  if (options.timeout_s < 0 || std::isnan(options.timeout_s)) {
+    throw InputError("timeout: must be >= 0 seconds, got " + std::to_string(options.timeout_s));
+  }
+  if (options.timeout_s > 0) {
+    deadline.seconds = options.timeout_s;
+    deadline.at = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.timeout_s));
+  }
+  const ScopedDeadline scope(options.timeout_s > 0 ? &deadline : nullptr);
+
+  SceneData view;
+  const RenderRequest request = make_request(scene.data(), options, impl_->options.threads, &view);
+  const SceneCache::Builds before = scene.cache().builds();
+  json stats;
+  stats["scene"] = view.file;
+  stats["method"] = method_name(view.render.method);
+  stats["timings_ms"]["load"] = scene.load_ms();
+  stats["counts"] = {{"triangles", view.triangles->triangle_count()},
+                     {"dropped_triangles", view.dropped_triangles},
+                     {"objects", view.objects.size()},
+                     {"lights", view.lights.size()}};
+  if (view.render.error_target > 0) {
+    stats["error_target"] = {{"target", view.render.error_target},
+                             {"cube_resolution", view.render.cube_resolution},
+                             {"bound_at_that_n", parallax_bound(view.render.cube_resolution)}};
+  }
+  stats["size"] = {{"width", view.camera.width}, {"height", view.camera.height},
+                   {"cube_resolution", view.render.cube_resolution}, {"max_depth", view.render.max_depth}};
+  stats["threads"] = thread_count(request.threads, SIZE_MAX);
+  stats["method_options"] = {{"search", search_mode_name(request.map.search.mode)},
+                             {"refine", search_refine_name(request.map.search.refine)},
+                             {"theta_max_deg", glm::degrees(request.map.search.theta_max)},
+                             {"refraction", refraction_mode_name(request.map.refraction)},
+                             {"envmap_lookup", envmap_lookup_name(request.map.lookup)},
+                             {"fresnel", view.render.fresnel}};
+
+  MethodContext mc{view, scene.cache(), request, stats, options.progress, nullptr, nullptr};
+  Image image;
+  switch (view.render.method) {
+    case Method::gpu: {
+      const Clock::time_point t0 = Clock::now();
+      const bool first_open = !impl_->gl_tried;
+      GlContext* ctx = impl_->open_gl();
+      if (!ctx) {
+        if (impl_->gl_choice == GlChoice::none) throw InputError("--method gpu needs OpenGL, but --gl none was given");
+        std::string log = impl_->gl_log;
+        for (char& c : log) c = c == '\n' ? ';' : c;
+        throw RuntimeFailure("--method gpu needs OpenGL and no GL path works here: " + log);
+      }
+      stats["gl"] = gl_json(ctx);
+      stats["timings_ms"]["gl_init"] = first_open ? ms_since(t0) : 0.0;
+      mc.gl_scene = &impl_->gl_scene_for(scene);
+      image = render_gpu(mc);
+      break;
+    }
+    case Method::abuffer:
+    case Method::zbuffer:
+    case Method::envmap:
+      image = render_map_method(mc);
+      stats["gl"] = {{"path", "none"}, {"renderer", "none (CPU A-buffer)"}};
+      break;
+    case Method::raytrace:
+      image = render_reference(mc, "raytrace");
+      stats["plan"]["passes"] = {"raytrace"};
+      stats["plan"]["skipped"] = {{{"pass", "gl"}, {"why", "the exact tracer needs no GL"}}};
+      stats["gl"] = {{"path", "none"}, {"renderer", "none (the tracer is CPU only)"}};
+      break;
+  }
+  std::optional<double> psnr;
+  if (request.reference) psnr = add_reference_error(mc, image);
+  RenderResult result;
+  if (!request.aovs.empty()) {
+    const Clock::time_point t0 = Clock::now();
+    result.aovs = render_aovs(mc, request.aovs);
+    stats["timings_ms"]["aovs"] = ms_since(t0);
+  }
+
+  // What this render built of the per-scene data (0 when an earlier render did).
+  const SceneCache::Builds after = scene.cache().builds();
+  const int built = (after.neighbours - before.neighbours) + (after.lenses - before.lenses) + (after.bvh - before.bvh);
+  stats["scene_data"] = {{"built_by_this_render", built},
+                         {"mesh_neighbours", {{"built", after.neighbours - before.neighbours}, {"ms", after.neighbours_ms}}},
+                         {"lens_fits", {{"built", after.lenses - before.lenses}, {"ms", after.lenses_ms}}},
+                         {"bvh", {{"built", after.bvh - before.bvh}, {"ms", after.bvh_ms}}}};
+  ++impl_->renders;
+  stats["renderer"] = {{"renders", impl_->renders}};
+  stats["timings_ms"]["total"] = ms_since(start);
+  stats["memory"] = {{"peak_rss_bytes", peak_rss_bytes()}};
+
+  result.image = std::move(image);
+  RenderStats& rs = result.stats;
+  rs.total_ms = stats["timings_ms"]["total"].get<double>();
+  for (const auto& [k, v] : stats["timings_ms"].items()) rs.timings_ms[k] = v.get<double>();
+  rs.gl_path = stats["gl"]["path"].get<std::string>();
+  rs.gl_renderer = stats["gl"]["renderer"].get<std::string>();
+  rs.scene_data_built = built;
+  rs.psnr_db = psnr;
+  if (options.stats) rs.json = stats.dump(2);
+  return result;
+}
+
+}  // namespace abcube

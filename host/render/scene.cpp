@@ -1,0 +1,46 @@
+// abcube::Scene: one loaded scene and its per-scene cache, shared by its copies.
+#include <abcube/scene.hpp>
+
+#include "base/timer.hpp"
+#include "render/scene_state.hpp"
+#include "scene/scene_load.hpp"
+
+namespace abcube {
+
+namespace {
+
+LoadLimits load_limits(const SceneLimits& limits) {
+  LoadLimits l;
+  l.root = limits.root;
+  l.max_triangles = limits.max_triangles;
+  return l;
+}
+
+}  // namespace
+
+Scene Scene::load(const std::string& path, const SceneLimits& limits) {
+  const Clock::time_point t0 = Clock::now();
+  SceneData data = load_scene(path, load_limits(limits));
+  return Scene(std::make_shared<const State>(std::move(data), ms_since(t0)));
+}
+
+Scene Scene::from_json(const std::string& json_text, const std::string& name, const std::string& base_dir,
+                       const SceneLimits& limits) {
+  const Clock::time_point t0 = Clock::now();
+  SceneData data = load_scene_text(json_text, name, base_dir, load_limits(limits));
+  return Scene(std::make_shared<const State>(std::move(data), ms_since(t0)));
+}
+
+const std::string& Scene::name() const { return state_->data.file; }
+int Scene::width() const { return state_->data.camera.width; }
+int Scene::height() const { return state_->data.camera.height; }
+size_t Scene::triangle_count() const { return state_->data.triangles->triangle_count(); }
+size_t Scene::object_count() const { return state_->data.objects.size(); }
+std::string Scene::method() const { return method_name(state_->data.render.method); }
+int Scene::cube_resolution() const { return state_->data.render.cube_resolution; }
+int Scene::max_depth() const { return state_->data.render.max_depth; }
+double Scene::load_ms() const { return state_->load_ms; }
+const SceneData& Scene::data() const { return state_->data; }
+const SceneCache& Scene::cache() const { return state_->cache; }
+
+}  // namespace abcube
