@@ -35,12 +35,22 @@ bool parse_search_refine(const std::string& s, SearchRefine* out) { return parse
 
 const char* miss_reason_name(MissReason r) { return enum_name(MISS_REASON_NAMES, r); }
 
+namespace {
+
+// The walk's counts, which every kind of result carries.
+template <class Result>
+void add_walk(SearchKindStats* s, const Result& r) {
+  ++s->rays;
+  s->texels += r.texels_visited;
+  s->max_texels = std::max<uint64_t>(s->max_texels, r.texels_visited);
+  s->fragments += r.fragments_tested;
+  s->candidates += r.candidates;
+}
+
+}  // namespace
+
 void SearchKindStats::add(const SearchResult& r) {
-  ++rays;
-  texels += r.texels_visited;
-  max_texels = std::max<uint64_t>(max_texels, r.texels_visited);
-  fragments += r.fragments_tested;
-  candidates += r.candidates;
+  add_walk(this, r);
   if (r.hit) {
     ++hits;
     return;
@@ -52,11 +62,7 @@ void SearchKindStats::add(const SearchResult& r) {
 }
 
 void SearchKindStats::add(const ShadowResult& r) {
-  ++rays;
-  texels += r.texels_visited;
-  max_texels = std::max<uint64_t>(max_texels, r.texels_visited);
-  fragments += r.fragments_tested;
-  candidates += r.candidates;
+  add_walk(this, r);
   if (r.blockers > 0) ++hits;
   else ++misses;
   threshold_rejections += r.blockers == 0 && r.threshold_rejections > 0;

@@ -123,18 +123,23 @@ SceneData load_text(const std::string& text, const std::string& dir = ".") {
   return load_scene_text(text, "scene.json", dir);
 }
 
-// The message of the InputError that loading raises (a test failure if none, or if the
-// message is not exactly one line).
-std::string load_error(const std::string& text, const std::string& dir = ".") {
+// The message of the InputError that load() raises (a test failure if none, or if the
+// message is not exactly one line); `what` names the load in the failure.
+template <class Load>
+std::string input_error(Load&& load, const std::string& what) {
   try {
-    load_text(text, dir);
+    load();
   } catch (const InputError& e) {
     const std::string m = e.what();
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
     return m;
   }
-  ADD_FAILURE() << "no error for:\n" << text;
+  ADD_FAILURE() << "no error for:\n" << what;
   return "";
+}
+
+std::string load_error(const std::string& text, const std::string& dir = ".") {
+  return input_error([&] { load_text(text, dir); }, text);
 }
 
 #define EXPECT_ERROR(text, place)                                     \
@@ -777,15 +782,7 @@ TEST(RepositoryScenes, HiddenPointSeenOnlyInTheMirror) {
 
 // The message of the InputError that loading the scene file `path` under `limits` raises.
 std::string limited_load_error(const std::string& path, const LoadLimits& limits) {
-  try {
-    load_scene(path, limits);
-  } catch (const InputError& e) {
-    const std::string m = e.what();
-    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
-    return m;
-  }
-  ADD_FAILURE() << "no InputError for " << path;
-  return "";
+  return input_error([&] { load_scene(path, limits); }, path);
 }
 
 // A scene file in `root`/scenes/ whose one object is the mesh `file`.
@@ -863,28 +860,18 @@ TEST(SceneLoadLimits, TriangleCapNamesTheCountAndTheCap) {
       {"type": "sphere", "center": [3,0,0], "radius": 1}])").str();
   LoadLimits limits;
   limits.max_triangles = one + 1;
-  try {
-    load_scene_text(text, "scene.json", ".", limits);
-    ADD_FAILURE() << "no InputError";
-  } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), "scene.json: objects[1].segments: the scene would have " +
-                                         std::to_string(2 * one) + " triangles, over the cap of " +
-                                         std::to_string(one + 1) + " (max_triangles)");
-  }
+  EXPECT_EQ(input_error([&] { load_scene_text(text, "scene.json", ".", limits); }, text),
+            "scene.json: objects[1].segments: the scene would have " + std::to_string(2 * one) +
+                " triangles, over the cap of " + std::to_string(one + 1) + " (max_triangles)");
   limits.max_triangles = 2 * one;
   EXPECT_EQ(load_scene_text(text, "scene.json", ".", limits).triangles->triangle_count(), 2 * one);
   // A mesh is counted from its faces before its triangles are made.
   TempDir dir;
   dir.write("cube.obj", CUBE_OBJ);
   limits.max_triangles = 11;
-  try {
-    load_scene_text(with_objects(R"([{"type": "mesh", "file": "cube.obj", "material": "white"}])").str(), "scene.json",
-                    dir.path().string(), limits);
-    ADD_FAILURE() << "no InputError";
-  } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()),
-              "scene.json: objects[0].file: the scene would have 12 triangles, over the cap of 11 (max_triangles)");
-  }
+  const std::string mesh = with_objects(R"([{"type": "mesh", "file": "cube.obj", "material": "white"}])").str();
+  EXPECT_EQ(input_error([&] { load_scene_text(mesh, "scene.json", dir.path().string(), limits); }, mesh),
+            "scene.json: objects[0].file: the scene would have 12 triangles, over the cap of 11 (max_triangles)");
 }
 
 }  // namespace
