@@ -13,22 +13,25 @@ It prints the time of the batch in the cluster and in this process, checks that 
 are equal, and with --out writes orbit/view_000.exr ... (float EXR, linear).
 
 How it works, and what to copy:
-  - Scenes do not travel between processes: send the scene's path (or its dict) and let
-    each task load it (a few ms for a small scene; cache it per process for big ones).
-  - Each task creates its own Renderer. The map methods (abuffer, zbuffer, envmap) and
-    raytrace need no GL: gl="none". A GL method ("gpu") needs the Renderer to be used on
-    the thread that opened it: with threads_per_worker=1 every task of a worker runs on
-    the same thread, so a Renderer kept per process (e.g. in a WorkerPlugin) is safe.
+  - Scenes do not travel between processes: send the scene's path (or its dict); each
+    worker process loads it once and keeps it (load), so the per-scene data the first
+    render builds (mesh neighbours, lens fits, BVH) serves every later task.
+  - Each worker thread keeps its own Renderer (renderer_for). The map methods (abuffer,
+    zbuffer, envmap) and raytrace need no GL: gl="none". A GL method ("gpu") needs its
+    Renderer used on the thread that opened it: hence one Renderer per thread.
   - threads_per_worker=1 and Renderer(threads=1): one render thread per worker process,
     as many workers as cores; the process-level split costs no synchronisation.
   - Workers are new processes (spawn): they get this process's environment, so PYTHONPATH
     must name the folder of the abcube module (render_in_cluster adds it).
 """
 import argparse
+import importlib
+import json
 import math
 import os
 import pathlib
 import sys
+import threading
 import time
 
 import numpy as np
@@ -57,22 +60,44 @@ def orbit_cameras(count, center, radius, height, width, image_height, fov_y=None
     return cameras
 
 
+# Per-process caches: a worker loads each scene once (its per-scene data, built by the
+# first render, is then reused by every later task) and keeps one Renderer per thread.
+_SCENES = {}
+_RENDERERS = {}
+
+
 def load(scene_source):
-    """A scene from a path or a dict (what travels to the workers)."""
-    if isinstance(scene_source, dict):
-        return abcube.scene_from_dict(scene_source)
-    return abcube.load_scene(str(scene_source))
+    """A scene from a path or a dict (what travels to the workers), loaded once per process."""
+    key = json.dumps(scene_source, sort_keys=True) if isinstance(scene_source, dict) \
+        else str(scene_source)
+    if key not in _SCENES:
+        _SCENES[key] = abcube.scene_from_dict(scene_source) if isinstance(scene_source, dict) \
+            else abcube.load_scene(str(scene_source))
+    return _SCENES[key]
+
+
+def renderer_for(method, threads):
+    """This thread's Renderer (a Renderer that opened GL stays on its thread)."""
+    gl = "none" if method in GL_FREE_METHODS else "auto"
+    key = (threading.get_ident(), gl, threads)
+    if key not in _RENDERERS:
+        _RENDERERS[key] = abcube.Renderer(gl=gl, threads=threads)
+    return _RENDERERS[key]
 
 
 def render_views(scene_source, cameras, method="abuffer", cube_res=None, max_depth=None,
                  threads=1):
-    """Renders `cameras` (a list of camera overrides) of one scene with one Renderer; the
-    unit of work of a Dask task. Returns a list of float32 H x W x 3 arrays."""
+    """Renders `cameras` (a list of camera overrides) of one scene; the unit of work of a
+    Dask task. Returns a list of float32 H x W x 3 arrays."""
     scene = load(scene_source)
-    renderer = abcube.Renderer(gl="none" if method in GL_FREE_METHODS else "auto",
-                               threads=threads)
+    renderer = renderer_for(method, threads)
     return [renderer.render(scene, method=method, cube_res=cube_res, max_depth=max_depth,
                             camera=camera) for camera in cameras]
+
+
+def worker_version():
+    """Run on every worker before the clock starts: abcube imports there, and its version."""
+    return abcube.__version__
 
 
 def chunks(items, size):
@@ -95,14 +120,21 @@ def render_in_cluster(scene_source, cameras, method="abuffer", cube_res=None, ma
     from dask.distributed import Client, LocalCluster
 
     os.environ["PYTHONPATH"] = worker_environment()
+    # Tasks name the function by module (dask_orbit.render_views), so that the workers
+    # import this file as a module and its per-process caches live across tasks; run as a
+    # script, this file is __main__, whose functions would travel by value instead.
+    task = importlib.import_module("dask_orbit").render_views if __name__ == "__main__" \
+        else render_views
     started = time.perf_counter()
     with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
                       dashboard_address=None) as cluster, Client(cluster) as client:
         # Every worker imports abcube once before the clock starts.
-        client.run(lambda: __import__("abcube").__version__)
+        versions = client.run(worker_version)
+        if set(versions.values()) != {abcube.__version__}:
+            raise RuntimeError(f"the workers import another abcube: {versions}")
         startup = time.perf_counter() - started
         begin = time.perf_counter()
-        futures = [client.submit(render_views, scene_source, part, method, cube_res, max_depth,
+        futures = [client.submit(task, scene_source, part, method, cube_res, max_depth,
                                  1, pure=False)
                    for part in chunks(cameras, chunk)]
         images = [image for part in client.gather(futures) for image in part]

@@ -220,7 +220,20 @@ def test_renderer_options_keywords(renderer, scene):
         renderer.render(scene, max_pixels=10)  # 32 x 24 > 10
 
 
+def find_key(tree, key):
+    """The values of `key` anywhere in a nested dict."""
+    if isinstance(tree, dict):
+        for k, v in tree.items():
+            if k == key:
+                yield v
+            yield from find_key(v, key)
+
+
 def test_reference_stats(renderer, scene):
+    # With reference=True the stats carry the error against the exact tracer's image.
     res = renderer.render(scene, method="abuffer", reference=True, stats=True)
-    assert "timings_ms" in res.stats
-    assert "psnr" in str(res.stats)
+    assert "timings_ms" in res.stats and "reference" in res.stats
+    psnr = list(find_key(res.stats["reference"], "psnr_db"))
+    assert psnr and all(math.isfinite(p) and p > 10 for p in psnr)
+    # Without it, no reference section.
+    assert "reference" not in renderer.render(scene, method="abuffer", stats=True).stats

@@ -1,6 +1,7 @@
 """python/examples/dask_orbit.py: a 64-view batch rendered by a Dask LocalCluster of worker
 processes equals the same batch rendered in this process, byte for byte."""
 import importlib
+import json
 import subprocess
 import sys
 
@@ -41,7 +42,7 @@ def test_cluster_equals_one_process(dask_orbit):
 def test_recipe_runs_as_a_script(tmp_path):
     # The documented command line, small: exit 0 means the images were equal.
     scene = tmp_path / "scene.json"
-    scene.write_text(__import__("json").dumps(small_scene_dict(16, 16, 32)))
+    scene.write_text(json.dumps(small_scene_dict(16, 16, 32)))
     done = subprocess.run([sys.executable, str(EXAMPLES / "dask_orbit.py"), str(scene),
                            "--views", "8", "--size", "16", "16", "--chunk", "2",
                            "--out", str(tmp_path / "orbit")],
