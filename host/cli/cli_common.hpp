@@ -1,40 +1,39 @@
-// Small pieces the abcube subcommands share: argument parsing, timing, progress.
+// What the abcube subcommands share: their registration on one CLI11 parser (main.cpp),
+// the render options render and batch both take, output writing and progress.
 #pragma once
-#include <chrono>
 #include <functional>
-#include <map>
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <abcube/renderer.hpp>
-
-#include "base/timer.hpp"
 
 namespace abcube {
 
-// Command-line words after the subcommand. Options are "--name value" or "--flag";
-// everything else is positional. Every error is an InputError naming the option.
-class Args {
- public:
-  // `with_value` lists options that take a value, `flags` those that do not.
-  Args(const std::vector<std::string>& words, const std::vector<std::string>& with_value,
-       const std::vector<std::string>& flags);
+// A subcommand's action, run after the whole command line parsed: returns the exit status.
+using CommandRun = std::function<int()>;
 
-  bool has(const std::string& name) const { return values_.count(name) > 0; }
-  std::string get(const std::string& name, const std::string& fallback = "") const;
-  // Integer option in [lo, hi]; `fallback` when absent.
-  int get_int(const std::string& name, int fallback, int lo, int hi) const;
-  double get_double(const std::string& name, double fallback, double lo, double hi) const;
-  const std::vector<std::string>& positional() const { return positional_; }
-  // Requires exactly `count` positional arguments named by `what` (for the message).
-  void expect_positional(size_t count, const std::string& what) const;
+// Each adds its subcommand (options, defaults, units, help) to `app` and returns its action.
+CommandRun add_render_command(CLI::App& app);
+CommandRun add_batch_command(CLI::App& app);
+CommandRun add_compare_command(CLI::App& app);
+CommandRun add_info_command(CLI::App& app);
+CommandRun add_export_pov_command(CLI::App& app);
+CommandRun add_crosscheck_command(CLI::App& app);
 
- private:
-  std::map<std::string, std::string> values_;
-  std::vector<std::string> positional_;
+// The options of one render that render and batch share (renderer.hpp RenderOptions,
+// RendererOptions, SceneLimits), registered on a subcommand with their defaults and units.
+struct RenderFlags {
+  RenderOptions options;
+  RendererOptions renderer;
+  SceneLimits limits;
+  std::string plan = "needed";
+  std::vector<std::string> aovs;
+  // `per_render`: the options a batch job can also set per line (method, sizes, ...).
+  void add_to(CLI::App* cmd);
+  // The options as parsed (validates --plan); InputError naming the option.
+  RenderOptions render_options() const;
 };
-
-
 
 // True when stderr is a terminal (progress is shown only then).
 bool stderr_is_terminal();
@@ -42,17 +41,14 @@ bool stderr_is_terminal();
 // "stage NN%" on stderr when it is a terminal; null (quiet) otherwise (cli.md).
 std::function<void(const std::string&, double)> progress_printer();
 
-// The render options the command line gives (render's options; batch's shared ones).
-RenderOptions render_options_from(const Args& args);
-
 // The image, and each AOV beside it as OUT_STEM.NAME.exr (float), each written atomically.
 void write_outputs(const std::string& output, const RenderResult& result);
 std::string aov_path(const std::string& output, const std::string& aov);
 
-int cmd_render(const std::vector<std::string>& words);
-int cmd_info(const std::vector<std::string>& words);
-int cmd_compare(const std::vector<std::string>& words);
-int cmd_export_pov(const std::vector<std::string>& words);
-int cmd_crosscheck(const std::vector<std::string>& words);
+// Refuses before any work an output whose format has no writer or whose folder is missing.
+void check_output_path(const std::string& path, bool image);
+
+// Every failure is reported on one line: embedded newlines (a GLSL log) become "; ".
+std::string one_line(std::string text);
 
 }  // namespace abcube

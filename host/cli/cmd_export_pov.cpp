@@ -1,21 +1,28 @@
 // abcube export-pov SCENE -o X.pov: the same triangles, camera, lights and materials for
 // POV-Ray 3.7 (mapping and residual differences: cpu_core/io/pov_export.hpp).
+#include <memory>
+
+#include <abcube/scene.hpp>
+
 #include "cli/cli_common.hpp"
-#include "base/error.hpp"
 #include "io/image_io.hpp"
 #include "io/pov_export.hpp"
-#include "scene/scene_load.hpp"
 
 namespace abcube {
 
-int cmd_export_pov(const std::vector<std::string>& words) {
-  const Args args(words, {"-o", "--output"}, {});
-  args.expect_positional(1, "SCENE.json");
-  const std::string out = args.has("-o") ? args.get("-o") : args.get("--output");
-  if (out.empty()) throw InputError("-o OUT.pov: an output file is required");
-  const SceneData scene = load_scene(args.positional()[0]);
-  write_text_atomic(out, export_pov(scene));
-  return 0;
+CommandRun add_export_pov_command(CLI::App& app) {
+  struct Args {
+    std::string scene, output;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand("export-pov", "write the scene for POV-Ray 3.7 (an independent tracer)");
+  cmd->add_option("SCENE", a->scene, "scene file")->required();
+  cmd->add_option("-o,--output", a->output, "output .pov file, written atomically")->required();
+  return [a] {
+    const Scene scene = Scene::load(a->scene);
+    write_text_atomic(a->output, export_pov(scene.data()));
+    return 0;
+  };
 }
 
 }  // namespace abcube

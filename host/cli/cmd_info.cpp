@@ -28,9 +28,7 @@ void print_context(const char* label, const GlContext* ctx, const std::string& w
 
 }  // namespace
 
-int cmd_info(const std::vector<std::string>& words) {
-  const Args args(words, {}, {});
-  args.expect_positional(0, "");
+int run_info() {
   std::printf("abcube info\n");
   std::printf("threads: %d hardware\n", thread_count(0, SIZE_MAX));
 
@@ -70,6 +68,11 @@ int cmd_info(const std::vector<std::string>& words) {
   }
   std::printf("--gl auto picks: %s\n", auto_pick.empty() ? "none (CPU only)" : auto_pick.c_str());
   return 0;
+}
+
+CommandRun add_info_command(CLI::App& app) {
+  app.add_subcommand("info", "which GL paths work here, versions, renderer strings, threads");
+  return run_info;
 }
 
 }  // namespace abcube

@@ -1,63 +1,59 @@
-// abcube: headless hybrid renderer. Subcommands: render, compare, info (../shared/cli.md).
+// abcube: headless hybrid renderer. Subcommands: render, batch, compare, info,
+// export-pov, crosscheck (../shared/cli.md); one CLI11 parser, --help on each.
 #include <cstdio>
-#include <cstring>
 #include <string>
-#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <abcube/renderer.hpp>
 
 #include "cli/cli_common.hpp"
-#include "base/error.hpp"
-
-namespace {
-
-const char* USAGE =
-    "usage: abcube render SCENE.json -o OUT.png [--method abuffer|zbuffer|envmap|raytrace|gpu]\n"
-    "                     [--cube-res N] [--max-depth D] [--threads K] [--gl auto|egl|egl-device|\n"
-    "                     egl-surfaceless|osmesa|none] [--gl-device K] [--stats STATS.json] [--reference]\n"
-    "                     [--max-layers K] [--max-memory MiB] [--search crossing|thesis]\n"
-    "                     [--refine mesh|plane]\n"
-    "                     [--theta-max DEG] [--refraction search|thick_lens|thin_lens]\n"
-    "                     [--envmap-lookup R|bisector|position] [--fresnel] [--error-target E]\n"
-    "                     [--reference-image REF.exr] [--plan needed|everything]\n"
-    "       abcube compare A.png B.png [--diff HEAT.png] [--fail T] [--failpercent P]\n"
-    "       abcube info\n"
-    "       abcube export-pov SCENE.json -o OUT.pov\n"
-    "       abcube crosscheck SCENE.json [--cube-res N] [--gl ...] [--threads K] [--stats STATS.json]\n";
-
-// Every failure is reported on one line: embedded newlines (a GLSL log) become "; ".
-std::string one_line(std::string text) {
-  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
-  std::string out;
-  for (char c : text) {
-    if (c == '\n') {
-      out += "; ";
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fputs("abcube: missing command (render, compare, info, export-pov, crosscheck; see abcube --help)\n", stderr);
+  using namespace abcube;
+  CLI::App app("abcube: a headless hybrid renderer (GL raster + CPU A-buffered cube map searches)", "abcube");
+  app.set_version_flag("--version", version_string());
+  app.require_subcommand(1, 1);
+  const CommandRun runs[] = {add_render_command(app),  add_batch_command(app),      add_compare_command(app),
+                             add_info_command(app),    add_export_pov_command(app), add_crosscheck_command(app)};
+  // A first word that is no option and no command is named as such (CLI11 would only say
+  // that a subcommand is required).
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string names;
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+      known = known || sub->get_name() == argv[1];
+    }
+    if (!known) {
+      std::fprintf(stderr, "abcube: unknown command '%s' (%s)\n", argv[1], names.c_str());
+      return 2;
+    }
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // One line naming the option, exit 2 (cli.md); the subcommand's name when there is one.
+    std::string where;
+    for (const CLI::App* sub : app.get_subcommands()) where = sub->get_name() + ": ";
+    std::fprintf(stderr, "abcube: %s%s (see abcube %s--help)\n", where.c_str(), one_line(e.what()).c_str(),
+                 where.empty() ? "" : (where.substr(0, where.size() - 2) + " ").c_str());
     return 2;
   }
-  if (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
-    std::fputs(USAGE, stdout);
-    return 0;
+  const CLI::App* chosen = app.get_subcommands().front();
+  size_t index = 0;
+  for (const CLI::App* sub : app.get_subcommands({})) {
+    if (sub == chosen) break;
+    ++index;
   }
-  const std::string command = argv[1];
-  const std::vector<std::string> words(argv + 2, argv + argc);
   try {
-    if (command == "render") return abcube::cmd_render(words);
-    if (command == "compare") return abcube::cmd_compare(words);
-    if (command == "info") return abcube::cmd_info(words);
-    if (command == "export-pov") return abcube::cmd_export_pov(words);
-    if (command == "crosscheck") return abcube::cmd_crosscheck(words);
-    throw abcube::InputError("unknown command '" + command + "' (render, compare, info, export-pov, crosscheck)");
-  } catch (const abcube::InputError& e) {
+    return runs[index]();
+  } catch (const InputError& e) {
     std::fprintf(stderr, "abcube: %s\n", one_line(e.what()).c_str());
     return 2;
   } catch (const std::exception& e) {

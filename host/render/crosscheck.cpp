@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "base/statistics.hpp"
 #include "raster/abuffer.hpp"
 #include "scene/camera.hpp"
 #include "raster/cube_map.hpp"
@@ -14,13 +15,6 @@
 namespace abcube {
 
 namespace {
-
-double percentile(std::vector<double>& v, double q) {
-  if (v.empty()) return 0;
-  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
 
 // Local Phong of a camera A-buffer fragment at the point it stands for (shading.hpp).
 PixelShader local_phong_shader(const SceneData& scene, const ABuffer& buffer) {

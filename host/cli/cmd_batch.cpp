@@ -1,0 +1,271 @@
+// abcube batch JOBS.jsonl: many renders in one process through one Renderer (cli.md
+// "Batch"). The whole jobs file is read and checked before anything renders (a malformed
+// line: exit 2, naming it); GL is opened once and each distinct scene loaded once; a job
+// that fails is one stderr line, JOBS.jsonl:LINE: reason, and the others go on (exit 1).
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <list>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <abcube/renderer.hpp>
+#include <nlohmann/json.hpp>
+
+#include "base/statistics.hpp"
+#include "base/timer.hpp"
+#include "cli/cli_common.hpp"
+#include "io/image_io.hpp"
+
+namespace abcube {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// One line of the jobs file, paths resolved against the file's folder.
+struct Job {
+  size_t line = 0;
+  std::string scene, out, stats;
+  std::optional<std::string> method;
+  std::optional<int> cube_res, max_depth;
+  CameraOverride camera;
+  std::vector<std::string> aovs;
+};
+
+// Reads one job from its JSON line; InputError "FILE:LINE: reason" for anything malformed.
+class JobReader {
+ public:
+  JobReader(std::string file) : file_(std::move(file)), dir_(fs::path(file_).parent_path()) {}
+
+  Job read(const std::string& text, size_t line) const {
+    Job job;
+    job.line = line;
+    json j;
+    try {
+      j = json::parse(text);
+    } catch (const json::parse_error& e) {
+      fail(line, std::string("not JSON: ") + e.what());
+    }
+    if (!j.is_object()) fail(line, "a job must be a JSON object");
+    for (const auto& [key, value] : j.items()) read_key(job, key, value);
+    if (job.scene.empty()) fail(line, "\"scene\": required");
+    if (job.out.empty()) fail(line, "\"out\": required");
+    if (!image_format_supported(job.out)) fail(line, "\"out\": no image writer for '" + job.out + "'");
+    return job;
+  }
+
+  [[noreturn]] void fail(size_t line, const std::string& why) const {
+    throw InputError(file_ + ":" + std::to_string(line) + ": " + why);
+  }
+
+ private:
+  std::string path(const json& v, size_t line, const char* key) const {
+    if (!v.is_string() || v.get<std::string>().empty()) fail(line, std::string("\"") + key + "\": must be a path");
+    const fs::path p(v.get<std::string>());
+    return (p.is_absolute() ? p : dir_ / p).lexically_normal().string();
+  }
+
+  int integer(const json& v, size_t line, const std::string& key) const {
+    if (!v.is_number_integer()) fail(line, "\"" + key + "\": must be an integer");
+    return v.get<int>();
+  }
+
+  std::array<double, 3> vec3(const json& v, size_t line, const std::string& key) const {
+    if (!v.is_array() || v.size() != 3 || !std::all_of(v.begin(), v.end(), [](const json& x) { return x.is_number(); })) {
+      fail(line, "\"" + key + "\": must be 3 numbers");
+    }
+    return {v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
+  }
+
+  void read_camera(Job& job, const json& c) const {
+    if (!c.is_object()) fail(job.line, "\"camera\": must be an object");
+    for (const auto& [key, v] : c.items()) {
+      const std::string where = "camera." + key;
+      if (key == "position") job.camera.position = vec3(v, job.line, where);
+      else if (key == "look_at") job.camera.look_at = vec3(v, job.line, where);
+      else if (key == "up") job.camera.up = vec3(v, job.line, where);
+      else if (key == "fov_y") {
+        if (!v.is_number()) fail(job.line, "\"camera.fov_y\": must be a number");
+        job.camera.fov_y = v.get<double>();
+      } else if (key == "width") job.camera.width = integer(v, job.line, where);
+      else if (key == "height") job.camera.height = integer(v, job.line, where);
+      else fail(job.line, "\"" + where + "\": unknown key (position, look_at, up, fov_y, width, height)");
+    }
+  }
+
+  void read_key(Job& job, const std::string& key, const json& v) const {
+    if (key == "scene") job.scene = path(v, job.line, "scene");
+    else if (key == "out") job.out = path(v, job.line, "out");
+    else if (key == "stats") job.stats = path(v, job.line, "stats");
+    else if (key == "method") {
+      if (!v.is_string()) fail(job.line, "\"method\": must be a string");
+      job.method = v.get<std::string>();
+    } else if (key == "cube_res") job.cube_res = integer(v, job.line, key);
+    else if (key == "max_depth") job.max_depth = integer(v, job.line, key);
+    else if (key == "camera") read_camera(job, v);
+    else if (key == "aovs") {
+      if (!v.is_array()) fail(job.line, "\"aovs\": must be a list of names");
+      for (const json& a : v) {
+        if (!a.is_string()) fail(job.line, "\"aovs\": must be a list of names");
+        job.aovs.push_back(a.get<std::string>());
+      }
+    } else {
+      fail(job.line, "\"" + key + "\": unknown key (scene, out, method, cube_res, max_depth, camera, stats, aovs)");
+    }
+  }
+
+  std::string file_;
+  fs::path dir_;
+};
+
+// The scenes of the batch, each loaded once; the least recently used dropped past `capacity`.
+class SceneShelf {
+ public:
+  explicit SceneShelf(size_t capacity, SceneLimits limits) : capacity_(capacity), limits_(std::move(limits)) {}
+  Scene get(const std::string& path) {
+    for (auto it = scenes_.begin(); it != scenes_.end(); ++it) {
+      if (it->first == path) {
+        scenes_.splice(scenes_.begin(), scenes_, it);
+        return it->second;
+      }
+    }
+    scenes_.emplace_front(path, Scene::load(path, limits_));
+    if (scenes_.size() > capacity_) scenes_.pop_back();
+    ++loads_;
+    return scenes_.front().second;
+  }
+  size_t loads() const { return loads_; }
+
+ private:
+  size_t capacity_;
+  SceneLimits limits_;
+  std::list<std::pair<std::string, Scene>> scenes_;
+  size_t loads_ = 0;
+};
+
+// "[=====     ] 12/64 jobs, 1 failed" on a terminal, redrawn in place.
+void draw_progress(size_t done, size_t total, size_t failed) {
+  constexpr int WIDTH = 30;
+  const int filled = total ? static_cast<int>(WIDTH * done / total) : WIDTH;
+  std::fprintf(stderr, "\r[%s%s] %zu/%zu jobs%s", std::string(static_cast<size_t>(filled), '=').c_str(),
+               std::string(static_cast<size_t>(WIDTH - filled), ' ').c_str(), done, total,
+               failed ? (", " + std::to_string(failed) + " failed").c_str() : "");
+  if (done == total) std::fputc('\n', stderr);
+}
+
+struct BatchCommand {
+  std::string jobs_path, shard = "0/1";
+  bool skip_existing = false;
+  double job_timeout_s = 0;
+  size_t scene_cache = 4;
+  RenderFlags flags;
+
+  std::pair<size_t, size_t> parse_shard() const {
+    size_t i = 0, n = 0;
+    char slash = 0;
+    std::istringstream in(shard);
+    if (!(in >> i >> slash >> n) || slash != '/' || !in.eof() || n == 0 || i >= n) {
+      throw InputError("--shard: must be I/N with 0 <= I < N, got '" + shard + "'");
+    }
+    return {i, n};
+  }
+
+  // Every job of the file, checked; only this shard's are returned.
+  std::vector<Job> read_jobs(size_t shard_i, size_t shard_n) const {
+    std::ifstream in(jobs_path);
+    if (!in) throw InputError(jobs_path + ": cannot read the jobs file");
+    const JobReader reader(jobs_path);
+    std::vector<Job> mine;
+    std::string text;
+    size_t line = 0, index = 0;
+    while (std::getline(in, text)) {
+      ++line;
+      if (text.find_first_not_of(" \t\r") == std::string::npos) continue;  // blank lines hold no job
+      Job job = reader.read(text, line);
+      if (index++ % shard_n == shard_i) mine.push_back(std::move(job));
+    }
+    if (in.bad()) throw InputError(jobs_path + ": read error");
+    return mine;
+  }
+
+  RenderOptions job_options(const RenderOptions& base, const Job& job) const {
+    RenderOptions o = base;
+    if (job.method) o.method = *job.method;
+    if (job.cube_res) o.cube_resolution = *job.cube_res;
+    if (job.max_depth) o.max_depth = *job.max_depth;
+    o.camera = job.camera;
+    if (!job.aovs.empty()) o.aovs = job.aovs;
+    o.timeout_s = job_timeout_s;
+    return o;
+  }
+
+  int run() const {
+    const Clock::time_point start = Clock::now();
+    const auto [shard_i, shard_n] = parse_shard();
+    const RenderOptions base = flags.render_options();
+    const std::vector<Job> jobs = read_jobs(shard_i, shard_n);
+    Renderer renderer(flags.renderer);
+    SceneShelf scenes(std::max<size_t>(scene_cache, 1), flags.limits);
+    const bool terminal = stderr_is_terminal();
+    size_t done = 0, failed = 0, skipped = 0;
+    std::vector<double> render_ms, overhead_ms;
+    for (const Job& job : jobs) {
+      if (skip_existing && fs::exists(job.out) && (job.stats.empty() || fs::exists(job.stats))) {
+        ++skipped;
+      } else {
+        try {
+          const Clock::time_point t0 = Clock::now();
+          const Scene scene = scenes.get(job.scene);
+          for (const std::string* p : {&job.out, &job.stats}) {
+            if (!p->empty() && fs::path(*p).has_parent_path()) fs::create_directories(fs::path(*p).parent_path());
+          }
+          const RenderResult r = renderer.render(scene, job_options(base, job));
+          write_outputs(job.out, r);
+          if (!job.stats.empty()) write_text_atomic(job.stats, r.stats.json + "\n");
+          render_ms.push_back(ms_since(t0));
+        } catch (const std::exception& e) {
+          ++failed;
+          if (terminal) std::fputc('\n', stderr);
+          std::fprintf(stderr, "%s:%zu: %s\n", jobs_path.c_str(), job.line, one_line(e.what()).c_str());
+        }
+      }
+      ++done;
+      if (terminal) draw_progress(done, jobs.size(), failed);
+    }
+    const double total_ms = ms_since(start);
+    std::vector<double> sorted = render_ms;
+    const double median = sorted.empty() ? 0.0 : percentile(sorted, 0.5);
+    std::printf("batch %s shard %zu/%zu: %zu jobs, %zu rendered, %zu failed, %zu skipped; %zu scenes loaded; "
+                "%.1f ms per render (median, with load and write), %.1f s in all\n",
+                jobs_path.c_str(), shard_i, shard_n, jobs.size(), render_ms.size(), failed, skipped, scenes.loads(),
+                median, total_ms / 1000.0);
+    return failed ? 1 : 0;
+  }
+};
+
+}  // namespace
+
+CommandRun add_batch_command(CLI::App& app) {
+  auto c = std::make_shared<BatchCommand>();
+  CLI::App* cmd = app.add_subcommand(
+      "batch",
+      "many renders in one process: one JSON job per line, {\"scene\": ..., \"out\": ...} plus optional method, "
+      "cube_res, max_depth, camera, stats, aovs; paths relative to the jobs file");
+  cmd->add_option("JOBS", c->jobs_path, "jobs file (JSON lines)")->required();
+  cmd->add_option("--shard", c->shard, "render the jobs whose 0-based index modulo N is I")->capture_default_str();
+  cmd->add_flag("--skip-existing", c->skip_existing, "skip jobs whose output exists (resume an interrupted batch)");
+  cmd->add_option("--job-timeout", c->job_timeout_s, "stop one job past this many seconds, 0 = no limit")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e9));
+  cmd->add_option("--scene-cache", c->scene_cache, "distinct scenes kept loaded at once (least recently used dropped)")
+      ->capture_default_str()->check(CLI::Range(1, 1 << 20));
+  c->flags.add_to(cmd);
+  return [c] { return c->run(); };
+}
+
+}  // namespace abcube
