@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# abcube batch end to end (cli.md "Batch"): the same bytes as abcube render for the same
+# job, camera overrides, AOVs and stats, a malformed file refused before any render
+# (exit 2), a failing job reported by line while the others render (exit 1), shards that
+# together make the whole batch, --skip-existing. Usage: bash batch_cli.sh ABCUBE REPO
+set -u
+ABCUBE=$(realpath "$1")
+REPO=$(realpath "$2")
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/abcube_batch_cli.XXXXXX")
+trap 'rm -rf "$WORK"' EXIT
+passed=0
+failed=0
+check() { local what=$1; shift; if "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $what"; fi; }
+
+cp "$REPO/tests/golden/cornell.json" "$REPO/tests/golden/hidden_point.json" "$WORK/"
+# The cornell scene with the camera the override below gives (for abcube render).
+/usr/bin/python3 - "$WORK" <<'PY'
+import json, sys
+w = sys.argv[1]
+d = json.load(open(w + "/cornell.json"))
+d["camera"]["position"] = [0.5, 1.2, -2.5]
+d["camera"]["width"] = 40
+json.dump(d, open(w + "/cornell_moved.json", "w"))
+PY
+cat > "$WORK/jobs.jsonl" <<'EOF2'
+{"scene": "cornell.json", "out": "out/a.png", "method": "abuffer"}
+{"scene": "cornell.json", "out": "out/b.exr", "method": "raytrace", "stats": "out/b.json"}
+
+{"scene": "hidden_point.json", "out": "out/c.png", "method": "zbuffer", "cube_res": 64, "max_depth": 1}
+{"scene": "cornell.json", "out": "out/d.png", "camera": {"position": [0.5, 1.2, -2.5], "width": 40}, "aovs": ["distance", "object_id"]}
+{"scene": "cornell.json", "out": "out/e.png", "method": "gpu"}
+EOF2
+"$ABCUBE" batch "$WORK/jobs.jsonl" --gl egl > "$WORK/summary" 2> "$WORK/err"
+check "batch exits 0 ($(cat "$WORK/err"))" [ $? -eq 0 ]
+check "summary counts 5 rendered" grep -q "5 jobs, 5 rendered, 0 failed, 0 skipped; 2 scenes loaded" "$WORK/summary"
+cd "$WORK" || exit 1
+"$ABCUBE" render cornell.json -o ra.png --method abuffer
+"$ABCUBE" render cornell.json -o rb.exr --method raytrace
+"$ABCUBE" render hidden_point.json -o rc.png --method zbuffer --cube-res 64 --max-depth 1
+"$ABCUBE" render cornell_moved.json -o rd.png
+"$ABCUBE" render cornell.json -o re.png --method gpu --gl egl
+for k in a c d e; do check "job $k: the same PNG bytes as abcube render" cmp -s "out/$k.png" "r$k.png"; done
+check "job b: the same EXR bytes as abcube render" cmp -s out/b.exr rb.exr
+check "job b wrote its stats" grep -q '"primary_rays"' out/b.json
+check "job d: the distance AOV" [ -s out/d.distance.exr ]
+check "job d: the object_id AOV" [ -s out/d.object_id.exr ]
+check "no normal AOV unasked" [ ! -e out/d.normal.exr ]
+
+# --- a malformed jobs file: exit 2, FILE:LINE, nothing rendered
+printf '{"scene": "cornell.json", "out": "m/1.png"}\n{"scene": "cornell.json", "out": "m/2.png", "colour": 1}\n' > bad.jsonl
+"$ABCUBE" batch bad.jsonl 2> err; status=$?
+check "malformed: exit 2" [ $status -eq 2 ]
+check "malformed: names file and line" grep -q "bad.jsonl:2: \"colour\": unknown key" err
+check "malformed: nothing rendered" [ ! -e m/1.png ]
+check "malformed: one line" [ "$(wc -l < err)" -eq 1 ]
+printf '{"scene": "cornell.json", "out": "m/1.png"}\nnot json\n' > bad2.jsonl
+"$ABCUBE" batch bad2.jsonl 2> err; status=$?
+check "not JSON: exit 2 naming line 2" [ $status -eq 2 ] && grep -q "bad2.jsonl:2: not JSON" err
+printf '{"out": "m/1.png"}\n' > bad3.jsonl
+"$ABCUBE" batch bad3.jsonl 2> err
+check "missing scene key named" grep -q 'bad3.jsonl:1: "scene": required' err
+
+# --- a failing job: its line on stderr, the others rendered, exit 1
+printf '{"scene": "cornell.json", "out": "f/1.png", "method": "raytrace"}\n{"scene": "nowhere.json", "out": "f/2.png"}\n{"scene": "cornell.json", "out": "f/3.png", "method": "photon"}\n{"scene": "cornell.json", "out": "f/4.png", "method": "raytrace", "camera": {"position": [0, 1, 0]}}\n' > fail.jsonl
+"$ABCUBE" batch fail.jsonl > summary 2> err; status=$?
+check "failing jobs: exit 1" [ $status -eq 1 ]
+check "failing job 2 named by line" grep -q "fail.jsonl:2: .*nowhere.json" err
+check "failing job 3 named by line" grep -q "fail.jsonl:3: method: unknown method 'photon'" err
+check "the other jobs rendered" [ -s f/1.png ] && [ -s f/4.png ]
+check "summary counts failures" grep -q "4 jobs, 2 rendered, 2 failed" summary
+
+# --- shards make the whole batch; --skip-existing resumes
+"$ABCUBE" batch jobs.jsonl --shard 0/2 --gl egl > s0 2>&1 && "$ABCUBE" batch jobs.jsonl --shard 1/2 --gl egl > s1 2>&1
+check "both shards exit 0" [ $? -eq 0 ]
+check "shard 0/2 takes jobs 0, 2, 4" grep -q "shard 0/2: 3 jobs" s0
+check "shard 1/2 takes jobs 1, 3" grep -q "shard 1/2: 2 jobs" s1
+rm out/c.png
+"$ABCUBE" batch jobs.jsonl --skip-existing --gl egl > s2 2>&1
+check "--skip-existing renders only the missing job" grep -q "5 jobs, 1 rendered, 0 failed, 4 skipped" s2
+check "the missing job is back, same bytes" cmp -s out/c.png rc.png
+"$ABCUBE" batch jobs.jsonl --shard 2/2 2> err; status=$?
+check "--shard 2/2: exit 2" [ $status -eq 2 ] && grep -q -- "--shard" err
+
+echo "cli batch_cli: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
