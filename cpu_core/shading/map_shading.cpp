@@ -302,8 +302,20 @@ static bool differ(const glm::dvec3& a, const glm::dvec3& b) {
   return false;
 }
 
+// Secondary searches and those of them that found nothing (the "fallback" AOV, header).
+static std::pair<uint64_t, uint64_t> searches_and_failures(const MapShadingStats& s) {
+  const SearchStats& q = s.searches;
+  const uint64_t rays = q.reflection.rays + q.refraction_exit.rays + q.shadow.rays + s.lens_transfers + s.lens_fallbacks;
+  const uint64_t failed = q.reflection.misses + q.refraction_exit.misses + q.shadow.zero_area + q.shadow.aborted +
+                          s.lens_fallbacks;
+  return {rays, failed};
+}
+
 Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
-                      MapShadingStats* stats) {
+                      MapShadingStats* stats, Image* fallback) {
+  // Per pixel: secondary searches and failures (one resolve worker owns a row at a time).
+  std::vector<std::pair<uint64_t, uint64_t>> pixel_searches;
+  if (fallback) pixel_searches.assign(static_cast<size_t>(camera.width()) * static_cast<size_t>(camera.height()), {0, 0});
   ResolveOptions ro;
   ro.threads = threads;
   // Statistics per resolve worker, merged at the end: no lock while shading.
@@ -341,6 +353,7 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
       ++count;
     }
     glm::dvec3 c(0.0);
+    const std::pair<uint64_t, uint64_t> before = fallback ? searches_and_failures(*s) : std::pair<uint64_t, uint64_t>{};
     if (count <= 1) {
       c = shade_at(fragment_point(camera, *scene.triangles, f, x, y));
     } else {
@@ -349,11 +362,24 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
       const bool split = differ(first, last);
       for (int k = 1; k + 1 < count; ++k) c += weight[k] * (split ? shade_at(point[k]) : 0.5 * (first + last));
     }
+    if (fallback) {
+      const std::pair<uint64_t, uint64_t> after = searches_and_failures(*s);
+      auto& p = pixel_searches[static_cast<size_t>(y) * static_cast<size_t>(camera.width()) + static_cast<size_t>(x)];
+      p.first += after.first - before.first;
+      p.second += after.second - before.second;
+    }
     return ShadedFragment{c, scene.materials[scene.triangles->material_id[f.triangle()]].opacity};
   };
   Image image = resolve_image_per_worker(camera, *scene.triangles, shade, scene.background, ro);
   if (stats) {
     for (const MapShadingStats& s : per_worker) stats->merge(s);
+  }
+  if (fallback) {
+    *fallback = Image(camera.width(), camera.height(), 1, 0.f);
+    for (size_t k = 0; k < pixel_searches.size(); ++k) {
+      const auto [rays, failed] = pixel_searches[k];
+      if (rays > 0) fallback->data[k] = static_cast<float>(static_cast<double>(failed) / static_cast<double>(rays));
+    }
   }
   return image;
 }

@@ -150,8 +150,11 @@ class MapShader {
 };
 
 // The camera view through the camera A-buffer, every fragment shaded by `shader`, resolved
-// by Pack_Under_Mask (resolve.hpp). Stats merged over threads.
+// by Pack_Under_Mask (resolve.hpp). Stats merged over threads. `fallback` (optional, 1
+// channel): per pixel, the share of its fragments' secondary searches that found nothing
+// (a reflection or refraction-exit miss, a shadow walk on a zero-area surface or
+// aborted, a lens transfer refused), 0 where none was made.
 Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
-                      MapShadingStats* stats);
+                      MapShadingStats* stats, Image* fallback = nullptr);
 
 }  // namespace abcube

@@ -49,7 +49,7 @@ void RenderFlags::add_to(CLI::App* cmd) {
   cmd->add_option("--max-triangles", limits.max_triangles, "refuse a scene with more triangles, 0 = no cap")
       ->capture_default_str();
   cmd->add_option("--root", limits.root, "untrusted scenes: every file they reference must resolve inside DIR");
-  cmd->add_option("--aovs", aovs, "extra outputs beside the image: distance,normal,object_id (OUT_STEM.NAME.exr)")
+  cmd->add_option("--aovs", aovs, "extra outputs beside the image, comma-separated: distance, normal, object_id, fallback (OUT_STEM.NAME.exr)")
       ->delimiter(',');
 }
 

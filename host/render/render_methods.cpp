@@ -114,7 +114,7 @@ Image render_map_method(MethodContext& mc) {
   stats["timings_ms"]["camera_abuffer"] = ms_since(t0);
   t0 = Clock::now();
   MapShadingStats ms;
-  Image image = render_with_map(scene, camera, shader, r.threads, &ms);
+  Image image = render_with_map(scene, camera, shader, r.threads, &ms, mc.fallback);
   stats["timings_ms"]["shade_and_resolve"] = ms_since(t0);
   stats["abuffer"] = abuffer_json(as, false);
   stats["searches"] = map_shading_json(ms);

@@ -2,6 +2,7 @@
 // module and the tests call it; each method's passes are in render_methods.cpp.
 #include <abcube/renderer.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
 #include <thread>
@@ -247,7 +248,9 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
                              {"envmap_lookup", envmap_lookup_name(request.map.lookup)},
                              {"fresnel", view.render.fresnel}};
 
-  MethodContext mc{view, scene.cache(), request, stats, options.progress, nullptr, nullptr};
+  Image fallback;  // the map methods' "fallback" AOV, when asked
+  const bool wants_fallback = std::find(request.aovs.begin(), request.aovs.end(), "fallback") != request.aovs.end();
+  MethodContext mc{view, scene.cache(), request, stats, options.progress, nullptr, wants_fallback ? &fallback : nullptr};
   Image image;
   switch (view.render.method) {
     case Method::gpu: {
