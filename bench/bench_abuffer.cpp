@@ -38,27 +38,16 @@ struct Result {
   char error[256] = {0};
 };
 
-Options parse(int argc, char** argv) {
-  Options o;
-  ArgWalk args(argc, argv);
-  while (args.next()) {
-    const std::string a = args.word();
-    if (a == "--sizes") {
-      o.sizes = parse_int_list(a, args.value());
-    } else if (a == "--runs") {
-      o.runs = parse_int(a, args.value());
-    } else if (a == "--threads") {
-      o.threads = parse_int(a, args.value());
-    } else if (a == "--camera") {
-      o.camera = true;
-    } else if (!a.empty() && a[0] == '-') {
-      throw InputError("unknown option " + a);
-    } else {
-      o.scenes.push_back(a);
-    }
-  }
-  if (o.scenes.empty() || o.runs < 1) throw InputError("usage: bench_abuffer SCENE.json... [--sizes 256,512] [--runs 3]");
-  return o;
+// The command line: every option with its default and unit in --help.
+void add_options(CLI::App& app, Options& o) {
+  show_defaults(app);
+  app.add_option("scenes", o.scenes, "scene files (SCENE.json...)")->required();
+  app.add_option("--sizes", o.sizes, "cube resolutions N, texels per face edge (comma-separated)")
+      ->delimiter(',')->allow_extra_args(false)->check(CLI::Range(1, 65536));
+  app.add_option("--runs", o.runs, "runs per configuration (median, min and max reported)")
+      ->check(CLI::Range(1, 1000000));
+  app.add_option("--threads", o.threads, "worker threads (0 = every core)")->check(CLI::Range(0, 4096));
+  app.add_flag("--camera", o.camera, "also the camera view's A-buffer at the scene's image size (pixels)");
 }
 
 // One configuration, in this process: `size` 0 means the camera view.
@@ -136,8 +125,7 @@ void print(const std::string& path, int size, const Result& r) {
   std::fflush(stdout);
 }
 
-int run(int argc, char** argv) {
-  const Options o = parse(argc, argv);
+int run(const Options& o) {
   std::printf("# bench_abuffer: median of %d runs (min, max); Mfrag/s = stored fragments / median; "
               "peak RSS of a process doing only that build\n",
               o.runs);
@@ -154,5 +142,9 @@ int run(int argc, char** argv) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  return abcube::guarded_main("bench_abuffer", [&] { return abcube::run(argc, argv); });
+  abcube::Options options;
+  CLI::App app{"CPU cube A-buffer build: median ms, fragments, Mfrag/s and peak memory per scene and N"};
+  abcube::add_options(app, options);
+  if (const int status = abcube::parse_command_line(app, argc, argv, "bench_abuffer"); status >= 0) return status;
+  return abcube::guarded_main("bench_abuffer", [&] { return abcube::run(options); });
 }

@@ -14,8 +14,8 @@
 
 #include "bench_common.hpp"
 #include "base/statistics.hpp"
+#include "base/timer.hpp"
 #include "raster/abuffer.hpp"
-#include "cli/cli_common.hpp"
 #include "raster/cube_map.hpp"
 #include "base/error.hpp"
 #include "gl/gl_context.hpp"
@@ -25,6 +25,27 @@
 
 namespace abcube {
 namespace {
+
+struct Options {
+  std::string scene;
+  std::vector<int> sizes{256, 512, 1024};
+  int runs = 5;
+  std::string gl = "auto";
+  int error_samples = 20000;
+};
+
+// The command line: every option with its default and unit in --help.
+void add_options(CLI::App& app, Options& o) {
+  show_defaults(app);
+  app.add_option("scene", o.scene, "scene file (SCENE.json)")->required();
+  app.add_option("--sizes", o.sizes, "cube resolutions N, texels per face edge (comma-separated)")
+      ->delimiter(',')->allow_extra_args(false)->check(CLI::Range(1, 65536));
+  app.add_option("--runs", o.runs, "runs per N (median, min and max reported)")->check(CLI::Range(1, 1000));
+  app.add_option("--gl", o.gl, "GL path")
+      ->check(CLI::IsMember({"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"}));
+  app.add_option("--error-samples", o.error_samples, "texel-centre rays checked against the exact tracer")
+      ->check(CLI::Range(0, 100000000));
+}
 
 struct Spread {
   double median, lo, hi;
@@ -67,15 +88,10 @@ PrepassError prepass_error(const SceneData& scene, const RayTracer& rt, const Cu
   return e;
 }
 
-int run(const std::vector<std::string>& words) {
-  const Args args(words, {"--sizes", "--runs", "--gl", "--error-samples"}, {});
-  args.expect_positional(1, "SCENE.json");
-  const SceneData scene = load_scene(args.positional()[0]);
-  const int runs = args.get_int("--runs", 5, 1, 1000);
-  const int samples = args.get_int("--error-samples", 20000, 0, 100000000);
+int run(const Options& o) {
+  const SceneData scene = load_scene(o.scene);
   GlChoice choice = GlChoice::automatic;
-  if (args.has("--gl") && !parse_gl_choice(args.get("--gl"), &choice)) throw InputError("--gl: unknown path");
-  const std::vector<int> sizes = parse_int_list("--sizes", args.get("--sizes", "256,512,1024"));
+  if (!parse_gl_choice(o.gl, &choice)) throw InputError("--gl: unknown path " + o.gl);
 
   std::string log;
   auto ctx = open_gl_context(choice, -1, &log);
@@ -83,17 +99,17 @@ int run(const std::vector<std::string>& words) {
   const RayTracer rt(scene);
   GlScene gl(scene);
   std::printf("scene: %s (%zu triangles)\nrenderer: %s\nruns: %d (median [min, max] ms)\n\n",
-              args.positional()[0].c_str(), scene.triangles->triangle_count(), describe_gl(ctx.get()).c_str(),
-              runs);
+              o.scene.c_str(), scene.triangles->triangle_count(), describe_gl(ctx.get()).c_str(),
+              o.runs);
   std::printf("| N | prepass 6 faces ms | readback ms | camera %dx%d raster ms | prepass rel. distance error "
               "vs exact: median / p99 / max | same object | texels checked | CPU cube A-buffer ms | fragments | "
               "CPU/GPU |\n|---|---|---|---|---|---|---|---|---|---|\n",
               scene.camera.width, scene.camera.height);
-  for (int n : sizes) {
+  for (int n : o.sizes) {
     std::vector<double> prepass, readback, camera;
     CubeImage dist;
     CubeIds ids;
-    for (int r = 0; r < runs; ++r) {
+    for (int r = 0; r < o.runs; ++r) {
       const GpuTimings before = gl.timings();
       gl.cube_distance(scene.camera.position, n, &dist, &ids);
       prepass.push_back(gl.timings().cube_distance_ms - before.cube_distance_ms);
@@ -106,13 +122,13 @@ int run(const std::vector<std::string>& words) {
     ABufferStats as;
     ABufferOptions options;
     options.near_distance = gl.near_distance();
-    for (int r = 0; r < runs; ++r) {
+    for (int r = 0; r < o.runs; ++r) {
       const Clock::time_point t0 = Clock::now();
       const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, n, options, &as);
       cpu.push_back(ms_since(t0));
     }
     const Spread p = spread(prepass), rb = spread(readback), c = spread(camera), a = spread(cpu);
-    const PrepassError e = prepass_error(scene, rt, dist, ids, samples);
+    const PrepassError e = prepass_error(scene, rt, dist, ids, o.error_samples);
     std::printf("| %d | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1e / %.1e / %.1e | %.4f | %zu "
                 "| %.1f [%.1f, %.1f] | %llu | %.1f |\n",
                 n, p.median, p.lo, p.hi, rb.median, rb.lo, rb.hi, c.median, c.lo, c.hi, e.median_rel, e.p99_rel,
@@ -127,5 +143,9 @@ int run(const std::vector<std::string>& words) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  return abcube::guarded_main("bench_gl_passes", [&] { return abcube::run(std::vector<std::string>(argv + 1, argv + argc)); });
+  abcube::Options options;
+  CLI::App app{"GL passes: the six-face distance prepass and the camera raster against N, with their error"};
+  abcube::add_options(app, options);
+  if (const int status = abcube::parse_command_line(app, argc, argv, "bench_gl_passes"); status >= 0) return status;
+  return abcube::guarded_main("bench_gl_passes", [&] { return abcube::run(options); });
 }

@@ -33,53 +33,28 @@ namespace {
 struct Options {
   std::vector<std::string> scenes;
   std::vector<int> sizes{64, 128, 256, 512, 1024};
-  std::vector<SearchMode> modes{SearchMode::crossing, SearchMode::thesis};
-  SearchLayers layers = SearchLayers::all;
-  bool merge = true;  // the renderer's default map
+  std::vector<std::string> modes{"crossing", "thesis"};  // SearchMode names
+  std::string layers = "all";                            // all | nearest (SearchLayers)
+  std::string merge = "on";                              // on: the renderer's default map
   int runs = 3;
   int rays = 20000;
   unsigned seed = 1;
 };
 
-Options parse(int argc, char** argv) {
-  Options o;
-  ArgWalk args(argc, argv);
-  while (args.next()) {
-    const std::string a = args.word();
-    if (a == "--sizes") {
-      o.sizes = parse_int_list(a, args.value());
-    } else if (a == "--modes") {
-      o.modes.clear();
-      for (const std::string& s : split_list(args.value())) {
-        SearchMode m;
-        if (!parse_search_mode(s, &m)) throw InputError("--modes: unknown mode " + s);
-        o.modes.push_back(m);
-      }
-    } else if (a == "--layers") {
-      const std::string v = args.value();
-      if (v != "all" && v != "nearest") throw InputError("--layers: all or nearest, got " + v);
-      o.layers = v == "all" ? SearchLayers::all : SearchLayers::nearest;
-    } else if (a == "--merge") {
-      const std::string v = args.value();
-      if (v != "on" && v != "off") throw InputError("--merge: on or off, got " + v);
-      o.merge = v == "on";
-    } else if (a == "--runs") {
-      o.runs = parse_int(a, args.value());
-    } else if (a == "--rays") {
-      o.rays = parse_int(a, args.value());
-    } else if (a == "--seed") {
-      o.seed = static_cast<unsigned>(parse_int(a, args.value()));
-    } else if (!a.empty() && a[0] == '-') {
-      throw InputError("unknown option " + a);
-    } else {
-      o.scenes.push_back(a);
-    }
-  }
-  if (o.scenes.empty() || o.runs < 1 || o.rays < 1) {
-    throw InputError("usage: bench_search SCENE.json... [--sizes 64,128] [--runs 3] [--rays 20000] "
-                     "[--modes crossing,thesis] [--layers all|nearest] [--merge on|off]");
-  }
-  return o;
+// The command line: every option with its default and unit in --help.
+void add_options(CLI::App& app, Options& o) {
+  show_defaults(app);
+  app.add_option("scenes", o.scenes, "scene files (SCENE.json...)")->required();
+  app.add_option("--sizes", o.sizes, "cube resolutions N, texels per face edge (comma-separated)")
+      ->delimiter(',')->allow_extra_args(false)->check(CLI::Range(1, 65536));
+  app.add_option("--modes", o.modes, "search modes (comma-separated)")
+      ->delimiter(',')->allow_extra_args(false)->check(CLI::IsMember({"crossing", "thesis"}));
+  app.add_option("--layers", o.layers, "map layers searched")->check(CLI::IsMember({"all", "nearest"}));
+  app.add_option("--merge", o.merge, "merge the cube A-buffer's fragments as the renderer does")
+      ->check(CLI::IsMember({"on", "off"}));
+  app.add_option("--runs", o.runs, "timed runs per row (median, min and max reported)")->check(CLI::Range(1, 1000000));
+  app.add_option("--rays", o.rays, "reflection rays per scene")->check(CLI::Range(1, 1000000000));
+  app.add_option("--seed", o.seed, "seed of the random pixel samples");
 }
 
 // A reflection ray and the exact answer for it.
@@ -172,12 +147,19 @@ void print_row(const std::string& scene, int n, SearchMode mode, const Row& r, d
   std::fflush(stdout);
 }
 
-int run(int argc, char** argv) {
-  const Options o = parse(argc, argv);
+int run(const Options& o) {
+  // The command line's names (checked by CLI11) as the search's enums.
+  std::vector<SearchMode> modes;
+  for (const std::string& name : o.modes) {
+    SearchMode m;
+    if (!parse_search_mode(name, &m)) throw InputError("--modes: unknown mode " + name);
+    modes.push_back(m);
+  }
+  const SearchLayers layers = o.layers == "all" ? SearchLayers::all : SearchLayers::nearest;
   std::printf("# bench_search: reflection rays from camera-visible reflective points, one thread; ns/ray median of "
               "%d runs (min, max); x/2N = ns/ray ratio to the previous N (2.00 = linear in N); agree = same object "
               "as the exact tracer or both miss; EP = Error_Parallax of hits (thesis 9.3); layers %s, merge %s\n",
-              o.runs, o.layers == SearchLayers::all ? "all" : "nearest", o.merge ? "on" : "off");
+              o.runs, o.layers.c_str(), o.merge.c_str());
   print_header();
   for (const std::string& path : o.scenes) {
     const SceneData scene = load_scene(path);
@@ -187,20 +169,20 @@ int run(int argc, char** argv) {
       std::printf("%-36s no reflective surface visible\n", path.c_str());
       continue;
     }
-    std::vector<double> previous(o.modes.size(), 0.0);
+    std::vector<double> previous(modes.size(), 0.0);
     for (const int n : o.sizes) {
       const Clock::time_point start = Clock::now();
       ABufferOptions ao;
-      ao.merge = o.merge;
+      ao.merge = o.merge == "on";
       const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, n, ao);
       const double build_ms = ms_since(start);
       const SearchContext ctx(scene, cube);
-      for (size_t m = 0; m < o.modes.size(); ++m) {
+      for (size_t m = 0; m < modes.size(); ++m) {
         SearchOptions so;
-        so.mode = o.modes[m];
-        so.layers = o.layers;
+        so.mode = modes[m];
+        so.layers = layers;
         const Row row = measure(ctx, rays, so, o.runs);
-        print_row(path, n, o.modes[m], row, previous[m]);
+        print_row(path, n, modes[m], row, previous[m]);
         previous[m] = row.ns_median;
       }
       std::printf("# %s N=%d: cube A-buffer built in %.0f ms, %zu zero-area triangles\n", path.c_str(), n, build_ms,
@@ -214,5 +196,9 @@ int run(int argc, char** argv) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  return abcube::guarded_main("bench_search", [&] { return abcube::run(argc, argv); });
+  abcube::Options options;
+  CLI::App app{"Reflection searches in the cube A-buffer: cost per ray and error against N"};
+  abcube::add_options(app, options);
+  if (const int status = abcube::parse_command_line(app, argc, argv, "bench_search"); status >= 0) return status;
+  return abcube::guarded_main("bench_search", [&] { return abcube::run(options); });
 }
