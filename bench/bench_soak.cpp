@@ -1,0 +1,224 @@
+// Soak benchmark: many small renders in one process through the library (the way a
+// service or a Python worker uses it), cycling every method, to find what leaks.
+//
+// Phase 1: ONE Renderer renders N images of a tiny scene (the camera orbits it, a new
+// Scene every few renders); every K renders a line with the resident memory (VmRSS) and
+// the open file descriptors. At the end, their growth after warm-up (from render N/10 to
+// the last) against the goal "under 2 MB and 0 descriptors", and renders per second.
+// Phase 2: a Renderer created and destroyed per render (GL opened and closed each time:
+// the EGL re-creation that fails in pyrender), with its own growth figures.
+// Every image must have the size asked, finite values and some light; exit 1 otherwise
+// or when any render throws.
+//
+//   bench_soak [--renders 10000] [--every 500] [--gl auto] [--methods abuffer,zbuffer,...]
+//              [--recreate 300] [--new-scene-every 100] [--threads 0]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <abcube/renderer.hpp>
+
+#include "bench_common.hpp"
+#include "process_usage.hpp"
+#include "tiny_scene.hpp"
+
+namespace abcube {
+namespace {
+
+struct Options {
+  int renders = 10000;
+  int every = 500;
+  std::string gl = "auto";
+  std::vector<std::string> methods{"abuffer", "zbuffer", "envmap", "raytrace", "gpu"};
+  int recreate = 300;
+  int new_scene_every = 100;
+  int threads = 0;
+  int width = 32, height = 24, cube_res = 32;
+};
+
+// The command line: every option with its default and unit in --help.
+void add_options(CLI::App& app, Options& o) {
+  show_defaults(app);
+  app.add_option("--renders", o.renders, "renders of phase 1 (one Renderer)")->check(CLI::Range(1, 100000000));
+  app.add_option("--every", o.every, "renders between two memory and descriptor samples")
+      ->check(CLI::Range(1, 100000000));
+  app.add_option("--gl", o.gl, "the Renderer's GL path (gpu renders)")
+      ->check(CLI::IsMember({"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"}));
+  app.add_option("--methods", o.methods, "methods cycled through, one per render (comma-separated)")
+      ->delimiter(',')->allow_extra_args(false)
+      ->check(CLI::IsMember({"abuffer", "zbuffer", "envmap", "raytrace", "gpu"}));
+  app.add_option("--recreate", o.recreate, "renders of phase 2 (a new Renderer each; 0 = skip it)")
+      ->check(CLI::Range(0, 100000000));
+  app.add_option("--new-scene-every", o.new_scene_every, "renders between two new Scenes (0 = one Scene)")
+      ->check(CLI::Range(0, 100000000));
+  app.add_option("--threads", o.threads, "worker threads per render (0 = every core)")->check(CLI::Range(0, 4096));
+  app.add_option("--width", o.width, "image width, pixels")->check(CLI::Range(1, 4096));
+  app.add_option("--height", o.height, "image height, pixels")->check(CLI::Range(1, 4096));
+  app.add_option("--cube-res", o.cube_res, "cube resolution N, texels per face edge")->check(CLI::Range(1, 4096));
+}
+
+struct Sample {
+  int render = 0;  // renders done when taken
+  double rss_mb = 0;
+  int fds = 0;
+};
+
+Sample sample_now(int render) {
+  return {render, static_cast<double>(resident_bytes()) / (1024.0 * 1024.0), open_descriptors()};
+}
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// What is wrong with an image, or "" when it has the size asked, finite values and light.
+std::string image_problem(const Image& image, int width, int height) {
+  if (image.width != width || image.height != height || image.channels < 1 ||
+      image.data.size() != static_cast<size_t>(width) * height * image.channels) {
+    return "image is " + std::to_string(image.width) + "x" + std::to_string(image.height) + ", asked " +
+           std::to_string(width) + "x" + std::to_string(height);
+  }
+  double sum = 0;
+  for (float v : image.data) {
+    if (!std::isfinite(v)) return "image has a NaN or infinite value";
+    sum += v;
+  }
+  return sum > 0 ? "" : "image is black";
+}
+
+// Render i's options: the method cycles, the camera orbits the scene.
+RenderOptions render_options(const Options& o, int i) {
+  RenderOptions r;
+  r.method = o.methods[static_cast<size_t>(i) % o.methods.size()];
+  r.cube_resolution = o.cube_res;
+  r.threads = o.threads;
+  r.stats = true;
+  const double angle = 0.05 * i;
+  r.camera.position = std::array<double, 3>{3.0 * std::sin(angle), 1.2, 3.0 * std::cos(angle)};
+  r.camera.width = o.width;
+  r.camera.height = o.height;
+  return r;
+}
+
+// Counts failed renders and prints the first few.
+struct Failures {
+  int count = 0;
+  void add(const char* phase, int i, const std::string& method, const std::string& why) {
+    if (++count <= 10) std::printf("FAILED %s render %d (%s): %s\n", phase, i, method.c_str(), why.c_str());
+    std::fflush(stdout);
+  }
+};
+
+// One render, checked; a failure is counted, never thrown.
+void render_checked(Renderer& renderer, const Scene& scene, const Options& o, int i, const char* phase,
+                    Failures* failures) {
+  const RenderOptions options = render_options(o, i);
+  try {
+    const RenderResult r = renderer.render(scene, options);
+    const std::string problem = image_problem(r.image, o.width, o.height);
+    if (!problem.empty()) failures->add(phase, i, options.method, problem);
+  } catch (const std::exception& e) {
+    failures->add(phase, i, options.method, e.what());
+  }
+}
+
+void print_sample(const char* phase, const Sample& s, double renders_per_s) {
+  std::printf("%-8s render %7d  RSS %8.1f MB  fds %4d  %8.1f renders/s\n", phase, s.render, s.rss_mb, s.fds,
+              renders_per_s);
+  std::fflush(stdout);
+}
+
+// Growth from the first sample at or after `warm` renders to the last one, against the goal.
+bool print_growth(const char* phase, const std::vector<Sample>& samples, int warm) {
+  const auto from = std::find_if(samples.begin(), samples.end(), [&](const Sample& s) { return s.render >= warm; });
+  const Sample& a = from == samples.end() ? samples.back() : *from;
+  const Sample& b = samples.back();
+  const double mb = b.rss_mb - a.rss_mb;
+  const int fds = b.fds - a.fds;
+  const bool met = mb < 2.0 && fds <= 0;
+  std::printf("%s growth after warm-up (render %d -> %d): %+.2f MB, %+d descriptors; goal under 2 MB and 0 "
+              "descriptors: %s\n",
+              phase, a.render, b.render, mb, fds, met ? "met" : "NOT met");
+  return met;
+}
+
+// The first render that counts as past warm-up: 10% of the run, on a sample.
+int warm_up(int renders, int every) { return std::max(every, renders / 10 / every * every); }
+
+// Phase 1: one Renderer for every render.
+void soak_one_renderer(const Options& o, Failures* failures) {
+  const RendererOptions ro{o.gl, -1, o.threads};
+  Renderer renderer(ro);
+  const std::string json = tiny_scene_json(o.width, o.height, o.cube_res);
+  Scene scene = Scene::from_json(json, "tiny");
+  std::vector<Sample> samples{sample_now(0)};
+  print_sample("phase1", samples.back(), 0);
+  const Clock::time_point start = Clock::now();
+  Clock::time_point last = start;
+  for (int i = 0; i < o.renders; ++i) {
+    if (o.new_scene_every > 0 && i > 0 && i % o.new_scene_every == 0) scene = Scene::from_json(json, "tiny");
+    render_checked(renderer, scene, o, i, "phase1", failures);
+    if ((i + 1) % o.every == 0 || i + 1 == o.renders) {
+      const int done_since = (i + 1) - samples.back().render;
+      samples.push_back(sample_now(i + 1));
+      print_sample("phase1", samples.back(), done_since / seconds_since(last));
+      last = Clock::now();
+    }
+  }
+  const double seconds = seconds_since(start);
+  std::printf("phase1: %d renders in %.1f s: %.1f renders/s (methods cycled; GL path %s, %s)\n", o.renders, seconds,
+              o.renders / seconds, renderer.gl_path().c_str(), renderer.gl_renderer().c_str());
+  print_growth("phase1", samples, warm_up(o.renders, o.every));
+}
+
+// Phase 2: a new Renderer per render, GL opened and closed each time it renders gpu.
+void soak_new_renderers(const Options& o, Failures* failures) {
+  const RendererOptions ro{o.gl, -1, o.threads};
+  const Scene scene = Scene::from_json(tiny_scene_json(o.width, o.height, o.cube_res), "tiny");
+  const int every = std::max(1, std::min(o.every, o.recreate / 6));
+  std::vector<Sample> samples{sample_now(0)};
+  print_sample("phase2", samples.back(), 0);
+  const Clock::time_point start = Clock::now();
+  Clock::time_point last = start;
+  for (int i = 0; i < o.recreate; ++i) {
+    try {
+      Renderer renderer(ro);
+      render_checked(renderer, scene, o, i, "phase2", failures);
+    } catch (const std::exception& e) {
+      failures->add("phase2", i, "Renderer", e.what());
+    }
+    if ((i + 1) % every == 0 || i + 1 == o.recreate) {
+      const int done_since = (i + 1) - samples.back().render;
+      samples.push_back(sample_now(i + 1));
+      print_sample("phase2", samples.back(), done_since / seconds_since(last));
+      last = Clock::now();
+    }
+  }
+  const double seconds = seconds_since(start);
+  std::printf("phase2: %d Renderers created, rendered once and destroyed in %.1f s: %.1f renders/s\n", o.recreate,
+              seconds, o.recreate / seconds);
+  print_growth("phase2", samples, warm_up(o.recreate, every));
+}
+
+int run(const Options& o) {
+  std::printf("# bench_soak: %dx%d images, cube N = %d, methods %zu cycled, threads %d (0 = every core), gl %s\n",
+              o.width, o.height, o.cube_res, o.methods.size(), o.threads, o.gl.c_str());
+  Failures failures;
+  soak_one_renderer(o, &failures);
+  if (o.recreate > 0) soak_new_renderers(o, &failures);
+  std::printf("failed renders: %d\n", failures.count);
+  return failures.count == 0 ? 0 : 1;
+}
+
+}  // namespace
+}  // namespace abcube
+
+int main(int argc, char** argv) {
+  abcube::Options options;
+  CLI::App app{"Soak: many small renders in one process; resident memory, descriptors and renders/s"};
+  abcube::add_options(app, options);
+  if (const int status = abcube::parse_command_line(app, argc, argv, "bench_soak"); status >= 0) return status;
+  return abcube::guarded_main("bench_soak", [&] { return abcube::run(options); });
+}
