@@ -21,11 +21,17 @@ py::array image_to_array(Image&& image) {
 
 Image array_to_image(const py::handle& array, const std::string& what) {
   // Any numeric array-like, made a C-contiguous float32 array (a view when it already is one).
-  using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
-  FloatArray pixels = FloatArray::ensure(array);
-  if (!pixels) {
-    throw InputError(what + ": must be a numeric array (H x W x C), got " + type_name(array));
+  // Integer pixels (uint8 PNG codes) are refused: the values are linear light in floats.
+  const py::array any = py::array::ensure(array);
+  if (!any || (any.dtype().kind() != 'f' && any.dtype().kind() != 'i' && any.dtype().kind() != 'u')) {
+    throw InputError(what + ": must be a float array (H x W x C), got " + type_name(array));
   }
+  if (any.dtype().kind() != 'f' && py::isinstance<py::array>(array)) {
+    throw InputError(what + ": must hold floats (linear values), got " +
+                     std::string(py::str(any.dtype())) + " pixels");
+  }
+  using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+  const FloatArray pixels = FloatArray::ensure(any);
   const py::ssize_t ndim = pixels.ndim();
   const py::ssize_t channels = ndim == 3 ? pixels.shape(2) : 1;
   if ((ndim != 2 && ndim != 3) || channels < 1 || channels > 4 || pixels.shape(0) < 1 ||

@@ -120,9 +120,6 @@ current per thread); from another thread render() raises RuntimeError. Give each
 
 constexpr const char* RENDER_DOC = R"doc(Renders `scene` and returns its image.
 
-render(scene, method=None, cube_res=None, max_depth=None, camera=None, aovs=None,
-       stats=False, timeout=None, reference=False, threads=None, ...)
-
 Returns a float32 array H x W x 3 (linear RGB, row 0 at the top), identical to the float
 EXR `abcube render` writes for the same inputs. With `aovs` (a list of "distance",
 "normal", "object_id", "fallback") or stats=True it returns a RenderResult instead:

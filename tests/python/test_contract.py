@@ -130,6 +130,12 @@ def test_write_image_errors(tmp_path):
         abcube.write_image(str(tmp_path / "out.exr"), np.zeros((2, 2, 7), np.float32))
     with pytest.raises(abcube.SceneError):
         abcube.read_image(str(tmp_path / "missing.exr"))
+    with pytest.raises(abcube.SceneError, match="float"):
+        abcube.write_image(str(tmp_path / "out.png"), np.zeros((2, 2, 3), np.uint8))
+    with pytest.raises(abcube.SceneError):
+        abcube.compare("a", "b")
+    # Lists of numbers are arrays too.
+    assert abcube.compare([[[0.5, 0.5, 0.5]]], np.full((1, 1, 3), 0.5))["rmse"] == 0
 
 
 def test_root_confinement(tmp_path):
