@@ -68,6 +68,17 @@ RenderOptions options_from_args(const RenderArgs& a) {
   return o;
 }
 
+// A misspelt keyword is a bad argument (SceneError naming it), not a TypeError.
+void reject_unknown_keywords(const py::kwargs& unknown) {
+  if (unknown.empty()) return;
+  const std::string name = py::str(unknown.begin()->first);
+  throw InputError("render: unknown keyword '" + name +
+                   "' (method, cube_res, max_depth, camera, aovs, stats, timeout, reference, "
+                   "threads, search, refine, theta_max_deg, refraction, envmap_lookup, "
+                   "error_target, fresnel, max_layers, max_memory_mib, max_pixels, "
+                   "plan_everything, reference_image)");
+}
+
 // Renders with the GIL released: arguments converted before, results after.
 py::object render(Renderer& renderer, const py::handle& scene_object, const RenderArgs& args) {
   if (!py::isinstance<Scene>(scene_object)) {
@@ -170,7 +181,8 @@ void bind_renderer(py::module_& m) {
              const py::object& error_target, const py::object& fresnel,
              const py::object& max_layers, const py::object& max_memory_mib,
              const py::object& max_pixels, const py::object& plan_everything,
-             const py::object& reference_image) {
+             const py::object& reference_image, const py::kwargs& unknown) {
+            reject_unknown_keywords(unknown);
             return render(self, scene,
                           RenderArgs{method, cube_res, max_depth, camera, aovs, stats, timeout,
                                      reference, threads, search, refine, theta_max_deg,

@@ -205,6 +205,8 @@ def test_bad_arguments_raise_scene_error(renderer, scene):
     for kwargs in cases:
         with pytest.raises(abcube.SceneError):
             renderer.render(scene, **kwargs)
+    with pytest.raises(abcube.SceneError, match="cube_resolution"):
+        renderer.render(scene, cube_resolution=64)
     with pytest.raises(abcube.SceneError, match="camera.positon"):
         renderer.render(scene, camera={"positon": [0, 1, 2]})
     with pytest.raises(abcube.SceneError, match="scene"):
