@@ -35,6 +35,7 @@ struct RenderCommand {
     if (!stats_path.empty()) {
       // The library's stats, with the CLI's own write time in the total.
       nlohmann::json stats = nlohmann::json::parse(r.stats.json);
+      stats["timings_ms"]["load"] = s.load_ms();
       stats["timings_ms"]["write"] = ms_since(t0);
       stats["timings_ms"]["total"] = ms_since(start);
       write_text_atomic(stats_path, stats.dump(2) + "\n");

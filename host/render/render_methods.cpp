@@ -32,7 +32,7 @@ Image render_gpu(MethodContext& mc) {
   const SceneData& scene = mc.scene;
   json& stats = mc.stats;
   GlScene& gl = *mc.gl_scene;
-  const GpuTimings before = gl.timings();
+  const GpuTimings& before = mc.gl_before;
   // Model only what the scene needs: shadow maps for shadow-casting lights, the
   // environment map for reflecting or refracting materials (none at max_depth 0).
   json passes = json::array(), skipped = json::array();

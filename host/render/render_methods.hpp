@@ -36,6 +36,7 @@ struct MethodContext {
   nlohmann::json& stats;
   const std::function<void(const std::string&, double)>& progress;
   GlScene* gl_scene;            // the scene on the GPU (gpu method only)
+  GpuTimings gl_before;         // its timings before this render (zero when it uploaded now)
   // Filled by the map methods for the "fallback" AOV: per pixel, the share of secondary
   // searches that found nothing.
   Image* fallback;

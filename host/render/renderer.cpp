@@ -173,8 +173,9 @@ struct Renderer::Impl {
     return gl.get();
   }
 
-  GlScene& gl_scene_for(const Scene& scene) {
-    if (!gl_scene_owner || &gl_scene_owner->data() != &scene.data()) {
+  GlScene& gl_scene_for(const Scene& scene, bool* uploaded) {
+    *uploaded = !gl_scene_owner || &gl_scene_owner->data() != &scene.data();
+    if (*uploaded) {
       gl_scene.reset();
       gl_scene_owner = scene;
       gl_scene = std::make_unique<GlScene>(scene.data());
@@ -228,7 +229,6 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   json stats;
   stats["scene"] = view.file;
   stats["method"] = method_name(view.render.method);
-  stats["timings_ms"]["load"] = scene.load_ms();
   stats["counts"] = {{"triangles", view.triangles->triangle_count()},
                      {"dropped_triangles", view.dropped_triangles},
                      {"objects", view.objects.size()},
@@ -250,7 +250,8 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
 
   Image fallback;  // the map methods' "fallback" AOV, when asked
   const bool wants_fallback = std::find(request.aovs.begin(), request.aovs.end(), "fallback") != request.aovs.end();
-  MethodContext mc{view, scene.cache(), request, stats, options.progress, nullptr, wants_fallback ? &fallback : nullptr};
+  MethodContext mc{view, scene.cache(), request, stats, options.progress, nullptr, {},
+                   wants_fallback ? &fallback : nullptr};
   Image image;
   switch (view.render.method) {
     case Method::gpu: {
@@ -265,7 +266,9 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
       }
       stats["gl"] = gl_json(ctx);
       stats["timings_ms"]["gl_init"] = first_open ? ms_since(t0) : 0.0;
-      mc.gl_scene = &impl_->gl_scene_for(scene);
+      bool uploaded = false;
+      mc.gl_scene = &impl_->gl_scene_for(scene, &uploaded);
+      if (!uploaded) mc.gl_before = mc.gl_scene->timings();  // else its upload is this render's
       image = render_gpu(mc);
       break;
     }
@@ -295,6 +298,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   const SceneCache::Builds after = scene.cache().builds();
   const int built = (after.neighbours - before.neighbours) + (after.lenses - before.lenses) + (after.bvh - before.bvh);
   stats["scene_data"] = {{"built_by_this_render", built},
+                         {"scene_load_ms", scene.load_ms()},
                          {"mesh_neighbours", {{"built", after.neighbours - before.neighbours}, {"ms", after.neighbours_ms}}},
                          {"lens_fits", {{"built", after.lenses - before.lenses}, {"ms", after.lenses_ms}}},
                          {"bvh", {{"built", after.bvh - before.bvh}, {"ms", after.bvh_ms}}}};
@@ -307,6 +311,11 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   RenderStats& rs = result.stats;
   rs.total_ms = stats["timings_ms"]["total"].get<double>();
   for (const auto& [k, v] : stats["timings_ms"].items()) rs.timings_ms[k] = v.get<double>();
+  for (const char* tracer : {"raytrace", "reference"}) {  // the exact tracer's passes, by name
+    if (stats.contains(tracer) && stats[tracer].contains("timings_ms")) {
+      for (const auto& [k, v] : stats[tracer]["timings_ms"].items()) rs.timings_ms[std::string(tracer) + "." + k] = v.get<double>();
+    }
+  }
   rs.gl_path = stats["gl"]["path"].get<std::string>();
   rs.gl_renderer = stats["gl"]["renderer"].get<std::string>();
   rs.scene_data_built = built;

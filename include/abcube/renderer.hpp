@@ -86,7 +86,9 @@ struct RenderOptions {
 // milliseconds, counts, memory, the GL path, error figures with reference).
 struct RenderStats {
   double total_ms = 0;
-  std::map<std::string, double> timings_ms;  // per pass
+  // Per pass; the exact tracer's as "raytrace.trace", "reference.bvh_build", ...; no
+  // scene loading (Scene::load_ms; the CLI adds it as "load").
+  std::map<std::string, double> timings_ms;
   std::string gl_path;                       // "egl-surfaceless", "osmesa", ... or "none"
   std::string gl_renderer;
   // Per-scene data built by THIS render (0 when an earlier render of the scene built it):
