@@ -1,5 +1,7 @@
 // The Renderer through the public API: per-scene data reused across views, Renderers on
 // several threads, Renderers created and destroyed in a row (GL re-creation).
+#include <condition_variable>
+#include <mutex>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -89,6 +91,61 @@ TEST(RendererApi, HundredEglRenderersInARow) {
     ASSERT_TRUE(images_equal(r.image, first)) << "Renderer " << i;
     ASSERT_NE(renderer.gl_path(), "none");
   }
+}
+
+// A GL Renderer on one thread keeps working while another thread's GL Renderer, on the same
+// EGL display, is created, renders and is destroyed (the display is shared; one Renderer's
+// end must not take it down for the other).
+TEST(RendererApi, GlRenderersOnTwoThreadsOutliveEachOther) {
+  const Scene scene = Scene::load(scene_path("default.json"));
+  const RenderOptions o = small_options("gpu", 16, 12, 16);
+  Image first, second, other;
+  std::string error;
+  std::mutex m;
+  std::condition_variable cv;
+  int stage = 0;  // 1: first rendered; 2: the other thread's Renderer is gone
+  std::thread a([&] {
+    try {
+      Renderer renderer(RendererOptions{"egl", -1, 0});
+      first = renderer.render(scene, o).image;
+      {
+        std::unique_lock<std::mutex> lock(m);
+        stage = 1;
+        cv.notify_all();
+        cv.wait(lock, [&] { return stage == 2; });
+      }
+      second = renderer.render(scene, o).image;
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(m);
+      error = e.what();
+      stage = 2;
+      cv.notify_all();
+    }
+  });
+  std::thread b([&] {
+    {
+      std::unique_lock<std::mutex> lock(m);
+      cv.wait(lock, [&] { return stage >= 1; });
+    }
+    try {
+      Renderer renderer(RendererOptions{"egl", -1, 0});
+      other = renderer.render(scene, o).image;
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(m);
+      if (error.empty()) error = e.what();
+    }
+    std::lock_guard<std::mutex> lock(m);
+    stage = 2;
+    cv.notify_all();
+  });
+  a.join();
+  b.join();
+  if (error.find("no GL path") != std::string::npos || error.find("EGL") != std::string::npos) {
+    GTEST_SKIP() << "no EGL path works here: " << error;
+  }
+  ASSERT_EQ(error, "");
+  EXPECT_TRUE(images_equal(first, other));
+  EXPECT_TRUE(images_equal(first, second)) << "the first Renderer broke when the other one was destroyed";
 }
 
 }  // namespace
