@@ -142,9 +142,7 @@ int run(const Options& o) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  abcube::Options options;
-  CLI::App app{"CPU cube A-buffer build: median ms, fragments, Mfrag/s and peak memory per scene and N"};
-  abcube::add_options(app, options);
-  if (const int status = abcube::parse_command_line(app, argc, argv, "bench_abuffer"); status >= 0) return status;
-  return abcube::guarded_main("bench_abuffer", [&] { return abcube::run(options); });
+  return abcube::bench_main<abcube::Options>(argc, argv, "bench_abuffer",
+                                             "CPU cube A-buffer build: median ms, fragments, Mfrag/s and peak memory per scene and N",
+                                             abcube::add_options, abcube::run);
 }

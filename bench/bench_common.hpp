@@ -47,4 +47,17 @@ int guarded_main(const char* name, Fn&& fn) {
   }
 }
 
+// A benchmark program's whole main: its options registered by add_options(app, options)
+// on a parser described by `description`, parsed (parse_command_line), then
+// run(options) under guarded_main.
+template <class Options, class AddOptions, class Run>
+int bench_main(int argc, char** argv, const char* name, const char* description, AddOptions&& add_options,
+               Run&& run) {
+  Options options;
+  CLI::App app{description};
+  add_options(app, options);
+  if (const int status = parse_command_line(app, argc, argv, name); status >= 0) return status;
+  return guarded_main(name, [&] { return run(options); });
+}
+
 }  // namespace abcube

@@ -143,9 +143,7 @@ int run(const Options& o) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  abcube::Options options;
-  CLI::App app{"GL passes: the six-face distance prepass and the camera raster against N, with their error"};
-  abcube::add_options(app, options);
-  if (const int status = abcube::parse_command_line(app, argc, argv, "bench_gl_passes"); status >= 0) return status;
-  return abcube::guarded_main("bench_gl_passes", [&] { return abcube::run(options); });
+  return abcube::bench_main<abcube::Options>(argc, argv, "bench_gl_passes",
+                                             "GL passes: the six-face distance prepass and the camera raster against N, with their error",
+                                             abcube::add_options, abcube::run);
 }

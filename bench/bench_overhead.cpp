@@ -176,9 +176,7 @@ int run(const Options& o) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  abcube::Options options;
-  CLI::App app{"Per-render overhead of the library (wall - passes) against `abcube render` processes"};
-  abcube::add_options(app, options);
-  if (const int status = abcube::parse_command_line(app, argc, argv, "bench_overhead"); status >= 0) return status;
-  return abcube::guarded_main("bench_overhead", [&] { return abcube::run(options); });
+  return abcube::bench_main<abcube::Options>(argc, argv, "bench_overhead",
+                                             "Per-render overhead of the library (wall - passes) against `abcube render` processes",
+                                             abcube::add_options, abcube::run);
 }

@@ -196,9 +196,7 @@ int run(const Options& o) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  abcube::Options options;
-  CLI::App app{"Reflection searches in the cube A-buffer: cost per ray and error against N"};
-  abcube::add_options(app, options);
-  if (const int status = abcube::parse_command_line(app, argc, argv, "bench_search"); status >= 0) return status;
-  return abcube::guarded_main("bench_search", [&] { return abcube::run(options); });
+  return abcube::bench_main<abcube::Options>(argc, argv, "bench_search",
+                                             "Reflection searches in the cube A-buffer: cost per ray and error against N",
+                                             abcube::add_options, abcube::run);
 }

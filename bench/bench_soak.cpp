@@ -216,9 +216,7 @@ int run(const Options& o) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  abcube::Options options;
-  CLI::App app{"Soak: many small renders in one process; resident memory, descriptors and renders/s"};
-  abcube::add_options(app, options);
-  if (const int status = abcube::parse_command_line(app, argc, argv, "bench_soak"); status >= 0) return status;
-  return abcube::guarded_main("bench_soak", [&] { return abcube::run(options); });
+  return abcube::bench_main<abcube::Options>(argc, argv, "bench_soak",
+                                             "Soak: many small renders in one process; resident memory, descriptors and renders/s",
+                                             abcube::add_options, abcube::run);
 }
