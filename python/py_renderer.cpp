@@ -21,7 +21,7 @@ struct PyRenderResult {
 struct RenderArgs {
   py::object method, cube_res, max_depth, camera, aovs, stats, timeout, reference, threads,
       search, refine, theta_max_deg, refraction, envmap_lookup, error_target, fresnel,
-      max_layers, max_memory_mib, max_pixels, plan_everything, reference_image;
+      max_layers, max_memory_mib, max_pixels, plan_everything, reference_image, resolve;
 };
 
 // Copies the keyword arguments given into RenderOptions; the others keep the struct's
@@ -54,6 +54,7 @@ RenderOptions options_from_args(const RenderArgs& a) {
   if (!a.theta_max_deg.is_none()) o.theta_max_deg = float_arg(a.theta_max_deg, "theta_max_deg");
   if (!a.refraction.is_none()) o.refraction = string_arg(a.refraction, "refraction");
   if (!a.envmap_lookup.is_none()) o.envmap_lookup = string_arg(a.envmap_lookup, "envmap_lookup");
+  if (!a.resolve.is_none()) o.resolve = string_arg(a.resolve, "resolve");
   if (!a.error_target.is_none()) o.error_target = float_arg(a.error_target, "error_target");
   if (!a.fresnel.is_none()) o.fresnel = bool_arg(a.fresnel, "fresnel");
   if (!a.max_layers.is_none()) {
@@ -76,7 +77,7 @@ void reject_unknown_keywords(const py::kwargs& unknown) {
                    "' (method, cube_res, max_depth, camera, aovs, stats, timeout, reference, "
                    "threads, search, refine, theta_max_deg, refraction, envmap_lookup, "
                    "error_target, fresnel, max_layers, max_memory_mib, max_pixels, "
-                   "plan_everything, reference_image)");
+                   "plan_everything, reference_image, resolve)");
 }
 
 // Renders with the GIL released: arguments converted before, results after.
@@ -145,7 +146,8 @@ reference: also trace the exact image, error figures in the stats. The other key
 the CLI's options by their RenderOptions names: search (crossing | thesis), refine (mesh |
 plane), theta_max_deg, refraction (search | thick_lens | thin_lens), envmap_lookup (R |
 bisector | position), max_layers, max_memory_mib, max_pixels, plan_everything,
-reference_image.
+reference_image, resolve (exact | thesis: intersecting fragments by per-sample priority
+masks or by the thesis' Vis_front estimate).
 
 A bad argument or scene raises SceneError (a ValueError) naming it; other failures
 RuntimeError. The GIL is released while the render runs (see Renderer).)doc";
@@ -181,14 +183,14 @@ void bind_renderer(py::module_& m) {
              const py::object& error_target, const py::object& fresnel,
              const py::object& max_layers, const py::object& max_memory_mib,
              const py::object& max_pixels, const py::object& plan_everything,
-             const py::object& reference_image, const py::kwargs& unknown) {
+             const py::object& reference_image, const py::object& resolve, const py::kwargs& unknown) {
             reject_unknown_keywords(unknown);
             return render(self, scene,
                           RenderArgs{method, cube_res, max_depth, camera, aovs, stats, timeout,
                                      reference, threads, search, refine, theta_max_deg,
                                      refraction, envmap_lookup, error_target, fresnel,
                                      max_layers, max_memory_mib, max_pixels, plan_everything,
-                                     reference_image});
+                                     reference_image, resolve});
           },
           py::arg("scene"), py::kw_only(), py::arg("method") = py::none(),
           py::arg("cube_res") = py::none(), py::arg("max_depth") = py::none(),
@@ -201,6 +203,7 @@ void bind_renderer(py::module_& m) {
           py::arg("fresnel") = py::none(), py::arg("max_layers") = py::none(),
           py::arg("max_memory_mib") = py::none(), py::arg("max_pixels") = py::none(),
           py::arg("plan_everything") = false, py::arg("reference_image") = py::none(),
+          py::arg("resolve") = py::none(),
           RENDER_DOC)
       .def_property_readonly("gl_path", &Renderer::gl_path,
                              "The GL path opened (\"\" before the first GL render; \"none\" "

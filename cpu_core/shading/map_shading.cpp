@@ -241,7 +241,9 @@ glm::dvec3 MapShader::envmap_texel(int face, int i, int j) const {
     const glm::dvec3 nn = face_forward(sp.shading_normal, v);
     return ShadedFragment{phong_ambient(m, scene_.ambient) + lights(sp, v, nn, nullptr), m.opacity};
   };
-  return pack_under_mask(buffer.list(i, j), FULL_MASK, shade_fragment, *scene_.triangles, scene_.background);
+  const SampleDepth depth{&buffer.view, &*scene_.triangles, i, j};
+  return pack_under_mask(buffer.list(i, j), FULL_MASK, shade_fragment, *scene_.triangles, scene_.background, nullptr,
+                         options_.exact_priority ? &depth : nullptr);
 }
 
 // Error_CP and Error_Parallax of one reflection ray against the exact tracer (thesis 9).
@@ -318,6 +320,7 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
   if (fallback) pixel_searches.assign(static_cast<size_t>(camera.width()) * static_cast<size_t>(camera.height()), {0, 0});
   ResolveOptions ro;
   ro.threads = threads;
+  ro.exact_priority = shader.exact_priority();
   // Statistics per resolve worker, merged at the end: no lock while shading.
   std::vector<MapShadingStats> per_worker(static_cast<size_t>(resolve_workers(camera, ro)));
   // The fragment shaded at its covered quarters, adaptively (header, QUARTER_SPLIT_SRGB).

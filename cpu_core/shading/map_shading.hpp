@@ -59,6 +59,9 @@ struct MapShadingOptions {
   // --plan everything: also walk the shadows of lights that cast none (result unused), to
   // measure what the plan's skip saves. The image does not change.
   bool walk_all_shadows = false;
+  // The resolve of intersecting fragments (resolve.hpp): exact priority masks, or the
+  // thesis' Vis_front estimate (--resolve thesis).
+  bool exact_priority = true;
 };
 
 // Ray-level error against the exact tracer (thesis ch. 9), for the reflection rays of
@@ -121,6 +124,7 @@ class MapShader {
   // SearchRefine::mesh (search.hpp MESH REFINEMENT): besides the crossing searches' candidates,
   // camera fragments' shading points are moved onto the surface the same way (any mode).
   bool refines_on_mesh() const { return options_.search.refine == SearchRefine::mesh; }
+  bool exact_priority() const { return options_.exact_priority; }
 
  private:
   glm::dvec3 trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, uint32_t inside,

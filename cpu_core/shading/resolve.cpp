@@ -1,6 +1,7 @@
 #include "shading/resolve.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include "base/error.hpp"
 #include "base/parallel.hpp"
@@ -27,7 +28,7 @@ size_t first_overlapping(FragmentList list, size_t i, CoverageMask mask) {
 // for "weight * pack(list from position, mask)".
 template <class Shade>
 glm::dvec3 pack(FragmentList list, CoverageMask search, Shade&& shade, const TriangleSoup& triangles,
-                const glm::dvec3& background, PackScratch* sc) {
+                const glm::dvec3& background, PackScratch* sc, const SampleDepth* depth) {
   if (search == 0) return background;
   const size_t n = list.size();
   sc->shaded.resize(n);
@@ -62,8 +63,26 @@ glm::dvec3 pack(FragmentList list, CoverageMask search, Shade&& shade, const Tri
     const ShadedFragment& sf = shaded(i);
     double alpha = sf.opacity;  // thesis 5.2.1.1: C_in = Op_f C_f + (1 - Op_f) C_behind
     const size_t j = first_overlapping(list, i + 1, in);
-    if (j < n && list[j].zmin < f.zmax &&
-        triangles.object_id[list[j].triangle()] != triangles.object_id[f.triangle()]) {
+    const bool intersecting = j < n && list[j].zmin < f.zmax &&
+                              triangles.object_id[list[j].triangle()] != triangles.object_id[f.triangle()];
+    if (intersecting && depth) {
+      // EXACT PRIORITY MASKS (thesis 11.2.4; header): next is in front where its plane is nearer.
+      const CoverageMask behind = depth->nearer(f, list[j], in & list[j].mask), front = in & ~behind;
+      if (behind != 0) {
+        const double w_b = w_in * (mask_count(behind) / static_cast<double>(mask_count(in)));
+        const ShadedFragment& sn = shaded(j);
+        colour += (w_b * sn.opacity) * sn.colour + (w_b * (1.0 - sn.opacity) * sf.opacity) * sf.colour;
+        const double through = w_b * (1.0 - sn.opacity) * (1.0 - sf.opacity);
+        if (through > 0.0) sc->stack.push_back({j + 1, behind, through});
+      }
+      if (front != 0) {
+        const double w_f = w_in * (mask_count(front) / static_cast<double>(mask_count(in)));
+        colour += (w_f * sf.opacity) * sf.colour;
+        if (sf.opacity < 1.0) sc->stack.push_back({i + 1, front, w_f * (1.0 - sf.opacity)});
+      }
+      continue;
+    }
+    if (intersecting) {
       // Thesis 5.2.1.2, intersecting surfaces: alpha_in = Vis Op_f + (1 - Vis)(1 - alpha_next),
       // times Op_f for a transparent front fragment (resolve.hpp).
       const double vis = visible_fraction(f, list[j]);
@@ -77,10 +96,30 @@ glm::dvec3 pack(FragmentList list, CoverageMask search, Shade&& shade, const Tri
 
 }  // namespace
 
+double SampleDepth::t(const Fragment& f, int k) const {
+  const size_t v = 3 * static_cast<size_t>(f.triangle());
+  const glm::dvec3 a(triangles->positions[v]), b(triangles->positions[v + 1]), c(triangles->positions[v + 2]);
+  const glm::dvec3 normal = glm::cross(b - a, c - a);
+  const glm::dvec3 d = view->direction(x + sample_dx(k), y + sample_dy(k));
+  const double along = glm::dot(normal, d);
+  if (along == 0.0) return std::numeric_limits<double>::infinity();
+  return glm::dot(normal, a - view->centre) / along;  // plane: normal . (X - a) = 0
+}
+
+CoverageMask SampleDepth::nearer(const Fragment& a, const Fragment& b, CoverageMask in) const {
+  CoverageMask out = 0;
+  for (CoverageMask m = in; m != 0; m &= m - 1) {
+    const int k = __builtin_ctz(m);
+    if (t(b, k) < t(a, k)) out |= CoverageMask{1} << k;
+  }
+  return out;
+}
+
 glm::dvec3 pack_under_mask(FragmentList list, CoverageMask search, const FragmentShader& shade,
-                           const TriangleSoup& triangles, const glm::dvec3& background, PackScratch* scratch) {
+                           const TriangleSoup& triangles, const glm::dvec3& background, PackScratch* scratch,
+                           const SampleDepth* depth) {
   PackScratch local;
-  return pack(list, search, shade, triangles, background, scratch ? scratch : &local);
+  return pack(list, search, shade, triangles, background, scratch ? scratch : &local, depth);
 }
 
 int resolve_workers(const ABuffer& camera, const ResolveOptions& options) {
@@ -103,8 +142,9 @@ Image resolve_image_per_worker(const ABuffer& camera, const TriangleSoup& triang
     const int y = static_cast<int>(row);
     for (int x = 0; x < camera.width(); ++x) {
       const auto shade_here = [&](const Fragment& f) { return shade(f, x, y, worker); };
+      const SampleDepth depth{&camera.view, &triangles, x, y};
       const glm::dvec3 c = pack(camera.list(x, y), FULL_MASK, shade_here, triangles, background,
-                                &scratch[static_cast<size_t>(worker)]);
+                                &scratch[static_cast<size_t>(worker)], options.exact_priority ? &depth : nullptr);
       image.set_rgb(x, y, glm::vec3(c));
     }
   });

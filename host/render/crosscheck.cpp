@@ -139,13 +139,15 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
       {"failures", r.failures}};
 }
 
-Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options, nlohmann::json* stats) {
+Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options, nlohmann::json* stats,
+                           bool exact_priority) {
   ABufferStats s;
   Clock::time_point t0 = Clock::now();
   const ABuffer camera = build_camera_abuffer(scene, options, &s);
   const double build_ms = ms_since(t0);
   ResolveOptions ro;
   ro.threads = options.threads;
+  ro.exact_priority = exact_priority;
   t0 = Clock::now();
   Image image = resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera), scene.background, ro);
   (*stats)["timings_ms"]["camera_abuffer"] = build_ms;

@@ -53,6 +53,8 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
 
 // The camera view through the CPU A-buffer with local Phong (no searches yet).
 // Options: threads, layer cap, memory budget (abuffer.hpp).
-Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options, nlohmann::json* stats);
+// `exact_priority`: the resolve's rule for intersecting fragments (resolve.hpp).
+Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options, nlohmann::json* stats,
+                           bool exact_priority = true);
 
 }  // namespace abcube

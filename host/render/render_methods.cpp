@@ -94,7 +94,7 @@ Image render_map_method(MethodContext& mc) {
   stats["plan"]["passes"] = passes;
   stats["plan"]["skipped"] = skipped;
   stats["plan"]["mode"] = r.plan_everything ? "everything" : "needed";
-  if (!plan.cube_map) return render_abuffer_local(scene, r.abuffer, &stats);
+  if (!plan.cube_map) return render_abuffer_local(scene, r.abuffer, &stats, r.map.exact_priority);
   Clock::time_point t0 = Clock::now();
   ABufferStats cs;
   const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, scene.render.cube_resolution, r.abuffer, &cs);

@@ -133,6 +133,10 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   r.map.search.theta_max = glm::radians(o.theta_max_deg);
   r.map.refraction = parse_named(o.refraction, parse_refraction_mode, "refraction", "mode", "search, thick_lens, thin_lens");
   r.map.lookup = parse_named(o.envmap_lookup, parse_envmap_lookup, "envmap-lookup", "lookup", "R, bisector, position");
+  if (o.resolve != "exact" && o.resolve != "thesis") {
+    throw InputError("resolve: unknown rule '" + o.resolve + "' (exact, thesis)");
+  }
+  r.map.exact_priority = o.resolve == "exact";
   r.abuffer.max_layers = o.max_layers;
   if (o.max_memory_mib > (uint64_t{1} << 30)) throw InputError("max-memory: must be at most 2^30 MiB");
   r.abuffer.max_memory_bytes = o.max_memory_mib << 20;
@@ -142,6 +146,51 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   r.aovs = o.aovs;
   check_render_size(*view, available_memory_bytes());
   return r;
+}
+
+// What a render's stats say before any pass: the scene, sizes, method and its options.
+json request_stats(const SceneData& view, const RenderRequest& request) {
+  json stats;
+  stats["scene"] = view.file;
+  stats["method"] = method_name(view.render.method);
+  stats["counts"] = {{"triangles", view.triangles->triangle_count()},
+                     {"dropped_triangles", view.dropped_triangles},
+                     {"objects", view.objects.size()},
+                     {"lights", view.lights.size()}};
+  if (view.render.error_target > 0) {
+    stats["error_target"] = {{"target", view.render.error_target},
+                             {"cube_resolution", view.render.cube_resolution},
+                             {"bound_at_that_n", parallax_bound(view.render.cube_resolution)}};
+  }
+  stats["size"] = {{"width", view.camera.width}, {"height", view.camera.height},
+                   {"cube_resolution", view.render.cube_resolution}, {"max_depth", view.render.max_depth}};
+  stats["threads"] = thread_count(request.threads, SIZE_MAX);
+  stats["method_options"] = {{"search", search_mode_name(request.map.search.mode)},
+                             {"refine", search_refine_name(request.map.search.refine)},
+                             {"theta_max_deg", glm::degrees(request.map.search.theta_max)},
+                             {"refraction", refraction_mode_name(request.map.refraction)},
+                             {"envmap_lookup", envmap_lookup_name(request.map.lookup)},
+                             {"resolve", request.map.exact_priority ? "exact" : "thesis"},
+                             {"fresnel", view.render.fresnel}};
+  return stats;
+}
+
+// The structure beside the JSON (renderer.hpp RenderStats).
+RenderStats render_stats(const json& stats, int built, std::optional<double> psnr, bool with_json) {
+  RenderStats rs;
+  rs.total_ms = stats["timings_ms"]["total"].get<double>();
+  for (const auto& [k, v] : stats["timings_ms"].items()) rs.timings_ms[k] = v.get<double>();
+  for (const char* tracer : {"raytrace", "reference"}) {  // the exact tracer's passes, by name
+    if (stats.contains(tracer) && stats[tracer].contains("timings_ms")) {
+      for (const auto& [k, v] : stats[tracer]["timings_ms"].items()) rs.timings_ms[std::string(tracer) + "." + k] = v.get<double>();
+    }
+  }
+  rs.gl_path = stats["gl"]["path"].get<std::string>();
+  rs.gl_renderer = stats["gl"]["renderer"].get<std::string>();
+  rs.scene_data_built = built;
+  rs.psnr_db = psnr;
+  if (with_json) rs.json = stats.dump(2);
+  return rs;
 }
 
 }  // namespace
@@ -226,28 +275,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   SceneData view;
   const RenderRequest request = make_request(scene.data(), options, impl_->options.threads, &view);
   const SceneCache::Builds before = scene.cache().builds();
-  json stats;
-  stats["scene"] = view.file;
-  stats["method"] = method_name(view.render.method);
-  stats["counts"] = {{"triangles", view.triangles->triangle_count()},
-                     {"dropped_triangles", view.dropped_triangles},
-                     {"objects", view.objects.size()},
-                     {"lights", view.lights.size()}};
-  if (view.render.error_target > 0) {
-    stats["error_target"] = {{"target", view.render.error_target},
-                             {"cube_resolution", view.render.cube_resolution},
-                             {"bound_at_that_n", parallax_bound(view.render.cube_resolution)}};
-  }
-  stats["size"] = {{"width", view.camera.width}, {"height", view.camera.height},
-                   {"cube_resolution", view.render.cube_resolution}, {"max_depth", view.render.max_depth}};
-  stats["threads"] = thread_count(request.threads, SIZE_MAX);
-  stats["method_options"] = {{"search", search_mode_name(request.map.search.mode)},
-                             {"refine", search_refine_name(request.map.search.refine)},
-                             {"theta_max_deg", glm::degrees(request.map.search.theta_max)},
-                             {"refraction", refraction_mode_name(request.map.refraction)},
-                             {"envmap_lookup", envmap_lookup_name(request.map.lookup)},
-                             {"fresnel", view.render.fresnel}};
-
+  json stats = request_stats(view, request);
   Image fallback;  // the map methods' "fallback" AOV, when asked
   const bool wants_fallback = std::find(request.aovs.begin(), request.aovs.end(), "fallback") != request.aovs.end();
   MethodContext mc{view, scene.cache(), request, stats, options.progress, nullptr, {},
@@ -308,19 +336,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   stats["memory"] = {{"peak_rss_bytes", peak_rss_bytes()}};
 
   result.image = std::move(image);
-  RenderStats& rs = result.stats;
-  rs.total_ms = stats["timings_ms"]["total"].get<double>();
-  for (const auto& [k, v] : stats["timings_ms"].items()) rs.timings_ms[k] = v.get<double>();
-  for (const char* tracer : {"raytrace", "reference"}) {  // the exact tracer's passes, by name
-    if (stats.contains(tracer) && stats[tracer].contains("timings_ms")) {
-      for (const auto& [k, v] : stats[tracer]["timings_ms"].items()) rs.timings_ms[std::string(tracer) + "." + k] = v.get<double>();
-    }
-  }
-  rs.gl_path = stats["gl"]["path"].get<std::string>();
-  rs.gl_renderer = stats["gl"]["renderer"].get<std::string>();
-  rs.scene_data_built = built;
-  rs.psnr_db = psnr;
-  if (options.stats) rs.json = stats.dump(2);
+  result.stats = render_stats(stats, built, psnr, options.stats);
   return result;
 }
 

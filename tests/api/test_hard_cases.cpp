@@ -1,0 +1,97 @@
+// Hard cases with known answers (issue 12, part 1): EXACT PRIORITY MASKS in the resolve
+// (cpu_core/shading/resolve.hpp). Flat colours (ambient only, no lights), so a pixel's
+// colour is the share of its samples each surface wins.
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include <abcube/renderer.hpp>
+
+#include "raster/samples.hpp"
+#include "scene/camera.hpp"
+#include "scene/scene_data.hpp"
+
+namespace abcube::test {
+namespace {
+
+// Two flat-coloured quads (red first, green second) seen by `camera`, ambient light only.
+std::string two_quads(const std::string& camera, const std::string& red, const std::string& green) {
+  std::ostringstream s;
+  s << R"({"version": 1, "camera": )" << camera << R"(, "background": [0, 0, 1], "ambient": [1, 1, 1],
+    "lights": [],
+    "materials": {"red": {"color": [1, 0, 0], "diffuse": 0}, "green": {"color": [0, 1, 0], "diffuse": 0}},
+    "objects": [{"type": "quad", "vertices": )"
+    << red << R"(, "material": "red"}, {"type": "quad", "vertices": )" << green
+    << R"(, "material": "green"}], "render": {"method": "abuffer", "cube_resolution": 64}})";
+  return s.str();
+}
+
+double psnr_against_raytrace(const Scene& scene) {
+  Renderer renderer(RendererOptions{"none", -1, 0});
+  RenderOptions o;
+  o.method = "abuffer";
+  const Image a = renderer.render(scene, o).image;
+  o.method = "raytrace";
+  const Image r = renderer.render(scene, o).image;
+  return image_error(a, r).psnr;
+}
+
+// A red decal lying `offset` above a 10 m green floor, seen 4 m away at a grazing angle:
+// the thesis' Vis_front blends the two (about 27 dB at 1 mm); per-sample planes do not.
+TEST(HardCases, DecalAboveAFloorResolvesPerSample) {
+  for (const double offset : {1e-1, 1e-2, 1e-3}) {  // 1e-2, 1e-3, 1e-4 of the 10 m floor
+    const std::string floor = "[[-5,0,-5],[-5,0,5],[5,0,5],[5,0,-5]]";
+    std::ostringstream decal;
+    decal << "[[-0.5," << offset << ",-2],[-0.5," << offset << ",2],[0.5," << offset << ",2],[0.5," << offset
+          << ",-2]]";
+    const std::string camera =
+        R"({"position": [0, 0.8, -4], "look_at": [0, 0, 0], "fov_y": 40, "width": 96, "height": 64})";
+    const Scene scene = Scene::from_json(two_quads(camera, decal.str(), floor), "decal.json");
+    const double psnr = psnr_against_raytrace(scene);
+    EXPECT_GE(psnr, 35.0) << "decal " << offset << " m above the floor";
+  }
+}
+
+// Two quads meeting at 1 degree along z = 0, seen from above: the green one (tilted) is in
+// front where z > 0. Every sample's winner is known from the two planes, so every pixel's
+// colour is known exactly: green share = the samples whose eye ray meets the green plane
+// first.
+TEST(HardCases, QuadsMeetingAtOneDegreeSplitEachPixelAsTheirPlanes) {
+  const double slope = std::tan(1.0 * M_PI / 180.0);  // green: y = slope * z
+  std::ostringstream green;
+  green << "[[-2," << -2 * slope << ",-2],[-2," << 2 * slope << ",2],[2," << 2 * slope << ",2],[2," << -2 * slope
+        << ",-2]]";
+  const std::string red = "[[-2,0,-2],[-2,0,2],[2,0,2],[2,0,-2]]";
+  const std::string camera =
+      R"({"position": [0.013, 3, 0.021], "look_at": [0.013, 0, 0.021], "up": [0, 0, 1], "fov_y": 20, "width": 40, "height": 40})";
+  const Scene scene = Scene::from_json(two_quads(camera, red, green.str()), "meeting.json");
+  Renderer renderer(RendererOptions{"none", -1, 0});
+  RenderOptions o;
+  o.method = "abuffer";
+  const Image image = renderer.render(scene, o).image;
+
+  const CameraFrame frame = make_camera_frame(scene.data().camera);
+  int split_pixels = 0;
+  for (int y = 0; y < frame.height; ++y) {
+    for (int x = 0; x < frame.width; ++x) {
+      int green_samples = 0;
+      for (int k = 0; k < MASK_SAMPLES; ++k) {
+        const glm::dvec3 d = frame.direction(x + sample_dx(k), y + sample_dy(k));
+        const double t_red = -frame.eye.y / d.y;                                       // y = 0
+        const double t_green = (slope * frame.eye.z - frame.eye.y) / (d.y - slope * d.z);  // y = slope z
+        green_samples += t_green < t_red;
+      }
+      const double share = green_samples / double(MASK_SAMPLES);
+      split_pixels += green_samples > 0 && green_samples < MASK_SAMPLES;
+      const glm::vec3 c = image.rgb(x, y);
+      EXPECT_NEAR(c.g, share, 1e-5) << "pixel " << x << ", " << y;
+      EXPECT_NEAR(c.r, 1.0 - share, 1e-5) << "pixel " << x << ", " << y;
+    }
+  }
+  EXPECT_GE(split_pixels, frame.width / 2) << "the meeting line crosses the image";
+}
+
+}  // namespace
+}  // namespace abcube::test
