@@ -79,27 +79,30 @@ bool bool_arg(const py::handle& value, const std::string& what) {
   throw InputError(what + ": must be True or False, got " + type_name(value));
 }
 
-int int_arg(const py::handle& value, const std::string& what) {
-  // Python int or numpy integer, in the range of a C int; never a float or a bool.
+namespace {
+
+// A Python int or numpy integer that fits T; never a float or a bool. `kind` names what is
+// expected in the message.
+template <class T>
+T integer_arg(const py::handle& value, const std::string& what, const char* kind, const char* range_message) {
   if (py::isinstance<py::bool_>(value) || !py::hasattr(value, "__index__")) {
-    throw InputError(what + ": must be an integer, got " + type_name(value));
+    throw InputError(what + ": must be " + kind + ", got " + type_name(value));
   }
   try {
-    return py::int_(py::reinterpret_borrow<py::object>(value)).cast<int>();
+    return py::int_(py::reinterpret_borrow<py::object>(value)).cast<T>();
   } catch (const py::cast_error&) {
-    throw InputError(what + ": integer out of range, got " + std::string(py::str(value)));
+    throw InputError(what + ": " + range_message + ", got " + std::string(py::str(value)));
   }
 }
 
+}  // namespace
+
+int int_arg(const py::handle& value, const std::string& what) {
+  return integer_arg<int>(value, what, "an integer", "integer out of range");
+}
+
 uint64_t unsigned_arg(const py::handle& value, const std::string& what) {
-  if (py::isinstance<py::bool_>(value) || !py::hasattr(value, "__index__")) {
-    throw InputError(what + ": must be an integer >= 0, got " + type_name(value));
-  }
-  try {
-    return py::int_(py::reinterpret_borrow<py::object>(value)).cast<uint64_t>();
-  } catch (const py::cast_error&) {
-    throw InputError(what + ": must be an integer >= 0, got " + std::string(py::str(value)));
-  }
+  return integer_arg<uint64_t>(value, what, "an integer >= 0", "must be an integer >= 0");
 }
 
 double float_arg(const py::handle& value, const std::string& what) {
