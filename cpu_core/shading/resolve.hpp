@@ -11,7 +11,7 @@
 //                  (thesis 5.2.1.2: "el identificador del objeto difiere y los fragmentos
 //                  se superponen en Z");
 //   intersecting, with the pixel's geometry (SampleDepth; every resolve_image): EXACT
-//   PRIORITY MASKS (thesis 11.2.4, "A-Buffers exactos"): per sample of `in`, the two
+//   PRIORITY MASKS (thesis 11.2.4, "Exact A_Buffers", its p-masks): per sample of `in`, the two
 //   fragments' triangle planes are met along the sample's own eye ray; behind = the samples
 //   where next's plane is strictly nearer (at equal depth f, first in the list, stays in
 //   front), front = in & ~behind. Then
