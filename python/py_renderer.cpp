@@ -21,7 +21,7 @@ struct PyRenderResult {
 struct RenderArgs {
   py::object method, cube_res, max_depth, camera, aovs, stats, timeout, reference, threads,
       search, refine, theta_max_deg, refraction, envmap_lookup, error_target, fresnel,
-      max_layers, max_memory_mib, max_pixels, plan_everything, reference_image, resolve;
+      max_layers, max_memory_mib, max_pixels, plan_everything, reference_image, resolve, side_structure;
 };
 
 // Copies the keyword arguments given into RenderOptions; the others keep the struct's
@@ -55,6 +55,7 @@ RenderOptions options_from_args(const RenderArgs& a) {
   if (!a.refraction.is_none()) o.refraction = string_arg(a.refraction, "refraction");
   if (!a.envmap_lookup.is_none()) o.envmap_lookup = string_arg(a.envmap_lookup, "envmap_lookup");
   if (!a.resolve.is_none()) o.resolve = string_arg(a.resolve, "resolve");
+  if (!a.side_structure.is_none()) o.side_structure = bool_arg(a.side_structure, "side_structure");
   if (!a.error_target.is_none()) o.error_target = float_arg(a.error_target, "error_target");
   if (!a.fresnel.is_none()) o.fresnel = bool_arg(a.fresnel, "fresnel");
   if (!a.max_layers.is_none()) {
@@ -77,7 +78,7 @@ void reject_unknown_keywords(const py::kwargs& unknown) {
                    "' (method, cube_res, max_depth, camera, aovs, stats, timeout, reference, "
                    "threads, search, refine, theta_max_deg, refraction, envmap_lookup, "
                    "error_target, fresnel, max_layers, max_memory_mib, max_pixels, "
-                   "plan_everything, reference_image, resolve)");
+                   "plan_everything, reference_image, resolve, side_structure)");
 }
 
 // Renders with the GIL released: arguments converted before, results after.
@@ -147,7 +148,9 @@ the CLI's options by their RenderOptions names: search (crossing | thesis), refi
 plane), theta_max_deg, refraction (search | thick_lens | thin_lens), envmap_lookup (R |
 bisector | position), max_layers, max_memory_mib, max_pixels, plan_everything,
 reference_image, resolve (exact | thesis: intersecting fragments by per-sample priority
-masks or by the thesis' Vis_front estimate).
+masks or by the thesis' Vis_front estimate), side_structure (default True; False is the
+CLI's --map-only: searches see only the map, no side structure for the triangles it cannot
+hold).
 
 A bad argument or scene raises SceneError (a ValueError) naming it; other failures
 RuntimeError. The GIL is released while the render runs (see Renderer).)doc";
@@ -183,14 +186,15 @@ void bind_renderer(py::module_& m) {
              const py::object& error_target, const py::object& fresnel,
              const py::object& max_layers, const py::object& max_memory_mib,
              const py::object& max_pixels, const py::object& plan_everything,
-             const py::object& reference_image, const py::object& resolve, const py::kwargs& unknown) {
+             const py::object& reference_image, const py::object& resolve,
+             const py::object& side_structure, const py::kwargs& unknown) {
             reject_unknown_keywords(unknown);
             return render(self, scene,
                           RenderArgs{method, cube_res, max_depth, camera, aovs, stats, timeout,
                                      reference, threads, search, refine, theta_max_deg,
                                      refraction, envmap_lookup, error_target, fresnel,
                                      max_layers, max_memory_mib, max_pixels, plan_everything,
-                                     reference_image, resolve});
+                                     reference_image, resolve, side_structure});
           },
           py::arg("scene"), py::kw_only(), py::arg("method") = py::none(),
           py::arg("cube_res") = py::none(), py::arg("max_depth") = py::none(),
@@ -203,7 +207,7 @@ void bind_renderer(py::module_& m) {
           py::arg("fresnel") = py::none(), py::arg("max_layers") = py::none(),
           py::arg("max_memory_mib") = py::none(), py::arg("max_pixels") = py::none(),
           py::arg("plan_everything") = false, py::arg("reference_image") = py::none(),
-          py::arg("resolve") = py::none(),
+          py::arg("resolve") = py::none(), py::arg("side_structure") = py::none(),
           RENDER_DOC)
       .def_property_readonly("gl_path", &Renderer::gl_path,
                              "The GL path opened (\"\" before the first GL render; \"none\" "

@@ -125,6 +125,7 @@
 
 #include "raster/abuffer.hpp"
 #include "raster/cube_map.hpp"
+#include "reference/bvh.hpp"
 #include "scene/scene_data.hpp"
 
 namespace abcube {
@@ -161,6 +162,7 @@ struct SearchOptions {
   SearchRefine refine = SearchRefine::mesh;  // MESH REFINEMENT (header)
   double self_offset_texels = 0;            // W's own surface and points closer; 0 = the mode's default
   uint32_t max_texels = 0;                  // walk cap; 0 = CubeWalk's default
+  bool side_structure = true;               // THE SIDE STRUCTURE answers what the map cannot hold
 };
 
 // The self offset `options` gives, in texels at W (its own, or the mode's default).
@@ -170,7 +172,7 @@ enum class MissReason { none, no_crossing, threshold_rejection, zero_area_surfac
 const char* miss_reason_name(MissReason r);
 
 // The geometry a search needs, prepared once per cube map: per triangle its plane relative
-// to the centre, and the triangles the map cannot hold (plane through the centre).
+// to the centre, and the triangles the map cannot hold (THE SIDE STRUCTURE).
 // The scene and cube must outlive it.
 class SearchContext {
  public:
@@ -182,6 +184,20 @@ class SearchContext {
   const SceneData& scene() const { return *scene_; }
   const CubeABuffer& cube() const { return *cube_; }
   const std::vector<uint32_t>& zero_area_triangles() const { return zero_area_; }
+  // THE SIDE STRUCTURE (header): the non-degenerate triangles the map cannot hold (zero
+  // area, or no fragment in any face), ascending, and a BVH over them (null when none).
+  const std::vector<uint32_t>& side_triangles() const { return side_; }
+  bool has_side_triangles() const { return side_bvh_ != nullptr; }
+  // Calls visit(triangle, l) for every side triangle the ray C + w + l d (w relative to the
+  // centre, d unit) crosses with 0 < l < l_end (the watertight test of reference/bvh.hpp),
+  // in no particular order, until visit returns false.
+  template <class Visit>
+  void for_each_side_crossing(const glm::dvec3& w, const glm::dvec3& d, double l_end, Visit&& visit) const {
+    if (!side_bvh_) return;
+    side_bvh_->for_each_hit(RayQuery(cube_->centre + w, d), l_end, [&](const TriangleHit& h) {
+      return visit(side_[h.triangle], h.t);
+    });
+  }
 
   struct Plane {
     glm::dvec3 normal{0.0};  // unit geometric normal, cross(b-a, c-a) direction
@@ -229,6 +245,8 @@ class SearchContext {
   std::vector<Plane> planes_;
   std::vector<TriangleBounds> bounds_;
   std::vector<uint32_t> zero_area_;
+  std::vector<uint32_t> side_;
+  std::shared_ptr<const Bvh> side_bvh_;  // over side_, in its order
   std::shared_ptr<const MeshNeighbours> neighbours_;
   // Per face and row j: the smallest and largest column holding a fragment over rows
   // <= j (prefix) and >= j (suffix), and in row j alone (n and -1 when none).
@@ -238,6 +256,7 @@ class SearchContext {
   std::array<RowBounds, 6> occupied_;
   int blocks_per_row_ = 0;
   std::array<std::vector<glm::vec2>, 6> block_z_;  // (min zmin, max zmax); empty: (+inf, -inf)
+  void build_side_structure(const std::vector<uint8_t>& seen);
   glm::vec2 block_bounds(int face, int i, int j) const {
     return block_z_[static_cast<size_t>(face)][static_cast<size_t>(j / BOUNDS_BLOCK) * static_cast<size_t>(blocks_per_row_) +
                                                static_cast<size_t>(i / BOUNDS_BLOCK)];
@@ -254,6 +273,7 @@ struct SearchResult {
   double distance = 0;         // |X' - W|
   double angle = 0;            // angle between the ray and X' - W (radians; 0 in crossing mode)
   double outside_texels = 0;   // crossing mode: X''s distance from its triangle, in texels
+  bool side = false;           // answered by THE SIDE STRUCTURE (texel is then meaningless)
   CubeTexel texel{0, 0, 0};    // where the fragment was found
   uint32_t texels_visited = 0;
   uint32_t fragments_tested = 0;  // z-interval tests
@@ -266,7 +286,8 @@ struct ShadowResult {
   uint32_t blockers = 0;          // distinct crossings counted
   uint32_t first_blocker = 0;     // triangle of the nearest counted blocker (if blockers > 0)
   bool aborted = false;
-  bool zero_area = false;         // the segment meets a surface the map cannot hold
+  bool zero_area = false;         // the segment meets a zero-area surface and no side structure answered
+  uint32_t side_blockers = 0;     // blockers found by THE SIDE STRUCTURE
   uint32_t texels_visited = 0;
   uint32_t fragments_tested = 0;
   uint32_t candidates = 0;
@@ -304,7 +325,8 @@ struct SearchKindStats {
   uint64_t hits = 0;                    // shadows: rays with a blocker
   uint64_t misses = 0;                  // every miss, whatever the reason; shadows: unblocked
   uint64_t threshold_rejections = 0;    // misses whose best candidate failed the threshold
-  uint64_t zero_area = 0;               // misses on a surface through the centre
+  uint64_t zero_area = 0;               // misses on a surface through the centre (map only)
+  uint64_t side_hits = 0;               // answered by THE SIDE STRUCTURE; shadows: rays with a side blocker
   uint64_t aborted = 0;                 // walks stopped by the cap
   double mean_texels() const { return rays ? static_cast<double>(texels) / static_cast<double>(rays) : 0.0; }
   void add(const SearchResult& r);

@@ -1,10 +1,11 @@
 // One fragment's answer for a ray (search.hpp MODE crossing, MODE thesis), the zero-area
-// check, and the result a search returns.
+// check, THE SIDE STRUCTURE's crossings, and the result a search returns.
 #include <algorithm>
 #include <cmath>
 
 #include "base/error.hpp"
 #include "search/search_internal.hpp"
+#include "search/search_scan.hpp"
 
 namespace abcube::detail {
 
@@ -142,14 +143,51 @@ bool meets_zero_area(const SearchContext& ctx, const SearchRay& q, double l_end)
   return false;
 }
 
-// The answer: the chosen candidate or a miss (`miss` unless the walk was aborted); a surface
-// the map cannot hold met before it turns it into a zero-area miss.
+bool side_crossing_counts(const SearchContext& ctx, const SearchRay& q, uint32_t tri, double l) {
+  if (!(l > q.self)) return false;
+  if (q.restrict_object && ctx.scene().triangles->object_id[tri] != q.object) return false;
+  return !own_surface(ctx.plane(tri), q);
+}
+
+bool side_back_face(const SearchContext& ctx, const SearchRay& q, uint32_t tri) {
+  const bool zero_area =
+      std::binary_search(ctx.zero_area_triangles().begin(), ctx.zero_area_triangles().end(), tri);
+  const SearchContext::Plane& p = ctx.plane(tri);
+  return zero_area ? glm::dot(p.normal, q.d) > 0.0 : p.offset > 0.0;
+}
+
+SideCrossing nearest_side_crossing(const SearchContext& ctx, const SearchRay& q, double l_end) {
+  SideCrossing best;
+  if (!q.side || !ctx.has_side_triangles()) return best;  // the common case: nothing to test
+  ctx.for_each_side_crossing(q.w, q.d, l_end, [&](uint32_t tri, double l) {
+    if (l < best.l && side_crossing_counts(ctx, q, tri, l)) best = {tri, l, false};
+    return true;
+  });
+  if (best.l < INF) best.back_face = side_back_face(ctx, q, best.triangle);
+  return best;
+}
+
+// The answer: the chosen candidate or a miss (`miss` unless the walk was aborted); a side
+// triangle crossed before it answers instead (THE SIDE STRUCTURE); without the side
+// structure, a zero-area surface met before it turns it into a zero-area miss.
 SearchResult finish(const SearchContext& ctx, const SearchRay& q, const Candidate* best, MissReason miss,
                     const ScanCounts& counts) {
   SearchResult r;
   if (best) r = make_result(ctx, q, *best);
   else r.miss = counts.aborted ? MissReason::aborted : miss;
-  if (meets_zero_area(ctx, q, best ? best->l : q.l_max)) {
+  const double l_end = best ? best->l : q.l_max;
+  const SideCrossing side = nearest_side_crossing(ctx, q, l_end);
+  if (side.l < INF) {
+    Candidate c;
+    c.l = side.l;
+    c.angle = 0.0;
+    c.x = q.w + side.l * q.d;
+    c.triangle = side.triangle;
+    c.back_face = side.back_face;
+    r = make_result(ctx, q, c);
+    r.texel = direction_to_texel(c.x, ctx.cube().n);
+    r.side = true;
+  } else if (!q.side && meets_zero_area(ctx, q, l_end)) {
     r.hit = false;
     r.miss = MissReason::zero_area_surface;
   }
@@ -168,6 +206,7 @@ SearchRay make_query(const SearchContext& ctx, const glm::dvec3& w_world, const 
   const double texel = texel_size_at(q.w, ctx.cube().n);
   q.self = self_offset_texels(o) * texel;
   q.self_tolerance = 2.0 * o.tolerance_texels * texel;
+  q.side = o.side_structure;
   return q;
 }
 

@@ -46,7 +46,9 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube,
     if (setup_triangle(view, soup, k, &setup) == SetupResult::edge_on) zero_area_.push_back(k);
   }
   if (!neighbours_) neighbours_ = std::make_shared<const MeshNeighbours>(build_mesh_neighbours(soup));
-  // Where each face holds fragments, row by row (empty_ahead), and BLOCK BOUNDS.
+  // Where each face holds fragments, row by row (empty_ahead), BLOCK BOUNDS, and which
+  // triangles have a fragment (THE SIDE STRUCTURE).
+  std::vector<uint8_t> seen(count, 0);
   const int n = cube.n;
   blocks_per_row_ = (std::max(n, 0) + BOUNDS_BLOCK - 1) / BOUNDS_BLOCK;
   for (size_t f = 0; f < occupied_.size(); ++f) {
@@ -69,6 +71,7 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube,
     const float inf = std::numeric_limits<float>::infinity();
     block_z_[f].assign(static_cast<size_t>(blocks_per_row_) * static_cast<size_t>(blocks_per_row_),
                        known ? glm::vec2(inf, -inf) : glm::vec2(-inf, inf));
+    if (!known) std::fill(seen.begin(), seen.end(), uint8_t{1});  // unknown layout: no side structure
     for (int j = 0; known && j < n; ++j) {
       for (int i = 0; i < n; ++i) {
         glm::vec2& z = block_z_[f][static_cast<size_t>(j / BOUNDS_BLOCK) * static_cast<size_t>(blocks_per_row_) +
@@ -76,6 +79,7 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube,
         for (const Fragment& frag : b.list(i, j)) {
           z.x = std::min(z.x, frag.zmin);
           z.y = std::max(z.y, frag.zmax);
+          if (frag.triangle() < count) seen[frag.triangle()] = 1;
         }
       }
     }
@@ -92,6 +96,25 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube,
       rb.max_suffix[j - 1] = std::max(rb.max_suffix[j - 1], rb.max_suffix[j]);
     }
   }
+  build_side_structure(seen);
+}
+
+// THE SIDE STRUCTURE (search.hpp): the zero-area triangles and those without a fragment,
+// non-degenerate (a plane), in a BVH of their own.
+void SearchContext::build_side_structure(const std::vector<uint8_t>& seen) {
+  for (uint32_t k = 0; k < seen.size(); ++k) {
+    const bool zero_area = std::binary_search(zero_area_.begin(), zero_area_.end(), k);
+    if ((zero_area || !seen[k]) && planes_[k].normal != glm::dvec3(0.0)) side_.push_back(k);
+  }
+  if (side_.empty()) return;
+  const TriangleSoup& soup = *scene_->triangles;
+  TriangleSoup sub;
+  for (const uint32_t k : side_) {
+    for (size_t v = 0; v < 3; ++v) sub.positions.push_back(soup.positions[3 * static_cast<size_t>(k) + v]);
+    sub.object_id.push_back(soup.object_id[k]);
+    sub.material_id.push_back(soup.material_id[k]);
+  }
+  side_bvh_ = std::make_shared<const Bvh>(sub);
 }
 
 // Vertices are the same when their object and float position are (bit for bit, -0 = +0);

@@ -25,6 +25,7 @@ struct SearchRay {
   double self_tolerance = 0;  // nearest tolerance candidate accepted, world units (SELF-HITS)
   bool restrict_object = false;
   uint32_t object = 0;
+  bool side = true;           // SearchOptions::side_structure
 };
 
 // What the walk over the map saw of one ray.
@@ -83,8 +84,27 @@ Candidate thesis_candidate(const SearchContext& ctx, const SearchRay& q, const W
 // Does the exact ray meet a triangle the map cannot hold before parameter l_end?
 bool meets_zero_area(const SearchContext& ctx, const SearchRay& q, double l_end);
 
-// The answer: the chosen candidate or a miss (`miss` unless the walk was aborted); a surface
-// the map cannot hold met before it turns it into a zero-area miss.
+// A side triangle the ray crosses (THE SIDE STRUCTURE), and its facing (header).
+struct SideCrossing {
+  uint32_t triangle = 0;
+  double l = INF;
+  bool back_face = false;
+};
+
+// Is the side crossing (tri, l) one the search takes? Past the self offset, not W's own
+// surface, and in the object a refraction exit is restricted to.
+bool side_crossing_counts(const SearchContext& ctx, const SearchRay& q, uint32_t tri, double l);
+
+// Its facing: as the map gives it (seen from the centre), or, for a plane through the
+// centre, the ray's direction against the geometric normal.
+bool side_back_face(const SearchContext& ctx, const SearchRay& q, uint32_t tri);
+
+// The nearest side crossing with l < l_end (l = INF when none or the option is off).
+SideCrossing nearest_side_crossing(const SearchContext& ctx, const SearchRay& q, double l_end);
+
+// The answer: the chosen candidate or a miss (`miss` unless the walk was aborted); a side
+// triangle crossed before it answers instead (THE SIDE STRUCTURE); without the side
+// structure, a zero-area surface met before it turns it into a zero-area miss.
 SearchResult finish(const SearchContext& ctx, const SearchRay& q, const Candidate* best, MissReason miss,
                     const ScanCounts& counts);
 

@@ -88,6 +88,33 @@ bool already_counted(const std::vector<ShadowCrossing>& counted, const SearchCon
   return false;
 }
 
+// THE SIDE STRUCTURE on a shadow segment: every side triangle it crosses, nearest first, is
+// a blocker (counted once, as the map's), until an opaque one.
+void add_side_blockers(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o,
+                       std::vector<ShadowCrossing>* counted, ShadowResult* res) {
+  if (!q.side || !ctx.has_side_triangles()) return;  // the common case: nothing to test
+  std::vector<SideCrossing> crossings;
+  ctx.for_each_side_crossing(q.w, q.d, q.l_max, [&](uint32_t tri, double l) {
+    if (side_crossing_counts(ctx, q, tri, l)) crossings.push_back({tri, l, side_back_face(ctx, q, tri)});
+    return true;
+  });
+  std::sort(crossings.begin(), crossings.end(), [](const SideCrossing& a, const SideCrossing& b) { return a.l < b.l; });
+  const TriangleSoup& soup = *ctx.scene().triangles;
+  for (const SideCrossing& s : crossings) {
+    Candidate c;
+    c.triangle = s.triangle;
+    c.back_face = s.back_face;
+    c.l = s.l;
+    c.x = q.w + s.l * q.d;
+    if (already_counted(*counted, ctx, o, c)) continue;
+    counted->push_back({s.triangle, soup.object_id[s.triangle], s.back_face, c.x, s.l});
+    ++res->side_blockers;
+    res->transmittance *= blocker_transmittance(ctx.scene().materials[soup.material_id[s.triangle]]);  // thesis 8.3
+    res->blocked = res->transmittance == glm::dvec3(0.0);
+    if (res->blocked) return;
+  }
+}
+
 }  // namespace
 
 SearchResult reflection_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& r,
@@ -132,6 +159,7 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
   };
   const auto after_texel = [&](const WalkTexel&, uint32_t) { return !res.blocked; };
   const ScanCounts counts = scan(ctx, q, options, on_fragment, after_texel, [] { return true; });
+  if (!res.blocked) add_side_blockers(ctx, q, options, &counted, &res);
   res.blockers = static_cast<uint32_t>(counted.size());
   if (!counted.empty()) {
     res.first_blocker = std::min_element(counted.begin(), counted.end(), [](const ShadowCrossing& a,
@@ -140,7 +168,7 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
                         })->triangle;
   }
   res.aborted = counts.aborted;
-  res.zero_area = meets_zero_area(ctx, q, len);
+  res.zero_area = !q.side && meets_zero_area(ctx, q, len);
   res.texels_visited = counts.texels;
   res.fragments_tested = counts.fragments;
   res.candidates = counts.candidates;

@@ -53,6 +53,7 @@ void SearchKindStats::add(const SearchResult& r) {
   add_walk(this, r);
   if (r.hit) {
     ++hits;
+    side_hits += r.side;
     return;
   }
   ++misses;
@@ -67,6 +68,7 @@ void SearchKindStats::add(const ShadowResult& r) {
   else ++misses;
   threshold_rejections += r.blockers == 0 && r.threshold_rejections > 0;
   zero_area += r.zero_area;
+  side_hits += r.side_blockers > 0;
   aborted += r.aborted;
 }
 
@@ -80,6 +82,7 @@ void SearchKindStats::merge(const SearchKindStats& o) {
   misses += o.misses;
   threshold_rejections += o.threshold_rejections;
   zero_area += o.zero_area;
+  side_hits += o.side_hits;
   aborted += o.aborted;
 }
 

@@ -42,6 +42,8 @@ void RenderFlags::add_to(CLI::App* cmd) {
   cmd->add_option("--resolve", options.resolve,
                   "intersecting fragments: exact (per-sample priority masks, thesis 11.2.4) | thesis (Vis_front, 5.2.1.2)")
       ->capture_default_str();
+  cmd->add_flag("--map-only", [this](int64_t) { options.side_structure = false; },
+                "searches see only the map: no side structure for triangles it cannot hold");
   cmd->add_flag("--fresnel", [this](int64_t) { options.fresnel = true; }, "Schlick weights for kr and kt");
   cmd->add_option("--max-layers", options.max_layers, "A-buffer layers kept per list, 0 = all")
       ->capture_default_str()->check(CLI::Range(0, 1 << 20));

@@ -137,6 +137,7 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
     throw InputError("resolve: unknown rule '" + o.resolve + "' (exact, thesis)");
   }
   r.map.exact_priority = o.resolve == "exact";
+  r.map.search.side_structure = o.side_structure;
   r.abuffer.max_layers = o.max_layers;
   if (o.max_memory_mib > (uint64_t{1} << 30)) throw InputError("max-memory: must be at most 2^30 MiB");
   r.abuffer.max_memory_bytes = o.max_memory_mib << 20;
@@ -171,6 +172,7 @@ json request_stats(const SceneData& view, const RenderRequest& request) {
                              {"refraction", refraction_mode_name(request.map.refraction)},
                              {"envmap_lookup", envmap_lookup_name(request.map.lookup)},
                              {"resolve", request.map.exact_priority ? "exact" : "thesis"},
+                             {"side_structure", request.map.search.side_structure},
                              {"fresnel", view.render.fresnel}};
   return stats;
 }

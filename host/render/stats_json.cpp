@@ -10,7 +10,7 @@ json search_kind_json(const SearchKindStats& s) {
   return {{"rays", s.rays}, {"texels_mean", s.mean_texels()}, {"texels_max", s.max_texels},
           {"fragments_tested", s.fragments}, {"candidates", s.candidates}, {"hits", s.hits},
           {"misses", s.misses}, {"threshold_rejections", s.threshold_rejections},
-          {"zero_area_misses", s.zero_area}, {"aborted", s.aborted}};
+          {"zero_area_misses", s.zero_area}, {"side_hits", s.side_hits}, {"aborted", s.aborted}};
 }
 
 json map_shading_json(const MapShadingStats& ms) {

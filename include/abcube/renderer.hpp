@@ -63,6 +63,7 @@ struct RenderOptions {
   std::string refraction = "search"; // search | thick_lens | thin_lens
   std::string envmap_lookup = "R";   // R | bisector | position (envmap method)
   std::string resolve = "exact";     // intersecting fragments: exact (priority masks) | thesis (Vis_front)
+  bool side_structure = true;        // searches also test the triangles the map cannot hold (false: --map-only)
   uint32_t max_layers = 0;       // A-buffer layers kept per list (0 = all)
   uint64_t max_memory_mib = 0;   // A-buffer budget, MiB (0 = what the machine has)
   uint64_t max_pixels = 0;       // refuse a camera image larger than this (0 = no cap)

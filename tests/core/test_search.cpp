@@ -569,10 +569,15 @@ TEST(SearchDegenerate, GrazingReflectionDoesNotFindItsOwnSurface) {
   }
 }
 
-TEST(SearchDegenerate, SurfaceThroughTheCentreIsAZeroAreaMiss) {
+// THE SIDE STRUCTURE (search.hpp): the quad in y = 0 holds no fragment; the searches find
+// it exactly there, and only say "zero_area_surface" when it is off (--map-only).
+TEST(SearchDegenerate, SurfaceThroughTheCentreIsAnsweredByTheSideStructure) {
   const auto world = make_world(room_scene(), 64);
   ASSERT_EQ(world->ctx->zero_area_triangles().size(), 2u);  // the quad in y = 0
-  SearchKindStats stats;
+  ASSERT_TRUE(world->ctx->has_side_triangles());
+  SearchOptions map_only;
+  map_only.side_structure = false;
+  SearchKindStats stats, stats_map_only;
   int checked = 0;
   for (int k = 0; k < 20; ++k) {
     // From the floor wall up through the quad (x in [1.5, 2.5], z in [-1, 1]).
@@ -584,12 +589,23 @@ TEST(SearchDegenerate, SurfaceThroughTheCentreIsAZeroAreaMiss) {
     ASSERT_EQ(h.object_id, 3u);
     const SearchResult r = reflection_search(*world->ctx, s.w, s.r);
     stats.add(r);
-    EXPECT_FALSE(r.hit);
-    EXPECT_EQ(r.miss, MissReason::zero_area_surface);
+    ASSERT_TRUE(r.hit) << k;
+    EXPECT_TRUE(r.side);
+    EXPECT_EQ(r.object_id, 3u);
+    EXPECT_LT(glm::length(r.point - h.point), 1e-7 * world->tracer->scene_scale());  // the tracer starts offset
+    EXPECT_TRUE(r.back_face);  // the ray goes up, along the quad's geometric normal +y: its back
+    const SearchResult m = reflection_search(*world->ctx, s.w, s.r, map_only);
+    stats_map_only.add(m);
+    EXPECT_FALSE(m.hit);
+    EXPECT_EQ(m.miss, MissReason::zero_area_surface);
     ++checked;
   }
-  EXPECT_EQ(stats.zero_area, static_cast<uint64_t>(checked));
-  EXPECT_EQ(stats.misses, static_cast<uint64_t>(checked));
+  EXPECT_EQ(stats.side_hits, static_cast<uint64_t>(checked));
+  EXPECT_EQ(stats.hits, static_cast<uint64_t>(checked));
+  EXPECT_EQ(stats.zero_area, 0u);
+  EXPECT_EQ(stats_map_only.zero_area, static_cast<uint64_t>(checked));
+  EXPECT_EQ(stats_map_only.misses, static_cast<uint64_t>(checked));
+  EXPECT_EQ(stats_map_only.side_hits, 0u);
 }
 
 TEST(Search, StatsCountEveryRay) {
