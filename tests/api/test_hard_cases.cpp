@@ -1,11 +1,13 @@
 // Hard cases with known answers (issue 12, part 1): EXACT PRIORITY MASKS in the resolve
 // (cpu_core/shading/resolve.hpp). Flat colours (ambient only, no lights), so a pixel's
-// colour is the share of its samples each surface wins.
+// colour is the share of its samples each surface wins. Part 3: what the map cannot hold,
+// answered by the searches' SIDE STRUCTURE (cpu_core/search/search.hpp).
 #include <cmath>
 #include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <abcube/renderer.hpp>
 
@@ -28,10 +30,11 @@ std::string two_quads(const std::string& camera, const std::string& red, const s
   return s.str();
 }
 
-double psnr_against_raytrace(const Scene& scene) {
+double psnr_against_raytrace(const Scene& scene, bool side_structure = true) {
   Renderer renderer(RendererOptions{"none", -1, 0});
   RenderOptions o;
   o.method = "abuffer";
+  o.side_structure = side_structure;
   const Image a = renderer.render(scene, o).image;
   o.method = "raytrace";
   const Image r = renderer.render(scene, o).image;
@@ -91,6 +94,57 @@ TEST(HardCases, QuadsMeetingAtOneDegreeSplitEachPixelAsTheirPlanes) {
     }
   }
   EXPECT_GE(split_pixels, frame.width / 2) << "the meeting line crosses the image";
+}
+
+// A wide plane exactly at the camera's height (y = 1: its plane holds the cube centre, so it
+// has no area in the map) seen only in a mirror below the eye, tilted to send the view
+// back and up to it. Map only, the mirror shows the background (6 dB). The plane starts
+// behind the eye: eye rays from a point on a plane meet it only by rounding (the exact
+// tracer speckles there).
+TEST(HardCases, PlaneThroughTheCentreSeenInATiltedMirror) {
+  const std::string scene_json = R"({"version": 1, "background": [0, 0, 1], "ambient": [1, 1, 1], "lights": [],
+    "camera": {"position": [0, 1, 0], "look_at": [0, 0, -3], "fov_y": 40, "width": 64, "height": 48},
+    "materials": {"yellow": {"color": [1, 0.8, 0], "diffuse": 0},
+                  "mirror": {"color": [0, 0, 0], "diffuse": 0, "reflect": 1}},
+    "objects": [{"type": "quad", "vertices": [[-20, 1, 0.5], [-20, 1, 40], [20, 1, 40], [20, 1, 0.5]], "material": "yellow"},
+                {"type": "quad", "vertices": [[-2, -0.6, -2.81], [2, -0.6, -2.81], [2, 0.6, -3.19], [-2, 0.6, -3.19]],
+                 "material": "mirror"}],
+    "render": {"method": "abuffer", "cube_resolution": 128}})";
+  const Scene scene = Scene::from_json(scene_json, "plane_through_centre.json");
+  const double with_side = psnr_against_raytrace(scene);
+  const double map_only = psnr_against_raytrace(scene, false);
+  EXPECT_GE(with_side, 35.0);
+  EXPECT_GE(with_side - map_only, 15.0) << "map only " << map_only << " dB";
+  // The stats count the side structure's answers, and none map only.
+  Renderer renderer(RendererOptions{"none", -1, 0});
+  RenderOptions o;
+  o.method = "abuffer";
+  for (const bool side : {true, false}) {
+    o.side_structure = side;
+    const nlohmann::json stats = nlohmann::json::parse(renderer.render(scene, o).stats.json);
+    const nlohmann::json& reflection = stats["searches"]["reflection"];
+    EXPECT_EQ(reflection["side_hits"].get<uint64_t>() > 0, side) << reflection;
+    EXPECT_EQ(reflection["zero_area_misses"].get<uint64_t>() > 0, !side) << reflection;
+  }
+}
+
+// A thin vertical fin in the plane x = 0, which holds the camera (no area in the map),
+// between a light and the floor: its shadow is there, as the exact tracer draws it. 33 dB:
+// the same fin moved to x = 0.3 (in the map) gives the same figure, the per-pixel shading
+// of the shadow's edge; map only, 14 dB.
+TEST(HardCases, ShadowOfAFinThroughTheCentre) {
+  const std::string scene_json = R"({"version": 1, "background": [0, 0, 0], "ambient": [0, 0, 0],
+    "lights": [{"type": "point", "position": [-3, 4, -4], "color": [1, 1, 1], "cast_shadows": true}],
+    "camera": {"position": [0, 2, 2], "look_at": [0, 0, -4], "fov_y": 50, "width": 64, "height": 48},
+    "materials": {"floor": {"color": [0.8, 0.8, 0.8]}, "fin": {"color": [0.8, 0.2, 0.2]}},
+    "objects": [{"type": "quad", "vertices": [[-6, 0, -10], [-6, 0, 4], [6, 0, 4], [6, 0, -10]], "material": "floor"},
+                {"type": "quad", "vertices": [[0, 0.5, -5], [0, 0.5, -3], [0, 2.5, -3], [0, 2.5, -5]], "material": "fin"}],
+    "render": {"method": "abuffer", "cube_resolution": 128}})";
+  const Scene scene = Scene::from_json(scene_json, "fin_shadow.json");
+  const double with_side = psnr_against_raytrace(scene);
+  const double map_only = psnr_against_raytrace(scene, false);
+  EXPECT_GE(with_side, 31.0);
+  EXPECT_GE(with_side - map_only, 15.0) << "map only " << map_only << " dB";
 }
 
 }  // namespace
