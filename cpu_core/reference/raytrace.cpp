@@ -130,6 +130,7 @@ glm::dvec3 RayTracer::light_visibility(const Hit& hit, const PointLight& light, 
   bool opaque = false;
   std::vector<Crossing> crossings;
   bvh_->for_each_hit(RayQuery(origin, dir), dist, [&](const TriangleHit& th) {
+    if (plane_holds_light(soup, th.triangle, light.position)) return true;
     const glm::dvec3 tr = blocker_transmittance(scene_->materials[soup.material_id[th.triangle]]);
     if (tr == glm::dvec3(0.0)) {
       opaque = true;

@@ -91,11 +91,12 @@ bool already_counted(const std::vector<ShadowCrossing>& counted, const SearchCon
 // THE SIDE STRUCTURE on a shadow segment: every side triangle it crosses, nearest first, is
 // a blocker (counted once, as the map's), until an opaque one.
 void add_side_blockers(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o,
-                       std::vector<ShadowCrossing>* counted, ShadowResult* res) {
+                       const glm::dvec3& light, std::vector<ShadowCrossing>* counted, ShadowResult* res) {
   if (!q.side || !ctx.has_side_triangles()) return;  // the common case: nothing to test
   std::vector<SideCrossing> crossings;
   ctx.for_each_side_crossing(q.w, q.d, q.l_max, [&](uint32_t tri, double l) {
-    if (side_crossing_counts(ctx, q, tri, l)) crossings.push_back({tri, l, side_back_face(ctx, q, tri)});
+    if (side_crossing_counts(ctx, q, tri, l) && !plane_holds_light(*ctx.scene().triangles, tri, light))
+      crossings.push_back({tri, l, side_back_face(ctx, q, tri)});
     return true;
   });
   std::sort(crossings.begin(), crossings.end(), [](const SideCrossing& a, const SideCrossing& b) { return a.l < b.l; });
@@ -150,6 +151,7 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
       }
       return;
     }
+    if (plane_holds_light(*ctx.scene().triangles, c.triangle, light_position)) return;
     if (already_counted(counted, ctx, options, c)) return;
     const uint32_t tri = c.triangle;
     counted.push_back({tri, ctx.scene().triangles->object_id[tri], c.back_face, c.x, c.l});
@@ -159,7 +161,7 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
   };
   const auto after_texel = [&](const WalkTexel&, uint32_t) { return !res.blocked; };
   const ScanCounts counts = scan(ctx, q, options, on_fragment, after_texel, [] { return true; });
-  if (!res.blocked) add_side_blockers(ctx, q, options, &counted, &res);
+  if (!res.blocked) add_side_blockers(ctx, q, options, light_position, &counted, &res);
   res.blockers = static_cast<uint32_t>(counted.size());
   if (!counted.empty()) {
     res.first_blocker = std::min_element(counted.begin(), counted.end(), [](const ShadowCrossing& a,

@@ -761,5 +761,37 @@ TEST(MeshRefine, ACreaseDoesNotShadowItsOwnFace) {
   EXPECT_GT(plane_false, points / 10);  // the scenario shows the plane tolerance's error
 }
 
+// A point light lying on a floor (flat, then tilted with coordinates float cannot hold), a
+// wall facing it: the segment from the wall to the light meets the floor's plane only at
+// the light. Neither the tracer nor the shadow search may call it a blocker (rule "lights
+// on surfaces", shading.hpp); without the rule both decide by rounding, and differently.
+TEST(ShadowRules, ALightLyingOnASurfaceIsNotShadowedByIt) {
+  for (const dvec3 slope : {dvec3(0.0, 0.0, 0.0), dvec3(0.3137, 0.0, 0.1171)}) {
+    const auto height = [&](double x, double z) { return slope.x * x + slope.z * z + (slope.x > 0 ? 0.0731 : 0.0); };
+    SceneData s = empty_scene({0.3, 1.1, 3}, {0, 0.5, 0}, 50, 64, 48);
+    const uint32_t white = add_material(s, Material{});
+    add_quad(s, {-4, height(-4, -4), -4}, {-4, height(-4, 4), 4}, {4, height(4, 4), 4}, {4, height(4, -4), -4}, white);
+    add_quad(s, {-2, 1.5, -1}, {2, 1.5, -1}, {2, 3.5, -1}, {-2, 3.5, -1}, white);
+    const auto w = make_world(s, 128, true);
+    int points = 0, tracer_shadowed = 0, search_shadowed = 0;
+    for (int k = 0; k < 40; ++k) {
+      const double lx = -1.5 + 3.0 * ((k * 7) % 40) / 40.0, lz = 0.3 + 1.2 * ((k * 13) % 40) / 40.0;
+      const PointLight light{dvec3(lx, height(lx, lz), lz), dvec3(1.0), true};
+      for (int j = 0; j < 10; ++j) {
+        const dvec3 probe(-1.8 + 0.4 * j, 1.6 + std::fmod(0.17 * k, 1.8), 0.0);
+        Hit h;
+        ASSERT_TRUE(w->tracer->intersect(probe, {0, 0, -1}, &h));
+        ++points;
+        tracer_shadowed += w->tracer->light_visibility(h, light, nullptr) != dvec3(1.0);
+        search_shadowed += shadow_search(*w->ctx, h.point, light.position).blockers > 0;
+      }
+    }
+    std::printf("light on a floor (slope %g): %d points, shadowed by the tracer %d, by the search %d\n", slope.x,
+                points, tracer_shadowed, search_shadowed);
+    EXPECT_EQ(tracer_shadowed, 0);
+    EXPECT_EQ(search_shadowed, 0);
+  }
+}
+
 }  // namespace
 }  // namespace abcube
