@@ -4,9 +4,11 @@
 #include <array>
 #include <cfloat>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "base/error.hpp"
+#include "scene/tie_rule.hpp"
 
 namespace abcube {
 
@@ -127,6 +129,9 @@ Bvh::Bvh(const TriangleSoup& soup) {
   build(items, 0, static_cast<uint32_t>(n), 0);
   vertices_.resize(3 * n);
   slot_of_.assign(n, 0);
+  double magnitude = 0.0;
+  for (uint32_t t = 0; t < n; ++t) magnitude = std::max(magnitude, triangle_magnitude(soup, t));
+  tie_bound_max_ = TIE_RELATIVE * magnitude;
   for (uint32_t s = 0; s < n; ++s) {
     slot_of_[order_[s]] = s;
     for (int k = 0; k < 3; ++k) vertices_[3 * s + k] = glm::dvec3(soup.positions[3 * order_[s] + k]);
@@ -224,22 +229,21 @@ bool Bvh::intersect_triangle(const RayQuery& ray, uint32_t triangle, double tmax
   return intersect_slot(ray, slot_of_[triangle], tmax, hit);
 }
 
-bool Bvh::closest_hit(const RayQuery& ray, double tmax, TriangleHit* hit) const {
-  if (nodes_.empty()) return false;
-  bool found = false;
+// Front-to-back traversal: on_hit(const TriangleHit&) for every hit with t < cull, `cull`
+// re-read after each (the caller's callback narrows it).
+template <class OnHit>
+void Bvh::traverse_near_first(const RayQuery& ray, const double& cull, OnHit&& on_hit) const {
   uint32_t stack[BVH_MAX_STACK];
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const uint32_t index = stack[--top];
     const BvhNode& node = nodes_[index];
-    if (!hits_box(ray, node, tmax)) continue;
+    if (!hits_box(ray, node, cull)) continue;
     if (node.count > 0) {
       for (uint32_t s = node.offset; s < node.offset + node.count; ++s) {
-        if (intersect_slot(ray, s, tmax, hit)) {
-          tmax = hit->t;
-          found = true;
-        }
+        TriangleHit h;
+        if (intersect_slot(ray, s, cull, &h)) on_hit(static_cast<const TriangleHit&>(h));
       }
       continue;
     }
@@ -252,7 +256,68 @@ bool Bvh::closest_hit(const RayQuery& ray, double tmax, TriangleHit* hit) const 
       stack[top++] = index + 1;
     }
   }
+}
+
+bool Bvh::closest_hit(const RayQuery& ray, double tmax, TriangleHit* hit) const {
+  if (nodes_.empty()) return false;
+  bool found = false;
+  traverse_near_first(ray, tmax, [&](const TriangleHit& h) {
+    *hit = h;
+    tmax = h.t;
+    found = true;
+  });
   return found;
+}
+
+bool Bvh::visible_hit(const RayQuery& ray, double tmax, const TriangleSoup& soup, TriangleHit* hit) const {
+  if (nodes_.empty()) return false;
+  constexpr double INF = std::numeric_limits<double>::infinity();
+  constexpr int KEEP = 8;
+  std::array<TriangleHit, KEEP> kept;
+  int n_kept = 0;
+  bool incomplete = false, found = false;
+  TriangleHit nearest;
+  double cull = tmax;  // every hit with t < cull is found
+  // The end of the tie window of a hit: no surface beyond it can be at its distance.
+  const auto window_end = [&](const TriangleHit& h) {
+    const double c = std::fabs(glm::dot(tie_normal(soup, h.triangle), ray.dir));
+    const double end = c > 0.0 ? std::nextafter(h.t + tie_bound_max_ / c, INF) : INF;
+    return std::min(tmax, end);
+  };
+  const auto add = [&](const TriangleHit& h) {
+    if (!found || h.t < nearest.t || (h.t == nearest.t && ranks_above(soup, h.triangle, nearest.triangle))) {
+      const double end = window_end(h);
+      if (found && end > cull) incomplete = true;  // hits culled before may lie in the new window
+      nearest = h;
+      found = true;
+      cull = end;
+      int w = 0;
+      for (int i = 0; i < n_kept; ++i) {
+        if (kept[static_cast<size_t>(i)].t < cull) kept[static_cast<size_t>(w++)] = kept[static_cast<size_t>(i)];
+      }
+      n_kept = w;
+    }
+    if (n_kept < KEEP) {
+      kept[static_cast<size_t>(n_kept++)] = h;
+    } else {
+      incomplete = true;
+    }
+  };
+  traverse_near_first(ray, cull, add);
+  if (!found) return false;
+  const SurfaceAt near_at{nearest.triangle, nearest.t};
+  TriangleHit best = nearest;
+  const auto consider = [&](const TriangleHit& h) {
+    if (ranks_above(soup, h.triangle, best.triangle) && same_distance(soup, ray.dir, near_at, {h.triangle, h.t})) best = h;
+    return true;
+  };
+  if (incomplete) {
+    for_each_hit(ray, cull, consider);  // the nearest hit's whole window, again
+  } else {
+    for (int i = 0; i < n_kept; ++i) consider(kept[static_cast<size_t>(i)]);
+  }
+  *hit = best;
+  return true;
 }
 
 }  // namespace abcube

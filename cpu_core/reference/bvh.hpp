@@ -52,6 +52,16 @@ class Bvh {
   // The nearest hit with 0 < t < tmax (t in units of |dir|). Ties keep the first found.
   bool closest_hit(const RayQuery& ray, double tmax, TriangleHit* hit) const;
 
+  // The VISIBLE hit with 0 < t < tmax by THE TIE RULE (scene/tie_rule.hpp): of the hits at
+  // the same distance as the nearest one (the nearest: smallest t, then ranking above),
+  // the one ranking highest (later object, then higher triangle). `soup` is the one the
+  // BVH was built from. Same answer as that rule applied to a loop over every triangle:
+  // one traversal culling at the nearest hit's tie window (tie_bound over the whole soup
+  // divided by |n . dir|), keeping the hits inside it; when the window of a new nearest
+  // hit reaches past what was culled before, or more than a few hits share it, a second
+  // traversal collects that window again.
+  bool visible_hit(const RayQuery& ray, double tmax, const TriangleSoup& soup, TriangleHit* hit) const;
+
   // Calls visit(const TriangleHit&) for every hit with 0 < t < tmax, in no particular
   // (but deterministic) order, until visit returns false.
   template <class Visit>
@@ -69,12 +79,15 @@ class Bvh {
   uint32_t build(std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t end, int depth);
   bool intersect_slot(const RayQuery& ray, uint32_t slot, double tmax, TriangleHit* hit) const;
   static bool hits_box(const RayQuery& ray, const BvhNode& node, double tmax);
+  template <class OnHit>
+  void traverse_near_first(const RayQuery& ray, const double& cull, OnHit&& on_hit) const;
 
   std::vector<glm::dvec3> vertices_;  // 3 per triangle slot, in leaf order
   std::vector<uint32_t> order_;       // slot -> triangle index in the soup
   std::vector<uint32_t> slot_of_;     // triangle index -> slot
   std::vector<BvhNode> nodes_;        // depth first; node 0 is the root
   int depth_ = 0;
+  double tie_bound_max_ = 0;          // TIE_RELATIVE * the largest absolute vertex coordinate
 };
 
 // Deepest possible traversal stack: the build falls back to median splits past depth 64,

@@ -87,7 +87,7 @@ Hit RayTracer::make_hit(const TriangleHit& th, const glm::dvec3& dir) const {
 bool RayTracer::intersect(const glm::dvec3& origin, const glm::dvec3& dir, double tmax, Hit* hit) const {
   ABCUBE_CHECK(dir != glm::dvec3(0.0), "ray direction must not be zero");
   TriangleHit th;
-  if (!bvh_->closest_hit(RayQuery(origin, dir), tmax, &th)) return false;
+  if (!bvh_->visible_hit(RayQuery(origin, dir), tmax, *scene_->triangles, &th)) return false;  // tie_rule.hpp
   *hit = make_hit(th, dir);
   return true;
 }

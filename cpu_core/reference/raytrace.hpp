@@ -11,7 +11,9 @@
 //
 // A ray that hits nothing returns SceneData::background (primary and secondary rays alike).
 //
-// Hit shading, at the nearest hit with t > 0 of ray (o, d), d unit, depth k:
+// Hit shading, at the nearest hit with t > 0 of ray (o, d), d unit, depth k; of surfaces
+// at the same distance (coplanar ones), the one THE TIE RULE picks (scene/tie_rule.hpp:
+// the later object, then the higher triangle; Bvh::visible_hit):
 //   N_g  unit geometric normal cross(b-a, c-a) (outward for closed objects)
 //   N_s  barycentric interpolation of TriangleSoup::normals, renormalised (N_g if that
 //        interpolation vanishes)
@@ -48,8 +50,8 @@
 // within rounding and the offset ray cannot see that plane again, grazing or not.
 //
 // Exactness. RayTracer::intersect is the double-precision watertight test (Woop et al.
-// 2013) on the float vertex data, through a BVH that returns the same first hit as a
-// loop over all triangles (bvh.hpp). Later methods measure Error_Parallax against it.
+// 2013) on the float vertex data, through a BVH that returns the same visible hit as the
+// tie rule over a loop over all triangles (bvh.hpp). Later methods measure Error_Parallax against it.
 //
 // Determinism. Pixels are independent and shaded in a fixed order, rows are handed to
 // threads dynamically, so the image is bit-identical for any number of threads.
