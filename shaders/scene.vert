@@ -7,6 +7,9 @@ layout(location = 3) in uint a_material;
 
 uniform mat4 u_clip;
 uniform vec3 u_center;
+// THE TIE RULE (cpu_core/scene/tie_rule.hpp): window depth near/w scaled by
+// 1 + u_tie_step (object + 1), so at equal depth the later object passes GL_GREATER.
+uniform float u_tie_step;
 
 out vec3 v_relative;  // position relative to the eye, interpolated perspective-correctly
 out vec3 v_normal;
@@ -15,6 +18,7 @@ flat out uint v_material;
 
 void main() {
   gl_Position = u_clip * vec4(a_position, 1.0);
+  gl_Position.z *= 1.0 + u_tie_step * float(a_object + 1u);
   v_relative = a_position - u_center;
   v_normal = a_normal;
   v_object = a_object;

@@ -8,6 +8,7 @@
 
 #include "raster/cube_map.hpp"
 #include "base/error.hpp"
+#include "scene/tie_rule.hpp"
 #include "base/memory.hpp"
 #include "base/timer.hpp"
 #include "base/parallel.hpp"
@@ -396,16 +397,19 @@ void nearest_layer_face(const CubeABuffer& cube, const TriangleSoup& triangles, 
   ids.assign(static_cast<size_t>(cube.n) * static_cast<size_t>(cube.n), std::numeric_limits<uint32_t>::max());
   for (int y = 0; y < cube.n; ++y) {
     for (int x = 0; x < cube.n; ++x) {
-      const glm::dvec3 d = b.view.direction(x + 0.5, y + 0.5);
+      const glm::dvec3 d = glm::normalize(b.view.direction(x + 0.5, y + 0.5));
       double best = HUGE_VAL;
-      uint32_t best_id = std::numeric_limits<uint32_t>::max();
+      uint32_t best_id = std::numeric_limits<uint32_t>::max(), best_triangle = 0;
       for (const Fragment& f : b.list(x, y)) {
         if ((f.mask & CENTRE_SAMPLES) == 0) continue;
         const glm::dvec3 r = point_on_triangle_plane(b.view, triangles, f.triangle(), x + 0.5, y + 0.5) - cube.centre;
         const double dist = glm::length(r);
-        if (glm::dot(r, d) > 0.0 && dist < best) {
+        // THE TIE RULE (scene/tie_rule.hpp): at the same distance the later object wins.
+        if (glm::dot(r, d) > 0.0 &&
+            (best == HUGE_VAL || seen_before(triangles, d, {f.triangle(), dist}, {best_triangle, best}))) {
           best = dist;
           best_id = triangles.object_id[f.triangle()];
+          best_triangle = f.triangle();
         }
       }
       if (best < HUGE_VAL) distance.at(x, y)[0] = static_cast<float>(best);

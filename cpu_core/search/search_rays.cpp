@@ -24,7 +24,8 @@ SearchResult search_crossing(const SearchContext& ctx, const SearchRay& q, const
       return;
     }
     Candidate& best = c.exact ? exact : near;
-    if (c.l < best.l) best = c;
+    // The first crossing; at the same distance THE TIE RULE (scene/tie_rule.hpp) picks.
+    if (!best.fragment || seen_before(*ctx.scene().triangles, q.d, {c.triangle, c.l}, {best.triangle, best.l})) best = c;
   };
   const auto after_texel = [&](const WalkTexel& t, uint32_t index) {
     const double best_l = std::min(exact.l, near.l);

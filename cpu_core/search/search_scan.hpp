@@ -8,12 +8,14 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/tie_rule.hpp"
 #include "search/search_internal.hpp"
 
 namespace abcube::detail {
 
 // The fragment nearest_layer() keeps for texel (x, y): a centre sample covered, the nearest
 // plane along the texel-centre direction v (abuffer.hpp, the Z-buffered map's layer).
+// At the same distance THE TIE RULE picks (scene/tie_rule.hpp).
 inline const Fragment* nearest_fragment(const SearchContext& ctx, FragmentList list, const glm::dvec3& v) {
   const Fragment* best = nullptr;
   double best_a = INF;
@@ -23,7 +25,7 @@ inline const Fragment* nearest_fragment(const SearchContext& ctx, FragmentList l
     const double den = glm::dot(p.normal, v);
     if (den == 0.0) continue;
     const double a = p.offset / den;
-    if (a > 0.0 && a < best_a) {
+    if (a > 0.0 && (!best || seen_before(*ctx.scene().triangles, v, {f.triangle(), a}, {best->triangle(), best_a}))) {
       best_a = a;
       best = &f;
     }

@@ -5,6 +5,7 @@
 
 #include "base/error.hpp"
 #include "base/parallel.hpp"
+#include "scene/tie_rule.hpp"
 
 namespace abcube {
 
@@ -63,7 +64,7 @@ glm::dvec3 pack(FragmentList list, CoverageMask search, Shade&& shade, const Tri
     const ShadedFragment& sf = shaded(i);
     double alpha = sf.opacity;  // thesis 5.2.1.1: C_in = Op_f C_f + (1 - Op_f) C_behind
     const size_t j = first_overlapping(list, i + 1, in);
-    const bool intersecting = j < n && list[j].zmin < f.zmax &&
+    const bool intersecting = j < n && list[j].zmin <= f.zmax &&
                               triangles.object_id[list[j].triangle()] != triangles.object_id[f.triangle()];
     if (intersecting && depth) {
       // EXACT PRIORITY MASKS (thesis 11.2.4; header): next is in front where its plane is nearer.
@@ -110,7 +111,9 @@ CoverageMask SampleDepth::nearer(const Fragment& a, const Fragment& b, CoverageM
   CoverageMask out = 0;
   for (CoverageMask m = in; m != 0; m &= m - 1) {
     const int k = __builtin_ctz(m);
-    if (t(b, k) < t(a, k)) out |= CoverageMask{1} << k;
+    // THE TIE RULE (scene/tie_rule.hpp): at the same distance the later object wins.
+    const glm::dvec3 d = view->direction(x + sample_dx(k), y + sample_dy(k));
+    if (seen_before(*triangles, d, {b.triangle(), t(b, k)}, {a.triangle(), t(a, k)})) out |= CoverageMask{1} << k;
   }
   return out;
 }

@@ -7,14 +7,16 @@
 //   in = search & f.mask, out = search & ~f.mask, a_in, a_out their bit counts;
 //   C_out = pack(rest after f, out)                                  (if out != 0)
 //   next  = the first fragment after f with next.mask & in != 0;
-//   intersecting = next exists, next's object differs from f's, and next.zmin < f.zmax
+//   intersecting = next exists, next's object differs from f's, and next.zmin <= f.zmax
 //                  (thesis 5.2.1.2: "el identificador del objeto difiere y los fragmentos
 //                  se superponen en Z");
 //   intersecting, with the pixel's geometry (SampleDepth; every resolve_image): EXACT
 //   PRIORITY MASKS (thesis 11.2.4, "Exact A_Buffers", its p-masks): per sample of `in`, the two
 //   fragments' triangle planes are met along the sample's own eye ray; behind = the samples
-//   where next's plane is strictly nearer (at equal depth f, first in the list, stays in
-//   front), front = in & ~behind. Then
+//   where next's plane is seen before f's by THE TIE RULE (scene/tie_rule.hpp: nearer, or
+//   at the same distance within its float bound and of a later object; so two coplanar
+//   surfaces give the later object every sample, and zmin == zmax ranges are compared
+//   too), front = in & ~behind. Then
 //     C_front  = op_f C_f + (1 - op_f) pack(rest after f, front)
 //     C_behind = op_n C_n + (1 - op_n) (op_f C_f + (1 - op_f) pack(rest after next, behind))
 //   weighted by their bit counts: per sample exact for two surfaces, whatever their angle or
@@ -81,7 +83,7 @@ struct SampleDepth {
   // Ray parameter t of sample k's ray centre + t D_k (D_k = view->direction(x + dx, y + dy))
   // at the plane of fragment f's triangle; +inf when the ray runs along the plane.
   double t(const Fragment& f, int k) const;
-  // The samples of `in` where b's plane is strictly nearer than a's.
+  // The samples of `in` where b's plane is seen before a's (THE TIE RULE, tie_rule.hpp).
   CoverageMask nearer(const Fragment& a, const Fragment& b, CoverageMask in) const;
 };
 
