@@ -98,6 +98,9 @@ def main():
     ap.add_argument("--templates", default=",".join(hard_scenes.TEMPLATES))
     ap.add_argument("--methods", default="abuffer,zbuffer,envmap,gpu")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--size", default="64x48",
+                    help="image WxH of the generated scenes (default 64x48, the test suite's); another "
+                         "size writes hard_cases_WxH.{md,csv}")
     ap.add_argument("--out", default=os.path.join(REPO, "bench", "results"))
     ap.add_argument("--work", help="scene and image folder (default: a temporary one)")
     ap.add_argument("--keep", action="store_true", help="keep the work folder")
@@ -124,7 +127,7 @@ def main():
         scenes = []   # (template, stem)
         for t in templates:
             gen = [sys.executable, os.path.join(REPO, "tools", "hard_scenes.py"), "--seed", str(args.seed),
-                   "--count", str(args.count_per_template), "--templates", t, "--out", work]
+                   "--count", str(args.count_per_template), "--templates", t, "--size", args.size, "--out", work]
             subprocess.run(gen, check=True, stdout=subprocess.DEVNULL)
             scenes += [(t, "%s_%d_%d" % (t, args.seed, k)) for k in range(args.count_per_template)]
         cpu_jobs, gpu_jobs = [], []
@@ -164,7 +167,8 @@ def main():
                 rows.append(row)
 
         os.makedirs(args.out, exist_ok=True)
-        with open(os.path.join(args.out, "hard_cases.csv"), "w", newline="") as f:
+        base = "hard_cases" if args.size == "64x48" else "hard_cases_" + args.size
+        with open(os.path.join(args.out, base + ".csv"), "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
             w.writeheader()
             for row in rows:
@@ -174,8 +178,9 @@ def main():
                 w.writerow(out)
 
         load_after = load_average()
-        cmd = "/usr/bin/python3 bench/hard_cases.py --seed %d --count-per-template %d --threads %d" % (
-            args.seed, args.count_per_template, args.threads)
+        cmd = "/usr/bin/python3 bench/hard_cases.py --seed %d --count-per-template %d --threads %d --size %s" % (
+            args.seed, args.count_per_template, args.threads, args.size)
+        width, height = (int(v) for v in args.size.split("x"))
         lines = [
             "# Hard cases against the exact tracer",
             "",
@@ -186,7 +191,7 @@ def main():
             "random.Random(SEED + K)). Side share: search rays answered from the side "
             "structure (stats side_hits / rays), n/a where the stats carry no side_hits."
             % (cmd, datetime.date.today().isoformat(), len(scenes), platform.node() or "this machine",
-               64, 48, load_before, load_after, os.cpu_count() or 0, args.seed, args.count_per_template),
+               width, height, load_before, load_after, os.cpu_count() or 0, args.seed, args.count_per_template),
             "",
             "| template | method | median PSNR dB | worst PSNR dB | worst scene | failed | side share |",
             "|---|---|---|---|---|---|---|",
@@ -207,7 +212,7 @@ def main():
                 lines.append("| %s | %s | %s | %s | %s | %d | %s |" % (
                     t if m == methods[0] else "", m, fmt_db(statistics.median(vals)),
                     fmt_db(worst["psnr_db"]), worst["scene"], fails, share))
-        with open(os.path.join(args.out, "hard_cases.md"), "w") as f:
+        with open(os.path.join(args.out, base + ".md"), "w") as f:
             f.write("\n".join(lines) + "\n")
         print("\n".join(lines))
         print("load average after: %s" % load_after)
