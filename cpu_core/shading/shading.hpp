@@ -20,6 +20,7 @@
 #include <glm/glm.hpp>
 
 #include "scene/scene_data.hpp"
+#include "scene/tie_rule.hpp"
 
 namespace abcube {
 
@@ -166,21 +167,20 @@ inline glm::dvec3 blocker_transmittance(const Material& m) {
 }
 
 // Lights on surfaces (rule "shadows"): a triangle whose plane passes through the light L,
-// within the precision its vertices are stored in (float: 4 ulps of the largest coordinate
-// of its vertices and L), is not a blocker of L. A segment P..L meets that plane only at L
-// itself (or lies in it, where N . L = 0 lights nothing), so "blocked" would be decided by
-// rounding: the tracer and the map would both speckle, each differently (hard suite
-// light_on_surface, a point light lying on the floor). The tracer and every shadow search
-// ask this one test. A degenerate triangle has no plane and is never skipped here.
+// at the same distance by THE TIE RULE's bound (scene/tie_rule.hpp: within TIE_RELATIVE of
+// its largest vertex coordinate, the float rounding of its vertices; L itself is double),
+// is not a blocker of L. A segment P..L meets that plane only at L itself (or lies in it,
+// where N . L = 0 lights nothing), so "blocked" would be decided by rounding: the tracer
+// and the map would both speckle, each differently (hard suite light_on_surface, a point
+// light lying on the floor). The tracer and every shadow search ask this one test. A
+// degenerate triangle has no plane and is never skipped here.
 inline bool plane_holds_light(const TriangleSoup& soup, uint32_t triangle, const glm::dvec3& light) {
   const size_t i = 3 * static_cast<size_t>(triangle);
   const glm::dvec3 a(soup.positions[i]), b(soup.positions[i + 1]), c(soup.positions[i + 2]);
   const glm::dvec3 n = glm::cross(b - a, c - a);
   const double len = glm::length(n);
   if (!(len > 0.0)) return false;
-  const glm::dvec3 m = glm::max(glm::max(glm::abs(a), glm::abs(b)), glm::max(glm::abs(c), glm::abs(light)));
-  const double ulp = std::ldexp(1.0, -23) * std::fmax(m.x, std::fmax(m.y, m.z));
-  return std::fabs(glm::dot(n, light - a)) <= 4.0 * ulp * len;
+  return std::fabs(glm::dot(n, light - a)) <= TIE_RELATIVE * triangle_magnitude(soup, triangle) * len;
 }
 
 // Coverage transparency (rule "opacity"; thesis 5.2.1, Pack_Under_Mask blend):
