@@ -395,11 +395,14 @@ void nearest_layer_face(const CubeABuffer& cube, const TriangleSoup& triangles, 
   Image& distance = out->distance.faces[static_cast<size_t>(face)];
   std::vector<uint32_t>& ids = out->object.faces[static_cast<size_t>(face)];
   ids.assign(static_cast<size_t>(cube.n) * static_cast<size_t>(cube.n), std::numeric_limits<uint32_t>::max());
+  std::vector<uint32_t>& tied = out->tied.faces[static_cast<size_t>(face)];
+  tied.assign(static_cast<size_t>(cube.n) * static_cast<size_t>(cube.n), 0);
   for (int y = 0; y < cube.n; ++y) {
     for (int x = 0; x < cube.n; ++x) {
       const glm::dvec3 d = glm::normalize(b.view.direction(x + 0.5, y + 0.5));
       double best = HUGE_VAL;
       uint32_t best_id = std::numeric_limits<uint32_t>::max(), best_triangle = 0;
+      CoverageMask best_mask = 0;
       for (const Fragment& f : b.list(x, y)) {
         if ((f.mask & CENTRE_SAMPLES) == 0) continue;
         const glm::dvec3 r = point_on_triangle_plane(b.view, triangles, f.triangle(), x + 0.5, y + 0.5) - cube.centre;
@@ -410,10 +413,24 @@ void nearest_layer_face(const CubeABuffer& cube, const TriangleSoup& triangles, 
           best = dist;
           best_id = triangles.object_id[f.triangle()];
           best_triangle = f.triangle();
+          best_mask = f.mask;
         }
       }
       if (best < HUGE_VAL) distance.at(x, y)[0] = static_cast<float>(best);
-      ids[static_cast<size_t>(y) * static_cast<size_t>(cube.n) + static_cast<size_t>(x)] = best_id;
+      const size_t texel = static_cast<size_t>(y) * static_cast<size_t>(cube.n) + static_cast<size_t>(x);
+      ids[texel] = best_id;
+      // A tie: another object's surface over one of the same centre samples at the same
+      // distance (the rule decided; surfaces meeting at an edge cover disjoint samples).
+      for (const Fragment& f : b.list(x, y)) {
+        if (best == HUGE_VAL || (f.mask & best_mask & CENTRE_SAMPLES) == 0 || triangles.object_id[f.triangle()] == best_id) {
+          continue;
+        }
+        const glm::dvec3 r = point_on_triangle_plane(b.view, triangles, f.triangle(), x + 0.5, y + 0.5) - cube.centre;
+        if (glm::dot(r, d) > 0.0 && same_distance(triangles, d, {f.triangle(), glm::length(r)}, {best_triangle, best})) {
+          tied[texel] = 1;
+          break;
+        }
+      }
     }
   }
 }
@@ -424,6 +441,7 @@ NearestLayer nearest_layer(const CubeABuffer& cube, const TriangleSoup& triangle
   NearestLayer out;
   out.distance = CubeImage(cube.n, 1, std::numeric_limits<float>::infinity());
   out.object.n = cube.n;
+  out.tied.n = cube.n;
   parallel_for(CUBE_FACES, thread_count(0, CUBE_FACES),
                [&](size_t face, int) { nearest_layer_face(cube, triangles, static_cast<int>(face), &out); });
   return out;

@@ -67,6 +67,9 @@ class Bvh {
   template <class Visit>
   void for_each_hit(const RayQuery& ray, double tmax, Visit&& visit) const;
 
+  // TIE_RELATIVE times the largest absolute vertex coordinate (tie_rule.hpp): no two of
+  // these triangles are at the same distance beyond this separation along their normals.
+  double tie_bound_max() const { return tie_bound_max_; }
   size_t node_count() const { return nodes_.size(); }
   int depth() const { return depth_; }
   size_t triangle_count() const { return order_.size(); }

@@ -211,6 +211,8 @@ class SearchContext {
   // area, or no fragment in any face), ascending, and a BVH over them (null when none).
   const std::vector<uint32_t>& side_triangles() const { return side_; }
   bool has_side_triangles() const { return side_bvh_ != nullptr; }
+  // tie_rule.hpp's bound for a side triangle against any (0 when there is none).
+  double side_tie_bound_max() const { return side_bvh_ ? side_bvh_->tie_bound_max() : 0.0; }
   // Calls visit(triangle, l) for every side triangle the ray C + w + l d (w relative to the
   // centre, d unit) crosses with 0 < l < l_end (the watertight test of reference/bvh.hpp),
   // in no particular order, until visit returns false.

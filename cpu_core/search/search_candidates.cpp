@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "base/error.hpp"
+#include "scene/tie_rule.hpp"
 #include "search/search_internal.hpp"
 #include "search/search_scan.hpp"
 
@@ -159,8 +160,12 @@ bool side_back_face(const SearchContext& ctx, const SearchRay& q, uint32_t tri) 
 SideCrossing nearest_side_crossing(const SearchContext& ctx, const SearchRay& q, double l_end) {
   SideCrossing best;
   if (!q.side || !ctx.has_side_triangles()) return best;  // the common case: nothing to test
+  const TriangleSoup& soup = *ctx.scene().triangles;
   ctx.for_each_side_crossing(q.w, q.d, l_end, [&](uint32_t tri, double l) {
-    if (l < best.l && side_crossing_counts(ctx, q, tri, l)) best = {tri, l, false};
+    // The nearest; at the same distance THE TIE RULE (scene/tie_rule.hpp) picks.
+    if ((best.l == INF || seen_before(soup, q.d, {tri, l}, {best.triangle, best.l})) && side_crossing_counts(ctx, q, tri, l)) {
+      best = {tri, l, false};
+    }
     return true;
   });
   if (best.l < INF) best.back_face = side_back_face(ctx, q, best.triangle);
@@ -175,8 +180,18 @@ SearchResult finish(const SearchContext& ctx, const SearchRay& q, const Candidat
   SearchResult r;
   if (best) r = make_result(ctx, q, *best);
   else r.miss = counts.aborted ? MissReason::aborted : miss;
-  const double l_end = best ? best->l : q.l_max;
-  const SideCrossing side = nearest_side_crossing(ctx, q, l_end);
+  // Side crossings up to the map's answer and, for THE TIE RULE (scene/tie_rule.hpp), the
+  // window past it where a side triangle may be at its distance; one there answers only if
+  // the rule puts it first.
+  const TriangleSoup& soup = *ctx.scene().triangles;
+  double l_end = q.l_max;
+  if (best) {
+    const double c = std::fabs(glm::dot(ctx.plane(best->triangle).normal, q.d));
+    const double bound = std::max(ctx.side_tie_bound_max(), tie_bound(soup, best->triangle, best->triangle));
+    l_end = std::min(q.l_max, c > 0.0 ? best->l + bound / c : INF);
+  }
+  SideCrossing side = nearest_side_crossing(ctx, q, l_end);
+  if (best && side.l < INF && !seen_before(soup, q.d, {side.triangle, side.l}, {best->triangle, best->l})) side = {};
   if (side.l < INF) {
     Candidate c;
     c.l = side.l;
@@ -187,7 +202,7 @@ SearchResult finish(const SearchContext& ctx, const SearchRay& q, const Candidat
     r = make_result(ctx, q, c);
     r.texel = direction_to_texel(c.x, ctx.cube().n);
     r.side = true;
-  } else if (!q.side && meets_zero_area(ctx, q, l_end)) {
+  } else if (!q.side && meets_zero_area(ctx, q, best ? best->l : q.l_max)) {
     r.hit = false;
     r.miss = MissReason::zero_area_surface;
   }

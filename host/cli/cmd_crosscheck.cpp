@@ -47,6 +47,8 @@ struct CrosscheckCommand {
                 r.distance_median_rel, tol.distance_median_rel, r.distance_p99_rel, tol.distance_p99_rel,
                 r.distance_max_rel);
     std::printf("same object id: %.5f (>= %.3f)\n", r.same_object, tol.same_object_min);
+    std::printf("exact ties (two objects at the same distance, tie_rule.hpp): %zu texels, resolved alike %zu\n",
+                r.tied, r.tied_agree);
     std::printf("camera interior pixels: %zu of %zu, RMSE %.2e (<= %.0e), max abs %.2e (<= %.2e)\n",
                 r.interior_pixels, r.pixels, r.interior_rmse, tol.interior_rmse, r.interior_max_abs,
                 tol.interior_max_abs);

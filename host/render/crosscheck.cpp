@@ -62,7 +62,12 @@ void compare_cube(const SceneData& scene, int n, int threads, GlScene& gl, Cross
       if (cc && !gc) ++r->cpu_only;
       if (!gc || !cc) continue;
       rel.push_back(std::abs(double(g) - double(c)) / double(c));
-      same += gpu_ids.faces[face][t] == cpu.object.faces[face][t];
+      const bool agree = gpu_ids.faces[face][t] == cpu.object.faces[face][t];
+      same += agree;
+      if (cpu.tied.faces[face][t]) {
+        ++r->tied;
+        r->tied_agree += agree;
+      }
     }
   }
   r->both_covered = rel.size();
@@ -128,7 +133,8 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
       {"cube", {{"texels", r.texels}, {"both_covered", r.both_covered}, {"gpu_only", r.gpu_only},
                 {"cpu_only", r.cpu_only}, {"distance_rel_median", r.distance_median_rel},
                 {"distance_rel_p99", r.distance_p99_rel}, {"distance_rel_max", r.distance_max_rel},
-                {"same_object", r.same_object}, {"gpu_prepass_ms", r.gpu_ms}, {"cpu_abuffer_ms", r.cpu_ms},
+                {"same_object", r.same_object}, {"tied", r.tied}, {"tied_agree", r.tied_agree},
+                {"gpu_prepass_ms", r.gpu_ms}, {"cpu_abuffer_ms", r.cpu_ms},
                 {"fragments", r.fragments}}},
       {"camera", {{"pixels", r.pixels}, {"interior_pixels", r.interior_pixels}, {"interior_rmse", r.interior_rmse},
                   {"interior_max_abs", r.interior_max_abs}}},

@@ -35,7 +35,12 @@ struct CrosscheckResult {
   // Cube map: GL prepass vs CPU A-buffer nearest layer (NearestLayer in abuffer.hpp).
   size_t texels = 0, both_covered = 0, gpu_only = 0, cpu_only = 0;
   double distance_median_rel = 0, distance_p99_rel = 0, distance_max_rel = 0;
-  double same_object = 0;
+  double same_object = 0;            // over every texel covered on both, ties included
+  // Exact ties (tie_rule.hpp): texels covered on both where the CPU's nearest layer had
+  // two objects over one centre sample at the same distance, and of those the ones where
+  // the GPU's object is the one the rule picked (the later object). Reported apart; before
+  // the rule the GPU kept the first drawn and the coplanar hard case failed same_object.
+  size_t tied = 0, tied_agree = 0;
   // Camera view: interior pixels (one opaque full-coverage front fragment, nothing
   // intersecting it) of the CPU A-buffer image against the GL Z-buffer image.
   size_t pixels = 0, interior_pixels = 0;

@@ -24,6 +24,37 @@ for scene in default hidden_point cornell shadows; do
     fi
   done
 done
+# Coplanar overlapping quads of two objects (THE TIE RULE, cpu_core/scene/tie_rule.hpp): on
+# a wall facing the camera, and on a slope (float-rounded vertices), plus the coplanar hard
+# case kept in tests/hard/regressions. The texels where both objects are at the same distance
+# are counted as ties, and both paths must give them to the later object.
+cat > "$WORK/coplanar.json" <<'JSON'
+{"version": 1, "camera": {"position": [0.03, 0.6, 1.2], "look_at": [0, 0.4, -1], "width": 96, "height": 64},
+ "lights": [{"type": "point", "position": [1, 3, 2], "color": [1, 1, 1]}],
+ "materials": {"red": {"color": [0.9, 0.1, 0.1]}, "green": {"color": [0.1, 0.9, 0.1]}, "floor": {"color": [0.6, 0.6, 0.6]}},
+ "objects": [
+  {"type": "quad", "material": "floor", "vertices": [[-3, 0, -3], [-3, 0, 3], [3, 0, 3], [3, 0, -3]]},
+  {"type": "quad", "material": "red", "vertices": [[-0.8, 0.1, -1], [0.4, 0.1, -1], [0.4, 1.0, -1], [-0.8, 1.0, -1]]},
+  {"type": "quad", "material": "green", "vertices": [[-0.3, 0.3, -1], [0.8, 0.3, -1], [0.8, 1.2, -1], [-0.3, 1.2, -1]]},
+  {"type": "quad", "material": "red", "vertices": [[1.1, 0.05, -0.2], [1.1, 0.35, -1.3], [2.1, 0.35, -1.3], [2.1, 0.05, -0.2]]},
+  {"type": "quad", "material": "green", "vertices": [[1.3, 0.1, -0.38333333], [1.3, 0.3, -1.11666667], [2.3, 0.3, -1.11666667], [2.3, 0.1, -0.38333333]]}],
+ "render": {"cube_resolution": 128}}
+JSON
+for scene in "$WORK/coplanar.json" "$REPO/tests/hard/regressions/coplanar_5000_91.json"; do
+  name=$(basename "$scene" .json)
+  for gl in egl osmesa; do
+    if "$ABCUBE" crosscheck "$scene" --gl "$gl" --stats "$WORK/$name.stats.json" > "$WORK/out" 2>&1 &&
+       python3 -c "import json,sys; c=json.load(open('$WORK/$name.stats.json'))['cube']; print('ties', c['tied'], 'alike', c['tied_agree']); sys.exit(0 if c['tied'] > 100 and c['tied_agree'] >= 0.99 * c['tied'] else 1)" \
+         > "$WORK/ties" 2>&1; then
+      passed=$((passed + 1))
+      echo "ok   $name ($gl): $(cat "$WORK/ties")"
+    else
+      failed=$((failed + 1))
+      echo "FAIL $name ($gl): $(cat "$WORK/ties" 2>/dev/null)"
+      cat "$WORK/out"
+    fi
+  done
+done
 if "$ABCUBE" render "$REPO/scenes/hidden_point.json" -o "$WORK/ab.png" --method abuffer \
     --stats "$WORK/ab.json" 2> "$WORK/err" && grep -q '"bytes_per_fragment": 20' "$WORK/ab.json"; then
   passed=$((passed + 1))
