@@ -26,13 +26,6 @@ std::shared_ptr<const Bvh> timed_build(const TriangleSoup& soup, std::shared_ptr
   return bvh;
 }
 
-double compute_scene_scale(const SceneData& scene) {
-  const Bounds b = scene.bounds();
-  if (b.empty()) return 0.0;
-  const glm::dvec3 m = glm::max(glm::abs(b.lo), glm::abs(b.hi));
-  return std::max(m.x, std::max(m.y, m.z)) + glm::length(b.hi - b.lo);
-}
-
 glm::dvec3 vertex(const TriangleSoup& soup, uint32_t tri, int k) {
   return glm::dvec3(soup.positions[3 * static_cast<size_t>(tri) + k]);
 }
@@ -50,7 +43,8 @@ struct Crossing {
 RayTracer::RayTracer(const SceneData& scene, std::shared_ptr<const Bvh> bvh)
     : scene_(&scene),
       bvh_(timed_build(*scene.triangles, std::move(bvh), &build_ms_)),
-      scene_scale_(compute_scene_scale(scene)) {
+      scene_scale_(abcube::scene_scale(scene)),
+      media_(std::make_shared<const Media>(scene)) {
   ABCUBE_CHECK(scene.triangles->normals.size() == scene.triangles->positions.size(),
                "one normal per triangle vertex");
   ABCUBE_CHECK(scene.triangles->material_id.size() == scene.triangles->triangle_count(),
@@ -159,7 +153,49 @@ glm::dvec3 RayTracer::light_visibility(const Hit& hit, const PointLight& light, 
   return s;
 }
 
+Interface RayTracer::crossing_set(const glm::dvec3& origin, const glm::dvec3& d, const Hit& hit,
+                                  const MediumStack& stack, Hit* shaded, Hit* far) const {
+  *shaded = hit;
+  *far = hit;
+  const MediumCrossing first{hit.triangle, !hit.front_face, hit.t};
+  if (!media_->is_medium(hit.triangle)) return media_->resolve(stack, &first, 1);
+  // Every surface crossed within the coincident tolerance past the nearest hit (media.hpp).
+  std::vector<TriangleHit> hits;
+  bvh_->for_each_hit(RayQuery(origin, d), hit.t + media_->tolerance(hit.point), [&](const TriangleHit& th) {
+    if (th.triangle != hit.triangle && th.t >= hit.t) hits.push_back(th);
+    return true;
+  });
+  if (hits.empty()) return media_->resolve(stack, &first, 1);
+  std::vector<MediumCrossing> set{first};
+  std::vector<Hit> set_hits{hit};
+  for (const TriangleHit& th : hits) {
+    set_hits.push_back(make_hit(th, d));
+    set.push_back({th.triangle, !set_hits.back().front_face, th.t});
+  }
+  const Interface itf = media_->resolve(stack, set.data(), set.size());
+  for (const Hit& h : set_hits) {
+    if (h.triangle == itf.triangle) *shaded = h;
+    if (h.t > far->t || (h.t == far->t && h.triangle > far->triangle)) *far = h;
+  }
+  return itf;
+}
+
+Ray RayTracer::transmitted_ray(const Hit& hit, const Hit& far, const glm::dvec3& dir, const Interface& itf,
+                               MediumStack* stack) const {
+  const Transmission tr = transmission_between(dir, hit.geometric_normal, hit.shading_normal, itf.n_from, itf.n_to);
+  const glm::dvec3 t = glm::normalize(tr.dir);
+  // Total internal reflection: the ray stays on the incoming side, in the media before.
+  *stack = tr.total_internal_reflection ? itf.before : itf.after;
+  return {offset_point(tr.total_internal_reflection ? hit : far, t), t};
+}
+
 glm::dvec3 RayTracer::shade(const Hit& hit, const glm::dvec3& dir, int depth, RayCounts* counts) const {
+  const MediumCrossing c{hit.triangle, !hit.front_face, hit.t};
+  return shade(hit, hit, dir, depth, media_->resolve(MediumStack{}, &c, 1), counts);
+}
+
+glm::dvec3 RayTracer::shade(const Hit& hit, const Hit& far, const glm::dvec3& dir, int depth, const Interface& itf,
+                            RayCounts* counts) const {
   RayCounts unused;
   if (!counts) counts = &unused;
   const Material& m = scene_->materials[hit.material_id];
@@ -167,9 +203,9 @@ glm::dvec3 RayTracer::shade(const Hit& hit, const glm::dvec3& dir, int depth, Ra
   // Coverage transparency: the surface covers `opacity` of the ray (thesis 5.2.1).
   glm::dvec3 behind(0.0);
   if (m.opacity < 1.0) {
-    const Ray r = continued_ray(hit, dir);
+    const Ray r = continued_ray(far, dir);
     ++counts->secondary;
-    behind = trace(r.origin, r.dir, depth, counts);
+    behind = trace(r.origin, r.dir, depth, itf.after, counts);
     if (m.opacity <= 0.0) return behind;
   }
   // Local Phong term with shadows (shading.hpp; thesis ch. 6).
@@ -184,27 +220,61 @@ glm::dvec3 RayTracer::shade(const Hit& hit, const glm::dvec3& dir, int depth, Ra
     c += lit * light_visibility(hit, light, counts);
   }
   // Whitted 1980: mirror and refracted rays, to the depth limit (weights: rule "fresnel").
-  const SecondaryWeights w =
-      secondary_weights(m, scene_->render.fresnel, dir,
-                        transmission(dir, hit.geometric_normal, hit.shading_normal, m.ior), hit.geometric_normal);
+  const SecondaryWeights w = secondary_weights(
+      m, scene_->render.fresnel, dir,
+      transmission_between(dir, hit.geometric_normal, hit.shading_normal, itf.n_from, itf.n_to), hit.geometric_normal);
   if (depth < max_depth && w.reflect > 0.0) {
     const Ray r = reflected_ray(hit, dir);
     ++counts->secondary;
-    c += w.reflect * trace(r.origin, r.dir, depth + 1, counts);
+    c += w.reflect * trace(r.origin, r.dir, depth + 1, itf.before, counts);
   }
   if (depth < max_depth && w.transmit > 0.0) {
-    const Ray r = transmitted_ray(hit, dir, nullptr);
+    MediumStack stack;
+    const Ray r = transmitted_ray(hit, far, dir, itf, &stack);
     ++counts->secondary;
-    c += w.transmit * trace(r.origin, r.dir, depth + 1, counts);
+    c += w.transmit * trace(r.origin, r.dir, depth + 1, stack, counts);
   }
   return m.opacity < 1.0 ? blend_coverage(m.opacity, c, behind) : c;
 }
 
 glm::dvec3 RayTracer::trace(const glm::dvec3& origin, const glm::dvec3& dir, int depth, RayCounts* counts) const {
+  return trace(origin, dir, depth, MediumStack{}, counts);
+}
+
+glm::dvec3 RayTracer::trace(const glm::dvec3& origin, const glm::dvec3& dir, int depth, const MediumStack& stack,
+                            RayCounts* counts) const {
   const glm::dvec3 d = glm::normalize(dir);
   Hit hit;
   if (!intersect(origin, d, &hit)) return scene_->background;
-  return shade(hit, d, depth, counts);
+  Hit shaded, far;
+  const Interface itf = crossing_set(origin, d, hit, stack, &shaded, &far);
+  if (itf.pass) {  // no interface: the same ray goes on from past the set
+    if (itf.after.passes > MEDIA_MAX_PASSES) return scene_->background;
+    return trace(offset_point(far, d), d, depth, itf.after, counts);
+  }
+  return shade(shaded, far, d, depth, itf, counts);
+}
+
+std::vector<Ray> RayTracer::transmitted_path(const glm::dvec3& origin, const glm::dvec3& dir, int max_rays) const {
+  std::vector<Ray> path;
+  Ray ray{origin, glm::normalize(dir)};
+  MediumStack stack;
+  while (static_cast<int>(path.size()) < max_rays) {
+    Hit hit;
+    if (!intersect(ray.origin, ray.dir, &hit)) break;
+    Hit shaded, far;
+    const Interface itf = crossing_set(ray.origin, ray.dir, hit, stack, &shaded, &far);
+    if (itf.pass) {
+      if (itf.after.passes > MEDIA_MAX_PASSES) break;
+      ray = {offset_point(far, ray.dir), ray.dir};
+      stack = itf.after;
+      continue;
+    }
+    if (!(scene_->materials[shaded.material_id].transmit > 0.0)) break;
+    ray = transmitted_ray(shaded, far, ray.dir, itf, &stack);
+    path.push_back(ray);
+  }
+  return path;
 }
 
 namespace {

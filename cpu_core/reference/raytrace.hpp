@@ -22,10 +22,21 @@
 //             + kr * trace(reflected, k+1)                    if kr > 0 and k < max_depth
 //             + kt * trace(transmitted, k+1)                  if kt > 0 and k < max_depth
 //   C = blend_coverage(opacity, C_surface, trace(continued straight on, k))  if opacity < 1
-//   reflected: reflect_dir(d, N_s). transmitted: transmission() in shading.hpp: entering
-//   iff dot(N_g, d) < 0, eta = 1/ior entering and ior leaving (air on the far side of every
-//   interface: no medium stack), bent about N_s flipped to the incoming side of N_g; on
-//   total internal reflection the kt weight follows the mirror direction instead.
+//   reflected: reflect_dir(d, N_s). transmitted: transmission_between() in shading.hpp,
+//   eta = n_from / n_to of the media on the two sides (NESTED DIELECTRICS below), bent
+//   about N_s flipped to the incoming side of N_g; on total internal reflection the kt
+//   weight follows the mirror direction instead.
+//
+// Nested dielectrics (media.hpp: Schmidt & Budge 2002 with priorities). Every ray carries
+// the stack of media it is inside (camera rays: none). The nearest hit and every surface
+// the ray crosses within coincident_tolerance past it (BVH for_each_hit) form one crossing
+// set, resolved by Media::resolve: a plain surface in it is the surface hit; a set of
+// medium surfaces with the same medium on both sides is no interface (the ray goes on
+// straight from past the set, same depth, unshaded); else one interface n_from -> n_to
+// shaded with the tie winner's triangle. Reflected rays keep the stack before the set and
+// start before it; transmitted and coverage-continued rays take the stack after it and
+// start past its furthest crossing. Only a set whose nearest hit is a medium's surface is
+// searched for coincident crossings (a plain nearest hit is the surface hit).
 //   A direction bent by an interpolated N_s may cross to the other side of the triangle's
 //   plane (near silhouettes of coarse meshes); it is traced as it is, from the side it
 //   travels into (no correction).
@@ -59,12 +70,14 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include <glm/glm.hpp>
 
 #include "reference/bvh.hpp"
 #include "io/image.hpp"
 #include "scene/scene_data.hpp"
+#include "shading/media.hpp"
 
 namespace abcube {
 
@@ -127,14 +140,24 @@ class RayTracer {
   // `counts` when given (the ray itself is counted by the caller: see render_raytrace).
   glm::dvec3 trace(const glm::dvec3& origin, const glm::dvec3& dir, int depth,
                    RayCounts* counts = nullptr) const;
+  // The same for a ray inside the media of `stack` (NESTED DIELECTRICS above).
+  glm::dvec3 trace(const glm::dvec3& origin, const glm::dvec3& dir, int depth, const MediumStack& stack,
+                   RayCounts* counts) const;
 
-  // The colour of a hit seen along unit dir, at depth `depth` (the rules above).
+  // The colour of a hit seen along unit dir, at depth `depth`, by a ray in air (the rules above).
   glm::dvec3 shade(const Hit& hit, const glm::dvec3& dir, int depth, RayCounts* counts) const;
+
+  // The path of the transmitted weight alone from origin along dir (camera in air): the ray
+  // after each interface it crosses (NESTED DIELECTRICS; total internal reflection gives the
+  // mirror ray), at most `max_rays` of them, until a ray meets nothing or a surface with
+  // kt = 0. What trace() follows for the kt terms: tests check it against Snell's law.
+  std::vector<Ray> transmitted_path(const glm::dvec3& origin, const glm::dvec3& dir, int max_rays) const;
 
   // S_l: the light's visibility from surface point `hit` (1 when it casts no shadows).
   glm::dvec3 light_visibility(const Hit& hit, const PointLight& light, RayCounts* counts) const;
 
-  // The secondary rays of a hit seen along unit dir (rules above).
+  // The secondary rays of a hit seen along unit dir (rules above; transmitted_ray: the
+  // hit's object in air).
   Ray reflected_ray(const Hit& hit, const glm::dvec3& dir) const;
   Ray transmitted_ray(const Hit& hit, const glm::dvec3& dir, bool* total_internal_reflection) const;
   Ray continued_ray(const Hit& hit, const glm::dvec3& dir) const;
@@ -150,11 +173,21 @@ class RayTracer {
 
  private:
   Hit make_hit(const TriangleHit& th, const glm::dvec3& dir) const;
+  // The crossing set at the nearest hit `hit` of (origin, d) for a ray carrying `stack`:
+  // its interface, the hit of the triangle shaded and the furthest crossing.
+  Interface crossing_set(const glm::dvec3& origin, const glm::dvec3& d, const Hit& hit, const MediumStack& stack,
+                         Hit* shaded, Hit* far) const;
+  glm::dvec3 shade(const Hit& hit, const Hit& far, const glm::dvec3& dir, int depth, const Interface& itf,
+                   RayCounts* counts) const;
+  // The transmitted ray of an interface and the stack it carries.
+  Ray transmitted_ray(const Hit& hit, const Hit& far, const glm::dvec3& dir, const Interface& itf,
+                      MediumStack* stack) const;
 
   const SceneData* scene_;
   double build_ms_ = 0;  // 0 when the BVH was given
   std::shared_ptr<const Bvh> bvh_;
   double scene_scale_ = 0;
+  std::shared_ptr<const Media> media_;
 };
 
 // Renders the scene's camera view with the rules above. Throws InputError for a bad

@@ -128,11 +128,20 @@
 // A blocker within the tolerance of a silhouette darkens (the crossing mode's silhouette
 // error, as for reflections).
 //
-// REFRACTION. The exit point of a ray inside a closed object is the first crossing of the
-// SAME object along the refracted direction (back faces are in the map):
-// refraction_exit_search. The caller bends the ray there (shading.hpp transmission; total
-// internal reflection gives a mirror direction, searched again with refraction_exit_search)
-// and searches what the emerging ray sees with reflection_search. With
+// REFRACTION. A ray inside a closed object meets next either that object's own surface
+// (back faces are in the map) or a surface lying inside it or touching it: another medium
+// nested in it or sharing a face with it (media.hpp, NESTED DIELECTRICS), an opaque object
+// inside the glass. refraction_exit_search finds the first crossing along the refracted
+// direction among the surfaces of the object and of every object whose bounding box meets
+// the object's: right by construction, since any surface the exact ray crosses before
+// leaving the object lies inside the object's bounds, so its object's bounds meet them;
+// and no nearer surface outside the object (a silhouette within the tolerance) can answer
+// it, as when the search was restricted to the object alone. The crossings coincident with
+// the answer (a face shared by two touching objects) are found by coincident_crossings.
+// The caller resolves the crossing set (media.hpp), bends the ray there (shading.hpp
+// transmission_between; total internal reflection gives a mirror direction, searched again
+// from inside) and searches what the emerging ray sees, with refraction_exit_search while it
+// is inside a medium and reflection_search once in air. With
 // SearchLayers::nearest the back faces are rarely the nearest layer: the one-layer map
 // finds few exits (its limitation, thesis 7.4.2).
 //
@@ -140,6 +149,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -150,6 +160,7 @@
 #include "raster/cube_map.hpp"
 #include "reference/bvh.hpp"
 #include "scene/scene_data.hpp"
+#include "shading/media.hpp"
 
 namespace abcube {
 
@@ -206,6 +217,8 @@ class SearchContext {
 
   const SceneData& scene() const { return *scene_; }
   const CubeABuffer& cube() const { return *cube_; }
+  // The scene's media (NESTED DIELECTRICS, media.hpp): what an exit search may cross.
+  const Media& media() const { return media_; }
   const std::vector<uint32_t>& zero_area_triangles() const { return zero_area_; }
   // THE SIDE STRUCTURE (header): the non-degenerate triangles the map cannot hold (zero
   // area, or no fragment in any face), ascending, and a BVH over them (null when none).
@@ -267,6 +280,7 @@ class SearchContext {
  private:
   const SceneData* scene_;
   const CubeABuffer* cube_;
+  Media media_;
   std::vector<Plane> planes_;
   std::vector<TriangleBounds> bounds_;
   std::vector<uint32_t> zero_area_;
@@ -324,8 +338,9 @@ struct ShadowResult {
 SearchResult reflection_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& r,
                                const SearchOptions& options = {});
 
-// The exit point of a ray inside object `object_id`: its first crossing of that object's
-// surface along W + l T (W world space, on the entry surface; T unit, refracted inwards).
+// The next surface met by a ray inside object `object_id`: its first crossing, along
+// W + l T (W world space, on the entry surface; T unit, refracted inwards), of that
+// object's surface or of a surface of an object whose bounds meet its (REFRACTION above).
 SearchResult refraction_exit_search(const SearchContext& ctx, const glm::dvec3& w,
                                     const glm::dvec3& t, uint32_t object_id,
                                     const SearchOptions& options = {});
@@ -336,6 +351,14 @@ SearchResult refraction_exit_search(const SearchContext& ctx, const glm::dvec3& 
 // its l (the smallest); false when none is crossed or the flood gave up.
 bool mesh_crossing(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& dir, uint32_t triangle,
                    double l_near, double radius, uint32_t* crossed, double* l);
+
+// The surfaces crossed together with a search's answer (NESTED DIELECTRICS, media.hpp): every
+// triangle other than `hit` that the ray W + l D (W world space, D unit) crosses exactly at
+// an l within `tolerance` of `l_hit`. Asked of the map: the fragments, in the 3 x 3 texels
+// around the point, whose depth range reaches it, each with the mesh around its triangle
+// (MESH REFINEMENT), and the side structure. visit(triangle, l) once per triangle.
+void coincident_crossings(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& d, uint32_t hit,
+                          double l_hit, double tolerance, const std::function<void(uint32_t, double)>& visit);
 
 // Visibility of point light `light_position` from surface point p (world space).
 ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p,

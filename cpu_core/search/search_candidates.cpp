@@ -128,7 +128,7 @@ Candidate thesis_candidate(const SearchContext& ctx, const SearchRay& q, const W
 // Does the exact ray meet a triangle the map cannot hold before parameter l_end?
 bool meets_zero_area(const SearchContext& ctx, const SearchRay& q, double l_end) {
   for (const uint32_t tri : ctx.zero_area_triangles()) {
-    if (q.restrict_object && ctx.scene().triangles->object_id[tri] != q.object) continue;
+    if (!allowed(ctx, q, ctx.scene().triangles->object_id[tri])) continue;
     // Moller & Trumbore 1997.
     const glm::dvec3 a = ctx.vertex(tri, 0), e1 = ctx.vertex(tri, 1) - a, e2 = ctx.vertex(tri, 2) - a;
     const glm::dvec3 pv = glm::cross(q.d, e2);
@@ -146,7 +146,7 @@ bool meets_zero_area(const SearchContext& ctx, const SearchRay& q, double l_end)
 
 bool side_crossing_counts(const SearchContext& ctx, const SearchRay& q, uint32_t tri, double l) {
   if (!(l > q.self)) return false;
-  if (q.restrict_object && ctx.scene().triangles->object_id[tri] != q.object) return false;
+  if (!allowed(ctx, q, ctx.scene().triangles->object_id[tri])) return false;
   return !own_surface(ctx.plane(tri), q);
 }
 

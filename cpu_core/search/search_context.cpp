@@ -18,7 +18,7 @@ static_assert(sizeof(SearchContext::Plane) <= 32 && sizeof(SearchContext::Triang
 
 SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube,
                              std::shared_ptr<const MeshNeighbours> neighbours)
-    : scene_(&scene), cube_(&cube), neighbours_(std::move(neighbours)) {
+    : scene_(&scene), cube_(&cube), media_(scene), neighbours_(std::move(neighbours)) {
   const TriangleSoup& soup = *scene.triangles;
   const uint32_t count = static_cast<uint32_t>(soup.triangle_count());
   planes_.resize(count);

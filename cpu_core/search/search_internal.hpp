@@ -23,10 +23,17 @@ struct SearchRay {
   double l_max = INF;         // end of the ray (shadow segments)
   double self = 0;            // self offset in world units (header, SELF-HITS)
   double self_tolerance = 0;  // nearest tolerance candidate accepted, world units (SELF-HITS)
-  bool restrict_object = false;
+  bool restrict_object = false;  // refraction exit: only `object` and what may lie inside it
   uint32_t object = 0;
   bool side = true;           // SearchOptions::side_structure
 };
+
+// May a surface of `object` answer this ray? Any, unless it is a refraction exit from inside
+// q.object: then that object's own surfaces and those of the objects whose bounding boxes
+// meet its (media.hpp): every surface the exact ray can cross before leaving q.object.
+inline bool allowed(const SearchContext& ctx, const SearchRay& q, uint32_t object) {
+  return !q.restrict_object || object == q.object || ctx.media().bounds_meet(object, q.object);
+}
 
 // What the walk over the map saw of one ray.
 struct ScanCounts {

@@ -109,7 +109,7 @@ ScanCounts scan(const SearchContext& ctx, const SearchRay& q, const SearchOption
         if (o.layers == SearchLayers::nearest && &f != only) continue;
         ++counts.fragments;
         if (static_cast<double>(f.zmax) * f.zmax < range2.x || static_cast<double>(f.zmin) * f.zmin > range2.y) continue;
-        if (q.restrict_object && soup.object_id[f.triangle()] != q.object) continue;
+        if (!allowed(ctx, q, soup.object_id[f.triangle()])) continue;
         const SearchContext::Plane& p = ctx.plane(f.triangle());
         if (own_surface(p, q)) continue;
         ++counts.candidates;

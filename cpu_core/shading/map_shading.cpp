@@ -21,8 +21,6 @@ namespace abcube {
 
 namespace {
 
-constexpr uint32_t OUTSIDE = UINT32_MAX;  // a ray in the open, not inside a closed object
-
 constexpr EnumName<EnvmapLookup> LOOKUP_NAMES[] = {
     {EnvmapLookup::reflected, "R"}, {EnvmapLookup::bisector, "bisector"}, {EnvmapLookup::position, "position"}};
 
@@ -89,29 +87,34 @@ MapShader::MapShader(const SceneData& scene, const CubeABuffer& cube, const MapS
 
 MapShader::~MapShader() = default;
 
-// Which closed object a ray leaving sp along d runs inside of (N_g is outward).
-static uint32_t inside_after(const SceneData& scene, const SurfacePoint& sp, const glm::dvec3& d) {
-  return scene.objects[sp.object].closed && glm::dot(sp.geometric_normal, d) < 0.0 ? sp.object : OUTSIDE;
-}
-
 glm::dvec3 MapShader::shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
                             MapShadingStats* stats) const {
+  const MediumCrossing c{sp.triangle, !(glm::dot(sp.geometric_normal, dir) < 0.0), 0.0};
+  return shade(Crossed{sp, sp.point, ctx_->media().resolve(MediumStack{}, &c, 1)}, dir, depth, primary, stats);
+}
+
+glm::dvec3 MapShader::shade(const Crossed& cr, const glm::dvec3& dir, int depth, bool primary,
+                            MapShadingStats* stats) const {
+  const SurfacePoint& sp = cr.sp;
   const Material& m = scene_.materials[sp.material];
   // Coverage transparency of a found surface: the ray goes on behind it, same depth.
   glm::dvec3 behind(0.0);
   const bool blend = !primary && m.opacity < 1.0;
   if (blend) {
-    behind = trace(sp.point, dir, depth, inside_after(scene_, sp, dir), stats, nullptr);
+    behind = trace(cr.far, dir, depth, cr.itf.after, stats, nullptr);
     if (m.opacity <= 0.0) return behind;
   }
   const glm::dvec3 v = -dir;
   const glm::dvec3 n = face_forward(sp.shading_normal, v);
   glm::dvec3 c = phong_ambient(m, scene_.ambient) + lights(sp, v, n, stats);
-  const SecondaryWeights w =
-      secondary_weights(m, scene_.render.fresnel, dir,
-                        transmission(dir, sp.geometric_normal, sp.shading_normal, m.ior), sp.geometric_normal);
-  if (depth < scene_.render.max_depth && w.reflect > 0.0) c += w.reflect * reflected(sp, dir, depth, primary, stats);
-  if (depth < scene_.render.max_depth && w.transmit > 0.0) c += w.transmit * transmitted(sp, dir, depth, stats);
+  const SecondaryWeights w = secondary_weights(
+      m, scene_.render.fresnel, dir,
+      transmission_between(dir, sp.geometric_normal, sp.shading_normal, cr.itf.n_from, cr.itf.n_to),
+      sp.geometric_normal);
+  if (depth < scene_.render.max_depth && w.reflect > 0.0) {
+    c += w.reflect * reflected(sp, dir, depth, primary, cr.itf.before, stats);
+  }
+  if (depth < scene_.render.max_depth && w.transmit > 0.0) c += w.transmit * transmitted(cr, dir, depth, stats);
   return blend ? blend_coverage(m.opacity, c, behind) : c;
 }
 
@@ -144,19 +147,55 @@ glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const 
   return c;
 }
 
+// The search for a ray from w along dir: from inside the top medium, or in air.
+SearchResult MapShader::search(const glm::dvec3& w, const glm::dvec3& dir, const MediumStack& stack,
+                               MapShadingStats* stats) const {
+  const bool inside = !stack.empty();
+  const SearchResult r = inside ? refraction_exit_search(*ctx_, w, dir, ctx_->media().top(stack), options_.search)
+                                : reflection_search(*ctx_, w, dir, options_.search);
+  if (stats) (inside ? stats->searches.refraction_exit : stats->searches.reflection).add(r);
+  return r;
+}
+
+// The crossing set of a found surface (media.hpp): with the surfaces crossed together with
+// it when it is a medium's.
+MapShader::Crossed MapShader::crossing_set(const glm::dvec3& w, const glm::dvec3& dir, const SearchResult& r,
+                                           const MediumStack& stack) const {
+  const Media& media = ctx_->media();
+  Crossed c{surface_point(scene_, r.triangle, r.point), r.point, {}};
+  const auto leaving = [&](uint32_t tri) { return !(glm::dot(ctx_->plane(tri).normal, dir) < 0.0); };
+  std::vector<MediumCrossing> set{{r.triangle, leaving(r.triangle), r.distance}};
+  if (media.is_medium(r.triangle)) {
+    coincident_crossings(*ctx_, w, dir, r.triangle, r.distance, media.tolerance(r.point),
+                         [&](uint32_t tri, double l) { set.push_back({tri, leaving(tri), l}); });
+  }
+  c.itf = media.resolve(stack, set.data(), set.size());
+  if (set.size() == 1) return c;
+  double far_l = r.distance;
+  for (const MediumCrossing& k : set) {
+    if (k.t > far_l) far_l = k.t;
+    if (k.triangle == c.itf.triangle && k.triangle != r.triangle) c.sp = surface_point(scene_, k.triangle, w + k.t * dir);
+  }
+  c.far = far_l > r.distance ? w + far_l * dir : r.point;
+  return c;
+}
+
 // What a ray from w along dir finds in the map, shaded one bounce deeper (or background).
-glm::dvec3 MapShader::trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, uint32_t inside,
+glm::dvec3 MapShader::trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, const MediumStack& stack,
                             MapShadingStats* stats, SearchResult* found) const {
-  const SearchResult r = inside != OUTSIDE ? refraction_exit_search(*ctx_, w, dir, inside, options_.search)
-                                           : reflection_search(*ctx_, w, dir, options_.search);
-  if (stats) (inside != OUTSIDE ? stats->searches.refraction_exit : stats->searches.reflection).add(r);
+  const SearchResult r = search(w, dir, stack, stats);
   if (found) *found = r;
   if (!r.hit) return scene_.background;
-  return shade(surface_point(scene_, r.triangle, r.point), dir, depth, false, stats);
+  const Crossed c = crossing_set(w, dir, r, stack);
+  if (c.itf.pass) {  // no interface: the same ray goes on from the crossing
+    if (c.itf.after.passes > MEDIA_MAX_PASSES) return scene_.background;
+    return trace(c.far, dir, depth, c.itf.after, stats, nullptr);
+  }
+  return shade(c, dir, depth, false, stats);
 }
 
 glm::dvec3 MapShader::reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
-                                MapShadingStats* stats) const {
+                                const MediumStack& stack, MapShadingStats* stats) const {
   const glm::dvec3 r = glm::normalize(reflect_dir(dir, sp.shading_normal));
   if (options_.method == Method::envmap) {
     if (stats) ++stats->envmap_lookups;
@@ -165,31 +204,62 @@ glm::dvec3 MapShader::reflected(const SurfacePoint& sp, const glm::dvec3& dir, i
     return envmap_at(lookup);
   }
   SearchResult found;
-  const glm::dvec3 c = trace(sp.point, r, depth + 1, inside_after(scene_, sp, r), stats, &found);
+  const glm::dvec3 c = trace(sp.point, r, depth + 1, stack, stats, &found);
   if (primary && reference_ && stats) measure(sp.point, r, &found, nullptr, stats);
   return c;
 }
 
-glm::dvec3 MapShader::transmitted(const SurfacePoint& sp, const glm::dvec3& dir, int depth,
-                                  MapShadingStats* stats) const {
-  const Material& m = scene_.materials[sp.material];
-  const Transmission tr = transmission(dir, sp.geometric_normal, sp.shading_normal, m.ior);
-  const glm::dvec3 t = glm::normalize(tr.dir);
+// The transmitted ray of an interface and the stack it carries: from the furthest crossing
+// in the media after it, or, on total internal reflection, from the surface in those before.
+Ray MapShader::transmitted_ray(const Crossed& c, const Transmission& tr, MediumStack* stack) const {
+  *stack = tr.total_internal_reflection ? c.itf.before : c.itf.after;
+  return {tr.total_internal_reflection ? c.sp.point : c.far, glm::normalize(tr.dir)};
+}
+
+glm::dvec3 MapShader::transmitted(const Crossed& c, const glm::dvec3& dir, int depth, MapShadingStats* stats) const {
+  const SurfacePoint& sp = c.sp;
+  const Transmission tr =
+      transmission_between(dir, sp.geometric_normal, sp.shading_normal, c.itf.n_from, c.itf.n_to);
   if (options_.method == Method::envmap) {
     if (stats) ++stats->envmap_lookups;
-    return envmap_at(envmap_direction(sp.point, t));
+    return envmap_at(envmap_direction(sp.point, glm::normalize(tr.dir)));
   }
-  // Patow-Delrieux lens: entry to emergence in one paraxial transfer, no exit search.
+  // Patow-Delrieux lens: entry from air to emergence in one paraxial transfer, no exit search.
   const int lens = lens_of_object_[sp.object];
-  if (lens >= 0 && tr.entering) {
+  if (lens >= 0 && tr.entering && c.itf.before.empty()) {
     LensRay out;
     if (lens_transfer(lenses_[static_cast<size_t>(lens)], options_.refraction, sp.point, dir, &out)) {
       if (stats) ++stats->lens_transfers;
-      return trace(out.point, out.dir, depth + 1, OUTSIDE, stats, nullptr);
+      return trace(out.point, out.dir, depth + 1, MediumStack{}, stats, nullptr);
     }
     if (stats) ++stats->lens_fallbacks;
   }
-  return trace(sp.point, t, depth + 1, inside_after(scene_, sp, t), stats, nullptr);
+  MediumStack stack;
+  const Ray ray = transmitted_ray(c, tr, &stack);
+  return trace(ray.origin, ray.dir, depth + 1, stack, stats, nullptr);
+}
+
+std::vector<Ray> MapShader::transmitted_path(const glm::dvec3& origin, const glm::dvec3& dir, int max_rays) const {
+  std::vector<Ray> path;
+  Ray ray{origin, glm::normalize(dir)};
+  MediumStack stack;
+  while (static_cast<int>(path.size()) < max_rays) {
+    const SearchResult r = search(ray.origin, ray.dir, stack, nullptr);
+    if (!r.hit) break;
+    const Crossed c = crossing_set(ray.origin, ray.dir, r, stack);
+    if (c.itf.pass) {
+      if (c.itf.after.passes > MEDIA_MAX_PASSES) break;
+      ray.origin = c.far;
+      stack = c.itf.after;
+      continue;
+    }
+    if (!(scene_.materials[c.sp.material].transmit > 0.0)) break;
+    const Transmission tr =
+        transmission_between(ray.dir, c.sp.geometric_normal, c.sp.shading_normal, c.itf.n_from, c.itf.n_to);
+    ray = transmitted_ray(c, tr, &stack);
+    path.push_back(ray);
+  }
+  return path;
 }
 
 // The lookup direction of thesis 9.2: R, the bisector [[R + [[W]]]], or [[W]].

@@ -15,13 +15,20 @@
 //                                  (--envmap-lookup, thesis 9.2); no bounce
 //
 // Secondary rays start on the surface (the searches keep W's own surface out by their
-// texel-unit offset, search.hpp). A ray leaving a closed object's surface into its inside
-// (dot(N_g, dir) < 0, N_g outward) is searched with refraction_exit_search restricted to
-// that object: back faces are in the map. Refraction bends by shading.hpp transmission()
-// (total internal reflection follows the mirror direction, bounded by max_depth). The
-// lens modes (--refraction thick_lens|thin_lens, lens.hpp) replace the entry-exit pair of
-// a closed transparent object by the paraxial lens transfer, then search from the
-// emerging ray.
+// texel-unit offset, search.hpp). NESTED DIELECTRICS (media.hpp), decided as the exact
+// tracer decides them: every ray carries the stack of media it is inside (camera fragments:
+// none). A ray inside a medium is searched with refraction_exit_search from inside the
+// medium of highest priority (its own surfaces and those of the objects whose bounds meet
+// its: back faces, nested and touching media, search.hpp REFRACTION), a ray in air with
+// reflection_search. A found surface of a medium is completed into its crossing set by
+// coincident_crossings (search.hpp) and resolved by Media::resolve: no interface (the
+// search goes on from the crossing, same depth), or one interface n_from -> n_to.
+// Refraction bends by shading.hpp transmission_between (total internal reflection follows
+// the mirror direction, bounded by max_depth). Reflected rays keep the stack before the
+// crossing, transmitted and coverage-continued rays take the stack after it. The lens
+// modes (--refraction thick_lens|thin_lens, lens.hpp) replace the entry-exit pair of a
+// closed transparent object entered from air by the paraxial lens transfer, then search
+// from the emerging ray.
 //
 // Which shadows the envmap method casts: the same shadow search as abuffer, so that
 // comparing the methods isolates the reflection and refraction lookups.
@@ -39,7 +46,9 @@
 #include "search/lens.hpp"
 #include "io/metrics.hpp"
 #include "scene/scene_data.hpp"
+#include "reference/raytrace.hpp"
 #include "search/search.hpp"
+#include "shading/shading.hpp"
 
 namespace abcube {
 
@@ -119,6 +128,11 @@ class MapShader {
   glm::dvec3 shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
                    MapShadingStats* stats) const;
 
+  // The path of the transmitted weight alone from `origin` (in air, not a surface) along
+  // `dir`, answered by the searches: the ray after each interface, as
+  // RayTracer::transmitted_path (the same rules), at most `max_rays`.
+  std::vector<Ray> transmitted_path(const glm::dvec3& origin, const glm::dvec3& dir, int max_rays) const;
+
   const std::vector<LensFit>& lenses() const { return lenses_; }
   const SearchContext& context() const { return *ctx_; }
   // SearchRefine::mesh (search.hpp MESH REFINEMENT): besides the crossing searches' candidates,
@@ -127,14 +141,26 @@ class MapShader {
   bool exact_priority() const { return options_.exact_priority; }
 
  private:
-  glm::dvec3 trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, uint32_t inside,
+  // A crossing set (media.hpp): the surface point shaded, the furthest crossing, the interface.
+  struct Crossed {
+    SurfacePoint sp;
+    glm::dvec3 far{0.0};
+    Interface itf;
+  };
+  SearchResult search(const glm::dvec3& w, const glm::dvec3& dir, const MediumStack& stack,
+                      MapShadingStats* stats) const;
+  Crossed crossing_set(const glm::dvec3& w, const glm::dvec3& dir, const SearchResult& r,
+                       const MediumStack& stack) const;
+  glm::dvec3 shade(const Crossed& c, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats) const;
+  Ray transmitted_ray(const Crossed& c, const Transmission& tr, MediumStack* stack) const;
+  glm::dvec3 trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, const MediumStack& stack,
                    MapShadingStats* stats, SearchResult* found) const;
   glm::dvec3 lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n,
                     MapShadingStats* stats) const;
   glm::dvec3 visibility(const glm::dvec3& p, const PointLight& light, MapShadingStats* stats) const;
   glm::dvec3 reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
-                       MapShadingStats* stats) const;
-  glm::dvec3 transmitted(const SurfacePoint& sp, const glm::dvec3& dir, int depth, MapShadingStats* stats) const;
+                       const MediumStack& stack, MapShadingStats* stats) const;
+  glm::dvec3 transmitted(const Crossed& c, const glm::dvec3& dir, int depth, MapShadingStats* stats) const;
   glm::dvec3 envmap_direction(const glm::dvec3& w, const glm::dvec3& r) const;
   glm::dvec3 envmap_at(const glm::dvec3& direction) const;
   void measure(const glm::dvec3& w, const glm::dvec3& r, const SearchResult* found, const glm::dvec3* lookup,

@@ -106,9 +106,11 @@ inline glm::dvec3 offset_origin(const glm::dvec3& p, const glm::dvec3& geometric
 }
 
 // Refraction at an interface (rule "refraction", Whitted 1980 with Snell's law):
-// - entering iff the ray runs against the unit geometric normal cross(b-a, c-a) (outward
-//   for closed objects): dot(N_g, d) < 0. Entering uses eta = 1/ior, leaving eta = ior
-//   (air on the other side of every interface: no stack of nested media).
+// - the ray passes from a medium of index n_from into one of index n_to, eta = n_from / n_to.
+//   Which media those are is media.hpp's rule (a stack of nested media, Schmidt & Budge
+//   2002); for a single object in air: entering iff the ray runs against the unit geometric
+//   normal cross(b-a, c-a) (outward for closed objects), dot(N_g, d) < 0, eta = 1/ior
+//   entering and ior leaving (transmission(d, N_g, N_s, ior)).
 // - the ray bends about the shading normal flipped to the incoming ray's side of the
 //   geometric normal; if that normal still faces along the ray (interpolated normals can),
 //   the geometric normal is used instead.
@@ -117,15 +119,18 @@ inline glm::dvec3 offset_origin(const glm::dvec3& p, const glm::dvec3& geometric
 struct Transmission {
   glm::dvec3 dir{0.0};  // unit when d is unit
   double eta = 1.0;     // n1 / n2
-  bool entering = true;
+  double n1 = 1.0, n2 = 1.0;
+  bool entering = true;  // against the geometric normal
   bool total_internal_reflection = false;
 };
 
-inline Transmission transmission(const glm::dvec3& d, const glm::dvec3& geometric_normal,
-                                 const glm::dvec3& shading_normal, double ior) {
+inline Transmission transmission_between(const glm::dvec3& d, const glm::dvec3& geometric_normal,
+                                         const glm::dvec3& shading_normal, double n_from, double n_to) {
   Transmission r;
   r.entering = glm::dot(geometric_normal, d) < 0.0;
-  r.eta = r.entering ? 1.0 / ior : ior;
+  r.n1 = n_from;
+  r.n2 = n_to;
+  r.eta = n_from / n_to;
   const glm::dvec3 n_against = r.entering ? geometric_normal : -geometric_normal;
   glm::dvec3 n = glm::dot(shading_normal, n_against) >= 0.0 ? shading_normal : -shading_normal;
   if (glm::dot(n, d) >= 0.0) n = n_against;
@@ -134,11 +139,19 @@ inline Transmission transmission(const glm::dvec3& d, const glm::dvec3& geometri
   return r;
 }
 
+// One object in air: 1 -> ior entering, ior -> 1 leaving.
+inline Transmission transmission(const glm::dvec3& d, const glm::dvec3& geometric_normal,
+                                 const glm::dvec3& shading_normal, double ior) {
+  const bool entering = glm::dot(geometric_normal, d) < 0.0;
+  return transmission_between(d, geometric_normal, shading_normal, entering ? 1.0 : ior, entering ? ior : 1.0);
+}
+
 // The weights of the reflected and transmitted terms (rule "fresnel"). Off (the thesis's
 // model, the default): kr and kt as the material says. On (--fresnel): for a material with
-// kt > 0, Schlick 1994's reflectance F = F0 + (1 - F0)(1 - cos)^5, F0 = ((ior-1)/(ior+1))^2,
-// cos the angle in the outer medium (the incident one entering, the transmitted one
-// leaving), moves the share F of kt to the mirror term: kr' = kr + F kt, kt' = (1 - F) kt.
+// kt > 0, Schlick 1994's reflectance F = F0 + (1 - F0)(1 - cos)^5, F0 = ((n1-n2)/(n1+n2))^2
+// for the interface's two indices (tr.n1, tr.n2; 1 and ior for an object in air), cos the
+// angle in the medium of lower index (the incident one when n1 <= n2, else the transmitted
+// one), moves the share F of kt to the mirror term: kr' = kr + F kt, kt' = (1 - F) kt.
 // Under total internal reflection kt already follows the mirror direction (transmission).
 struct SecondaryWeights {
   double reflect = 0, transmit = 0;
@@ -149,8 +162,9 @@ inline SecondaryWeights secondary_weights(const Material& m, bool fresnel, const
   if (!fresnel || m.transmit <= 0.0 || tr.total_internal_reflection) return w;
   const double cos_d = std::abs(glm::dot(d, geometric_normal));
   const double cos_t = std::abs(glm::dot(tr.dir, geometric_normal)) / std::max(glm::length(tr.dir), 1e-300);
-  const double c = tr.entering ? cos_d : cos_t;
-  const double f0 = ((m.ior - 1.0) / (m.ior + 1.0)) * ((m.ior - 1.0) / (m.ior + 1.0));
+  const double c = tr.n1 <= tr.n2 ? cos_d : cos_t;
+  const double r0 = (tr.n1 - tr.n2) / (tr.n1 + tr.n2);
+  const double f0 = r0 * r0;
   const double f = f0 + (1.0 - f0) * std::pow(1.0 - std::min(c, 1.0), 5.0);
   w.reflect = m.reflect + f * m.transmit;
   w.transmit = (1.0 - f) * m.transmit;
