@@ -159,10 +159,13 @@ Interface RayTracer::crossing_set(const glm::dvec3& origin, const glm::dvec3& d,
   *far = hit;
   const MediumCrossing first{hit.triangle, !hit.front_face, hit.t};
   if (!media_->is_medium(hit.triangle)) return media_->resolve(stack, &first, 1);
-  // Every surface crossed within the coincident tolerance past the nearest hit (media.hpp).
+  // Every surface crossed within the coincident tolerance of the nearest hit (media.hpp), on
+  // both sides: the nearest hit's t and a coincident triangle's may differ by rounding
+  // either way (measured: 3e-17 below it on a face shared by two boxes).
+  const double tol = media_->tolerance(hit.point);
   std::vector<TriangleHit> hits;
-  bvh_->for_each_hit(RayQuery(origin, d), hit.t + media_->tolerance(hit.point), [&](const TriangleHit& th) {
-    if (th.triangle != hit.triangle && th.t >= hit.t) hits.push_back(th);
+  bvh_->for_each_hit(RayQuery(origin, d), hit.t + tol, [&](const TriangleHit& th) {
+    if (th.triangle != hit.triangle && th.t >= hit.t - tol) hits.push_back(th);
     return true;
   });
   if (hits.empty()) return media_->resolve(stack, &first, 1);

@@ -29,7 +29,7 @@
 //
 // Nested dielectrics (media.hpp: Schmidt & Budge 2002 with priorities). Every ray carries
 // the stack of media it is inside (camera rays: none). The nearest hit and every surface
-// the ray crosses within coincident_tolerance past it (BVH for_each_hit) form one crossing
+// the ray crosses within coincident_tolerance of it (BVH for_each_hit) form one crossing
 // set, resolved by Media::resolve: a plain surface in it is the surface hit; a set of
 // medium surfaces with the same medium on both sides is no interface (the ray goes on
 // straight from past the set, same depth, unshaded); else one interface n_from -> n_to

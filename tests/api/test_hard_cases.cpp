@@ -179,7 +179,8 @@ Image render_method(const Scene& scene, const std::string& method) {
 // Two boxes of one clear glass sharing a face look like one box spanning both: the shared
 // face is one interface from the glass into the same glass, no bend and (no Phong, no
 // mirror term) nothing to see. Before the model the tracer left the first box into "air"
-// there and entered nothing (the second box's coincident face lay behind the ray's offset).
+// there and entered nothing (the second box's coincident face lay behind the ray's offset):
+// 33.9 dB (raytrace), 32.9 dB (abuffer).
 TEST(HardCases, TouchingBoxesOfOneGlassLookLikeOneBox) {
   // Both lifted 0.1 mm off the floor: only the shared face differs between the two scenes.
   const std::string two =
@@ -192,7 +193,13 @@ TEST(HardCases, TouchingBoxesOfOneGlassLookLikeOneBox) {
   for (const std::string method : {"raytrace", "abuffer"}) {
     const double psnr = image_error(render_method(a, method), render_method(b, method)).psnr;
     std::printf("%s: two touching boxes against one box %.2f dB\n", method.c_str(), psnr);
-    EXPECT_GE(psnr, method == "raytrace" ? 60.0 : 45.0) << method;
+    if (method == "raytrace") {
+      // The same image: every sample's path crosses the shared face as one interface (69.3 dB
+      // when a coincident triangle 3e-17 nearer than the BVH's nearest hit was left out).
+      EXPECT_TRUE(std::isinf(psnr)) << method << " " << psnr << " dB";
+    } else {
+      EXPECT_GE(psnr, 60.0) << method;
+    }
   }
 }
 
