@@ -1,5 +1,6 @@
 // NESTED DIELECTRICS (media.hpp): the stack, the priority and the crossing sets.
 #include "shading/media.hpp"
+#include "scene/tie_rule.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +10,10 @@ namespace abcube {
 
 namespace {
 constexpr uint32_t AIR = std::numeric_limits<uint32_t>::max();
-}
+
+// THE TIE RULE (scene/tie_rule.hpp): of two coincident triangles, the one ranking above.
+uint32_t tie_winner(const TriangleSoup& soup, uint32_t a, uint32_t b) { return ranks_above(soup, b, a) ? b : a; }
+}  // namespace
 
 double scene_scale(const SceneData& scene) {
   const Bounds b = scene.bounds();
@@ -21,12 +25,6 @@ double scene_scale(const SceneData& scene) {
 double coincident_tolerance(const glm::dvec3& p, double scene_scale) {
   const double m = std::fmax(std::fabs(p.x), std::fmax(std::fabs(p.y), std::fabs(p.z)));
   return COINCIDENT_REL * (m + scene_scale);
-}
-
-uint32_t tie_winner(const TriangleSoup& soup, uint32_t a, uint32_t b) {
-  const uint32_t oa = soup.object_id[a], ob = soup.object_id[b];
-  if (oa != ob) return oa > ob ? a : b;
-  return std::max(a, b);
 }
 
 bool MediumStack::contains(uint32_t o) const {

@@ -18,7 +18,7 @@
 // PRIORITY. Where a ray is inside several media at once, the medium it travels in is the
 // one of highest priority: an object outranks another iff its bounding box has the smaller
 // volume, and at equal volume iff it is listed later in the scene (the tie rule,
-// tie_winner below). So a medium nested inside another (its bounds inside the other's)
+// scene/tie_rule.hpp). So a medium nested inside another (its bounds inside the other's)
 // always wins: a ray inside a glass sphere that meets a water sphere inside it enters the
 // water, whatever the order of the objects in the file. Overlapping media (a modelling
 // choice, not nesting) are decided by the same rule: the smaller wins in the overlap.
@@ -43,9 +43,11 @@
 // stack before the set; transmitted rays and coverage-continued rays (opacity < 1) take the
 // stack after it. Shadow rays are unchanged (every surface crossed filters the light).
 //
-// WHAT THE TIE RULE DECIDES HERE (tie_winner). Which of coincident triangles is shaded.
-// The project's single tie rule for coincident surfaces is "at equal distance the object
-// listed later wins" (issue 12 part 2); until its header lands this function holds it.
+// WHAT THE TIE RULE DECIDES HERE. Which of a crossing set's triangles is shaded: the one
+// ranking highest by the project's single tie rule (scene/tie_rule.hpp ranks_above: the
+// object listed later, then the higher triangle). The crossing set's own window,
+// coincident_tolerance, is wider than the rule's tie_bound (2^-22 of the coordinates): it
+// also gathers surfaces a few ulps of rounding apart after a transform, as one interface.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -74,10 +76,6 @@ double scene_scale(const SceneData& scene);
 
 // The coincident tolerance at point p (INTERFACES above), world units.
 double coincident_tolerance(const glm::dvec3& p, double scene_scale);
-
-// THE TIE RULE for two coincident triangles: the one of the object listed later, and of two
-// triangles of one object the later one. Returns the winner.
-uint32_t tie_winner(const TriangleSoup& soup, uint32_t a, uint32_t b);
 
 struct MediumStack {
   std::array<uint32_t, MEDIA_STACK_MAX> object{};
