@@ -2,19 +2,27 @@
 //   C = ka Ia Od + sum_l S_l I_l (kd Od max(0, N.L) + ks max(0, R.V)^n),  R = reflect(-L, N),
 // with N turned to face the viewer (two-sided lighting). p is relative to the eye.
 
-// S_l from the light's cube shadow map: 1 if p is no farther from the light than the
-// nearest surface the map stored in that direction, plus a bias of u_shadow_bias_texels
-// texels (a texel at distance d is about u_shadow_texel * d wide), grown at grazing
-// light. Every blocker is opaque here (the GPU path does not attenuate by kt).
-float light_visibility(int i, vec3 p, vec3 n) {
+// S_l from the light's cube shadow maps (rule "shadows", as the CPU's shadow search): 0 if
+// p is farther from the light than the nearest opaque surface the map stored in that
+// direction, plus a bias of u_shadow_bias_texels texels (a texel at distance d is about
+// u_shadow_texel * d wide), grown at grazing light; else the product of the transmittances
+// of the translucent layers nearer to the light than p (less the same bias).
+vec3 light_visibility(int i, vec3 p, vec3 n) {
   float layer = lights[i].position.w;
-  if (!u_shadows || layer < 0.0) return 1.0;
+  if (!u_shadows || layer < 0.0) return vec3(1.0);
   vec3 d = p - lights[i].position.xyz;
   float dist = length(d);
   float stored = texture(u_shadow_maps, vec4(d, layer)).r;
   float slope = max(abs(dot(n, d / dist)), 0.2);
   float bias = u_shadow_bias_texels * u_shadow_texel * dist / slope;
-  return dist <= stored + bias ? 1.0 : 0.0;
+  if (dist > stored + bias) return vec3(0.0);
+  vec3 s = vec3(1.0);
+  for (int k = 0; k < u_shadow_peels; ++k) {
+    vec4 crossing = texture(u_shadow_peel_maps[k], vec4(d, layer));
+    if (!(crossing.r + bias < dist)) break;  // layers are sorted: the rest are farther
+    s *= blocker_transmittance(materials[int(crossing.b)]);
+  }
+  return s;
 }
 
 vec3 phong_local(MaterialGpu m, vec3 p, vec3 n_in) {

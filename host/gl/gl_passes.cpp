@@ -1,19 +1,28 @@
 #include "gl/gl_passes.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <algorithm>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "raster/cube_map.hpp"
+#include "raster/samples.hpp"
 #include "base/error.hpp"
 #include "base/timer.hpp"
 #include "scene/tie_rule.hpp"
+#include "shading/shading.hpp"
 
 namespace abcube {
 
 namespace {
+
+// The camera pass renders at most this many samples a side at once (tiles beyond).
+constexpr int CAMERA_TILE = 2048;
+// Texture units: 1 the opaque shadow maps, 2 the environment, 3.. the translucent peels.
+constexpr GLenum PEEL_UNIT = 3;
 
 
 struct Vertex {
@@ -164,6 +173,8 @@ GlScene::GlScene(const SceneData& scene) : scene_(scene) {
   phong_program_ = std::make_unique<GlProgram>(
       std::vector<const char*>{"scene.vert"},
       std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "phong.frag"});
+  shadow_program_ = std::make_unique<GlProgram>(std::vector<const char*>{"scene.vert"},
+                                                std::vector<const char*>{"common_scene.glsl", "shadow_caster.frag"});
   glFinish();
   check_gl("scene upload");
   timings_.upload_ms = ms_since(t0);
@@ -173,6 +184,7 @@ GlScene::~GlScene() {
   target_.reset();
   const GLuint textures[] = {shadow_maps_, environment_};
   glDeleteTextures(2, textures);
+  glDeleteTextures(static_cast<GLsizei>(shadow_peels_.size()), shadow_peels_.data());
   glDeleteRenderbuffers(1, &lookup_depth_);
   glDeleteFramebuffers(1, &lookup_fbo_);
   glDeleteBuffers(1, &vbo_);
@@ -233,6 +245,14 @@ void GlScene::bind_lookups(const GlProgram& program, bool with_environment) {
   glUniform1f(program.uniform("u_shadow_bias_texels"), float(SHADOW_BIAS_TEXELS));
   glActiveTexture(GL_TEXTURE1);
   glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, shadow_maps_);
+  glUniform1i(program.uniform("u_shadow_peels"), shadows ? static_cast<GLint>(shadow_peels_.size()) : 0);
+  GLint units[MAX_SHADOW_PEELS];
+  for (int k = 0; k < MAX_SHADOW_PEELS; ++k) {
+    units[k] = static_cast<GLint>(PEEL_UNIT) + k;
+    glActiveTexture(GL_TEXTURE0 + PEEL_UNIT + static_cast<GLenum>(k));
+    glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, static_cast<size_t>(k) < shadow_peels_.size() ? shadow_peels_[static_cast<size_t>(k)] : 0);
+  }
+  glUniform1iv(program.uniform("u_shadow_peel_maps"), MAX_SHADOW_PEELS, units);
   const bool environment = with_environment && environment_ != 0;
   glUniform1i(program.uniform("u_environment"), environment);
   glUniform1i(program.uniform("u_environment_map"), 2);
@@ -265,21 +285,89 @@ int GlScene::build_shadow_maps(int n) {
   glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
   glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   bind_lookup_target(n);
-  const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_NONE};
-  for (size_t i = 0; i < scene_.lights.size(); ++i) {
-    if (shadow_layer_[i] < 0) continue;
-    const glm::dvec3 light = scene_.lights[i].position;
-    for (int face = 0; face < CUBE_FACES; ++face) {
-      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, shadow_maps_, 0, 6 * shadow_layer_[i] + face);
-      glDrawBuffers(1, buffers);
-      clear_lookup_target(n, true);
-      draw(*distance_program_, face_clip_matrix(face, light, near_), light);
-    }
-  }
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, 0);  // no feedback: the opaque maps are the target
+  glActiveTexture(GL_TEXTURE0);
+  shadow_program_->use();
+  glUniform1i(shadow_program_->uniform("u_peel"), -1);
+  draw_shadow_casters(shadow_maps_);
+  peel_translucent_casters(n, layers);
   glFinish();
   check_gl("cube shadow maps");
   timings_.shadow_maps_ms += ms_since(t0);
   return layers;
+}
+
+// Draws the shadow program from every shadow-casting light into its six layers of `maps`
+// (the lookup target, bound), each cleared first; the program's pass uniforms are set.
+void GlScene::draw_shadow_casters(GLuint maps) {
+  const GLenum buffers[] = {GL_COLOR_ATTACHMENT0};
+  for (size_t i = 0; i < scene_.lights.size(); ++i) {
+    if (shadow_layer_[i] < 0) continue;
+    const glm::dvec3 light = scene_.lights[i].position;
+    shadow_program_->use();
+    glUniform1f(shadow_program_->uniform("u_light_layer"), float(shadow_layer_[i]));
+    for (int face = 0; face < CUBE_FACES; ++face) {
+      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, maps, 0, 6 * shadow_layer_[i] + face);
+      glDrawBuffers(1, buffers);
+      clear_lookup_target(n_of_lookup_, true);
+      draw(*shadow_program_, face_clip_matrix(face, light, near_), light);
+    }
+  }
+}
+
+// The translucent casters in front of the opaque ones, peeled one layer a pass (nearest
+// first, shadow_caster.frag) until a pass draws nothing or MAX_SHADOW_PEELS are kept; one
+// more pass then says whether crossings were left out (shadow_peels_capped()).
+void GlScene::peel_translucent_casters(int n, int layers) {
+  glDeleteTextures(static_cast<GLsizei>(shadow_peels_.size()), shadow_peels_.data());
+  shadow_peels_.clear();
+  shadow_peels_capped_ = false;
+  bool translucent = false;
+  for (const Material& m : scene_.materials) {
+    const glm::dvec3 t = blocker_transmittance(m);
+    translucent = translucent || (t != glm::dvec3(0.0) && t != glm::dvec3(1.0));
+  }
+  if (!translucent) return;
+  GLuint query = 0;
+  glGenQueries(1, &query);
+  shadow_program_->use();
+  glUniform1i(shadow_program_->uniform("u_opaque"), 1);
+  glUniform1i(shadow_program_->uniform("u_previous"), static_cast<GLint>(PEEL_UNIT));
+  for (int k = 0; k <= MAX_SHADOW_PEELS; ++k) {
+    GLuint peel = 0;
+    glGenTextures(1, &peel);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, peel);
+    glTexStorage3D(GL_TEXTURE_CUBE_MAP_ARRAY, 1, GL_RGBA32F, n, n, 6 * layers);
+    glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_CUBE_MAP_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, 0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, shadow_maps_);
+    glActiveTexture(GL_TEXTURE0 + PEEL_UNIT);
+    glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, k > 0 ? shadow_peels_.back() : 0);
+    glActiveTexture(GL_TEXTURE0);
+    shadow_program_->use();
+    glUniform1i(shadow_program_->uniform("u_peel"), k);
+    glBeginQuery(GL_ANY_SAMPLES_PASSED, query);
+    draw_shadow_casters(peel);
+    glEndQuery(GL_ANY_SAMPLES_PASSED);
+    GLuint drew = 0;
+    glGetQueryObjectuiv(query, GL_QUERY_RESULT, &drew);
+    if (!drew || k == MAX_SHADOW_PEELS) {
+      shadow_peels_capped_ = drew != 0;
+      glDeleteTextures(1, &peel);
+      break;
+    }
+    shadow_peels_.push_back(peel);
+  }
+  glDeleteQueries(1, &query);
+  glActiveTexture(GL_TEXTURE0 + PEEL_UNIT);
+  glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, 0);
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, 0);
+  glActiveTexture(GL_TEXTURE0);
 }
 
 void GlScene::build_environment(const glm::dvec3& center, int n) {
@@ -310,6 +398,7 @@ void GlScene::build_environment(const glm::dvec3& center, int n) {
 
 // Binds the framebuffer that renders into the lookup textures, with an n x n depth buffer.
 void GlScene::bind_lookup_target(int n) {
+  n_of_lookup_ = n;
   if (!lookup_fbo_) glGenFramebuffers(1, &lookup_fbo_);
   glDeleteRenderbuffers(1, &lookup_depth_);
   glGenRenderbuffers(1, &lookup_depth_);
@@ -380,29 +469,51 @@ CubeImage GlScene::cube_color(const glm::dvec3& center, int n) {
   return out;
 }
 
-Image GlScene::camera_color(const Camera& camera) {
-  Target& t = target(camera.width, camera.height, false);
+Image GlScene::camera_color(const Camera& camera, CameraSamples samples) {
+  const bool mask = samples == CameraSamples::mask_4x8;
+  const int64_t sx = mask ? MASK_COLUMNS : 1, sy = mask ? MASK_ROWS : 1;
+  const int64_t full_w = camera.width * sx, full_h = camera.height * sy;
+  const int64_t tile_max = std::min(CAMERA_TILE, max_size_);
+  const int tile_w = static_cast<int>(std::min(full_w, tile_max)), tile_h = static_cast<int>(std::min(full_h, tile_max));
+  Target& t = target(tile_w, tile_h, false);
   upload_lights(camera.position);
   bind_lookups(*phong_program_, true);
-  Clock::time_point t0 = Clock::now();
-  t.clear(scene_.background);
   const double aspect = static_cast<double>(camera.width) / camera.height;
-  draw(*phong_program_,
-       camera_clip_matrix(camera.position, camera.look_at, camera.up, glm::radians(camera.fov_y_deg),
-                          aspect, near_),
-       camera.position);
-  glFinish();
-  timings_.camera_ms += ms_since(t0);
-  t0 = Clock::now();
-  std::vector<float> rgba(static_cast<size_t>(camera.width) * camera.height * 4);
-  t.read(0, GL_RGBA, GL_FLOAT, rgba.data());
-  // GL's row 0 is the bottom; the image's row 0 is the top.
-  Image out(camera.width, camera.height, 3);
-  for (int y = 0; y < camera.height; ++y) {
-    const float* src = &rgba[static_cast<size_t>(camera.height - 1 - y) * camera.width * 4];
-    for (int x = 0; x < camera.width; ++x) out.set_rgb(x, y, {src[4 * x], src[4 * x + 1], src[4 * x + 2]});
+  const glm::mat4 clip = camera_clip_matrix(camera.position, camera.look_at, camera.up,
+                                            glm::radians(camera.fov_y_deg), aspect, near_);
+  std::vector<float> rgba(static_cast<size_t>(tile_w) * static_cast<size_t>(tile_h) * 4);
+  std::vector<double> sum(static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height) * 3, 0.0);
+  // Tile (x0, y0) in GL window coordinates of the full sample grid (y up): the clip
+  // coordinates scaled and shifted so that the tile fills the viewport (one tile: identity).
+  for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
+    for (int64_t x0 = 0; x0 < full_w; x0 += tile_w) {
+      Clock::time_point t0 = Clock::now();
+      glm::mat4 tile(1.f);
+      tile[0][0] = float(double(full_w) / tile_w);
+      tile[3][0] = float(-double(full_w) / tile_w * (double(2 * x0 + tile_w) / double(full_w) - 1.0));
+      tile[1][1] = float(double(full_h) / tile_h);
+      tile[3][1] = float(-double(full_h) / tile_h * (double(2 * y0 + tile_h) / double(full_h) - 1.0));
+      t.clear(scene_.background);
+      draw(*phong_program_, tile * clip, camera.position);
+      glFinish();
+      timings_.camera_ms += ms_since(t0);
+      t0 = Clock::now();
+      t.read(0, GL_RGBA, GL_FLOAT, rgba.data());
+      // GL's row 0 is the bottom; the image's row 0 is the top.
+      for (int64_t gy = 0; gy < tile_h && y0 + gy < full_h; ++gy) {
+        const size_t row = static_cast<size_t>((full_h - 1 - (y0 + gy)) / sy);
+        const float* src = &rgba[static_cast<size_t>(gy) * static_cast<size_t>(tile_w) * 4];
+        for (int64_t gx = 0; gx < tile_w && x0 + gx < full_w; ++gx) {
+          double* dst = &sum[(row * static_cast<size_t>(camera.width) + static_cast<size_t>((x0 + gx) / sx)) * 3];
+          for (int c = 0; c < 3; ++c) dst[c] += src[4 * gx + c];
+        }
+      }
+      timings_.readback_ms += ms_since(t0);
+    }
   }
-  timings_.readback_ms += ms_since(t0);
+  Image out(camera.width, camera.height, 3);
+  const double samples_per_pixel = double(sx * sy);
+  for (size_t k = 0; k < sum.size(); ++k) out.data[k] = static_cast<float>(sum[k] / samples_per_pixel);
   check_gl("camera pass");
   return out;
 }

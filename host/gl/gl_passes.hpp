@@ -25,6 +25,14 @@ struct GpuTimings {
 
 // Shadow bias of the GPU cube shadow maps, in texels (common_shading.glsl).
 constexpr double SHADOW_BIAS_TEXELS = 1.5;
+// Translucent shadow casters peeled per light, at most (shadow_caster.frag; the GLSL
+// constant of the same name). Crossings beyond the last layer let the light through.
+constexpr int MAX_SHADOW_PEELS = 8;
+
+// Where the camera pass samples each pixel: its centre (one sample, aliased), or the
+// A-buffer's 4x8 sample positions (samples.hpp), box-filtered as the CPU resolve weighs
+// its masks.
+enum class CameraSamples { pixel_centre, mask_4x8 };
 
 // Value of a prepass texel that no surface covers.
 constexpr float NO_DISTANCE = INFINITY;
@@ -48,14 +56,21 @@ class GlScene {
   // Z-buffer Phong colour of the six faces seen from `center` (no shadows).
   CubeImage cube_color(const glm::dvec3& center, int n);
 
-  // Z-buffer Phong image of the camera view (aliased: one sample per pixel centre). Uses
-  // the shadow maps and the environment map when they have been built.
-  Image camera_color(const Camera& camera);
+  // Z-buffer Phong image of the camera view, sampled at `samples`. Uses the shadow maps
+  // and the environment map when they have been built. mask_4x8 renders the view at 8x
+  // the columns and 4x the rows, in tiles, and averages each pixel's 32 samples.
+  Image camera_color(const Camera& camera, CameraSamples samples = CameraSamples::pixel_centre);
 
-  // One cube shadow map (distance prepass from the light) per light with cast_shadows, at
-  // n x n per face; later colour passes are shadowed by them. Returns how many. Maps of
-  // the same size built before are kept (the lights do not change).
+  // One cube shadow map per light with cast_shadows, at n x n per face; later colour passes
+  // are shadowed by them (the CPU's rule "shadows", shading.hpp): the distance to the
+  // nearest opaque caster, and the translucent casters in front of it peeled into up to
+  // MAX_SHADOW_PEELS layers, whose transmittances multiply. Returns how many lights. Maps
+  // of the same size built before are kept (the lights do not change).
   int build_shadow_maps(int n);
+  // Translucent layers the last build_shadow_maps peeled (0: no translucent caster), and
+  // whether crossings were left beyond MAX_SHADOW_PEELS.
+  int shadow_peels() const { return static_cast<int>(shadow_peels_.size()); }
+  bool shadow_peels_capped() const { return shadow_peels_capped_; }
 
   // The Z-buffer colour of the six faces around `center` (with shadows if built) kept on
   // the GPU as a cube texture; later camera passes look it up for kr and kt (Blinn & Newell
@@ -80,12 +95,17 @@ class GlScene {
   const SceneData& scene_;
   GLuint vao_ = 0, vbo_ = 0, materials_ = 0, lights_ = 0;
   GLuint shadow_maps_ = 0, environment_ = 0, lookup_fbo_ = 0, lookup_depth_ = 0;
+  std::vector<GLuint> shadow_peels_;  // one cube-map array (a layer per light and face) per peel
+  bool shadow_peels_capped_ = false;
   int shadow_n_ = 0;
   std::vector<int> shadow_layer_;  // per light, -1 when it casts no shadows
   GLsizei vertex_count_ = 0;
   double near_ = 1e-4;
   int max_size_ = 0;
-  std::unique_ptr<GlProgram> distance_program_, phong_program_;
+  void draw_shadow_casters(GLuint maps);
+  void peel_translucent_casters(int n, int layers);
+  int n_of_lookup_ = 0;  // the lookup target's size (bind_lookup_target)
+  std::unique_ptr<GlProgram> distance_program_, phong_program_, shadow_program_;
   std::unique_ptr<Target> target_;
   GpuTimings timings_;
 };

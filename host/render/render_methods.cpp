@@ -9,6 +9,7 @@
 #include "base/parallel.hpp"
 #include "base/timer.hpp"
 #include "io/metrics.hpp"
+#include "raster/samples.hpp"
 #include "reference/raytrace.hpp"
 #include "render/crosscheck.hpp"
 #include "render/stats_json.hpp"
@@ -55,7 +56,9 @@ Image render_gpu(MethodContext& mc) {
     mirrors = false;
   }
   check_deadline();
-  Image image = gl.camera_color(scene.camera);
+  // The camera view at the A-buffer's 4x8 sample positions, box-filtered as its resolve
+  // weighs the masks: the same edges as abuffer (issue 12 part 4).
+  Image image = gl.camera_color(scene.camera, CameraSamples::mask_4x8);
   passes.push_back("camera_raster");
   skipped.push_back({{"pass", "cube_distance"}, {"why", "method gpu does no map search"}});
   const GpuTimings& t = gl.timings();
@@ -65,6 +68,9 @@ Image render_gpu(MethodContext& mc) {
   stats["timings_ms"]["camera_raster"] = t.camera_ms - before.camera_ms;
   stats["timings_ms"]["readback"] = t.readback_ms - before.readback_ms;
   stats["counts"]["shadow_maps"] = maps;
+  stats["counts"]["shadow_translucent_layers"] = maps > 0 ? gl.shadow_peels() : 0;
+  stats["counts"]["shadow_translucent_layers_capped"] = maps > 0 && gl.shadow_peels_capped();
+  stats["counts"]["camera_samples_per_pixel"] = MASK_SAMPLES;
   stats["plan"]["passes"] = passes;
   stats["plan"]["skipped"] = skipped;
   return image;

@@ -81,4 +81,18 @@ inline void add_box(SceneData& s, glm::dvec3 lo, glm::dvec3 hi, uint32_t materia
   add_quad(s, p(0, 1, 0), p(0, 1, 1), p(1, 1, 1), p(1, 1, 0), material);
 }
 
+// Thesis figures 11.1-11.2: a white material lit by ambient 1 alone, a black background,
+// the camera at (0, 0, 3) looking at the origin. The caller adds the white triangle.
+inline SceneData white_on_black_scene(int width, int height, uint32_t* white) {
+  SceneData s;
+  s.ambient = glm::dvec3(1);
+  s.background = glm::dvec3(0);
+  s.camera.position = glm::dvec3(0, 0, 3);
+  s.camera.look_at = glm::dvec3(0);
+  s.camera.width = width;
+  s.camera.height = height;
+  *white = add_material(s, glm::dvec3(1));
+  return s;
+}
+
 }  // namespace abcube::test

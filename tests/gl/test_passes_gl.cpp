@@ -163,14 +163,8 @@ namespace {
 // intermediate values matching the covered area, is in tests/core).
 TEST(ZbufferGl, WhiteTriangleEdgesAreAliased) {
   test::test_context();
-  SceneData s;
-  s.ambient = glm::dvec3(1);
-  s.background = glm::dvec3(0);
-  s.camera.position = glm::dvec3(0, 0, 3);
-  s.camera.look_at = glm::dvec3(0);
-  s.camera.width = 64;
-  s.camera.height = 64;
-  const uint32_t white = test::add_material(s, glm::dvec3(1));
+  uint32_t white = 0;
+  SceneData s = test::white_on_black_scene(64, 64, &white);
   test::add_triangle(s, {-1, -0.8, 0}, {1.1, -0.5, 0}, {-0.2, 1, 0}, white);
   GlScene gl(s);
   const Image img = gl.camera_color(s.camera);
