@@ -54,8 +54,12 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
                           double radius) {
   MeshAnswer a;
   // A start triangle away from the ray: the mesh near the ray may be elsewhere in the
-  // fragment's patch (merged), the flood cannot say.
-  if (!near_ray(ctx.triangle_bounds(start), q, l_lo, l_hi, radius)) return a;
+  // fragment's patch (merged). The straight walk below may still reach it, across
+  // triangles away from the ray, and its crossing counts if it lies in [l_lo, l_hi];
+  // otherwise the flood cannot say. (Before, such fragments were never refined: a glass
+  // ball's exit crossing seen only in a texel of a merged fragment was lost, speckles in
+  // its shadow on scenes/cornell.json.)
+  const bool start_near = near_ray(ctx.triangle_bounds(start), q, l_lo, l_hi, radius);
   // First the straight way: from triangle to triangle across the edge the ray's crossing
   // of the current plane lies furthest outside of, while the next is near the ray. On a
   // smooth patch this reaches the triangle crossed in a few steps.
@@ -64,7 +68,7 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
     const PlaneCrossing c = plane_crossing(ctx, q, walker);
     if (c.l == INF) break;
     if (c.outside_edge < 0) {  // on this triangle
-      if (c.l >= q.self && c.l <= q.l_max) {
+      if (c.l >= q.self && c.l <= q.l_max && (start_near || (c.l >= l_lo && c.l <= l_hi))) {
         a.result = Refined::hit;
         a.triangle = walker;
         a.l = c.l;
@@ -73,9 +77,10 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
       break;
     }
     const uint32_t nb = ctx.neighbour(walker, c.outside_edge);
-    if (nb == SearchContext::NO_NEIGHBOUR || !near_ray(ctx.triangle_bounds(nb), q, l_lo, l_hi, radius)) break;
+    if (nb == SearchContext::NO_NEIGHBOUR || (start_near && !near_ray(ctx.triangle_bounds(nb), q, l_lo, l_hi, radius))) break;
     walker = nb;
   }
+  if (!start_near) return a;
   // Then every triangle near the ray, breadth-first.
   std::array<uint32_t, REFINE_MAX_TRIANGLES> seen{};
   size_t count = 0, next = 0;
