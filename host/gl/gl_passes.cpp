@@ -225,7 +225,10 @@ void GlScene::draw(const GlProgram& program, const glm::mat4& clip, const glm::d
   program.use();
   glUniformMatrix4fv(program.uniform("u_clip"), 1, GL_FALSE, &clip[0][0]);
   glUniform3f(program.uniform("u_center"), float(center.x), float(center.y), float(center.z));
-  glUniform1f(program.uniform("u_tie_step"), float(gl_tie_step(scene_.objects.size())));  // tie_rule.hpp
+  // tie_rule.hpp; not in the shadow passes, whose casters all count and whose translucent
+  // peels order equal depths by triangle (shadow_caster.frag), GL_GREATER's draw order.
+  const bool ties = &program != shadow_program_.get();
+  glUniform1f(program.uniform("u_tie_step"), ties ? float(gl_tie_step(scene_.objects.size())) : 0.f);
   glUniform3f(program.uniform("u_ambient"), float(scene_.ambient.r), float(scene_.ambient.g),
               float(scene_.ambient.b));
   glUniform1i(program.uniform("u_light_count"), static_cast<GLint>(scene_.lights.size()));
