@@ -49,19 +49,41 @@ vec3 phong_local(MaterialGpu m, vec3 p, vec3 n_in) {
 // Blinn & Newell 1976: what a mirror (kr) and a refracting surface (kt) show, looked up in
 // the environment map around the eye in the reflected and refracted directions, as if
 // everything were infinitely far away. Refraction is one interface (Snell with eta =
-// 1/ior; total internal reflection looks up the mirror direction).
+// 1/ior; total internal reflection looks up the mirror direction). The lookup direction
+// is the envmap method's (map_shading.cpp envmap_direction, thesis 9.2): u_lookup 0 the
+// ray's direction R, 1 the bisector [[R + [[W]]]], 2 [[W]] (W = p, the eye is the map's
+// centre). With u_fresnel, Schlick's weights as shading.hpp secondary_weights (the cosine
+// on the incident side: this one interface is always entered).
+uniform int u_lookup;
+uniform bool u_fresnel;
+
+vec3 lookup_direction(vec3 p, vec3 r) {
+  vec3 w = normalize(p);
+  if (u_lookup == 1) {
+    vec3 b = r + w;
+    return dot(b, b) > 1e-24 ? normalize(b) : r;  // R = -[[W]]: no bisector
+  }
+  return u_lookup == 2 ? w : r;
+}
+
 vec3 environment_terms(MaterialGpu m, vec3 p, vec3 n_in) {
   float kr = m.coefficients.w, kt = m.transmission.x;
   if (!u_environment || (kr <= 0.0 && kt <= 0.0)) return vec3(0.0);
   vec3 i = normalize(p);
   vec3 n = normalize(n_in);
   if (dot(n, i) > 0.0) n = -n;
-  vec3 c = vec3(0.0);
-  if (kr > 0.0) c += kr * texture(u_environment_map, reflect(i, n)).rgb;
-  if (kt > 0.0) {
-    vec3 t = refract(i, n, 1.0 / m.transmission.y);
-    if (t == vec3(0.0)) t = reflect(i, n);
-    c += kt * texture(u_environment_map, t).rgb;
+  vec3 t = refract(i, n, 1.0 / m.transmission.y);
+  bool total = t == vec3(0.0);
+  if (total) t = reflect(i, n);
+  if (u_fresnel && kt > 0.0 && !total) {
+    float ior = m.transmission.y;
+    float f0 = ((ior - 1.0) / (ior + 1.0)) * ((ior - 1.0) / (ior + 1.0));
+    float f = f0 + (1.0 - f0) * pow(1.0 - min(abs(dot(i, n)), 1.0), 5.0);
+    kr += f * kt;
+    kt *= 1.0 - f;
   }
+  vec3 c = vec3(0.0);
+  if (kr > 0.0) c += kr * texture(u_environment_map, lookup_direction(p, reflect(i, n))).rgb;
+  if (kt > 0.0) c += kt * texture(u_environment_map, lookup_direction(p, t)).rgb;
   return c;
 }

@@ -258,6 +258,8 @@ void GlScene::bind_lookups(const GlProgram& program, bool with_environment) {
   glUniform1iv(program.uniform("u_shadow_peel_maps"), MAX_SHADOW_PEELS, units);
   const bool environment = with_environment && environment_ != 0;
   glUniform1i(program.uniform("u_environment"), environment);
+  glUniform1i(program.uniform("u_lookup"), lookup_ == EnvmapLookup::bisector ? 1 : lookup_ == EnvmapLookup::position ? 2 : 0);
+  glUniform1i(program.uniform("u_fresnel"), fresnel_);
   glUniform1i(program.uniform("u_environment_map"), 2);
   glActiveTexture(GL_TEXTURE2);
   glBindTexture(GL_TEXTURE_CUBE_MAP, environment ? environment_ : 0);

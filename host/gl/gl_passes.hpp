@@ -9,6 +9,7 @@
 #include "gl/gl_program.hpp"
 #include "io/image.hpp"
 #include "scene/scene_data.hpp"
+#include "shading/map_shading.hpp"
 
 namespace abcube {
 
@@ -78,6 +79,12 @@ class GlScene {
   void build_environment(const glm::dvec3& center, int n);
   // Later camera passes look up no environment (max_depth 0, or nothing reflects).
   void drop_environment();
+  // How later camera passes look the environment up: the envmap method's lookup direction
+  // (R, bisector, position) and Schlick's weights for kr and kt (shading.hpp).
+  void set_environment_lookup(EnvmapLookup lookup, bool fresnel) {
+    lookup_ = lookup;
+    fresnel_ = fresnel;
+  }
 
   const GpuTimings& timings() const { return timings_; }
   double near_distance() const { return near_; }
@@ -104,7 +111,9 @@ class GlScene {
   int max_size_ = 0;
   void draw_shadow_casters(GLuint maps);
   void peel_translucent_casters(int n, int layers);
-  int n_of_lookup_ = 0;  // the lookup target's size (bind_lookup_target)
+  int n_of_lookup_ = 0;
+  EnvmapLookup lookup_ = EnvmapLookup::reflected;
+  bool fresnel_ = false;  // the lookup target's size (bind_lookup_target)
   std::unique_ptr<GlProgram> distance_program_, phong_program_, shadow_program_;
   std::unique_ptr<Target> target_;
   GpuTimings timings_;

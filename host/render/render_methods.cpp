@@ -46,15 +46,20 @@ Image render_gpu(MethodContext& mc) {
   }
   bool mirrors = false;
   for (const Material& m : scene.materials) mirrors = mirrors || m.reflect > 0 || m.transmit > 0;
-  if (mirrors && scene.render.max_depth > 0) {
+  const bool needed = mirrors && scene.render.max_depth > 0;
+  if (needed || mc.request.plan_everything) {
     gl.build_environment(scene.camera.position, n);
-    passes.push_back("environment_map");
-  } else {
-    gl.drop_environment();
-    skipped.push_back({{"pass", "environment_map"},
-                       {"why", mirrors ? "max_depth 0: no reflected or refracted ray" : "no material reflects or transmits"}});
-    mirrors = false;
+    passes.push_back(needed ? "environment_map" : "environment_map (unused: --plan everything)");
   }
+  if (!needed) {
+    gl.drop_environment();
+    if (!mc.request.plan_everything) {
+      skipped.push_back({{"pass", "environment_map"},
+                         {"why", mirrors ? "max_depth 0: no reflected or refracted ray" : "no material reflects or transmits"}});
+    }
+  }
+  stats["plan"]["mode"] = mc.request.plan_everything ? "everything" : "needed";
+  gl.set_environment_lookup(mc.request.map.lookup, scene.render.fresnel);
   check_deadline();
   // The camera view at the A-buffer's 4x8 sample positions, box-filtered as its resolve
   // weighs the masks: the same edges as abuffer (issue 12 part 4).
@@ -64,7 +69,7 @@ Image render_gpu(MethodContext& mc) {
   const GpuTimings& t = gl.timings();
   stats["timings_ms"]["upload"] = t.upload_ms - before.upload_ms;
   if (maps > 0) stats["timings_ms"]["shadow_maps"] = t.shadow_maps_ms - before.shadow_maps_ms;
-  if (mirrors) stats["timings_ms"]["environment_map"] = t.environment_ms - before.environment_ms;
+  if (needed || mc.request.plan_everything) stats["timings_ms"]["environment_map"] = t.environment_ms - before.environment_ms;
   stats["timings_ms"]["camera_raster"] = t.camera_ms - before.camera_ms;
   stats["timings_ms"]["readback"] = t.readback_ms - before.readback_ms;
   stats["counts"]["shadow_maps"] = maps;

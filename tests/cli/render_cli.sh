@@ -5,13 +5,8 @@
 set -u
 ABCUBE=$1
 REPO=$2
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/abcube_render_cli.XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
-passed=0
-failed=0
-ok() { passed=$((passed + 1)); }
-bad() { failed=$((failed + 1)); echo "FAIL: $*"; }
-check() { local what=$1; shift; if "$@"; then ok; else bad "$what"; fi; }
+CLI_TEST=render_cli
+. "$(dirname "$0")/lib/check.sh"
 
 # A small scene: a mirror, a red and a green triangle, a floor, one light.
 cat > "$WORK/small.json" <<'JSON'
