@@ -28,6 +28,7 @@ struct RenderCommand {
     o.progress = progress_printer();
     Renderer renderer(flags.renderer);
     const Scene s = Scene::load(scene, flags.limits);
+    refuse_unused_options(s, o);
     const RenderResult r = renderer.render(s, o);
 
     const Clock::time_point t0 = Clock::now();

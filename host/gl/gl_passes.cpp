@@ -21,8 +21,10 @@ namespace {
 
 // The camera pass renders at most this many samples a side at once (tiles beyond).
 constexpr int CAMERA_TILE = 2048;
-// Texture units: 1 the opaque shadow maps, 2 the environment, 3.. the translucent peels.
+// Texture units: 1 the opaque shadow maps, 2 the environment, 3.. the translucent peels,
+// then the camera's previous layer.
 constexpr GLenum PEEL_UNIT = 3;
+constexpr GLenum CAMERA_PREVIOUS_UNIT = PEEL_UNIT + MAX_SHADOW_PEELS;
 
 
 struct Vertex {
@@ -74,10 +76,10 @@ struct GlScene::Target {
       return tex;
     };
     color0 = make(distance ? GL_R32F : GL_RGBA32F, GL_COLOR_ATTACHMENT0);
-    if (distance) color1 = make(GL_R32UI, GL_COLOR_ATTACHMENT1);
+    color1 = make(distance ? GL_R32UI : GL_RG32F, GL_COLOR_ATTACHMENT1);
     depth = make(GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT);
     const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    glDrawBuffers(distance ? 2 : 1, buffers);
+    glDrawBuffers(2, buffers);
     const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE) {
       throw RuntimeFailure("framebuffer " + std::to_string(w) + "x" + std::to_string(h) +
@@ -104,7 +106,9 @@ struct GlScene::Target {
       glClearBufferuiv(GL_COLOR, 1, none);
     } else {
       const float bg[4] = {float(background.x), float(background.y), float(background.z), 1.f};
+      const float none[4] = {NO_DISTANCE, -1.f, 0, 0};
       glClearBufferfv(GL_COLOR, 0, bg);
+      glClearBufferfv(GL_COLOR, 1, none);
     }
   }
 
@@ -486,35 +490,89 @@ Image GlScene::camera_color(const Camera& camera, CameraSamples samples) {
   const double aspect = static_cast<double>(camera.width) / camera.height;
   const glm::mat4 clip = camera_clip_matrix(camera.position, camera.look_at, camera.up,
                                             glm::radians(camera.fov_y_deg), aspect, near_);
-  std::vector<float> rgba(static_cast<size_t>(tile_w) * static_cast<size_t>(tile_h) * 4);
+  // Coverage transparency (rule "opacity"): the view is peeled front to back, each layer
+  // blended under the ones before it, C += T op c, T *= 1 - op, the background last.
+  bool transparent = false;
+  for (const uint32_t id : scene_.triangles->material_id) transparent = transparent || scene_.materials[id].opacity < 1.0;
+  const size_t tile_samples = static_cast<size_t>(tile_w) * static_cast<size_t>(tile_h);
+  std::vector<float> rgba(tile_samples * 4);
+  std::vector<double> colour(tile_samples * 3), through(tile_samples);
   std::vector<double> sum(static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height) * 3, 0.0);
+  GLuint previous = 0, query = 0;
+  if (transparent) {
+    glGenTextures(1, &previous);
+    glBindTexture(GL_TEXTURE_2D, previous);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RG32F, tile_w, tile_h);
+    glGenQueries(1, &query);
+    phong_program_->use();
+    glUniform1i(phong_program_->uniform("u_previous"), static_cast<GLint>(CAMERA_PREVIOUS_UNIT));
+  }
+  const glm::dvec3 bg = scene_.background;
+  camera_layers_ = 0;
+  camera_layers_capped_ = false;
   // Tile (x0, y0) in GL window coordinates of the full sample grid (y up): the clip
   // coordinates scaled and shifted so that the tile fills the viewport (one tile: identity).
   for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
     for (int64_t x0 = 0; x0 < full_w; x0 += tile_w) {
-      Clock::time_point t0 = Clock::now();
       glm::mat4 tile(1.f);
       tile[0][0] = float(double(full_w) / tile_w);
       tile[3][0] = float(-double(full_w) / tile_w * (double(2 * x0 + tile_w) / double(full_w) - 1.0));
       tile[1][1] = float(double(full_h) / tile_h);
       tile[3][1] = float(-double(full_h) / tile_h * (double(2 * y0 + tile_h) / double(full_h) - 1.0));
-      t.clear(scene_.background);
-      draw(*phong_program_, tile * clip, camera.position);
-      glFinish();
-      timings_.camera_ms += ms_since(t0);
-      t0 = Clock::now();
-      t.read(0, GL_RGBA, GL_FLOAT, rgba.data());
+      std::fill(colour.begin(), colour.end(), 0.0);
+      std::fill(through.begin(), through.end(), 1.0);
+      for (int layer = 0; layer < (transparent ? MAX_CAMERA_LAYERS : 1); ++layer) {
+        Clock::time_point t0 = Clock::now();
+        phong_program_->use();
+        glUniform1i(phong_program_->uniform("u_peel"), layer);
+        if (layer > 0) {
+          glCopyImageSubData(t.color1, GL_TEXTURE_2D, 0, 0, 0, 0, previous, GL_TEXTURE_2D, 0, 0, 0, 0, tile_w, tile_h, 1);
+          glActiveTexture(GL_TEXTURE0 + CAMERA_PREVIOUS_UNIT);
+          glBindTexture(GL_TEXTURE_2D, previous);
+          glActiveTexture(GL_TEXTURE0);
+        }
+        t.clear(bg);
+        if (transparent) {
+          const float none[4] = {0, 0, 0, 0};  // alpha 0: no surface at this sample
+          glClearBufferfv(GL_COLOR, 0, none);
+          glBeginQuery(GL_ANY_SAMPLES_PASSED, query);
+        }
+        draw(*phong_program_, tile * clip, camera.position);
+        GLuint drew = 1;
+        if (transparent) {
+          glEndQuery(GL_ANY_SAMPLES_PASSED);
+          glGetQueryObjectuiv(query, GL_QUERY_RESULT, &drew);
+        }
+        glFinish();
+        timings_.camera_ms += ms_since(t0);
+        if (!drew) break;
+        camera_layers_ = std::max(camera_layers_, layer + 1);
+        camera_layers_capped_ = camera_layers_capped_ || (transparent && layer + 1 == MAX_CAMERA_LAYERS);
+        t0 = Clock::now();
+        t.read(0, GL_RGBA, GL_FLOAT, rgba.data());
+        for (size_t k = 0; k < tile_samples; ++k) {
+          const double a = transparent ? rgba[4 * k + 3] : 1.0;
+          for (int c = 0; c < 3; ++c) colour[3 * k + static_cast<size_t>(c)] += through[k] * a * rgba[4 * k + static_cast<size_t>(c)];
+          through[k] *= 1.0 - a;
+        }
+        timings_.readback_ms += ms_since(t0);
+      }
       // GL's row 0 is the bottom; the image's row 0 is the top.
       for (int64_t gy = 0; gy < tile_h && y0 + gy < full_h; ++gy) {
         const size_t row = static_cast<size_t>((full_h - 1 - (y0 + gy)) / sy);
-        const float* src = &rgba[static_cast<size_t>(gy) * static_cast<size_t>(tile_w) * 4];
         for (int64_t gx = 0; gx < tile_w && x0 + gx < full_w; ++gx) {
+          const size_t k = static_cast<size_t>(gy) * static_cast<size_t>(tile_w) + static_cast<size_t>(gx);
           double* dst = &sum[(row * static_cast<size_t>(camera.width) + static_cast<size_t>((x0 + gx) / sx)) * 3];
-          for (int c = 0; c < 3; ++c) dst[c] += src[4 * gx + c];
+          for (int c = 0; c < 3; ++c) dst[c] += colour[3 * k + static_cast<size_t>(c)] + through[k] * bg[c];
         }
       }
-      timings_.readback_ms += ms_since(t0);
     }
+  }
+  if (transparent) {
+    phong_program_->use();
+    glUniform1i(phong_program_->uniform("u_peel"), 0);
+    glDeleteTextures(1, &previous);
+    glDeleteQueries(1, &query);
   }
   Image out(camera.width, camera.height, 3);
   const double samples_per_pixel = double(sx * sy);

@@ -29,6 +29,9 @@ constexpr double SHADOW_BIAS_TEXELS = 1.5;
 // Translucent shadow casters peeled per light, at most (shadow_caster.frag; the GLSL
 // constant of the same name). Crossings beyond the last layer let the light through.
 constexpr int MAX_SHADOW_PEELS = 8;
+// Layers of the camera view peeled when a material has coverage transparency (opacity
+// < 1), at most; behind the last, the background shows through what is left.
+constexpr int MAX_CAMERA_LAYERS = 16;
 
 // Where the camera pass samples each pixel: its centre (one sample, aliased), or the
 // A-buffer's 4x8 sample positions (samples.hpp), box-filtered as the CPU resolve weighs
@@ -72,6 +75,10 @@ class GlScene {
   // whether crossings were left beyond MAX_SHADOW_PEELS.
   int shadow_peels() const { return static_cast<int>(shadow_peels_.size()); }
   bool shadow_peels_capped() const { return shadow_peels_capped_; }
+  // Layers the last camera_color drew (1 without coverage transparency), and whether
+  // samples were left beyond MAX_CAMERA_LAYERS.
+  int camera_layers() const { return camera_layers_; }
+  bool camera_layers_capped() const { return camera_layers_capped_; }
 
   // The Z-buffer colour of the six faces around `center` (with shadows if built) kept on
   // the GPU as a cube texture; later camera passes look it up for kr and kt (Blinn & Newell
@@ -104,6 +111,8 @@ class GlScene {
   GLuint shadow_maps_ = 0, environment_ = 0, lookup_fbo_ = 0, lookup_depth_ = 0;
   std::vector<GLuint> shadow_peels_;  // one cube-map array (a layer per light and face) per peel
   bool shadow_peels_capped_ = false;
+  int camera_layers_ = 0;
+  bool camera_layers_capped_ = false;
   int shadow_n_ = 0;
   std::vector<int> shadow_layer_;  // per light, -1 when it casts no shadows
   GLsizei vertex_count_ = 0;

@@ -76,6 +76,8 @@ Image render_gpu(MethodContext& mc) {
   stats["counts"]["shadow_translucent_layers"] = maps > 0 ? gl.shadow_peels() : 0;
   stats["counts"]["shadow_translucent_layers_capped"] = maps > 0 && gl.shadow_peels_capped();
   stats["counts"]["camera_samples_per_pixel"] = MASK_SAMPLES;
+  stats["counts"]["camera_layers"] = gl.camera_layers();  // > 1: coverage transparency peeled
+  stats["counts"]["camera_layers_capped"] = gl.camera_layers_capped();
   stats["plan"]["passes"] = passes;
   stats["plan"]["skipped"] = skipped;
   return image;

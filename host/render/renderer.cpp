@@ -84,50 +84,6 @@ Enum parse_named(const std::string& value, bool (*parse)(const std::string&, Enu
   return e;
 }
 
-// What each method honours (README "What each method honours"): an option given to a
-// render whose method has no use for it is refused with one line, never ignored. The
-// scene file's own settings (render.cube_resolution, ...) are every method's defaults and
-// are not refused; a scene the method cannot draw as written is (gpu and opacity).
-void refuse_unused_options(const SceneData& view, const RenderOptions& o) {
-  const Method m = view.render.method;
-  const bool map = m == Method::abuffer || m == Method::zbuffer || m == Method::envmap;
-  const RenderOptions defaults;
-  const auto refuse = [&](const std::string& option, const char* why) {
-    throw InputError(option + ": not used by --method " + method_name(m) + " (" + why + ")");
-  };
-  if (m == Method::raytrace) {
-    if (o.cube_resolution != 0) refuse("cube-res", "the exact tracer builds no cube map");
-    if (o.error_target > 0) refuse("error-target", "it picks the cube map's N; the exact tracer has no map");
-    if (o.plan_everything) refuse("plan everything", "the exact tracer skips no pass");
-  }
-  if (!map) {
-    const char* searches = "map searches only: abuffer, zbuffer, envmap";
-    if (o.search != defaults.search) refuse("search", searches);
-    if (o.refine != defaults.refine) refuse("refine", searches);
-    if (o.theta_max_deg != defaults.theta_max_deg) refuse("theta-max", searches);
-    if (o.side_structure != defaults.side_structure) refuse("map-only", searches);
-    if (o.resolve != defaults.resolve) refuse("resolve", "the CPU A-buffer's resolve: abuffer, zbuffer, envmap");
-    if (o.max_layers != defaults.max_layers) refuse("max-layers", "the CPU A-buffer's lists: abuffer, zbuffer, envmap");
-  }
-  if (o.refraction != defaults.refraction && m != Method::abuffer && m != Method::zbuffer) {
-    refuse("refraction", "the lens replaces an exit search: abuffer, zbuffer");
-  }
-  if (o.envmap_lookup != defaults.envmap_lookup && m != Method::envmap && m != Method::gpu) {
-    refuse("envmap-lookup", "environment map lookups: envmap, gpu");
-  }
-  if (m == Method::gpu) {
-    std::vector<bool> used(view.materials.size(), false);
-    for (const uint32_t id : view.triangles->material_id) used[id] = true;
-    for (size_t k = 0; k < view.materials.size(); ++k) {
-      const Material& mat = view.materials[k];
-      if (used[k] && mat.opacity < 1.0) {
-        throw InputError(view.file + ": materials." + mat.name + ".opacity: " + std::to_string(mat.opacity) +
-                         " < 1 is not drawn by --method gpu (its Z-buffer raster is opaque; abuffer, zbuffer, "
-                         "envmap and raytrace blend it)");
-      }
-    }
-  }
-}
 
 // The render request: the scene's settings with the options' overrides, validated.
 RenderRequest make_request(const SceneData& base, const RenderOptions& o, int renderer_threads, SceneData* view) {
@@ -190,7 +146,6 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
     if (!aov_known(a)) throw InputError("aovs: unknown AOV '" + a + "' (" + aov_names() + ")");
   }
   r.aovs = o.aovs;
-  refuse_unused_options(*view, o);
   check_render_size(*view, available_memory_bytes());
   return r;
 }
@@ -386,6 +341,39 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   result.image = std::move(image);
   result.stats = render_stats(stats, built, psnr, options.stats);
   return result;
+}
+
+// What each method honours (README "What each method honours"; renderer.hpp).
+void refuse_unused_options(const Scene& scene, const RenderOptions& o) {
+  Method m = scene.data().render.method;
+  if (!o.method.empty() && !parse_method(o.method, &m)) {
+    throw InputError("method: unknown method '" + o.method + "' (abuffer, zbuffer, envmap, raytrace, gpu)");
+  }
+  const bool map = m == Method::abuffer || m == Method::zbuffer || m == Method::envmap;
+  const RenderOptions defaults;
+  const auto refuse = [&](const std::string& option, const char* why) {
+    throw InputError(option + ": not used by --method " + method_name(m) + " (" + why + ")");
+  };
+  if (m == Method::raytrace) {
+    if (o.cube_resolution != 0) refuse("cube-res", "the exact tracer builds no cube map");
+    if (o.error_target > 0) refuse("error-target", "it picks the cube map's N; the exact tracer has no map");
+    if (o.plan_everything) refuse("plan everything", "the exact tracer skips no pass");
+  }
+  if (!map) {
+    const char* searches = "map searches only: abuffer, zbuffer, envmap";
+    if (o.search != defaults.search) refuse("search", searches);
+    if (o.refine != defaults.refine) refuse("refine", searches);
+    if (o.theta_max_deg != defaults.theta_max_deg) refuse("theta-max", searches);
+    if (o.side_structure != defaults.side_structure) refuse("map-only", searches);
+    if (o.resolve != defaults.resolve) refuse("resolve", "the CPU A-buffer's resolve: abuffer, zbuffer, envmap");
+    if (o.max_layers != defaults.max_layers) refuse("max-layers", "the CPU A-buffer's lists: abuffer, zbuffer, envmap");
+  }
+  if (o.refraction != defaults.refraction && m != Method::abuffer && m != Method::zbuffer) {
+    refuse("refraction", "the lens replaces an exit search: abuffer, zbuffer");
+  }
+  if (o.envmap_lookup != defaults.envmap_lookup && m != Method::envmap && m != Method::gpu) {
+    refuse("envmap-lookup", "environment map lookups: envmap, gpu");
+  }
 }
 
 }  // namespace abcube

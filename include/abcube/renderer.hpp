@@ -106,6 +106,14 @@ struct RenderResult {
   RenderStats stats;
 };
 
+// What each method honours (README "What each method honours"): throws InputError with
+// one line when `options` gives a setting that the render's method (options.method, or
+// the scene's) has no use for, e.g. --refraction thick_lens with raytrace. `abcube render`
+// calls it before rendering; Renderer::render itself leaves such settings unused, so that
+// one RenderOptions can serve renders of several methods. The scene file's own settings
+// (render.cube_resolution, ...) are every method's defaults and never refused.
+void refuse_unused_options(const Scene& scene, const RenderOptions& options);
+
 struct RendererOptions {
   std::string gl = "auto";  // auto | egl | egl-device | egl-surfaceless | osmesa | none
   int gl_device = -1;       // EGL device index (-1: ABCUBE_EGL_DEVICE, else the first hardware one)
