@@ -40,12 +40,26 @@ RayQuery::RayQuery(const glm::dvec3& o, const glm::dvec3& d) : origin(o), dir(d)
   inv_dir = glm::dvec3(1.0) / d;
 }
 
-// A triangle during construction: its bounds and centroid.
-struct BvhBuildItem {
-  Bounds box;
-  glm::dvec3 centroid{0.0};
-  uint32_t triangle = 0;
+namespace {
+
+// A triangle during construction is its index (4 bytes): its bounds are read from the
+// soup's float vertices when needed (float holds them exactly), its centroid in double.
+struct BuildBoxes {
+  const glm::vec3* positions;
+  Bounds box(uint32_t t) const {
+    const glm::vec3* v = positions + 3 * static_cast<size_t>(t);
+    Bounds b;
+    b.lo = glm::dvec3(glm::min(v[0], glm::min(v[1], v[2])));
+    b.hi = glm::dvec3(glm::max(v[0], glm::max(v[1], v[2])));
+    return b;
+  }
+  glm::dvec3 centroid(uint32_t t) const {
+    const Bounds b = box(t);
+    return 0.5 * (b.lo + b.hi);
+  }
 };
+
+}  // namespace
 
 namespace {
 
@@ -55,14 +69,14 @@ struct SahSplit {
   double cost = DBL_MAX;
 };
 
-int sah_bin(const BvhBuildItem& it, int axis, const Bounds& centroids) {
+int sah_bin(const BuildBoxes& boxes, uint32_t it, int axis, const Bounds& centroids) {
   const double scale = SAH_BINS / (centroids.hi[axis] - centroids.lo[axis]);
-  return std::min(static_cast<int>((it.centroid[axis] - centroids.lo[axis]) * scale), SAH_BINS - 1);
+  return std::min(static_cast<int>((boxes.centroid(it)[axis] - centroids.lo[axis]) * scale), SAH_BINS - 1);
 }
 
 // The cheapest binned-SAH split of items[begin, end) over the three axes (Wald 2007):
 // cost = TRAVERSAL_COST + (A_left N_left + A_right N_right) / A, in triangle tests.
-SahSplit best_sah_split(const std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t end, const Bounds& box,
+SahSplit best_sah_split(const BuildBoxes& boxes, const std::vector<uint32_t>& items, uint32_t begin, uint32_t end, const Bounds& box,
                         const Bounds& centroids) {
   SahSplit best;
   for (int axis = 0; axis < 3; ++axis) {
@@ -70,8 +84,8 @@ SahSplit best_sah_split(const std::vector<BvhBuildItem>& items, uint32_t begin, 
     std::array<Bounds, SAH_BINS> bins;
     std::array<uint32_t, SAH_BINS> counts{};
     for (uint32_t i = begin; i < end; ++i) {
-      const int b = sah_bin(items[i], axis, centroids);
-      bins[b].extend(items[i].box);
+      const int b = sah_bin(boxes, items[i], axis, centroids);
+      bins[b].extend(boxes.box(items[i]));
       ++counts[b];
     }
     // Sweep from the right for the right-hand areas, then from the left.
@@ -99,73 +113,71 @@ SahSplit best_sah_split(const std::vector<BvhBuildItem>& items, uint32_t begin, 
 }
 
 // Splits items[begin, end) at their median along `axis` (ties broken by triangle index).
-uint32_t median_split(std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t end, int axis) {
+uint32_t median_split(const BuildBoxes& boxes, std::vector<uint32_t>& items, uint32_t begin, uint32_t end, int axis) {
   const uint32_t mid = begin + (end - begin) / 2;
   std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
-                   [axis](const BvhBuildItem& a, const BvhBuildItem& b) {
-                     if (a.centroid[axis] != b.centroid[axis]) return a.centroid[axis] < b.centroid[axis];
-                     return a.triangle < b.triangle;
+                   [&boxes, axis](uint32_t a, uint32_t b) {
+                     const double ca = boxes.centroid(a)[axis], cb = boxes.centroid(b)[axis];
+                     if (ca != cb) return ca < cb;
+                     return a < b;
                    });
   return mid;
 }
 
 }  // namespace
 
-Bvh::Bvh(const TriangleSoup& soup) {
-  const size_t n = soup.triangle_count();
-  ABCUBE_CHECK(soup.positions.size() == 3 * n, "positions must hold 3 vertices per triangle");
-  ABCUBE_CHECK(n < UINT32_MAX / 3, "too many triangles for 32-bit indices");
+Bvh::Bvh(const TriangleSoup& soup, const std::vector<uint32_t>& subset) : soup_(&soup) {
+  const size_t all = soup.triangle_count();
+  ABCUBE_CHECK(soup.positions.size() == 3 * all, "positions must hold 3 vertices per triangle");
+  ABCUBE_CHECK(all < UINT32_MAX / 3, "too many triangles for 32-bit indices");
+  const bool whole = subset.empty();
+  const size_t n = whole ? all : subset.size();
   if (n == 0) return;
-  std::vector<BvhBuildItem> items(n);
+  // The leaves take the items in order, so the items once built are the leaf order.
+  std::vector<uint32_t> items(n);
   for (size_t i = 0; i < n; ++i) {
-    Bounds b;
-    for (int k = 0; k < 3; ++k) b.extend(glm::dvec3(soup.positions[3 * i + k]));
-    items[i] = {b, 0.5 * (b.lo + b.hi), static_cast<uint32_t>(i)};
+    const uint32_t t = whole ? static_cast<uint32_t>(i) : subset[i];
+    ABCUBE_CHECK(t < all && (i == 0 || whole || subset[i - 1] < t), "subset must be ascending soup triangles");
+    items[i] = t;
   }
-  nodes_.reserve(2 * n);
-  order_.reserve(n);
+  nodes_.reserve(2 * n);  // untouched room costs no memory
   build(items, 0, static_cast<uint32_t>(n), 0);
-  vertices_.resize(3 * n);
-  slot_of_.assign(n, 0);
-  for (uint32_t s = 0; s < n; ++s) {
-    slot_of_[order_[s]] = s;
-    for (int k = 0; k < 3; ++k) vertices_[3 * s + k] = glm::dvec3(soup.positions[3 * order_[s] + k]);
-  }
+  order_ = std::move(items);
 }
 
 // Builds the subtree over items[begin, end) and returns its node index (depth first).
-uint32_t Bvh::build(std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t end, int depth) {
+uint32_t Bvh::build(std::vector<uint32_t>& items, uint32_t begin, uint32_t end, int depth) {
+  const BuildBoxes boxes{soup_->positions.data()};
   const uint32_t index = static_cast<uint32_t>(nodes_.size());
   nodes_.emplace_back();
   depth_ = std::max(depth_, depth + 1);
   Bounds box, centroids;
   for (uint32_t i = begin; i < end; ++i) {
-    box.extend(items[i].box);
-    centroids.extend(items[i].centroid);
+    box.extend(boxes.box(items[i]));
+    centroids.extend(boxes.centroid(items[i]));
   }
-  nodes_[index].lo = box.lo;
-  nodes_[index].hi = box.hi;
+  nodes_[index].lo = glm::vec3(box.lo);  // exact: float coordinates
+  nodes_[index].hi = glm::vec3(box.hi);
   const uint32_t count = end - begin;
   const glm::dvec3 extent = centroids.hi - centroids.lo;
   const int widest = extent.x > extent.y ? (extent.x > extent.z ? 0 : 2) : (extent.y > extent.z ? 1 : 2);
-  const SahSplit split = depth < SAH_DEPTH_LIMIT && count > 2 ? best_sah_split(items, begin, end, box, centroids)
+  const SahSplit split = depth < SAH_DEPTH_LIMIT && count > 2 ? best_sah_split(boxes, items, begin, end, box, centroids)
                                                               : SahSplit{};
   const bool leaf_is_cheaper = split.axis >= 0 && split.cost >= static_cast<double>(count);
   const bool cannot_split = !(extent[widest] > 0.0);  // coincident centroids
   if (count <= 2 || (count <= MAX_LEAF && (leaf_is_cheaper || cannot_split))) {
-    nodes_[index].offset = static_cast<uint32_t>(order_.size());
-    nodes_[index].count = count;
-    for (uint32_t i = begin; i < end; ++i) order_.push_back(items[i].triangle);
+    nodes_[index].offset = begin;  // leaves come left to right: slots [begin, end)
+    nodes_[index].count = static_cast<uint16_t>(count);
     return index;
   }
   uint32_t mid = begin;
   if (split.axis >= 0) {
-    auto goes_left = [&](const BvhBuildItem& it) { return sah_bin(it, split.axis, centroids) < split.bin; };
+    auto goes_left = [&](uint32_t it) { return sah_bin(boxes, it, split.axis, centroids) < split.bin; };
     mid = static_cast<uint32_t>(std::stable_partition(items.begin() + begin, items.begin() + end, goes_left) -
                                 items.begin());
   }
-  if (mid == begin || mid == end) mid = median_split(items, begin, end, widest);  // no SAH split, or too deep
-  nodes_[index].axis = static_cast<uint32_t>(split.axis >= 0 ? split.axis : widest);
+  if (mid == begin || mid == end) mid = median_split(boxes, items, begin, end, widest);  // no SAH split, or too deep
+  nodes_[index].axis = static_cast<uint16_t>(split.axis >= 0 ? split.axis : widest);
   build(items, begin, mid, depth + 1);
   const uint32_t second = build(items, mid, end, depth + 1);
   nodes_[index].offset = second;
@@ -178,8 +190,8 @@ uint32_t Bvh::build(std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t e
 bool Bvh::hits_box(const RayQuery& ray, const BvhNode& node, double tmax) {
   double t0 = 0.0, t1 = tmax;
   for (int a = 0; a < 3; ++a) {
-    double tn = (node.lo[a] - ray.origin[a]) * ray.inv_dir[a];
-    double tf = (node.hi[a] - ray.origin[a]) * ray.inv_dir[a];
+    double tn = (static_cast<double>(node.lo[a]) - ray.origin[a]) * ray.inv_dir[a];
+    double tf = (static_cast<double>(node.hi[a]) - ray.origin[a]) * ray.inv_dir[a];
     if (tn > tf) std::swap(tn, tf);
     tf *= BOX_FAR_SCALE;
     t0 = tn > t0 ? tn : t0;
@@ -191,37 +203,37 @@ bool Bvh::hits_box(const RayQuery& ray, const BvhNode& node, double tmax) {
 
 // Woop, Benthin, Wald 2013, "Watertight ray/triangle intersection", figure 10,
 // without back-face culling, in double precision.
-bool Bvh::intersect_slot(const RayQuery& ray, uint32_t slot, double tmax, TriangleHit* hit) const {
-  const glm::dvec3 a = vertices_[3 * slot] - ray.origin;
-  const glm::dvec3 b = vertices_[3 * slot + 1] - ray.origin;
-  const glm::dvec3 c = vertices_[3 * slot + 2] - ray.origin;
+bool Bvh::intersect_triangle(const RayQuery& ray, uint32_t triangle, double tmax, TriangleHit* hit) const {
+  ABCUBE_CHECK(triangle < soup_->triangle_count(), "triangle index out of range");
+  return intersect(ray, triangle, tmax, hit);
+}
+
+bool Bvh::intersect(const RayQuery& ray, uint32_t triangle, double tmax, TriangleHit* hit) const {
+  const glm::vec3* v = &soup_->positions[3 * static_cast<size_t>(triangle)];
+  const glm::dvec3 a = glm::dvec3(v[0]) - ray.origin;
+  const glm::dvec3 b = glm::dvec3(v[1]) - ray.origin;
+  const glm::dvec3 c = glm::dvec3(v[2]) - ray.origin;
   const double ax = a[ray.kx] - ray.sx * a[ray.kz], ay = a[ray.ky] - ray.sy * a[ray.kz];
   const double bx = b[ray.kx] - ray.sx * b[ray.kz], by = b[ray.ky] - ray.sy * b[ray.kz];
   const double cx = c[ray.kx] - ray.sx * c[ray.kz], cy = c[ray.ky] - ray.sy * c[ray.kz];
   const double u = cx * by - cy * bx;
-  const double v = ax * cy - ay * cx;
+  const double v_ = ax * cy - ay * cx;
   const double w = bx * ay - by * ax;
-  if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) return false;
-  const double det = u + v + w;
+  if ((u < 0.0 || v_ < 0.0 || w < 0.0) && (u > 0.0 || v_ > 0.0 || w > 0.0)) return false;
+  const double det = u + v_ + w;
   if (det == 0.0) return false;
-  const double t_scaled = ray.sz * (u * a[ray.kz] + v * b[ray.kz] + w * c[ray.kz]);
+  const double t_scaled = ray.sz * (u * a[ray.kz] + v_ * b[ray.kz] + w * c[ray.kz]);
   if (det > 0.0 ? (t_scaled <= 0.0 || t_scaled >= tmax * det)
                 : (t_scaled >= 0.0 || t_scaled <= tmax * det)) {
     return false;
   }
   const double inv_det = 1.0 / det;
   hit->t = t_scaled * inv_det;
-  hit->triangle = order_[slot];
+  hit->triangle = triangle;
   hit->b0 = u * inv_det;
-  hit->b1 = v * inv_det;
+  hit->b1 = v_ * inv_det;
   hit->b2 = w * inv_det;
   return true;
-}
-
-bool Bvh::intersect_triangle(const RayQuery& ray, uint32_t triangle, double tmax,
-                             TriangleHit* hit) const {
-  ABCUBE_CHECK(triangle < slot_of_.size(), "triangle index out of range");
-  return intersect_slot(ray, slot_of_[triangle], tmax, hit);
 }
 
 bool Bvh::closest_hit(const RayQuery& ray, double tmax, TriangleHit* hit) const {

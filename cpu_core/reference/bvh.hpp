@@ -2,6 +2,11 @@
 // the binned surface area heuristic (Wald 2007, "On fast construction of SAH-based
 // bounding volume hierarchies"), traversed and intersected in double precision.
 //
+// Memory: the BVH keeps no copy of the triangles. It reads the soup's float vertices
+// (which must outlive it, unchanged) and converts them to double on each test; its nodes
+// hold float boxes, exact because every bound is one of those float coordinates. About
+// 4 bytes a triangle (the leaf order) plus 32 a node.
+//
 // Exactness: the float vertices are converted to double exactly; the ray-triangle test is
 // the watertight one of Woop, Benthin and Wald 2013 ("Watertight ray/triangle
 // intersection", JCGT 2(1)): a ray through a shared edge or vertex of a closed mesh hits at
@@ -18,8 +23,6 @@
 #include "scene/scene_data.hpp"
 
 namespace abcube {
-
-struct BvhBuildItem;  // bvh.cpp
 
 // A ray prepared for the watertight test: the axis kz of the largest direction component,
 // kx, ky the other two (swapped to keep the winding), and the shear (sx, sy, sz).
@@ -38,16 +41,19 @@ struct TriangleHit {
   double b0 = 0, b1 = 0, b2 = 0;
 };
 
+// 32 bytes. The box is a union of float vertex coordinates: float holds it exactly.
 struct BvhNode {
-  glm::dvec3 lo{0.0}, hi{0.0};
+  glm::vec3 lo{0.0f}, hi{0.0f};
   uint32_t offset = 0;  // leaf: first slot in the leaf order; inner: index of the second child
-  uint32_t count = 0;   // leaf: number of triangles; inner: 0 (the first child is this + 1)
-  uint32_t axis = 0;    // inner: split axis, to visit the nearer child first
+  uint16_t count = 0;   // leaf: number of triangles (<= 8); inner: 0 (the first child is this + 1)
+  uint16_t axis = 0;    // inner: split axis, to visit the nearer child first
 };
 
 class Bvh {
  public:
-  explicit Bvh(const TriangleSoup& soup);
+  // Over every triangle of `soup`, or only over `subset` (triangle indices, ascending) when
+  // given. Hits name soup triangles either way. `soup` must outlive the BVH, unchanged.
+  explicit Bvh(const TriangleSoup& soup, const std::vector<uint32_t>& subset = {});
 
   // The nearest hit with 0 < t < tmax (t in units of |dir|). Ties keep the first found.
   bool closest_hit(const RayQuery& ray, double tmax, TriangleHit* hit) const;
@@ -61,19 +67,21 @@ class Bvh {
   int depth() const { return depth_; }
   size_t triangle_count() const { return order_.size(); }
 
-  // The watertight test against one triangle (Woop et al. 2013), exposed for tests.
+  // The watertight test against one soup triangle (Woop et al. 2013), exposed for tests.
   bool intersect_triangle(const RayQuery& ray, uint32_t triangle, double tmax,
                           TriangleHit* hit) const;
 
  private:
-  uint32_t build(std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t end, int depth);
-  bool intersect_slot(const RayQuery& ray, uint32_t slot, double tmax, TriangleHit* hit) const;
+  uint32_t build(std::vector<uint32_t>& items, uint32_t begin, uint32_t end, int depth);
+  bool intersect(const RayQuery& ray, uint32_t triangle, double tmax, TriangleHit* hit) const;
+  bool intersect_slot(const RayQuery& ray, uint32_t slot, double tmax, TriangleHit* hit) const {
+    return intersect(ray, order_[slot], tmax, hit);
+  }
   static bool hits_box(const RayQuery& ray, const BvhNode& node, double tmax);
 
-  std::vector<glm::dvec3> vertices_;  // 3 per triangle slot, in leaf order
-  std::vector<uint32_t> order_;       // slot -> triangle index in the soup
-  std::vector<uint32_t> slot_of_;     // triangle index -> slot
-  std::vector<BvhNode> nodes_;        // depth first; node 0 is the root
+  const TriangleSoup* soup_;
+  std::vector<uint32_t> order_;  // slot -> triangle index in the soup, in leaf order
+  std::vector<BvhNode> nodes_;   // depth first; node 0 is the root
   int depth_ = 0;
 };
 

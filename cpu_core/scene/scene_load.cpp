@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "base/error.hpp"
+#include "base/memory.hpp"
 #include "scene/scene_load_state.hpp"
 #include "scene/tessellate.hpp"
 
@@ -256,7 +257,7 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   if (const Json* t = f.find("transform")) {
     transform = read_transform(Fields(st.src, *t, f.at("transform"), {"translate", "rotate_deg", "scale"}));
   }
-  const LocalMesh local = read_geometry(st, f, type, material != nullptr);
+  LocalMesh local = read_geometry(st, f, type, material != nullptr);
   // Without a "material", a primitive gets the default and a mesh its per-face MTL ones.
   if (!material && local.material.empty()) obj.material = default_material(st);
   if (st.scene.triangles->triangle_count() + local.triangle_count() > MAX_TRIANGLES) {
@@ -269,7 +270,11 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   obj.first_triangle = static_cast<uint32_t>(soup.triangle_count());
   st.scene.dropped_triangles += append_triangles(local, make_affine_map(transform), id, obj.material, &soup);
   obj.triangle_count = static_cast<uint32_t>(soup.triangle_count() - obj.first_triangle);
-  if (!material && !local.material.empty()) {
+  const bool per_face_materials = !local.material.empty();
+  const bool from_file = local.indexed;
+  local = LocalMesh{};  // freed before the closed-surface test: peak memory
+  if (from_file) release_free_memory();  // the OBJ parser's many small blocks
+  if (!material && per_face_materials) {
     obj.material = obj.triangle_count > 0 ? soup.material_id[obj.first_triangle] : default_material(st);
   }
   // A closed surface has an inside; make its geometric normals point out of it.

@@ -67,26 +67,20 @@ std::string find_line(const std::string& text, const char* needle) {
   return "";
 }
 
-// Appends one OBJ face (already validated) to `out`, triangulating polygons.
-void add_obj_face(const tinyobj::attrib_t& a, const tinyobj::index_t* corners, size_t n, int material,
-                  LocalMesh* out) {
-  std::vector<glm::dvec3> p(n), nrm(n, glm::dvec3(0.0));
+// Appends one OBJ face (already validated) to `out` (indexed, positions and normals
+// already copied from the file's), triangulating polygons.
+void add_obj_face(const tinyobj::index_t* corners, size_t n, int material, LocalMesh* out) {
+  std::vector<glm::dvec3> p(n);
   bool smooth = true;
   for (size_t k = 0; k < n; ++k) {
-    const size_t v = static_cast<size_t>(corners[k].vertex_index);
-    p[k] = glm::dvec3(a.vertices[3 * v], a.vertices[3 * v + 1], a.vertices[3 * v + 2]);
-    const int ni = corners[k].normal_index;
-    smooth = smooth && ni >= 0;
-    if (ni >= 0) {
-      const size_t w = static_cast<size_t>(ni);
-      nrm[k] = glm::dvec3(a.normals[3 * w], a.normals[3 * w + 1], a.normals[3 * w + 2]);
-    }
+    p[k] = out->positions[static_cast<size_t>(corners[k].vertex_index)];
+    smooth = smooth && corners[k].normal_index >= 0;
   }
-  if (!smooth) std::fill(nrm.begin(), nrm.end(), glm::dvec3(0.0));  // zero: flat
   for (const auto& t : triangulate_polygon(p)) {
     for (int k : t) {
-      out->positions.push_back(p[static_cast<size_t>(k)]);
-      out->normals.push_back(nrm[static_cast<size_t>(k)]);
+      const tinyobj::index_t& c = corners[static_cast<size_t>(k)];
+      out->position_index.push_back(static_cast<uint32_t>(c.vertex_index));
+      out->normal_index.push_back(smooth ? static_cast<uint32_t>(c.normal_index) : LocalMesh::NO_NORMAL);  // flat
     }
     out->material.push_back(material);
   }
@@ -208,7 +202,7 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
     fail(st.src, path, "cannot read mesh \"" + resolved + "\": " + (exists ? "not a regular file" : "no such file"));
   }
   const ObjFile obj = parse_obj(st, path, resolved);
-  check_triangle_cap(st, path, obj_triangle_count(obj));
+  check_triangle_cap(st, path, obj_triangle_count(obj));  // before anything is made
   if (use_mtl) {
     const std::string missing = find_line(obj.warning, "not found");
     if (!missing.empty()) fail(st.src, path, "mesh \"" + resolved + "\": " + missing);
@@ -218,6 +212,19 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
   const int vertex_count = static_cast<int>(a.vertices.size() / 3);
   const int normal_count = static_cast<int>(a.normals.size() / 3);
   LocalMesh m;
+  m.indexed = true;
+  m.positions.reserve(static_cast<size_t>(vertex_count));
+  for (size_t v = 0; v < static_cast<size_t>(vertex_count); ++v) {
+    m.positions.emplace_back(a.vertices[3 * v], a.vertices[3 * v + 1], a.vertices[3 * v + 2]);
+  }
+  m.normals.reserve(static_cast<size_t>(normal_count));
+  for (size_t v = 0; v < static_cast<size_t>(normal_count); ++v) {
+    m.normals.emplace_back(a.normals[3 * v], a.normals[3 * v + 1], a.normals[3 * v + 2]);
+  }
+  const uint64_t triangles = obj_triangle_count(obj);
+  m.position_index.reserve(3 * triangles);
+  m.normal_index.reserve(3 * triangles);
+  m.material.reserve(triangles);
   for (const tinyobj::shape_t& shape : obj.shapes) {
     size_t offset = 0;
     for (size_t face = 0; face < shape.mesh.num_face_vertices.size(); ++face) {
@@ -236,7 +243,7 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
         material = mtl >= 0 && static_cast<size_t>(mtl) < mtl_ids.size() ? static_cast<int>(mtl_ids[static_cast<size_t>(mtl)])
                                                                          : static_cast<int>(default_material(st));
       }
-      add_obj_face(a, corners, n, material, &m);
+      add_obj_face(corners, n, material, &m);
       if (st.scene.triangles->triangle_count() + m.triangle_count() > MAX_TRIANGLES) {
         fail(st.src, path, "the scene would exceed " + std::to_string(MAX_TRIANGLES) + " triangles");
       }

@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <unordered_map>
 #include <utility>
+
+#include "base/error.hpp"
 
 namespace abcube {
 
@@ -21,6 +22,11 @@ void push_triangle(LocalMesh* m, const glm::dvec3& a, const glm::dvec3& b, const
   m->positions.push_back(b);
   m->positions.push_back(c);
 }
+
+// Rounds to float, out of line: GCC 12 -O3 (SLP vectorizer) inlined into append_triangles
+// once kept the double x and y where they were rounded, converted back (the soup's
+// normals then differed from the positions' by an ulp; tests/golden caught it).
+[[gnu::noinline]] glm::vec3 to_float(const glm::dvec3& v) { return glm::vec3(v); }
 
 bool finite3(const glm::dvec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -91,13 +97,6 @@ struct VertexKey {
     return bits[0] == o.bits[0] && bits[1] == o.bits[1] && bits[2] == o.bits[2];
   }
 };
-struct VertexKeyHash {
-  size_t operator()(const VertexKey& k) const {
-    uint64_t h = 1469598103934665603ull;  // FNV-1a
-    for (uint32_t b : k.bits) h = (h ^ b) * 1099511628211ull;
-    return static_cast<size_t>(h);
-  }
-};
 
 VertexKey vertex_key(const glm::vec3& p) {
   VertexKey k{};
@@ -106,6 +105,52 @@ VertexKey vertex_key(const glm::vec3& p) {
     std::memcpy(&k.bits[i], &f, sizeof f);
   }
   return k;
+}
+
+// A 64-bit mix (the splitmix64 finalizer, Steele et al. 2014) for the hash tables below.
+uint64_t mix64(uint64_t x) {
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+// For items 0..n-1: the smallest index of an item equal to each (its own when it is the
+// first), or NO_PARTNER for an item skip(i) leaves out. An open-addressing hash table of
+// item indices (linear probing, kept at most 3/4 full, doubled as it fills): 4 bytes an
+// item for the answer and 5 to 11 bytes a distinct key for the table, no sort.
+template <class Hash, class Equal, class Skip>
+std::vector<uint32_t> first_equal(size_t n, Hash&& hash, Equal&& equal, Skip&& skip) {
+  constexpr uint32_t EMPTY = NO_PARTNER;
+  std::vector<uint32_t> first(n, NO_PARTNER);
+  std::vector<uint32_t> table(1024, EMPTY);
+  size_t used = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    if (skip(i)) continue;
+    if (4 * (used + 1) > 3 * table.size()) {
+      std::vector<uint32_t> grown(2 * table.size(), EMPTY);
+      for (const uint32_t e : table) {
+        if (e == EMPTY) continue;
+        size_t h = hash(e) & (grown.size() - 1);
+        while (grown[h] != EMPTY) h = (h + 1) & (grown.size() - 1);
+        grown[h] = e;
+      }
+      table.swap(grown);
+    }
+    for (size_t h = hash(i) & (table.size() - 1);; h = (h + 1) & (table.size() - 1)) {
+      const uint32_t e = table[h];
+      if (e == EMPTY) {
+        table[h] = i;
+        ++used;
+        first[i] = i;
+        break;
+      }
+      if (equal(e, i)) {
+        first[i] = e;
+        break;
+      }
+    }
+  }
+  return first;
 }
 
 }  // namespace
@@ -269,12 +314,22 @@ size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t obj
   // A mirroring transform reverses the winding; swapping b and c restores the sense of
   // the geometric normal.
   const int order[3] = {0, m.mirrors ? 2 : 1, m.mirrors ? 1 : 2};
+  // Room for the whole object at once and half as much again: a large mesh is never copied
+  // while it grows, nor by the small objects after it (peak memory).
+  const size_t need = soup->object_id.size() + local.triangle_count();
+  if (soup->object_id.capacity() < need) {
+    const size_t room = std::max(need + need / 2, 2 * soup->object_id.size());  // untouched room costs no memory
+    soup->positions.reserve(3 * room);
+    soup->normals.reserve(3 * room);
+    soup->object_id.reserve(room);
+    soup->material_id.reserve(room);
+  }
   size_t dropped = 0;
   for (size_t t = 0; t < local.triangle_count(); ++t) {
     glm::vec3 f[3];
     glm::dvec3 p[3];
     for (int k = 0; k < 3; ++k) {
-      f[k] = glm::vec3(m.point(local.positions[3 * t + static_cast<size_t>(order[k])]));
+      f[k] = to_float(m.point(local.position(3 * t + static_cast<size_t>(order[k]))));
       p[k] = glm::dvec3(f[k]);  // judge the triangle the renderer will see
     }
     if (!finite3(p[0]) || !finite3(p[1]) || !finite3(p[2]) || is_zero_area(p[0], p[1], p[2])) {
@@ -286,7 +341,7 @@ size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t obj
     if (!local.normals.empty()) {
       bool smooth = true;
       for (int k = 0; k < 3 && smooth; ++k) {
-        const glm::dvec3 w = m.normal_matrix * local.normals[3 * t + static_cast<size_t>(order[k])];
+        const glm::dvec3 w = m.normal_matrix * local.normal(3 * t + static_cast<size_t>(order[k]));
         const double len = glm::length(w);
         smooth = std::isfinite(len) && len > 0.0;
         if (smooth) n[k] = w / len;
@@ -304,31 +359,55 @@ size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t obj
   return dropped;
 }
 
-bool is_closed_surface(const TriangleSoup& soup, size_t first, size_t count) {
-  if (count == 0) return false;
-  std::unordered_map<VertexKey, uint32_t, VertexKeyHash> ids;
-  ids.reserve(count * 2);
-  auto id_of = [&](size_t corner) {
-    const auto it = ids.emplace(vertex_key(soup.positions[corner]), static_cast<uint32_t>(ids.size()));
-    return uint64_t{it.first->second};
+std::vector<uint32_t> edge_partners(const TriangleSoup& soup, size_t first, size_t count) {
+  ABCUBE_CHECK(3 * (first + count) <= soup.positions.size() && 3 * count < NO_PARTNER - 1, "triangle range");
+  const glm::vec3* p = soup.positions.data() + 3 * first;
+  const uint32_t* object = soup.object_id.data() + first;
+  // Vertex ids: the first corner with the same object and position.
+  std::vector<uint32_t> vertex = first_equal(
+      3 * count,
+      [&](uint32_t c) {
+        const VertexKey k = vertex_key(p[c]);
+        return mix64((uint64_t{k.bits[0]} << 32 | k.bits[1]) ^ mix64(uint64_t{k.bits[2]} << 32 | object[c / 3]));
+      },
+      [&](uint32_t a, uint32_t b) { return object[a / 3] == object[b / 3] && vertex_key(p[a]) == vertex_key(p[b]); },
+      [](uint32_t) { return false; });
+  // Edge ids: the first half-edge with the same two vertices, in either order.
+  const auto ends = [&](uint32_t h) {
+    const uint64_t a = vertex[h], b = vertex[h - h % 3 + (h % 3 + 1) % 3];
+    return std::min(a, b) << 32 | std::max(a, b);
   };
-  // Each directed edge as (undirected key, +1 or -1 for its direction).
-  std::vector<std::pair<uint64_t, int>> edges;
-  edges.reserve(3 * count);
-  for (size_t t = first; t < first + count; ++t) {
-    const uint64_t v[3] = {id_of(3 * t), id_of(3 * t + 1), id_of(3 * t + 2)};
-    for (int k = 0; k < 3; ++k) {
-      const uint64_t a = v[k], b = v[(k + 1) % 3];
-      edges.emplace_back(std::min(a, b) << 32 | std::max(a, b), a < b ? 1 : -1);
+  const std::vector<uint32_t> edge = first_equal(
+      3 * count, [&](uint32_t h) { return mix64(ends(h)); }, [&](uint32_t a, uint32_t b) { return ends(a) == ends(b); },
+      [&](uint32_t h) { return vertex[h] == vertex[h - h % 3 + (h % 3 + 1) % 3]; });
+  vertex = {};
+  // Pair each half-edge with the first of its edge; a third one unpairs the edge.
+  constexpr uint32_t SHARED = NO_PARTNER - 1;  // an edge of three or more half-edges
+  std::vector<uint32_t> partner(3 * count, NO_PARTNER);
+  for (uint32_t h = 0; h < partner.size(); ++h) {
+    const uint32_t f = edge[h];
+    if (f == NO_PARTNER || f == h) continue;
+    if (partner[f] == NO_PARTNER) {
+      partner[f] = h;
+      partner[h] = f;
+    } else {
+      if (partner[f] != SHARED) partner[partner[f]] = SHARED;
+      partner[f] = partner[h] = SHARED;
     }
   }
-  std::sort(edges.begin(), edges.end());
-  for (size_t i = 0; i < edges.size();) {
-    size_t j = i;
-    int direction_sum = 0;
-    for (; j < edges.size() && edges[j].first == edges[i].first; ++j) direction_sum += edges[j].second;
-    if (j - i != 2 || direction_sum != 0) return false;
-    i = j;
+  for (uint32_t& q : partner) q = q == SHARED ? NO_PARTNER : q;
+  return partner;
+}
+
+bool is_closed_surface(const TriangleSoup& soup, size_t first, size_t count) {
+  if (count == 0) return false;
+  const std::vector<uint32_t> partner = edge_partners(soup, first, count);
+  const glm::vec3* p = soup.positions.data() + 3 * first;
+  const auto next = [](uint32_t c) { return c - c % 3 + (c % 3 + 1) % 3; };
+  for (uint32_t h = 0; h < partner.size(); ++h) {
+    // Every edge shared by exactly two half-edges running in opposite directions.
+    const uint32_t q = partner[h];
+    if (q == NO_PARTNER || !(vertex_key(p[h]) == vertex_key(p[next(q)]))) return false;
   }
   return true;
 }

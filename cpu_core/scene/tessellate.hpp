@@ -17,11 +17,21 @@ namespace abcube {
 // triangle i. `normals` is empty (flat shading) or holds one normal per corner, where a
 // zero normal anywhere in a triangle means "flat" for that triangle. `material` is empty
 // or holds one entry per triangle, -1 meaning the object's own material.
+// Indexed (OBJ files, whose corners share vertices): when `indexed`, corner c is positions[position_index[c]] with normal normals[normal_index[c]] (a zero
+// normal for NO_NORMAL), so a shared vertex is held once.
 struct LocalMesh {
   std::vector<glm::dvec3> positions;
   std::vector<glm::dvec3> normals;
   std::vector<int> material;
-  size_t triangle_count() const { return positions.size() / 3; }
+  static constexpr uint32_t NO_NORMAL = 0xffffffffu;
+  bool indexed = false;
+  std::vector<uint32_t> position_index, normal_index;
+  size_t triangle_count() const { return (indexed ? position_index.size() : positions.size()) / 3; }
+  const glm::dvec3& position(size_t corner) const { return positions[indexed ? position_index[corner] : corner]; }
+  glm::dvec3 normal(size_t corner) const {
+    if (!indexed) return normals[corner];
+    return normal_index[corner] == NO_NORMAL ? glm::dvec3(0.0) : normals[normal_index[corner]];
+  }
 };
 
 LocalMesh tessellate_triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
@@ -73,6 +83,15 @@ bool is_zero_area(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
 // non-finite once stored as floats are skipped; returns how many were.
 size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t object_id,
                         uint32_t material, TriangleSoup* soup);
+
+// The half-edges of triangles [first, first + count) of the soup: half-edge 3 i + k runs
+// from corner k to corner k + 1 of triangle first + i. A vertex is an object and a float
+// position (bit for bit, -0 = +0). Returns each half-edge's partner, the other half-edge
+// with the same two vertices (in either direction) when exactly two have them, else
+// NO_PARTNER (a border, an edge of three or more, or one whose two ends are one vertex).
+// Hash tables, no sort: 4 bytes a half-edge, and at most about 20 more while it works.
+constexpr uint32_t NO_PARTNER = 0xffffffffu;
+std::vector<uint32_t> edge_partners(const TriangleSoup& soup, size_t first, size_t count);
 
 // Whether triangles [first, first + count) of the soup form a closed, consistently
 // oriented surface: every edge (by exact vertex position) is shared by exactly two

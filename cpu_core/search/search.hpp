@@ -139,6 +139,7 @@
 // Every search is a pure function of its inputs (thread safe); stats are per caller.
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -218,15 +219,25 @@ class SearchContext {
   void for_each_side_crossing(const glm::dvec3& w, const glm::dvec3& d, double l_end, Visit&& visit) const {
     if (!side_bvh_) return;
     side_bvh_->for_each_hit(RayQuery(cube_->centre + w, d), l_end, [&](const TriangleHit& h) {
-      return visit(side_[h.triangle], h.t);
+      return visit(h.triangle, h.t);
     });
   }
 
+  // Per-triangle geometry is computed from the soup's float vertices on each call, in
+  // double, by the same expressions every time (bit for bit the same answer): storing it
+  // took 160 bytes a triangle.
   struct Plane {
     glm::dvec3 normal{0.0};  // unit geometric normal, cross(b-a, c-a) direction
     double offset = 0;       // normal . X for X on the plane, X relative to the centre
   };
-  const Plane& plane(uint32_t triangle) const { return planes_[triangle]; }
+  // Zero for a degenerate triangle.
+  Plane plane(uint32_t triangle) const {
+    const glm::dvec3 a = vertex(triangle, 0);
+    const glm::dvec3 n = glm::cross(vertex(triangle, 1) - a, vertex(triangle, 2) - a);
+    const double len = glm::length(n);
+    if (!(len > 0.0 && std::isfinite(len))) return {};
+    return {n / len, glm::dot(n / len, a)};
+  }
   // What the MESH REFINEMENT tests per triangle, relative to the centre: the in-plane
   // inward unit normals of its edges (edge k from vertex k to k+1) with their offsets, and
   // a bounding sphere (centroid, largest vertex distance). Zero for a degenerate triangle.
@@ -236,9 +247,11 @@ class SearchContext {
     glm::dvec3 centroid{0.0};
     double radius = 0;
   };
-  const TriangleBounds& triangle_bounds(uint32_t triangle) const { return bounds_[triangle]; }
+  TriangleBounds triangle_bounds(uint32_t triangle) const;
   // The vertices of a triangle relative to the centre.
-  glm::dvec3 vertex(uint32_t triangle, int k) const;
+  glm::dvec3 vertex(uint32_t triangle, int k) const {
+    return glm::dvec3(positions_[3 * static_cast<size_t>(triangle) + static_cast<size_t>(k)]) - cube_->centre;
+  }
   // The triangle across edge k (vertices k, k+1) of `triangle`: same object, the same two
   // vertex positions bit for bit; NO_NEIGHBOUR on a border or a non-manifold edge.
   static constexpr uint32_t NO_NEIGHBOUR = 0xffffffffu;
@@ -265,11 +278,10 @@ class SearchContext {
  private:
   const SceneData* scene_;
   const CubeABuffer* cube_;
-  std::vector<Plane> planes_;
-  std::vector<TriangleBounds> bounds_;
+  const glm::vec3* positions_;  // the soup's, 3 per triangle
   std::vector<uint32_t> zero_area_;
   std::vector<uint32_t> side_;
-  std::shared_ptr<const Bvh> side_bvh_;  // over side_, in its order
+  std::shared_ptr<const Bvh> side_bvh_;  // over side_ (soup triangle indices)
   std::shared_ptr<const MeshNeighbours> neighbours_;
   // Per face and row j: the smallest and largest column holding a fragment over rows
   // <= j (prefix) and >= j (suffix), and in row j alone (n and -1 when none).

@@ -6,10 +6,12 @@
 #include <CLI/CLI.hpp>
 #include <abcube/renderer.hpp>
 
+#include "base/memory.hpp"
 #include "cli/cli_common.hpp"
 
 int main(int argc, char** argv) {
   using namespace abcube;
+  map_large_blocks_alone();  // freed scene-sized vectors leave the resident set at once
   CLI::App app("abcube: a headless hybrid renderer (GL raster + CPU A-buffered cube map searches)", "abcube");
   app.set_version_flag("--version", version_string());
   app.require_subcommand(1, 1);

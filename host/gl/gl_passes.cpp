@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <algorithm>
 #include <cstring>
 #include <vector>
 
@@ -112,22 +113,31 @@ GlScene::GlScene(const SceneData& scene) : scene_(scene) {
   const double radius = max_distance_from(scene, scene.camera.position);
   near_ = default_near_distance(radius);
 
+  // Uploaded in chunks: a copy of the whole vertex array beside the soup and the GL
+  // buffer cost 96 bytes a triangle at the peak.
   const TriangleSoup& t = *scene.triangles;
-  std::vector<Vertex> vertices(t.positions.size());
-  for (size_t v = 0; v < vertices.size(); ++v) {
-    Vertex& o = vertices[v];
-    std::memcpy(o.position, &t.positions[v].x, sizeof o.position);
-    std::memcpy(o.normal, &t.normals[v].x, sizeof o.normal);
-    o.object = t.object_id[v / 3];
-    o.material = t.material_id[v / 3];
-  }
-  vertex_count_ = static_cast<GLsizei>(vertices.size());
+  constexpr size_t CHUNK = 3 * 16384;  // vertices
+  vertex_count_ = static_cast<GLsizei>(t.positions.size());
   glGenVertexArrays(1, &vao_);
   glBindVertexArray(vao_);
   glGenBuffers(1, &vbo_);
   glBindBuffer(GL_ARRAY_BUFFER, vbo_);
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)),
-               vertices.data(), GL_STATIC_DRAW);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(t.positions.size() * sizeof(Vertex)), nullptr,
+               GL_STATIC_DRAW);
+  std::vector<Vertex> vertices;
+  for (size_t first = 0; first < t.positions.size(); first += CHUNK) {
+    vertices.resize(std::min(CHUNK, t.positions.size() - first));
+    for (size_t i = 0; i < vertices.size(); ++i) {
+      const size_t v = first + i;
+      Vertex& o = vertices[i];
+      std::memcpy(o.position, &t.positions[v].x, sizeof o.position);
+      std::memcpy(o.normal, &t.normals[v].x, sizeof o.normal);
+      o.object = t.object_id[v / 3];
+      o.material = t.material_id[v / 3];
+    }
+    glBufferSubData(GL_ARRAY_BUFFER, static_cast<GLintptr>(first * sizeof(Vertex)),
+                    static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data());
+  }
   const auto offset = [](size_t bytes) { return reinterpret_cast<const void*>(bytes); };
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), offset(offsetof(Vertex, position)));
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), offset(offsetof(Vertex, normal)));
