@@ -10,20 +10,25 @@ namespace abcube {
 namespace {
 
 // Bytes per unit of work, for the estimate: a camera pixel holds its colour and A-buffer
-// fragment headroom; a cube texel its distance and fragment headroom; a triangle its
-// soup entry (3 positions, 3 normals, 2 ids), acceleration-structure headroom (64), and
-// the searches' per-triangle data (search.hpp SearchContext: plane 32, refinement bounds
-// 128, neighbours 12 bytes, and 120 more while the neighbours are being built).
+// fragment headroom; a cube texel its distance and fragment headroom. A triangle: the peak
+// resident bytes a triangle of scene data costs above the process's own, measured by
+// bench/memory.py on 440k- and 1M-triangle meshes (bench/results/memory.txt: at most 373
+// marginal for raytrace, abuffer, zbuffer and envmap; the soup's 80 of it), rounded up;
+// the gpu method adds the GL vertex buffer (3 vertices of 32 bytes, gl_passes.cpp), which
+// the driver holds beside the soup.
 constexpr uint64_t PIXEL_BYTES = 3 * sizeof(float) + 64;
 constexpr uint64_t TEXEL_BYTES = 64;
-constexpr uint64_t TRIANGLE_BYTES = 6 * sizeof(glm::vec3) + 2 * sizeof(uint32_t) + 64 + 32 + 128 + 12 + 120;
+constexpr uint64_t TRIANGLE_BYTES = 380;
+constexpr uint64_t GL_TRIANGLE_BYTES = 3 * 32;
+static_assert(TRIANGLE_BYTES >= 6 * sizeof(glm::vec3) + 2 * sizeof(uint32_t), "the soup alone");
 
 }  // namespace
 
 uint64_t estimate_render_bytes(const SceneData& scene) {
   const uint64_t pixels = static_cast<uint64_t>(scene.camera.width) * static_cast<uint64_t>(scene.camera.height);
   const uint64_t n = static_cast<uint64_t>(scene.render.cube_resolution);
-  return pixels * PIXEL_BYTES + 6 * n * n * TEXEL_BYTES + scene.triangles->triangle_count() * TRIANGLE_BYTES;
+  const uint64_t per_triangle = TRIANGLE_BYTES + (scene.render.method == Method::gpu ? GL_TRIANGLE_BYTES : 0);
+  return pixels * PIXEL_BYTES + 6 * n * n * TEXEL_BYTES + scene.triangles->triangle_count() * per_triangle;
 }
 
 void check_render_size(const SceneData& scene, uint64_t budget_bytes) {

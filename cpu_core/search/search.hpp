@@ -148,6 +148,7 @@
 // Every search is a pure function of its inputs (thread safe); stats are per caller.
 #pragma once
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -237,11 +238,21 @@ class SearchContext {
     });
   }
 
+  // Per-triangle geometry is computed from the soup's float vertices on each call, in
+  // double, by the same expressions every time (bit for bit the same answer): storing it
+  // took 160 bytes a triangle.
   struct Plane {
     glm::dvec3 normal{0.0};  // unit geometric normal, cross(b-a, c-a) direction
     double offset = 0;       // normal . X for X on the plane, X relative to the centre
   };
-  const Plane& plane(uint32_t triangle) const { return planes_[triangle]; }
+  // Zero for a degenerate triangle.
+  Plane plane(uint32_t triangle) const {
+    const glm::dvec3 a = vertex(triangle, 0);
+    const glm::dvec3 n = glm::cross(vertex(triangle, 1) - a, vertex(triangle, 2) - a);
+    const double len = glm::length(n);
+    if (!(len > 0.0 && std::isfinite(len))) return {};
+    return {n / len, glm::dot(n / len, a)};
+  }
   // What the MESH REFINEMENT tests per triangle, relative to the centre: the in-plane
   // inward unit normals of its edges (edge k from vertex k to k+1) with their offsets, and
   // a bounding sphere (centroid, largest vertex distance). Zero for a degenerate triangle.
@@ -251,9 +262,11 @@ class SearchContext {
     glm::dvec3 centroid{0.0};
     double radius = 0;
   };
-  const TriangleBounds& triangle_bounds(uint32_t triangle) const { return bounds_[triangle]; }
+  TriangleBounds triangle_bounds(uint32_t triangle) const;
   // The vertices of a triangle relative to the centre.
-  glm::dvec3 vertex(uint32_t triangle, int k) const;
+  glm::dvec3 vertex(uint32_t triangle, int k) const {
+    return glm::dvec3(positions_[3 * static_cast<size_t>(triangle) + static_cast<size_t>(k)]) - cube_->centre;
+  }
   // The triangle across edge k (vertices k, k+1) of `triangle`: same object, the same two
   // vertex positions bit for bit; NO_NEIGHBOUR on a border or a non-manifold edge.
   static constexpr uint32_t NO_NEIGHBOUR = 0xffffffffu;
@@ -281,8 +294,7 @@ class SearchContext {
   const SceneData* scene_;
   const CubeABuffer* cube_;
   Media media_;
-  std::vector<Plane> planes_;
-  std::vector<TriangleBounds> bounds_;
+  const glm::vec3* positions_;  // the soup's, 3 per triangle
   std::vector<uint32_t> zero_area_;
   std::vector<uint32_t> side_;
   std::shared_ptr<const Bvh> side_bvh_;  // over side_, in its order

@@ -3,46 +3,24 @@
 // mesh neighbours (search.hpp MESH REFINEMENT).
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
-#include <tuple>
 
 #include "raster/raster.hpp"
+#include "scene/tessellate.hpp"
 #include "search/search.hpp"
 
 namespace abcube {
 
-// scene_load.cpp's memory estimate (TRIANGLE_BYTES) counts these sizes per triangle.
-static_assert(sizeof(SearchContext::Plane) <= 32 && sizeof(SearchContext::TriangleBounds) <= 128,
-              "update TRIANGLE_BYTES in scene_load.cpp");
-
 SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube,
                              std::shared_ptr<const MeshNeighbours> neighbours)
-    : scene_(&scene), cube_(&cube), media_(scene), neighbours_(std::move(neighbours)) {
+    : scene_(&scene), cube_(&cube), media_(scene), positions_(scene.triangles->positions.data()),
+      neighbours_(std::move(neighbours)) {
   const TriangleSoup& soup = *scene.triangles;
   const uint32_t count = static_cast<uint32_t>(soup.triangle_count());
-  planes_.resize(count);
-  bounds_.resize(count);
   // The raster's own rule decides which triangles the map cannot hold (raster.hpp).
   const RasterView view = cube_face_view(0, cube.centre, std::max(cube.n, 1), cube.near_distance);
   TriangleSetup setup;
   for (uint32_t k = 0; k < count; ++k) {
-    const glm::dvec3 a = vertex(k, 0);
-    const glm::dvec3 n = glm::cross(vertex(k, 1) - a, vertex(k, 2) - a);
-    const double len = glm::length(n);
-    if (len > 0.0 && std::isfinite(len)) {
-      planes_[k] = {n / len, glm::dot(n / len, a)};
-      TriangleBounds& b = bounds_[k];
-      const glm::dvec3 v[3] = {a, vertex(k, 1), vertex(k, 2)};
-      b.centroid = (v[0] + v[1] + v[2]) / 3.0;
-      for (size_t e = 0; e < 3; ++e) {
-        const glm::dvec3 m = glm::cross(n / len, v[(e + 1) % 3] - v[e]);
-        const double ml = glm::length(m);
-        if (ml > 0.0) b.edge_normal[e] = m / ml;
-        b.edge_offset[e] = glm::dot(b.edge_normal[e], v[e]);
-        b.radius = std::max(b.radius, glm::length(v[e] - b.centroid));
-      }
-    }
     if (setup_triangle(view, soup, k, &setup) == SetupResult::edge_on) zero_area_.push_back(k);
   }
   if (!neighbours_) neighbours_ = std::make_shared<const MeshNeighbours>(build_mesh_neighbours(soup));
@@ -104,7 +82,7 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube,
 void SearchContext::build_side_structure(const std::vector<uint8_t>& seen) {
   for (uint32_t k = 0; k < seen.size(); ++k) {
     const bool zero_area = std::binary_search(zero_area_.begin(), zero_area_.end(), k);
-    if ((zero_area || !seen[k]) && planes_[k].normal != glm::dvec3(0.0)) side_.push_back(k);
+    if ((zero_area || !seen[k]) && plane(k).normal != glm::dvec3(0.0)) side_.push_back(k);
   }
   if (side_.empty()) return;
   const TriangleSoup& soup = *scene_->triangles;
@@ -118,55 +96,12 @@ void SearchContext::build_side_structure(const std::vector<uint8_t>& seen) {
 }
 
 // Vertices are the same when their object and float position are (bit for bit, -0 = +0);
-// an edge links the two triangles that have it, in either direction.
+// an edge links the two triangles that have it, in either direction (tessellate.hpp).
 MeshNeighbours build_mesh_neighbours(const TriangleSoup& soup) {
-  constexpr uint32_t NO_NEIGHBOUR = SearchContext::NO_NEIGHBOUR;
-  const size_t count = soup.triangle_count();
-  MeshNeighbours neighbours(count, {NO_NEIGHBOUR, NO_NEIGHBOUR, NO_NEIGHBOUR});
-  struct Corner {
-    uint32_t object;
-    std::array<uint32_t, 3> bits;
-    uint32_t index;  // 3 * triangle + k
-  };
-  std::vector<Corner> corners(3 * count);
-  for (size_t c = 0; c < corners.size(); ++c) {
-    const glm::vec3 v = soup.positions[c] + glm::vec3(0.0f);  // -0 -> +0
-    Corner& k = corners[c];
-    k.object = soup.object_id[c / 3];
-    std::memcpy(k.bits.data(), &v[0], sizeof(float));
-    std::memcpy(k.bits.data() + 1, &v[1], sizeof(float));
-    std::memcpy(k.bits.data() + 2, &v[2], sizeof(float));
-    k.index = static_cast<uint32_t>(c);
-  }
-  std::sort(corners.begin(), corners.end(), [](const Corner& a, const Corner& b) {
-    return std::tie(a.object, a.bits, a.index) < std::tie(b.object, b.bits, b.index);
-  });
-  std::vector<uint32_t> vertex_id(corners.size());
-  uint32_t id = 0;
-  for (size_t c = 0; c < corners.size(); ++c) {
-    if (c > 0 && (corners[c].object != corners[c - 1].object || corners[c].bits != corners[c - 1].bits)) ++id;
-    vertex_id[corners[c].index] = id;
-  }
-  // (smaller vertex id, larger vertex id, 3 * triangle + edge), sorted: equal edges adjacent.
-  std::vector<std::pair<uint64_t, uint32_t>> edges;
-  edges.reserve(3 * count);
-  for (size_t t = 0; t < count; ++t) {
-    for (size_t k = 0; k < 3; ++k) {
-      const uint64_t a = vertex_id[3 * t + k], b = vertex_id[3 * t + (k + 1) % 3];
-      if (a == b) continue;
-      edges.push_back({std::min(a, b) << 32 | std::max(a, b), static_cast<uint32_t>(3 * t + k)});
-    }
-  }
-  std::sort(edges.begin(), edges.end());
-  for (size_t e = 0; e < edges.size();) {
-    size_t end = e + 1;
-    while (end < edges.size() && edges[end].first == edges[e].first) ++end;
-    if (end - e == 2) {  // manifold edge; a border (1) or a non-manifold edge (> 2) links nothing
-      const uint32_t x = edges[e].second, y = edges[e + 1].second;
-      neighbours[x / 3][x % 3] = y / 3;
-      neighbours[y / 3][y % 3] = x / 3;
-    }
-    e = end;
+  std::vector<uint32_t> partner = edge_partners(soup, 0, soup.triangle_count());
+  MeshNeighbours neighbours(soup.triangle_count());
+  for (size_t h = 0; h < partner.size(); ++h) {
+    neighbours[h / 3][h % 3] = partner[h] == NO_PARTNER ? SearchContext::NO_NEIGHBOUR : partner[h] / 3;
   }
   return neighbours;
 }
@@ -182,9 +117,21 @@ bool SearchContext::empty_ahead(int face, int i, int j, int step_i, int step_j) 
   return hi < i || lo > i;  // column i only
 }
 
-glm::dvec3 SearchContext::vertex(uint32_t triangle, int k) const {
-  return glm::dvec3(scene_->triangles->positions[3 * static_cast<size_t>(triangle) + static_cast<size_t>(k)]) -
-         cube_->centre;
+SearchContext::TriangleBounds SearchContext::triangle_bounds(uint32_t triangle) const {
+  TriangleBounds b;
+  const glm::dvec3 v[3] = {vertex(triangle, 0), vertex(triangle, 1), vertex(triangle, 2)};
+  const glm::dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
+  const double len = glm::length(n);
+  if (!(len > 0.0 && std::isfinite(len))) return b;
+  b.centroid = (v[0] + v[1] + v[2]) / 3.0;
+  for (size_t e = 0; e < 3; ++e) {
+    const glm::dvec3 m = glm::cross(n / len, v[(e + 1) % 3] - v[e]);
+    const double ml = glm::length(m);
+    if (ml > 0.0) b.edge_normal[e] = m / ml;
+    b.edge_offset[e] = glm::dot(b.edge_normal[e], v[e]);
+    b.radius = std::max(b.radius, glm::length(v[e] - b.centroid));
+  }
+  return b;
 }
 
 }  // namespace abcube
