@@ -1,122 +1,104 @@
-// Exact ray-triangle queries over a TriangleSoup: a bounding volume hierarchy built with
-// the binned surface area heuristic (Wald 2007, "On fast construction of SAH-based
-// bounding volume hierarchies"), traversed and intersected in double precision.
+// Exact ray queries over a TriangleSoup: Embree 3 (Wald et al. 2014, "Embree: a kernel
+// framework for efficient CPU ray tracing") builds and traverses the bounding volume
+// hierarchy, and every hit is decided in double precision by the watertight test of
+// triangle_test.hpp. Embree's float arithmetic never decides whether a triangle is hit.
 //
-// Exactness: the float vertices are converted to double exactly; the ray-triangle test is
-// the watertight one of Woop, Benthin and Wald 2013 ("Watertight ray/triangle
-// intersection", JCGT 2(1)): a ray through a shared edge or vertex of a closed mesh hits at
-// least one of the triangles around it, never slips through. The box test is the robust
-// slab test (Ize 2013, "Robust BVH ray traversal"; pbrt-v3 Bounds3::IntersectP), whose far
-// distance is enlarged by 2 gamma(3) so rounding never culls a box the ray touches.
-// A query returns the same hit as a loop over every triangle would (tests check it).
+// How. Each triangle is an Embree user primitive (RTC_GEOMETRY_TYPE_USER) whose box is the
+// triangle's float bounds widened by BOX_PAD below; leaves hold up to 4 primitives (device
+// option object_accel_max_leaf_size), the scene is built with RTC_SCENE_FLAG_COMPACT and
+// RTC_SCENE_FLAG_ROBUST (the latter is not read by Embree's user-geometry traversal, whose
+// box test is the fast one: the padding below covers its rounding). Embree hands every
+// triangle whose box the ray meets to a callback that runs the double test, and culls at
+// the distance the callback sets. Nothing of the soup is copied: Embree holds its tree only.
+//
+// Why not Embree's float triangles (RTC_GEOMETRY_TYPE_TRIANGLE). Its robust float test is
+// watertight, but where a ray passes within float rounding of an edge it can pick the
+// other triangle of the edge, which the double test rejects, or, at an open border, none,
+// where the double test hits: bench/embree_float_check counts those rays on the repository
+// scenes (README "Exact tracer"). Recovering them would take a second traversal per query
+// for the tie window and neighbourhood queries, and still miss the open borders.
+//
+// Exactness. A query's hits are exactly the triangles the double test accepts (a loop over
+// every triangle gives the same; tests check it), because no box that the double ray meets
+// is culled. Embree works in units of 2^ilogb(M), M the largest absolute vertex coordinate,
+// so that every vertex lies within 2 of the origin (no overflow of org/dir products in its
+// box test, no denormals); below, distances are in units of M.
+//  - Embree's ray is the double ray rounded to float: its origin is the query's origin
+//    when that lies in the cube |x|inf <= 2M, else the ray's entry point into that cube
+//    (no triangle lies before it), so |o_e| <= 2M; at any point x of a triangle (|x| <= M)
+//    the float ray is within 2^-24 (|o_e| + |x - o_e|) <= 5 2^-24 per coordinate.
+//  - Embree's box test, t = (lower - org) / dir computed as lower * rcp(dir) - org *
+//    rcp(dir) in float, with rcp good to about 2^-22, errs by at most about
+//    2^-24 |org| + 2^-22 |lower - org| <= 17 2^-24 per coordinate, along the ray.
+//  - Every box is widened by BOX_PAD = 2^-16 = 256 2^-24, over ten times their sum, and
+//    rounded outwards.
+// So the answers do not depend on which instruction set Embree picks (SSE, AVX2, AVX-512),
+// the threads that built the tree, or the order the tree is walked in.
+//
+// Thread safety: queries are const and may run from any number of threads at once (one
+// RTCScene, read only; a context per call).
 #pragma once
 #include <cstdint>
-#include <vector>
+#include <memory>
+#include <type_traits>
 
-#include <glm/glm.hpp>
-
+#include "reference/triangle_test.hpp"
 #include "scene/scene_data.hpp"
+
+struct RTCSceneTy;  // <embree3/rtcore.h>: RTCScene is RTCSceneTy*
 
 namespace abcube {
 
-struct BvhBuildItem;  // bvh.cpp
-
-// A ray prepared for the watertight test: the axis kz of the largest direction component,
-// kx, ky the other two (swapped to keep the winding), and the shear (sx, sy, sz).
-struct RayQuery {
-  glm::dvec3 origin{0.0}, dir{0.0}, inv_dir{0.0};
-  int kx = 0, ky = 1, kz = 2;
-  double sx = 0, sy = 0, sz = 1;
-  RayQuery(const glm::dvec3& o, const glm::dvec3& d);
-};
-
-// One ray-triangle intersection: origin + t * dir, t > 0, lies on the triangle at
-// barycentric weights (b0, b1, b2) of its vertices 0, 1, 2 (sum 1, each >= 0).
-struct TriangleHit {
-  double t = 0;
-  uint32_t triangle = 0;  // index into the TriangleSoup
-  double b0 = 0, b1 = 0, b2 = 0;
-};
-
-struct BvhNode {
-  glm::dvec3 lo{0.0}, hi{0.0};
-  uint32_t offset = 0;  // leaf: first slot in the leaf order; inner: index of the second child
-  uint32_t count = 0;   // leaf: number of triangles; inner: 0 (the first child is this + 1)
-  uint32_t axis = 0;    // inner: split axis, to visit the nearer child first
-};
-
 class Bvh {
  public:
+  // Builds Embree's tree over `soup`, which is read by every query, never copied: it must
+  // outlive the Bvh and not change. Throws RuntimeFailure when Embree fails (std::bad_alloc
+  // when out of memory).
   explicit Bvh(const TriangleSoup& soup);
+  ~Bvh();
+  Bvh(const Bvh&) = delete;
+  Bvh& operator=(const Bvh&) = delete;
 
-  // The nearest hit with 0 < t < tmax (t in units of |dir|). Ties keep the first found.
-  bool closest_hit(const RayQuery& ray, double tmax, TriangleHit* hit) const;
-
-  // The VISIBLE hit with 0 < t < tmax by THE TIE RULE (scene/tie_rule.hpp): of the hits at
-  // the same distance as the nearest one (the nearest: smallest t, then ranking above),
-  // the one ranking highest (later object, then higher triangle). `soup` is the one the
-  // BVH was built from. Same answer as that rule applied to a loop over every triangle:
-  // one traversal culling at the nearest hit's tie window (tie_bound over the whole soup
-  // divided by |n . dir|), keeping the hits inside it; when the window of a new nearest
-  // hit reaches past what was culled before, or more than a few hits share it, a second
+  // The VISIBLE hit with 0 < t < tmax (t in units of |dir|) by THE TIE RULE
+  // (scene/tie_rule.hpp): of the hits at the same distance as the nearest one (the nearest:
+  // smallest t, then ranking above), the one ranking highest (later object, then higher
+  // triangle). Same answer as that rule applied to a loop over every triangle: one
+  // traversal culling at the nearest hit's tie window (tie_bound over the whole soup
+  // divided by |n . dir|), keeping the hits inside it; when the window of a new nearest hit
+  // reaches past what was culled before, or more than a few hits share it, a second
   // traversal collects that window again.
-  bool visible_hit(const RayQuery& ray, double tmax, const TriangleSoup& soup, TriangleHit* hit) const;
+  bool visible_hit(const RayQuery& ray, double tmax, TriangleHit* hit) const;
 
-  // Calls visit(const TriangleHit&) for every hit with 0 < t < tmax, in no particular
-  // (but deterministic) order, until visit returns false.
+  // Calls visit(const TriangleHit&) for every hit with 0 < t < tmax, once each, in no
+  // particular order (Embree's traversal order: callers that need one sort), until visit
+  // returns false.
   template <class Visit>
-  void for_each_hit(const RayQuery& ray, double tmax, Visit&& visit) const;
+  void for_each_hit(const RayQuery& ray, double tmax, Visit&& visit) const {
+    using V = std::remove_reference_t<Visit>;
+    visit_hits(ray, tmax,
+               [](void* state, const TriangleHit& h) { return static_cast<bool>((*static_cast<V*>(state))(h)); },
+               const_cast<void*>(static_cast<const void*>(&visit)));
+  }
 
   // TIE_RELATIVE times the largest absolute vertex coordinate (tie_rule.hpp): no two of
   // these triangles are at the same distance beyond this separation along their normals.
   double tie_bound_max() const { return tie_bound_max_; }
-  size_t node_count() const { return nodes_.size(); }
-  int depth() const { return depth_; }
-  size_t triangle_count() const { return order_.size(); }
+  size_t triangle_count() const { return soup_->triangle_count(); }
+  const TriangleSoup& soup() const { return *soup_; }
+  // The largest absolute vertex coordinate, M.
+  double magnitude() const { return magnitude_; }
 
-  // The watertight test against one triangle (Woop et al. 2013), exposed for tests.
-  bool intersect_triangle(const RayQuery& ray, uint32_t triangle, double tmax,
-                          TriangleHit* hit) const;
+  // Widening of every primitive box, relative to the largest absolute vertex coordinate.
+  static constexpr double BOX_PAD = 0x1p-16;
 
  private:
-  uint32_t build(std::vector<BvhBuildItem>& items, uint32_t begin, uint32_t end, int depth);
-  bool intersect_slot(const RayQuery& ray, uint32_t slot, double tmax, TriangleHit* hit) const;
-  static bool hits_box(const RayQuery& ray, const BvhNode& node, double tmax);
-  template <class OnHit>
-  void traverse_near_first(const RayQuery& ray, const double& cull, OnHit&& on_hit) const;
+  using VisitFn = bool (*)(void* state, const TriangleHit& hit);
+  void visit_hits(const RayQuery& ray, double tmax, VisitFn visit, void* state) const;
 
-  std::vector<glm::dvec3> vertices_;  // 3 per triangle slot, in leaf order
-  std::vector<uint32_t> order_;       // slot -> triangle index in the soup
-  std::vector<uint32_t> slot_of_;     // triangle index -> slot
-  std::vector<BvhNode> nodes_;        // depth first; node 0 is the root
-  int depth_ = 0;
-  double tie_bound_max_ = 0;          // TIE_RELATIVE * the largest absolute vertex coordinate
+  const TriangleSoup* soup_;
+  RTCSceneTy* scene_ = nullptr;  // null when there is nothing to hit
+  double magnitude_ = 0;         // the largest absolute vertex coordinate, M
+  double tie_bound_max_ = 0;     // TIE_RELATIVE * M
 };
-
-// Deepest possible traversal stack: the build falls back to median splits past depth 64,
-// so no tree is deeper than 64 + 32 levels.
-constexpr int BVH_MAX_STACK = 128;
-
-template <class Visit>
-void Bvh::for_each_hit(const RayQuery& ray, double tmax, Visit&& visit) const {
-  if (nodes_.empty()) return;
-  uint32_t stack[BVH_MAX_STACK];
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const BvhNode& node = nodes_[stack[--top]];
-    if (!hits_box(ray, node, tmax)) continue;
-    if (node.count > 0) {
-      for (uint32_t s = node.offset; s < node.offset + node.count; ++s) {
-        TriangleHit h;
-        if (intersect_slot(ray, s, tmax, &h) && !visit(static_cast<const TriangleHit&>(h))) return;
-      }
-      continue;
-    }
-    const uint32_t first = static_cast<uint32_t>(&node - nodes_.data()) + 1;
-    stack[top++] = node.offset;
-    stack[top++] = first;
-  }
-}
 
 }  // namespace abcube

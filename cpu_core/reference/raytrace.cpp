@@ -81,7 +81,7 @@ Hit RayTracer::make_hit(const TriangleHit& th, const glm::dvec3& dir) const {
 bool RayTracer::intersect(const glm::dvec3& origin, const glm::dvec3& dir, double tmax, Hit* hit) const {
   ABCUBE_CHECK(dir != glm::dvec3(0.0), "ray direction must not be zero");
   TriangleHit th;
-  if (!bvh_->visible_hit(RayQuery(origin, dir), tmax, *scene_->triangles, &th)) return false;  // tie_rule.hpp
+  if (!bvh_->visible_hit(RayQuery(origin, dir), tmax, &th)) return false;  // tie_rule.hpp
   *hit = make_hit(th, dir);
   return true;
 }
@@ -169,6 +169,9 @@ Interface RayTracer::crossing_set(const glm::dvec3& origin, const glm::dvec3& d,
     return true;
   });
   if (hits.empty()) return media_->resolve(stack, &first, 1);
+  std::sort(hits.begin(), hits.end(), [](const TriangleHit& a, const TriangleHit& b) {  // not in Embree's order
+    return a.t != b.t ? a.t < b.t : a.triangle < b.triangle;
+  });
   std::vector<MediumCrossing> set{first};
   std::vector<Hit> set_hits{hit};
   for (const TriangleHit& th : hits) {
@@ -332,8 +335,6 @@ Image render_raytrace(const SceneData& scene, const RaytraceOptions& options, Ra
     stats->build_ms = tracer.build_ms();
     stats->trace_ms = ms_since(start);
     stats->triangles = scene.triangles->triangle_count();
-    stats->bvh_nodes = tracer.bvh().node_count();
-    stats->bvh_depth = tracer.bvh().depth();
     stats->threads = threads;
   }
   return image;

@@ -29,7 +29,7 @@
 //
 // Nested dielectrics (media.hpp: Schmidt & Budge 2002 with priorities). Every ray carries
 // the stack of media it is inside (camera rays: none). The nearest hit and every surface
-// the ray crosses within coincident_tolerance of it (BVH for_each_hit) form one crossing
+// the ray crosses within coincident_tolerance of it (Bvh::for_each_hit) form one crossing
 // set, resolved by Media::resolve: a plain surface in it is the surface hit; a set of
 // medium surfaces with the same medium on both sides is no interface (the ray goes on
 // straight from past the set, same depth, unshaded); else one interface n_from -> n_to
@@ -61,8 +61,9 @@
 // within rounding and the offset ray cannot see that plane again, grazing or not.
 //
 // Exactness. RayTracer::intersect is the double-precision watertight test (Woop et al.
-// 2013) on the float vertex data, through a BVH that returns the same visible hit as the
-// tie rule over a loop over all triangles (bvh.hpp). Later methods measure Error_Parallax against it.
+// 2013, triangle_test.hpp) on the float vertex data, through Embree's BVH, which returns
+// the same visible hit as the tie rule over a loop over all triangles (bvh.hpp). Later
+// methods measure Error_Parallax against it.
 //
 // Determinism. Pixels are independent and shaded in a fixed order, rows are handed to
 // threads dynamically, so the image is bit-identical for any number of threads.
@@ -94,11 +95,9 @@ struct RaytraceStats {
   uint64_t primary_rays = 0;
   uint64_t secondary_rays = 0;  // reflected, transmitted and opacity-continued rays
   uint64_t shadow_rays = 0;
-  double build_ms = 0;          // BVH construction
+  double build_ms = 0;          // BVH construction (Embree's, bvh.hpp)
   double trace_ms = 0;          // all rays of the image
   uint64_t triangles = 0;
-  uint64_t bvh_nodes = 0;
-  int bvh_depth = 0;
   int threads = 0;              // threads actually used
 };
 

@@ -91,9 +91,9 @@
 // triangles that produced no fragment in any of the six faces (thinner or smaller than the
 // samples of a texel: they fall between them), found by marking every triangle index seen
 // in the faces' lists. Only these, so the list is short; it is held in a small BVH of its
-// own (reference/bvh.hpp, built over just these triangles: a huge mesh at low N can leave
-// many), and each ray is tested with its watertight ray-triangle test (Woop et al.
-// 2013) in double. Every search asks it after its walk: reflection_search and
+// own (reference/bvh.hpp, Embree's, built over just these triangles: a huge mesh at low N
+// can leave many), and each ray is tested with the watertight ray-triangle test (Woop et
+// al. 2013, reference/triangle_test.hpp) in double. Every search asks it after its walk: reflection_search and
 // refraction_exit_search (restricted to the object) take the nearest side crossing with
 // self < l < the map's answer (or anywhere when the map found nothing), not on W's own
 // surface (the SELF-HITS rule), as THE answer: that triangle, its object and material, the
@@ -147,6 +147,7 @@
 //
 // Every search is a pure function of its inputs (thread safe); stats are per caller.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -228,14 +229,22 @@ class SearchContext {
   // tie_rule.hpp's bound for a side triangle against any (0 when there is none).
   double side_tie_bound_max() const { return side_bvh_ ? side_bvh_->tie_bound_max() : 0.0; }
   // Calls visit(triangle, l) for every side triangle the ray C + w + l d (w relative to the
-  // centre, d unit) crosses with 0 < l < l_end (the watertight test of reference/bvh.hpp),
-  // in no particular order, until visit returns false.
+  // centre, d unit) crosses with 0 < l < l_end (the watertight test of
+  // reference/triangle_test.hpp), in order of l, then triangle, until visit returns false.
   template <class Visit>
   void for_each_side_crossing(const glm::dvec3& w, const glm::dvec3& d, double l_end, Visit&& visit) const {
     if (!side_bvh_) return;
+    std::vector<TriangleHit> hits;  // Embree's order is its own: sorted, the answers are not
     side_bvh_->for_each_hit(RayQuery(cube_->centre + w, d), l_end, [&](const TriangleHit& h) {
-      return visit(side_[h.triangle], h.t);
+      hits.push_back(h);
+      return true;
     });
+    std::sort(hits.begin(), hits.end(), [](const TriangleHit& a, const TriangleHit& b) {
+      return a.t != b.t ? a.t < b.t : a.triangle < b.triangle;
+    });
+    for (const TriangleHit& h : hits) {
+      if (!visit(side_[h.triangle], h.t)) return;
+    }
   }
 
   // Per-triangle geometry is computed from the soup's float vertices on each call, in
@@ -297,7 +306,8 @@ class SearchContext {
   const glm::vec3* positions_;  // the soup's, 3 per triangle
   std::vector<uint32_t> zero_area_;
   std::vector<uint32_t> side_;
-  std::shared_ptr<const Bvh> side_bvh_;  // over side_, in its order
+  std::shared_ptr<const TriangleSoup> side_soup_;  // side_'s triangles, in its order
+  std::shared_ptr<const Bvh> side_bvh_;            // over side_soup_
   std::shared_ptr<const MeshNeighbours> neighbours_;
   // Per face and row j: the smallest and largest column holding a fragment over rows
   // <= j (prefix) and >= j (suffix), and in row j alone (n and -1 when none).

@@ -86,13 +86,14 @@ void SearchContext::build_side_structure(const std::vector<uint8_t>& seen) {
   }
   if (side_.empty()) return;
   const TriangleSoup& soup = *scene_->triangles;
-  TriangleSoup sub;
+  auto sub = std::make_shared<TriangleSoup>();
   for (const uint32_t k : side_) {
-    for (size_t v = 0; v < 3; ++v) sub.positions.push_back(soup.positions[3 * static_cast<size_t>(k) + v]);
-    sub.object_id.push_back(soup.object_id[k]);
-    sub.material_id.push_back(soup.material_id[k]);
+    for (size_t v = 0; v < 3; ++v) sub->positions.push_back(soup.positions[3 * static_cast<size_t>(k) + v]);
+    sub->object_id.push_back(soup.object_id[k]);
+    sub->material_id.push_back(soup.material_id[k]);
   }
-  side_bvh_ = std::make_shared<const Bvh>(sub);
+  side_soup_ = std::move(sub);
+  side_bvh_ = std::make_shared<const Bvh>(*side_soup_);  // side_soup_, declared first, outlives it
 }
 
 // Vertices are the same when their object and float position are (bit for bit, -0 = +0);

@@ -54,7 +54,7 @@ json cube_abuffer_json(const ABufferStats& s) {
 json raytrace_json(const RaytraceStats& rs) {
   return {{"timings_ms", {{"bvh_build", rs.build_ms}, {"trace", rs.trace_ms}}},
           {"counts", {{"primary_rays", rs.primary_rays}, {"secondary_rays", rs.secondary_rays},
-                      {"shadow_rays", rs.shadow_rays}, {"bvh_nodes", rs.bvh_nodes}, {"bvh_depth", rs.bvh_depth}}},
+                      {"shadow_rays", rs.shadow_rays}}},
           {"threads", rs.threads}};
 }
 
