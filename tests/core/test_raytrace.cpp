@@ -16,6 +16,7 @@
 #include "io/image_io.hpp"
 #include "io/metrics.hpp"
 #include "reference/raytrace.hpp"
+#include "scene/scene_load.hpp"
 #include "scene/tie_rule.hpp"
 #include "shading/shading.hpp"
 
@@ -854,6 +855,42 @@ TEST(Raytrace, ImageIdenticalForAnyThreadCount) {
   ASSERT_FALSE(progress.empty());
   EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
   EXPECT_EQ(progress.back(), 1.0);  // ends at 1 whichever thread did the last row
+}
+
+// The Embree tracer against the images of the tracer before it (the hand-written double
+// BVH, commit f347706): every repository scene at 128 pixels wide, 32 samples, 2 threads,
+// pinned in tests/golden/pre_embree/ (README.md there says how they were made). The
+// answers are exact both ways, so the images are expected identical; the floor is 60 dB.
+TEST(Raytrace, EmbreeTracerMatchesThePreEmbreeImagesOnEveryRepositoryScene) {
+  const std::filesystem::path root(ABCUBE_SOURCE_DIR);
+  std::vector<std::filesystem::path> scenes;
+  for (const char* dir : {"scenes", "scenes/bench"}) {
+    for (const auto& e : std::filesystem::directory_iterator(root / dir)) {
+      if (e.path().extension() == ".json") scenes.push_back(e.path());
+    }
+  }
+  std::sort(scenes.begin(), scenes.end());
+  ASSERT_GE(scenes.size(), 5u);
+  for (const std::filesystem::path& path : scenes) {
+    SceneData s = load_scene(path.string());
+    const int w = 128;
+    s.camera.height = (s.camera.height * w + s.camera.width / 2) / s.camera.width;
+    s.camera.width = w;
+    RaytraceOptions o;
+    o.threads = 2;
+    const Image now = render_raytrace(s, o);
+    const std::string name = path.stem().string();
+    const std::filesystem::path old = root / "tests/golden/pre_embree" / (name + "_raytrace.exr");
+    ASSERT_TRUE(std::filesystem::exists(old)) << "no pre-Embree image for " << path << ": " << old;
+    const Image before = read_image(old.string());
+    const ImageError e = image_error(now, before);
+    const bool identical = now.data == before.data;
+    std::printf("[ embree   ] %-16s %dx%d PSNR against the pre-Embree tracer %s dB%s\n", name.c_str(), now.width,
+                now.height, std::isinf(e.psnr) ? "inf" : std::to_string(e.psnr).c_str(),
+                identical ? " (identical floats)" : "");
+    EXPECT_GE(e.psnr, 60.0) << name;
+    if (!identical) save_failure("pre_embree_" + name, now, before);
+  }
 }
 
 TEST(Raytrace, RejectsBadOptions) {
