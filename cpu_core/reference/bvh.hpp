@@ -14,7 +14,7 @@
 // Why not Embree's float triangles (RTC_GEOMETRY_TYPE_TRIANGLE). Its robust float test is
 // watertight, but where a ray passes within float rounding of an edge it can pick the
 // other triangle of the edge, which the double test rejects, or, at an open border, none,
-// where the double test hits: bench/embree_float_check counts those rays on the repository
+// where the double test hits: bench/bench_embree_float counts those rays on the repository
 // scenes (README "Exact tracer"). Recovering them would take a second traversal per query
 // for the tie window and neighbourhood queries, and still miss the open borders.
 //
