@@ -1,9 +1,9 @@
 #include "reference/bvh.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cfloat>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <new>
 #include <string>
@@ -49,37 +49,51 @@ RTCDevice embree_device() {
   return d.device;
 }
 
+// The neighbours of a finite float (the next one towards +inf / -inf), without libm.
+float next_up(float f) {
+  if (f == 0.0f) return std::numeric_limits<float>::denorm_min();
+  uint32_t b;
+  std::memcpy(&b, &f, sizeof b);
+  b = f > 0.0f ? b + 1 : b - 1;
+  std::memcpy(&f, &b, sizeof b);
+  return f;
+}
+float next_down(float f) { return -next_up(-f); }
+
 // The float nearest to x, rounded towards -inf / +inf.
 float round_down(double x) {
   const float f = static_cast<float>(x);
-  return static_cast<double>(f) > x ? std::nextafter(f, -INFINITY) : f;
+  return static_cast<double>(f) > x ? next_down(f) : f;
 }
 float round_up(double x) {
   const float f = static_cast<float>(x);
-  return static_cast<double>(f) < x ? std::nextafter(f, INFINITY) : f;
+  return static_cast<double>(f) < x ? next_up(f) : f;
 }
+
+double max3(const glm::dvec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
 
 // Embree works in its own units: world coordinates times 2^-ilogb(M) (exact), so that
 // every vertex lies within 2 of the origin whatever the scene's size (no float overflow in
 // Embree's box tests, no denormals).
 double embree_unit(double magnitude) { return std::ldexp(1.0, -std::ilogb(magnitude)); }
 
-// Embree's ray for a query (bvh.hpp "Exactness"): origin o_e = origin + t0 dir, direction
-// dir * 2^-e (largest coordinate in [1, 2)), both in Embree's units, so that Embree's t is
-// (t - t0) * scale.
+// Embree's ray for a query (bvh.hpp "Exactness"): origin o_e = origin + t0 dir, both in
+// Embree's units, and the direction (scaled by a power of two when its size is extreme),
+// so that Embree's t is (t - t0) * scale.
 struct EmbreeRay {
   double t0 = 0, scale = 1;
   float to_embree(double t) const { return t == INF ? INFINITY : round_up((t - t0) * scale); }
 };
 
 // Sets up *r and *er for the query ray and 0 < t < tmax; false when the ray cannot meet
-// the cube |x|inf <= 2M that holds every triangle (or is not finite).
-bool embree_ray(const RayQuery& q, double tmax, double magnitude, RTCRay* r, EmbreeRay* er) {
+// the cube |x|inf <= 2M that holds every triangle (or is not finite). `unit` is
+// embree_unit(magnitude).
+bool embree_ray(const RayQuery& q, double tmax, double magnitude, double unit, RTCRay* r, EmbreeRay* er) {
   const glm::dvec3& o = q.origin;
   const glm::dvec3& d = q.dir;
   const double reach = 2.0 * magnitude;
   double t0 = 0.0;
-  if (std::fmax(std::fabs(o.x), std::fmax(std::fabs(o.y), std::fabs(o.z))) > reach) {
+  if (max3(glm::abs(o)) > reach) {
     double enter = 0.0, leave = INF;
     for (int a = 0; a < 3; ++a) {
       if (d[a] == 0.0) {
@@ -88,20 +102,21 @@ bool embree_ray(const RayQuery& q, double tmax, double magnitude, RTCRay* r, Emb
       }
       double tn = (-reach - o[a]) / d[a], tf = (reach - o[a]) / d[a];
       if (tn > tf) std::swap(tn, tf);
-      enter = std::fmax(enter, tn);
-      leave = std::fmin(leave, tf);
+      enter = std::max(enter, tn);
+      leave = std::min(leave, tf);
     }
     if (!(enter <= leave) || !(enter < tmax)) return false;
     t0 = enter;
   }
-  const double unit = embree_unit(magnitude);
   const glm::dvec3 oe = (o + t0 * d) * unit;
-  const double dmax = std::fmax(std::fabs(d.x), std::fmax(std::fabs(d.y), std::fabs(d.z)));
+  const double dmax = max3(glm::abs(d));
   if (!(dmax > 0.0) || !std::isfinite(dmax) || !std::isfinite(oe.x + oe.y + oe.z)) return false;
-  const int e = std::ilogb(dmax);
-  const glm::dvec3 ds = d * std::ldexp(1.0, -e);  // exact: a power of two
+  // A direction between 2^-64 and 2^64 goes as it is (float holds it to 2^-24 of dmax, the
+  // small coordinates included); another is brought to [1, 2) by an exact power of two.
+  const int e = dmax >= 0x1p-64 && dmax <= 0x1p64 ? 0 : std::ilogb(dmax);
+  const glm::dvec3 ds = e == 0 ? d : d * std::ldexp(1.0, -e);
   er->t0 = t0;
-  er->scale = std::ldexp(unit, e);
+  er->scale = e == 0 ? unit : std::ldexp(unit, e);
   r->org_x = static_cast<float>(oe.x);
   r->org_y = static_cast<float>(oe.y);
   r->org_z = static_cast<float>(oe.z);
@@ -128,7 +143,11 @@ struct Query {
   // visible_hit (bvh.hpp)
   double tie_bound_max = 0;
   double cull = INF;  // every hit with t < cull is found
-  std::array<TriangleHit, KEEP> kept;
+  struct Kept {  // no initialisers: not cleared for every query
+    double t;
+    uint32_t triangle;
+  };
+  Kept kept[KEEP];
   int n_kept = 0;
   bool incomplete = false, found = false;
   TriangleHit nearest;
@@ -138,13 +157,13 @@ struct Query {
   bool stopped = false;
 
   // Sets up the context and Embree's ray *r: false when the ray can meet nothing.
-  bool start(const TriangleSoup& s, const RayQuery& q, double t_max, double magnitude, RTCRay* r) {
+  bool start(const TriangleSoup& s, const RayQuery& q, double t_max, double magnitude, double unit, RTCRay* r) {
     rtcInitIntersectContext(&context);
     soup = &s;
     ray = &q;
     tmax = t_max;
     cull = t_max;
-    return embree_ray(q, t_max, magnitude, r, &er);
+    return embree_ray(q, t_max, magnitude, unit, r, &er);
   }
 
   // The end of the tie window of a hit: no surface beyond it can be at its distance.
@@ -163,12 +182,12 @@ struct Query {
       cull = end;
       int w = 0;
       for (int i = 0; i < n_kept; ++i) {
-        if (kept[static_cast<size_t>(i)].t < cull) kept[static_cast<size_t>(w++)] = kept[static_cast<size_t>(i)];
+        if (kept[i].t < cull) kept[w++] = kept[i];
       }
       n_kept = w;
     }
     if (n_kept < KEEP) {
-      kept[static_cast<size_t>(n_kept++)] = h;
+      kept[n_kept++] = {h.t, h.triangle};
     } else {
       incomplete = true;
     }
@@ -183,7 +202,7 @@ void visible_candidate(const RTCIntersectFunctionNArguments* args) {
   if (!intersect_triangle(*q->ray, *q->soup, args->primID, q->cull, &h)) return;
   q->add(h);
   float& tfar = RTCRayN_tfar(RTCRayHitN_RayN(args->rayhit, args->N), args->N, 0);
-  tfar = std::fmin(tfar, q->er.to_embree(q->cull));  // never widened: a wider window is the second traversal's
+  tfar = std::min(tfar, q->er.to_embree(q->cull));  // never widened: a wider window is the second traversal's
 }
 
 // Embree's callback for rtcOccluded1 (for_each_hit): the double test of one candidate;
@@ -204,7 +223,7 @@ void visit_candidate(const RTCOccludedFunctionNArguments* args) {
 void triangle_bounds(const RTCBoundsFunctionArguments* args) {
   const Bvh* bvh = static_cast<const Bvh*>(args->geometryUserPtr);
   const glm::vec3* p = &bvh->soup().positions[3 * static_cast<size_t>(args->primID)];
-  const double unit = embree_unit(bvh->magnitude());
+  const double unit = embree_unit(bvh->magnitude());  // Bvh::unit_
   const glm::dvec3 lo = glm::dvec3(glm::min(p[0], glm::min(p[1], p[2]))) * unit;
   const glm::dvec3 hi = glm::dvec3(glm::max(p[0], glm::max(p[1], p[2]))) * unit;
   const double pad = Bvh::BOX_PAD * bvh->magnitude() * unit;
@@ -239,6 +258,7 @@ Bvh::Bvh(const TriangleSoup& soup) : soup_(&soup) {
     }
   }
   if (n == 0 || !(magnitude_ > 0.0)) return;  // nothing to hit (all vertices at the origin: all degenerate)
+  unit_ = embree_unit(magnitude_);
   const RTCDevice device = embree_device();
   RTCScene scene = rtcNewScene(device);
   check_embree(device, "rtcNewScene");
@@ -271,7 +291,7 @@ bool Bvh::visible_hit(const RayQuery& ray, double tmax, TriangleHit* hit) const 
   if (!scene_) return false;
   Query q;
   RTCRayHit rh;
-  if (!q.start(*soup_, ray, tmax, magnitude_, &rh.ray)) return false;
+  if (!q.start(*soup_, ray, tmax, magnitude_, unit_, &rh.ray)) return false;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   q.tie_bound_max = tie_bound_max_;
@@ -287,7 +307,14 @@ bool Bvh::visible_hit(const RayQuery& ray, double tmax, TriangleHit* hit) const 
   if (q.incomplete) {
     for_each_hit(ray, q.cull, consider);  // the nearest hit's whole window, again
   } else {
-    for (int i = 0; i < q.n_kept; ++i) consider(q.kept[static_cast<size_t>(i)]);
+    for (int i = 0; i < q.n_kept; ++i) {  // a kept hit that wins is tested again: the same hit
+      const Query::Kept& k = q.kept[i];
+      TriangleHit h;
+      if (ranks_above(soup, k.triangle, best.triangle) && same_distance(soup, ray.dir, near_at, {k.triangle, k.t}) &&
+          intersect_triangle(ray, soup, k.triangle, INF, &h)) {
+        best = h;
+      }
+    }
   }
   *hit = best;
   return true;
@@ -297,7 +324,7 @@ void Bvh::visit_hits(const RayQuery& ray, double tmax, VisitFn visit, void* stat
   if (!scene_) return;
   Query q;
   RTCRay r;
-  if (!q.start(*soup_, ray, tmax, magnitude_, &r)) return;
+  if (!q.start(*soup_, ray, tmax, magnitude_, unit_, &r)) return;
   q.visit = visit;
   q.state = state;
   rtcOccluded1(scene_, &q.context, &r);

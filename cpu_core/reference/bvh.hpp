@@ -98,6 +98,7 @@ class Bvh {
   const TriangleSoup* soup_;
   RTCSceneTy* scene_ = nullptr;  // null when there is nothing to hit
   double magnitude_ = 0;         // the largest absolute vertex coordinate, M
+  double unit_ = 1;              // Embree's units: 2^-ilogb(M) (bvh.hpp "Exactness")
   double tie_bound_max_ = 0;     // TIE_RELATIVE * M
 };
 
