@@ -137,6 +137,7 @@ struct Query {
   static constexpr int KEEP = 8;
   RTCIntersectContext context;
   const TriangleSoup* soup = nullptr;
+  const uint32_t* triangles = nullptr;  // Embree's primitive k is triangle triangles[k] (null: k)
   const RayQuery* ray = nullptr;
   double tmax = INF;
   EmbreeRay er;
@@ -157,14 +158,18 @@ struct Query {
   bool stopped = false;
 
   // Sets up the context and Embree's ray *r: false when the ray can meet nothing.
-  bool start(const TriangleSoup& s, const RayQuery& q, double t_max, double magnitude, double unit, RTCRay* r) {
+  bool start(const TriangleSoup& s, const uint32_t* subset, const RayQuery& q, double t_max, double magnitude,
+             double unit, RTCRay* r) {
     rtcInitIntersectContext(&context);
     soup = &s;
+    triangles = subset;
     ray = &q;
     tmax = t_max;
     cull = t_max;
     return embree_ray(q, t_max, magnitude, unit, r, &er);
   }
+
+  uint32_t triangle(unsigned prim) const { return triangles ? triangles[prim] : prim; }
 
   // The end of the tie window of a hit: no surface beyond it can be at its distance.
   double window_end(const TriangleHit& h) const {
@@ -199,7 +204,7 @@ void visible_candidate(const RTCIntersectFunctionNArguments* args) {
   if (!args->valid[0]) return;  // rtcIntersect1: N = 1
   Query* q = reinterpret_cast<Query*>(args->context);
   TriangleHit h;
-  if (!intersect_triangle(*q->ray, *q->soup, args->primID, q->cull, &h)) return;
+  if (!intersect_triangle(*q->ray, *q->soup, q->triangle(args->primID), q->cull, &h)) return;
   q->add(h);
   float& tfar = RTCRayN_tfar(RTCRayHitN_RayN(args->rayhit, args->N), args->N, 0);
   tfar = std::min(tfar, q->er.to_embree(q->cull));  // never widened: a wider window is the second traversal's
@@ -212,7 +217,7 @@ void visit_candidate(const RTCOccludedFunctionNArguments* args) {
   Query* q = reinterpret_cast<Query*>(args->context);
   if (q->stopped) return;
   TriangleHit h;
-  if (!intersect_triangle(*q->ray, *q->soup, args->primID, q->tmax, &h)) return;
+  if (!intersect_triangle(*q->ray, *q->soup, q->triangle(args->primID), q->tmax, &h)) return;
   if (q->visit(q->state, h)) return;
   q->stopped = true;
   RTCRayN_tfar(args->ray, args->N, 0) = -INFINITY;
@@ -222,7 +227,7 @@ void visit_candidate(const RTCOccludedFunctionNArguments* args) {
 // rounded outwards.
 void triangle_bounds(const RTCBoundsFunctionArguments* args) {
   const Bvh* bvh = static_cast<const Bvh*>(args->geometryUserPtr);
-  const glm::vec3* p = &bvh->soup().positions[3 * static_cast<size_t>(args->primID)];
+  const glm::vec3* p = &bvh->soup().positions[3 * static_cast<size_t>(bvh->triangle(args->primID))];
   const double unit = embree_unit(bvh->magnitude());  // Bvh::unit_
   const glm::dvec3 lo = glm::dvec3(glm::min(p[0], glm::min(p[1], p[2]))) * unit;
   const glm::dvec3 hi = glm::dvec3(glm::max(p[0], glm::max(p[1], p[2]))) * unit;
@@ -243,18 +248,30 @@ void triangle_bounds(const RTCBoundsFunctionArguments* args) {
 
 }  // namespace
 
-Bvh::Bvh(const TriangleSoup& soup) : soup_(&soup) {
-  const size_t n = soup.triangle_count();
-  ABCUBE_CHECK(soup.positions.size() == 3 * n, "positions must hold 3 vertices per triangle");
-  ABCUBE_CHECK(n < UINT32_MAX / 3, "too many triangles for 32-bit indices");
+Bvh::Bvh(const TriangleSoup& soup) : soup_(&soup) { build(); }
+
+Bvh::Bvh(const TriangleSoup& soup, std::vector<uint32_t> triangles)
+    : soup_(&soup), all_(false), triangles_(std::move(triangles)) {
+  for (const uint32_t t : triangles_) ABCUBE_CHECK(t < soup.triangle_count(), "triangle index out of range");
+  build();
+}
+
+void Bvh::build() {
+  const TriangleSoup& soup = *soup_;
+  ABCUBE_CHECK(soup.positions.size() == 3 * soup.triangle_count(), "positions must hold 3 vertices per triangle");
+  ABCUBE_CHECK(soup.triangle_count() < UINT32_MAX / 3, "too many triangles for 32-bit indices");
+  const uint32_t n = static_cast<uint32_t>(triangle_count());
   double magnitude = 0.0;
-  for (uint32_t t = 0; t < n; ++t) magnitude = std::max(magnitude, triangle_magnitude(soup, t));
+  for (uint32_t k = 0; k < n; ++k) magnitude = std::max(magnitude, triangle_magnitude(soup, triangle(k)));
   tie_bound_max_ = TIE_RELATIVE * magnitude;
   // M over the finite coordinates (the loader drops triangles with others; a hand-made
   // soup's are given empty boxes: never hit).
-  for (const glm::vec3& p : soup.positions) {
-    for (int k = 0; k < 3; ++k) {
-      if (std::isfinite(p[k])) magnitude_ = std::max(magnitude_, static_cast<double>(std::fabs(p[k])));
+  for (uint32_t k = 0; k < n; ++k) {
+    for (size_t v = 0; v < 3; ++v) {
+      const glm::vec3& p = soup.positions[3 * static_cast<size_t>(triangle(k)) + v];
+      for (int c = 0; c < 3; ++c) {
+        if (std::isfinite(p[c])) magnitude_ = std::max(magnitude_, static_cast<double>(std::fabs(p[c])));
+      }
     }
   }
   if (n == 0 || !(magnitude_ > 0.0)) return;  // nothing to hit (all vertices at the origin: all degenerate)
@@ -291,7 +308,7 @@ bool Bvh::visible_hit(const RayQuery& ray, double tmax, TriangleHit* hit) const 
   if (!scene_) return false;
   Query q;
   RTCRayHit rh;
-  if (!q.start(*soup_, ray, tmax, magnitude_, unit_, &rh.ray)) return false;
+  if (!q.start(*soup_, all_ ? nullptr : triangles_.data(), ray, tmax, magnitude_, unit_, &rh.ray)) return false;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   q.tie_bound_max = tie_bound_max_;
@@ -324,7 +341,7 @@ void Bvh::visit_hits(const RayQuery& ray, double tmax, VisitFn visit, void* stat
   if (!scene_) return;
   Query q;
   RTCRay r;
-  if (!q.start(*soup_, ray, tmax, magnitude_, unit_, &r)) return;
+  if (!q.start(*soup_, all_ ? nullptr : triangles_.data(), ray, tmax, magnitude_, unit_, &r)) return;
   q.visit = visit;
   q.state = state;
   rtcOccluded1(scene_, &q.context, &r);

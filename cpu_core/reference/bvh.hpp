@@ -41,6 +41,7 @@
 #include <cstdint>
 #include <memory>
 #include <type_traits>
+#include <vector>
 
 #include "reference/triangle_test.hpp"
 #include "scene/scene_data.hpp"
@@ -55,6 +56,9 @@ class Bvh {
   // outlive the Bvh and not change. Throws RuntimeFailure when Embree fails (std::bad_alloc
   // when out of memory).
   explicit Bvh(const TriangleSoup& soup);
+  // The same over the soup's triangles `triangles` only (hits name them by their index in
+  // the soup; the searches' side structure).
+  Bvh(const TriangleSoup& soup, std::vector<uint32_t> triangles);
   ~Bvh();
   Bvh(const Bvh&) = delete;
   Bvh& operator=(const Bvh&) = delete;
@@ -80,10 +84,13 @@ class Bvh {
                const_cast<void*>(static_cast<const void*>(&visit)));
   }
 
-  // TIE_RELATIVE times the largest absolute vertex coordinate (tie_rule.hpp): no two of
-  // these triangles are at the same distance beyond this separation along their normals.
+  // TIE_RELATIVE times the largest absolute vertex coordinate of its triangles
+  // (tie_rule.hpp): no two of them are at the same distance beyond this separation along
+  // their normals.
   double tie_bound_max() const { return tie_bound_max_; }
-  size_t triangle_count() const { return soup_->triangle_count(); }
+  size_t triangle_count() const { return all_ ? soup_->triangle_count() : triangles_.size(); }
+  // Its k-th triangle's index in the soup.
+  uint32_t triangle(uint32_t k) const { return all_ ? k : triangles_[k]; }
   const TriangleSoup& soup() const { return *soup_; }
   // The largest absolute vertex coordinate, M.
   double magnitude() const { return magnitude_; }
@@ -94,8 +101,11 @@ class Bvh {
  private:
   using VisitFn = bool (*)(void* state, const TriangleHit& hit);
   void visit_hits(const RayQuery& ray, double tmax, VisitFn visit, void* state) const;
+  void build();
 
   const TriangleSoup* soup_;
+  bool all_ = true;                 // every triangle of the soup, else triangles_
+  std::vector<uint32_t> triangles_;
   RTCSceneTy* scene_ = nullptr;  // null when there is nothing to hit
   double magnitude_ = 0;         // the largest absolute vertex coordinate, M
   double unit_ = 1;              // Embree's units: 2^-ilogb(M) (bvh.hpp "Exactness")

@@ -243,7 +243,7 @@ class SearchContext {
       return a.t != b.t ? a.t < b.t : a.triangle < b.triangle;
     });
     for (const TriangleHit& h : hits) {
-      if (!visit(side_[h.triangle], h.t)) return;
+      if (!visit(h.triangle, h.t)) return;
     }
   }
 
@@ -306,8 +306,7 @@ class SearchContext {
   const glm::vec3* positions_;  // the soup's, 3 per triangle
   std::vector<uint32_t> zero_area_;
   std::vector<uint32_t> side_;
-  std::shared_ptr<const TriangleSoup> side_soup_;  // side_'s triangles, in its order
-  std::shared_ptr<const Bvh> side_bvh_;            // over side_soup_
+  std::shared_ptr<const Bvh> side_bvh_;  // over side_ (the scene's soup, not copied)
   std::shared_ptr<const MeshNeighbours> neighbours_;
   // Per face and row j: the smallest and largest column holding a fragment over rows
   // <= j (prefix) and >= j (suffix), and in row j alone (n and -1 when none).

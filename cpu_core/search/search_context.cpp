@@ -85,15 +85,7 @@ void SearchContext::build_side_structure(const std::vector<uint8_t>& seen) {
     if ((zero_area || !seen[k]) && plane(k).normal != glm::dvec3(0.0)) side_.push_back(k);
   }
   if (side_.empty()) return;
-  const TriangleSoup& soup = *scene_->triangles;
-  auto sub = std::make_shared<TriangleSoup>();
-  for (const uint32_t k : side_) {
-    for (size_t v = 0; v < 3; ++v) sub->positions.push_back(soup.positions[3 * static_cast<size_t>(k) + v]);
-    sub->object_id.push_back(soup.object_id[k]);
-    sub->material_id.push_back(soup.material_id[k]);
-  }
-  side_soup_ = std::move(sub);
-  side_bvh_ = std::make_shared<const Bvh>(*side_soup_);  // side_soup_, declared first, outlives it
+  side_bvh_ = std::make_shared<const Bvh>(*scene_->triangles, side_);
 }
 
 // Vertices are the same when their object and float position are (bit for bit, -0 = +0);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <numeric>
 #include <random>
 #include <string>
 #include <vector>
@@ -212,6 +213,36 @@ TriangleHit rule_over(const TriangleSoup& soup, const dvec3& dir, const std::vec
   return best;
 }
 
+// One query of `bvh` against a loop over `candidates` (its triangles): the set of all hits
+// (each once) and the visible hit by the rule, bit for bit. Returns whether the ray hits.
+bool check_query(const Bvh& bvh, const std::vector<uint32_t>& candidates, const RayQuery& q, const std::string& what) {
+  const TriangleSoup& soup = bvh.soup();
+  std::vector<TriangleHit> brute;
+  std::vector<uint32_t> brute_ids, ids;
+  for (const uint32_t t : candidates) {
+    TriangleHit h;
+    if (intersect_triangle(q, soup, t, INFINITY, &h)) {
+      brute.push_back(h);
+      brute_ids.push_back(t);
+    }
+  }
+  bvh.for_each_hit(q, INFINITY, [&](const TriangleHit& h) {
+    ids.push_back(h.triangle);
+    return true;
+  });
+  std::sort(ids.begin(), ids.end());
+  std::sort(brute_ids.begin(), brute_ids.end());
+  EXPECT_EQ(ids, brute_ids) << what;
+  TriangleHit fast;
+  EXPECT_EQ(bvh.visible_hit(q, INFINITY, &fast), !brute.empty()) << what;
+  if (brute.empty()) return false;
+  int tied = 0;
+  const TriangleHit best = rule_over(soup, q.dir, brute, &tied);
+  EXPECT_EQ(fast.triangle, best.triangle) << what;
+  EXPECT_EQ(fast.t, best.t) << what;
+  return true;
+}
+
 TEST(Raytrace, BvhMatchesBruteForce) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -260,6 +291,31 @@ TEST(Raytrace, BvhMatchesBruteForce) {
   EXPECT_GT(hits, 500);  // the comparison is not vacuous
 }
 
+// A Bvh over some of a soup's triangles (the searches' side structure) answers for those
+// only, naming them by their index in the soup.
+TEST(Raytrace, BvhOverASubsetAnswersForItsTrianglesOnly) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  SceneData s = empty_scene({0, 0, 5}, {0, 0, 0}, 60, 8, 8);
+  const uint32_t mat = add_material(s, Material{});
+  begin_object(s, "mesh", mat, false);
+  for (int i = 0; i < 600; ++i) {
+    const dvec3 c(u(rng), u(rng), u(rng));
+    add_flat_triangle(s, c, c + 0.3 * dvec3(u(rng), u(rng), u(rng)), c + 0.3 * dvec3(u(rng), u(rng), u(rng)));
+  }
+  const TriangleSoup& soup = *s.triangles;
+  std::vector<uint32_t> subset;
+  for (uint32_t t = 1; t < soup.triangle_count(); t += 3) subset.push_back(t);
+  const Bvh bvh(soup, subset);
+  ASSERT_EQ(bvh.triangle_count(), subset.size());
+  int hits = 0;
+  for (int r = 0; r < 3000; ++r) {
+    const RayQuery q(2.0 * dvec3(u(rng), u(rng), u(rng)), dvec3(u(rng), u(rng), u(rng)));
+    hits += check_query(bvh, subset, q, "ray " + std::to_string(r));
+  }
+  EXPECT_GT(hits, 100);
+}
+
 // Embree's float traversal never loses a hit the double test makes (bvh.hpp "Exactness"):
 // rays aimed exactly at the vertices and edge midpoints of closed spheres and open quads,
 // the worst case for float, from origins inside the scene and up to 1e4 times its size
@@ -281,6 +337,8 @@ TEST(Raytrace, BvhMatchesBruteForceAtEdgesFarAndAtEveryScale) {
     }
     const TriangleSoup& soup = *s.triangles;
     const Bvh bvh(soup);
+    std::vector<uint32_t> all(soup.triangle_count());
+    std::iota(all.begin(), all.end(), 0u);
     std::vector<dvec3> targets;
     for (size_t i = 0; i < soup.positions.size(); ++i) {
       const dvec3 v(soup.positions[i]), w(soup.positions[i % 3 == 2 ? i - 2 : i + 1]);
@@ -291,28 +349,8 @@ TEST(Raytrace, BvhMatchesBruteForceAtEdgesFarAndAtEveryScale) {
       const double reach = std::pow(10.0, 4.0 * (k % 5) / 4.0);  // 1 to 1e4 times the scene
       const dvec3 o = scale * reach * 2.0 * glm::normalize(dvec3(u(rng), u(rng), u(rng)));
       const RayQuery q(o, targets[k] - o);
-      std::vector<TriangleHit> brute;
-      for (uint32_t t = 0; t < soup.triangle_count(); ++t) {
-        TriangleHit h;
-        if (intersect_triangle(q, soup, t, INFINITY, &h)) brute.push_back(h);
-      }
-      std::vector<uint32_t> brute_ids, ids;
-      for (const TriangleHit& h : brute) brute_ids.push_back(h.triangle);
-      bvh.for_each_hit(q, INFINITY, [&](const TriangleHit& h) {
-        ids.push_back(h.triangle);
-        return true;
-      });
-      std::sort(ids.begin(), ids.end());
       ++queries;
-      ASSERT_EQ(ids, brute_ids) << "scale " << scale << " target " << k;
-      TriangleHit fast;
-      ASSERT_EQ(bvh.visible_hit(q, INFINITY, &fast), !brute.empty()) << "scale " << scale << " target " << k;
-      if (brute.empty()) continue;
-      ++hits;
-      int tied = 0;
-      const TriangleHit best = rule_over(soup, q.dir, brute, &tied);
-      EXPECT_EQ(fast.triangle, best.triangle) << "scale " << scale << " target " << k;
-      EXPECT_EQ(fast.t, best.t) << "scale " << scale << " target " << k;
+      hits += check_query(bvh, all, q, "scale " + std::to_string(scale) + " target " + std::to_string(k));
     }
   }
   EXPECT_GT(hits, queries * 9 / 10);  // aimed at the triangles: nearly every ray hits
