@@ -14,9 +14,10 @@
 // Why not Embree's float triangles (RTC_GEOMETRY_TYPE_TRIANGLE). Its robust float test is
 // watertight, but where a ray passes within float rounding of an edge it can pick the
 // other triangle of the edge, which the double test rejects, or, at an open border, none,
-// where the double test hits: bench/bench_embree_float counts those rays on the repository
-// scenes (README "Exact tracer"). Recovering them would take a second traversal per query
-// for the tie window and neighbourhood queries, and still miss the open borders.
+// where the double test hits: bench/bench_embree_float counts those rays on the
+// repository scenes (README "Exact tracer on Embree"). Recovering them would take a second
+// traversal per query for the tie window and neighbourhood queries, and still miss the
+// open borders.
 //
 // Exactness. A query's hits are exactly the triangles the double test accepts (a loop over
 // every triangle gives the same; tests check it), because no box that the double ray meets
@@ -31,7 +32,8 @@
 //    rcp(dir) in float, with rcp good to about 2^-22, errs by at most about
 //    2^-24 |org| + 2^-22 |lower - org| <= 17 2^-24 per coordinate, along the ray.
 //  - Every box is widened by BOX_PAD = 2^-16 = 256 2^-24, over ten times their sum, and
-//    rounded outwards.
+//    rounded outwards (tests/core/test_raytrace.cpp, rays aimed at edges: lost hits with
+//    no widening and with 2^-24, none from 2^-21).
 // So the answers do not depend on which instruction set Embree picks (SSE, AVX2, AVX-512),
 // the threads that built the tree, or the order the tree is walked in.
 //
@@ -39,7 +41,6 @@
 // RTCScene, read only; a context per call).
 #pragma once
 #include <cstdint>
-#include <memory>
 #include <type_traits>
 #include <vector>
 
