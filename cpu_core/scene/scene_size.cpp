@@ -12,14 +12,16 @@ namespace {
 // Bytes per unit of work, for the estimate: a camera pixel holds its colour and A-buffer
 // fragment headroom; a cube texel its distance and fragment headroom. A triangle: the peak
 // resident bytes a triangle of scene data costs above the process's own, measured by
-// bench/memory.py on 440k- and 1M-triangle meshes (bench/results/memory.txt: at most 373
-// marginal for raytrace, abuffer, zbuffer and envmap; the soup's 80 of it), rounded up;
-// the gpu method adds the GL vertex buffer (3 vertices of 32 bytes, gl_passes.cpp), which
-// the driver holds beside the soup.
+// bench/memory.py on 440k- and 1M-triangle meshes (bench/results/memory.txt, the exact
+// tracer and the side structure on Embree: at most 168 for raytrace, abuffer, zbuffer and
+// envmap; the soup's 80 of it), rounded up; the gpu method adds the GL vertex buffer
+// (3 vertices of 32 bytes, gl_passes.cpp) and what llvmpipe holds while it draws them
+// (about 90 more, measured from /proc/self/statm around the first draw); gpu measured
+// 380 a triangle at 1M triangles (marginal 230).
 constexpr uint64_t PIXEL_BYTES = 3 * sizeof(float) + 64;
 constexpr uint64_t TEXEL_BYTES = 64;
-constexpr uint64_t TRIANGLE_BYTES = 380;
-constexpr uint64_t GL_TRIANGLE_BYTES = 3 * 32;
+constexpr uint64_t TRIANGLE_BYTES = 170;
+constexpr uint64_t GL_TRIANGLE_BYTES = 3 * 32 + 90;
 static_assert(TRIANGLE_BYTES >= 6 * sizeof(glm::vec3) + 2 * sizeof(uint32_t), "the soup alone");
 
 }  // namespace
