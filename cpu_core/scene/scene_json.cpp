@@ -16,15 +16,6 @@ namespace abcube::detail {
 
 // ---- Messages ----------------------------------------------------------------------
 
-// One line, whatever the pieces contained.
-std::string one_line(std::string s) {
-  for (char& c : s) {
-    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
-  }
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s;
-}
-
 // Shortest text that reads back as the same double.
 std::string format_number(double x) {
   if (std::isnan(x)) return "nan";
@@ -41,11 +32,48 @@ std::string format_number(double x) {
   return buf;
 }
 
+namespace {
+
+constexpr size_t DESCRIBE_MAX_BYTES = 48;
+
+// Appends v in compact JSON form (strings quoted by quote()), stopping once `out` is longer
+// than DESCRIBE_MAX_BYTES: a value of megabytes costs no more than a short one.
+void describe_into(const Json& v, std::string& out) {
+  if (out.size() > DESCRIBE_MAX_BYTES) return;
+  if (v.is_string()) {
+    out += quote(v.get_ref<const std::string&>());
+  } else if (v.is_array()) {
+    out += '[';
+    for (auto it = v.begin(); it != v.end() && out.size() <= DESCRIBE_MAX_BYTES; ++it) {
+      if (it != v.begin()) out += ',';
+      describe_into(*it, out);
+    }
+    out += ']';
+  } else if (v.is_object()) {
+    out += '{';
+    for (auto it = v.begin(); it != v.end() && out.size() <= DESCRIBE_MAX_BYTES; ++it) {
+      if (it != v.begin()) out += ',';
+      out += quote(it.key()) + ':';
+      describe_into(it.value(), out);
+    }
+    out += '}';
+  } else {
+    out += v.dump();  // a number, true, false, null
+  }
+}
+
+}  // namespace
+
 // A JSON value as it appears after "got" in a message, cut short when long.
 std::string describe(const Json& v) {
   if (v.is_number()) return format_number(v.get<double>());
-  std::string s = v.dump();
-  if (s.size() > 48) s = s.substr(0, 45) + "...";
+  std::string s;
+  describe_into(v, s);
+  if (s.size() > DESCRIBE_MAX_BYTES) {
+    size_t cut = DESCRIBE_MAX_BYTES - 3;
+    while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;  // not inside a character
+    s = s.substr(0, cut) + "...";
+  }
   return s;
 }
 
@@ -55,9 +83,9 @@ std::string describe(const glm::dvec3& v) {
 
 // "parent.key", quoting keys that are not plain names (material names can be anything).
 std::string member_path(const std::string& parent, const std::string& key) {
-  bool plain = !key.empty();
+  bool plain = !key.empty() && key.size() <= QUOTE_MAX_CHARS;
   for (char c : key) plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-');
-  const std::string k = plain ? key : "[" + Json(key).dump() + "]";
+  const std::string k = plain ? key : "[" + quote(key) + "]";
   if (parent.empty()) return k;
   return plain ? parent + "." + k : parent + k;
 }
@@ -100,6 +128,17 @@ std::string parser_message(const std::string& what) {
   if (m.rfind("parse error", 0) == 0) {
     const size_t colon = m.find(": ");
     if (colon != std::string::npos) m = m.substr(colon + 2);
+  }
+  // The token nlohmann quotes ("...; last read: 'TOKEN'[; expected ...]", "number overflow
+  // parsing 'TOKEN'") can be a whole string or number of megabytes: cut short.
+  for (const char* opener : {"; last read: '", "number overflow parsing '"}) {
+    const size_t at = m.find(opener);
+    if (at == std::string::npos) continue;
+    const size_t from = at + std::strlen(opener);
+    size_t to = m.rfind("'; expected ");
+    if (to == std::string::npos || to < from) to = !m.empty() && m.back() == '\'' ? m.size() - 1 : std::string::npos;
+    if (to == std::string::npos || to < from) continue;
+    m = m.substr(0, from) + printable(std::string_view(m).substr(from, to - from)) + m.substr(to);
   }
   if (m.rfind("number overflow", 0) == 0) m += " (numbers must be finite)";
   return m;

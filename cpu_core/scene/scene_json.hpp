@@ -21,14 +21,15 @@ struct Source {
 
 // ---- Messages ----------------------------------------------------------------------
 
-// One line, whatever the pieces contained.
-std::string one_line(std::string s);
+// Messages quote input through base/error.hpp (quote, printable, one_line).
 // Shortest text that reads back as the same double.
 std::string format_number(double x);
-// A JSON value as it appears after "got" in a message, cut short when long.
+// A JSON value as it appears after "got" in a message: strings quoted, arrays and objects
+// cut short after about 48 characters (only what is shown is visited).
 std::string describe(const Json& v);
 std::string describe(const glm::dvec3& v);
-// "parent.key", quoting keys that are not plain names (material names can be anything).
+// "parent.key", or parent["key"] with the key quoted when it is not a short plain name
+// (material names can be anything).
 std::string member_path(const std::string& parent, const std::string& key);
 std::string index_path(const std::string& parent, size_t i);
 // Throws InputError "NAME: PATH: WHAT" (one line).

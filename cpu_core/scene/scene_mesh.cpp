@@ -1,7 +1,9 @@
 // Mesh objects: triangles from a Wavefront OBJ file, materials from the MTL files it
 // names, and the confinement of both to LoadLimits::root.
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -30,7 +32,8 @@ Material convert_mtl(const LoadState& st, const std::string& path, const std::st
   m.opacity = in.dissolve;
   m.ior = std::max(1.0, static_cast<double>(in.ior));
   auto bad = [&](const char* what, double x) {
-    fail(st.src, path, where + ": material \"" + in.name + "\": " + what + ", got " + format_number(x));
+    fail(st.src, path,
+         "mesh " + quote_path(where) + ": material " + quote(in.name) + ": " + what + ", got " + format_number(x));
   };
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(m.color[i]) || m.color[i] < 0) bad("Kd must be finite and >= 0", m.color[i]);
@@ -65,6 +68,21 @@ std::string find_line(const std::string& text, const char* needle) {
     if (line.find(needle) != std::string::npos) return line;
   }
   return "";
+}
+
+// tinyobjloader's warning of a material it did not find, the name it holds quoted:
+// "material [ 'NAME' ] not found in .mtl" (usemtl) and "Material file [ NAME ] not found
+// in a path : DIR" (mtllib). Other lines are shown as they are, cut short.
+std::string missing_material_message(const std::string& line) {
+  const auto between = [&](const std::string& head, const std::string& tail, const char* what) -> std::string {
+    if (line.rfind(head, 0) != 0) return "";
+    const size_t end = line.rfind(tail);
+    if (end == std::string::npos || end < head.size()) return "";
+    return std::string(what) + " " + quote(line.substr(head.size(), end - head.size())) + " not found";
+  };
+  std::string m = between("material [ '", "' ] not found", "usemtl: material");
+  if (m.empty()) m = between("Material file [ ", " ] not found", "mtllib: material file");
+  return m.empty() ? printable(line) : m;
 }
 
 // Appends one OBJ face (already validated) to `out` (indexed, positions and normals
@@ -135,16 +153,17 @@ struct ObjFile {
 ObjFile parse_obj(const LoadState& st, const std::string& path, const std::string& resolved) {
   ObjFile obj;
   std::ifstream in(resolved);
-  if (!in) fail(st.src, path, "cannot parse mesh \"" + resolved + "\": Cannot open file [" + resolved + "]");
+  if (!in) fail(st.src, path, "cannot read mesh " + quote_path(resolved) + ": " + std::strerror(errno));
   const size_t slash = resolved.find_last_of("/\\");
   const std::string base_dir = slash == std::string::npos || slash == 0 ? "" : resolved.substr(0, slash) + "/";
   ConfinedMaterialReader mtl(base_dir, st.root);
   const bool ok = tinyobj::LoadObj(&obj.attrib, &obj.shapes, &obj.materials, &obj.warning, &obj.error, &in, &mtl,
                                    false /* triangulate: ear-clipped here, keeping the winding */, false);
   if (!mtl.escaped.empty()) {
-    fail(st.src, path, "mtllib '" + mtl.escaped + "' of mesh \"" + resolved + "\" resolves outside --root " + st.root);
+    fail(st.src, path,
+         "mtllib " + quote_path(mtl.escaped) + " of mesh " + quote_path(resolved) + " resolves outside --root " + st.root);
   }
-  if (!ok) fail(st.src, path, "cannot parse mesh \"" + resolved + "\": " + obj.error);
+  if (!ok) fail(st.src, path, "cannot parse mesh " + quote_path(resolved) + ": " + printable(find_line(obj.error, ""), 160));
   return obj;
 }
 
@@ -186,7 +205,7 @@ bool inside_root(const std::string& root, const std::string& file) {
 void check_inside_root(const LoadState& st, const std::string& path, const std::string& file,
                        const std::string& resolved) {
   if (!st.root.empty() && !inside_root(st.root, resolved)) {
-    fail(st.src, path, "'" + file + "' resolves outside --root " + st.root);
+    fail(st.src, path, quote_path(file) + " resolves outside --root " + st.root);
   }
 }
 
@@ -199,13 +218,13 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(resolved, ec)) {
     const bool exists = std::filesystem::exists(resolved, ec);
-    fail(st.src, path, "cannot read mesh \"" + resolved + "\": " + (exists ? "not a regular file" : "no such file"));
+    fail(st.src, path, "cannot read mesh " + quote_path(resolved) + ": " + (exists ? "not a regular file" : "no such file"));
   }
   const ObjFile obj = parse_obj(st, path, resolved);
   check_triangle_cap(st, path, obj_triangle_count(obj));  // before anything is made
   if (use_mtl) {
     const std::string missing = find_line(obj.warning, "not found");
-    if (!missing.empty()) fail(st.src, path, "mesh \"" + resolved + "\": " + missing);
+    if (!missing.empty()) fail(st.src, path, "mesh " + quote_path(resolved) + ": " + missing_material_message(missing));
   }
   const std::vector<uint32_t> mtl_ids = use_mtl ? mtl_material_ids(st, path, file, resolved, obj.materials) : std::vector<uint32_t>{};
   const tinyobj::attrib_t& a = obj.attrib;
@@ -234,7 +253,8 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
       for (size_t k = 0; k < n; ++k) {
         if (corners[k].vertex_index < 0 || corners[k].vertex_index >= vertex_count ||
             corners[k].normal_index >= normal_count) {
-          fail(st.src, path, "mesh \"" + resolved + "\": face of shape \"" + shape.name + "\" has an index out of range");
+          fail(st.src, path,
+               "mesh " + quote_path(resolved) + ": face of shape " + quote(shape.name) + " has an index out of range");
         }
       }
       const int mtl = face < shape.mesh.material_ids.size() ? shape.mesh.material_ids[face] : -1;

@@ -37,7 +37,7 @@ void check_render_size(const SceneData& scene, uint64_t budget_bytes) {
   const uint64_t need = estimate_render_bytes(scene);
   if (need <= budget_bytes) return;
   constexpr uint64_t MIB = uint64_t{1} << 20;
-  throw InputError(detail::one_line(scene.file + ": render: estimated " + std::to_string((need + MIB - 1) / MIB) +
+  throw InputError(one_line(scene.file + ": render: estimated " + std::to_string((need + MIB - 1) / MIB) +
                             " MiB for " + std::to_string(scene.camera.width) + "x" +
                             std::to_string(scene.camera.height) + " and cube " +
                             std::to_string(scene.render.cube_resolution) + " exceeds available memory " +

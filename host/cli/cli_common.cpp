@@ -60,7 +60,7 @@ void RenderFlags::add_to(CLI::App* cmd) {
 
 RenderOptions RenderFlags::render_options() const {
   if (plan != "needed" && plan != "everything") {
-    throw InputError("--plan: must be needed or everything, got '" + plan + "'");
+    throw InputError("--plan: must be needed or everything, got " + quote(plan));
   }
   RenderOptions o = options;
   o.plan_everything = plan == "everything";
@@ -94,13 +94,6 @@ void check_output_path(const std::string& path, bool image) {
   if (!dir.empty() && !std::filesystem::is_directory(dir)) {
     throw InputError(path + ": folder " + dir.string() + " does not exist");
   }
-}
-
-std::string one_line(std::string text) {
-  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
-  std::string out;
-  for (char c : text) out += c == '\n' ? std::string("; ") : std::string(1, c);
-  return out;
 }
 
 }  // namespace abcube

@@ -48,7 +48,4 @@ std::string aov_path(const std::string& output, const std::string& aov);
 // Refuses before any work an output whose format has no writer or whose folder is missing.
 void check_output_path(const std::string& path, bool image);
 
-// Every failure is reported on one line: embedded newlines (a GLSL log) become "; ".
-std::string one_line(std::string text);
-
 }  // namespace abcube

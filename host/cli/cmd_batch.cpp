@@ -16,6 +16,7 @@
 #include <abcube/renderer.hpp>
 #include <nlohmann/json.hpp>
 
+#include "base/error.hpp"
 #include "base/statistics.hpp"
 #include "base/timer.hpp"
 #include "cli/cli_common.hpp"
@@ -50,13 +51,13 @@ class JobReader {
     try {
       j = json::parse(text);
     } catch (const json::parse_error& e) {
-      fail(line, std::string("not JSON: ") + e.what());
+      fail(line, "not JSON: " + printable(e.what(), 240));
     }
     if (!j.is_object()) fail(line, "a job must be a JSON object");
     for (const auto& [key, value] : j.items()) read_key(job, key, value);
     if (job.scene.empty()) fail(line, "\"scene\": required");
     if (job.out.empty()) fail(line, "\"out\": required");
-    if (!image_format_supported(job.out)) fail(line, "\"out\": no image writer for '" + job.out + "'");
+    if (!image_format_supported(job.out)) fail(line, "\"out\": no image writer for " + quote_path(job.out));
     return job;
   }
 
@@ -95,7 +96,7 @@ class JobReader {
         job.camera.fov_y = v.get<double>();
       } else if (key == "width") job.camera.width = integer(v, job.line, where);
       else if (key == "height") job.camera.height = integer(v, job.line, where);
-      else fail(job.line, "\"" + where + "\": unknown key (position, look_at, up, fov_y, width, height)");
+      else fail(job.line, quote(where) + ": unknown key (position, look_at, up, fov_y, width, height)");
     }
   }
 
@@ -116,7 +117,7 @@ class JobReader {
         job.aovs.push_back(a.get<std::string>());
       }
     } else {
-      fail(job.line, "\"" + key + "\": unknown key (scene, out, method, cube_res, max_depth, camera, stats, aovs)");
+      fail(job.line, quote(key) + ": unknown key (scene, out, method, cube_res, max_depth, camera, stats, aovs)");
     }
   }
 
@@ -171,7 +172,7 @@ struct BatchCommand {
     char slash = 0;
     std::istringstream in(shard);
     if (!(in >> i >> slash >> n) || slash != '/' || !in.eof() || n == 0 || i >= n) {
-      throw InputError("--shard: must be I/N with 0 <= I < N, got '" + shard + "'");
+      throw InputError("--shard: must be I/N with 0 <= I < N, got " + quote(shard));
     }
     return {i, n};
   }
@@ -232,7 +233,7 @@ struct BatchCommand {
         } catch (const std::exception& e) {
           ++failed;
           if (terminal) std::fputc('\n', stderr);
-          std::fprintf(stderr, "%s:%zu: %s\n", jobs_path.c_str(), job.line, one_line(e.what()).c_str());
+          std::fprintf(stderr, "%s:%zu: %s\n", jobs_path.c_str(), job.line, one_line(e.what(), "; ").c_str());
         }
       }
       ++done;

@@ -25,7 +25,7 @@ struct CrosscheckCommand {
 
   int run() const {
     GlChoice choice = GlChoice::automatic;
-    if (!parse_gl_choice(gl, &choice)) throw InputError("--gl: unknown path '" + gl + "'");
+    if (!parse_gl_choice(gl, &choice)) throw InputError("--gl: unknown path " + quote(gl));
     if (choice == GlChoice::none) throw InputError("--gl none: the cross-check compares GL with the CPU");
     check_output_path(stats_path, false);
     const Scene loaded = Scene::load(scene_path);

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <abcube/renderer.hpp>
 
+#include "base/error.hpp"
 #include "base/memory.hpp"
 #include "cli/cli_common.hpp"
 
@@ -27,7 +28,7 @@ int main(int argc, char** argv) {
       known = known || sub->get_name() == argv[1];
     }
     if (!known) {
-      std::fprintf(stderr, "abcube: unknown command '%s' (%s)\n", argv[1], names.c_str());
+      std::fprintf(stderr, "abcube: unknown command %s (%s)\n", quote(argv[1]).c_str(), names.c_str());
       return 2;
     }
   }
@@ -43,7 +44,7 @@ int main(int argc, char** argv) {
     // One line naming the option, exit 2 (cli.md); the subcommand's name when there is one.
     std::string where;
     for (const CLI::App* sub : app.get_subcommands()) where = sub->get_name() + ": ";
-    std::fprintf(stderr, "abcube: %s%s (see abcube %s--help)\n", where.c_str(), one_line(e.what()).c_str(),
+    std::fprintf(stderr, "abcube: %s%s (see abcube %s--help)\n", where.c_str(), one_line(e.what(), "; ").c_str(),
                  where.empty() ? "" : (where.substr(0, where.size() - 2) + " ").c_str());
     return 2;
   }
@@ -56,10 +57,10 @@ int main(int argc, char** argv) {
   try {
     return runs[index]();
   } catch (const InputError& e) {
-    std::fprintf(stderr, "abcube: %s\n", one_line(e.what()).c_str());
+    std::fprintf(stderr, "abcube: %s\n", one_line(e.what(), "; ").c_str());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "abcube: error: %s\n", one_line(e.what()).c_str());
+    std::fprintf(stderr, "abcube: error: %s\n", one_line(e.what(), "; ").c_str());
     return 1;
   }
 }

@@ -79,7 +79,7 @@ Enum parse_named(const std::string& value, bool (*parse)(const std::string&, Enu
                  const char* what, const char* choices) {
   Enum e{};
   if (!parse(value, &e)) {
-    throw InputError(std::string(option) + ": unknown " + what + " '" + value + "' (" + choices + ")");
+    throw InputError(std::string(option) + ": unknown " + what + " " + quote(value) + " (" + choices + ")");
   }
   return e;
 }
@@ -135,7 +135,7 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   r.map.refraction = parse_named(o.refraction, parse_refraction_mode, "refraction", "mode", "search, thick_lens, thin_lens");
   r.map.lookup = parse_named(o.envmap_lookup, parse_envmap_lookup, "envmap-lookup", "lookup", "R, bisector, position");
   if (o.resolve != "exact" && o.resolve != "thesis") {
-    throw InputError("resolve: unknown rule '" + o.resolve + "' (exact, thesis)");
+    throw InputError("resolve: unknown rule " + quote(o.resolve) + " (exact, thesis)");
   }
   r.map.exact_priority = o.resolve == "exact";
   r.map.search.side_structure = o.side_structure;
@@ -143,7 +143,7 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   if (o.max_memory_mib > (uint64_t{1} << 30)) throw InputError("max-memory: must be at most 2^30 MiB");
   r.abuffer.max_memory_bytes = o.max_memory_mib << 20;
   for (const std::string& a : o.aovs) {
-    if (!aov_known(a)) throw InputError("aovs: unknown AOV '" + a + "' (" + aov_names() + ")");
+    if (!aov_known(a)) throw InputError("aovs: unknown AOV " + quote(a) + " (" + aov_names() + ")");
   }
   r.aovs = o.aovs;
   check_render_size(*view, available_memory_bytes());
@@ -239,7 +239,7 @@ struct Renderer::Impl {
 Renderer::Renderer(const RendererOptions& options) : impl_(std::make_unique<Impl>()) {
   impl_->options = options;
   if (!parse_gl_choice(options.gl, &impl_->gl_choice)) {
-    throw InputError("gl: unknown path '" + options.gl + "' (auto, egl, egl-device, egl-surfaceless, osmesa, none)");
+    throw InputError("gl: unknown path " + quote(options.gl) + " (auto, egl, egl-device, egl-surfaceless, osmesa, none)");
   }
   if (options.threads < 0) throw InputError("threads: must be >= 0, got " + std::to_string(options.threads));
   if (options.gl_device < -1) throw InputError("gl-device: must be >= 0, got " + std::to_string(options.gl_device));
@@ -347,7 +347,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
 void refuse_unused_options(const Scene& scene, const RenderOptions& o) {
   Method m = scene.data().render.method;
   if (!o.method.empty() && !parse_method(o.method, &m)) {
-    throw InputError("method: unknown method '" + o.method + "' (abuffer, zbuffer, envmap, raytrace, gpu)");
+    throw InputError("method: unknown method " + quote(o.method) + " (abuffer, zbuffer, envmap, raytrace, gpu)");
   }
   const bool map = m == Method::abuffer || m == Method::zbuffer || m == Method::envmap;
   const RenderOptions defaults;

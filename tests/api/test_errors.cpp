@@ -1,6 +1,7 @@
 // Errors through the public API: each is the exception its kind promises (error.hpp),
 // with a message naming the place, never an exit or an abort.
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -85,6 +86,70 @@ TEST(ErrorsApi, InternalCheckThrowsInsteadOfAborting) {
     const std::string message = e.what();
     EXPECT_NE(message.find("operand == 4"), std::string::npos) << message;
     EXPECT_NE(message.find("operand is 3"), std::string::npos) << message;
+  }
+}
+
+// ---- Input text in messages (base/error.hpp): quoted, escaped, cut ----------------------
+
+// No byte a terminal would act on: C0 controls, DEL, and the C1 controls (raw or UTF-8).
+bool terminal_safe(const std::string& s) {
+  for (size_t i = 0; i < s.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if (c < 0x20 || c == 0x7F) return false;
+    if (c >= 0x80 && c <= 0x9F && (i == 0 || static_cast<unsigned char>(s[i - 1]) != 0xC2)) continue;  // continuation
+    if (c == 0xC2 && i + 1 < s.size() && static_cast<unsigned char>(s[i + 1]) <= 0x9F) return false;
+  }
+  return true;
+}
+
+TEST(ErrorsQuote, EscapesControlBytesAndQuotes) {
+  EXPECT_EQ(quote("glass"), "\"glass\"");
+  EXPECT_EQ(quote("my \"glass\" \\ 2"), "\"my \\\"glass\\\" \\\\ 2\"");
+  // OSC title and SGR colour sequences, as an OBJ usemtl could hold them.
+  EXPECT_EQ(quote("\x1b]0;pwned\x07\x1b[31mred"), "\"\\e]0;pwned\\x07\\e[31mred\"");
+  EXPECT_EQ(quote(std::string("a\nb\rc\td\0e\x7f", 10)), "\"a\\nb\\rc\\td\\x00e\\x7F\"");
+  // UTF-8 passes; the C1 control U+009B (CSI) and bytes that are not UTF-8 are escaped.
+  EXPECT_EQ(quote("verre \xC3\xA9 \xE2\x82\xAC"), "\"verre \xC3\xA9 \xE2\x82\xAC\"");
+  EXPECT_EQ(quote("\xC2\x9B" "31m"), "\"\\xC2\\x9B31m\"");
+  EXPECT_EQ(quote("\x9B" "31m \xFF \xC3"), "\"\\x9B31m \\xFF \\xC3\"");
+  EXPECT_EQ(quote("\xED\xA0\x80"), "\"\\xED\\xA0\\x80\"");  // a surrogate
+  EXPECT_EQ(printable("a\x1b[2Jb\"\\"), "a\\e[2Jb\"\\");     // unquoted: " and \ stay
+}
+
+TEST(ErrorsQuote, LongTextIsCutWithItsLength) {
+  const std::string name(200000, 'm');
+  const std::string q = quote(name);
+  EXPECT_EQ(q, "\"" + std::string(QUOTE_MAX_CHARS, 'm') + "\"... (200000 bytes)");
+  EXPECT_EQ(printable(name, 10), "mmmmmmmmmm... (200000 bytes)");
+  EXPECT_EQ(quote(std::string(QUOTE_MAX_CHARS, 'm')), "\"" + std::string(QUOTE_MAX_CHARS, 'm') + "\"");  // not cut
+  // Characters are counted, not bytes: a cut never splits one.
+  std::string accents;
+  for (int i = 0; i < 100; ++i) accents += "\xC3\xA9";
+  std::string expected;
+  for (size_t i = 0; i < QUOTE_MAX_CHARS; ++i) expected += "\xC3\xA9";
+  EXPECT_EQ(quote(accents), "\"" + expected + "\"... (200 bytes)");
+}
+
+TEST(ErrorsQuote, OneLineJoinsLinesAndEscapesTheRest) {
+  EXPECT_EQ(one_line("a\nb\r\nc\td  \n"), "a b c d");
+  EXPECT_EQ(one_line("shader log:\nline 1\nline 2\n", "; "), "shader log:; line 1; line 2");
+  EXPECT_EQ(one_line("x \x1b]0;t\x07 y"), "x \\e]0;t\\x07 y");
+  EXPECT_TRUE(terminal_safe(one_line(std::string("\x01\x02\x1b\x7f\xC2\x9B\x9B", 7))));
+}
+
+// A scene with hostile names: every message is one short line a terminal can print as is.
+TEST(ErrorsQuote, SceneMessagesAreShortAndTerminalSafe) {
+  const std::string long_key(5 << 20, 'k');
+  std::string json = tiny_scene_json(8, 8, 16);
+  // As written in the JSON text: ESC ] 0 ; ... BEL, ESC [ 31 m, and the C1 CSI U+009B.
+  const std::vector<std::string> hostile = {long_key, "\\u001b]0;pwned\\u0007\\u001b[31mred", "\\u009b2J"};
+  for (const std::string& key : hostile) {
+    const std::string text = "{\"" + key + "\": 1, " + json.substr(json.find('{') + 1);
+    const std::string message = input_error_of([&] { Scene::from_json(text, "bad.json"); });
+    EXPECT_NE(message.find("bad.json: "), std::string::npos) << message;
+    EXPECT_NE(message.find("unknown field"), std::string::npos) << message;
+    EXPECT_LT(message.size(), 400u) << message.substr(0, 400);
+    EXPECT_TRUE(terminal_safe(message)) << message;
   }
 }
 

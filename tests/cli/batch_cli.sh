@@ -65,7 +65,7 @@ printf '{"scene": "cornell.json", "out": "f/1.png", "method": "raytrace"}\n{"sce
 "$ABCUBE" batch fail.jsonl > summary 2> err; status=$?
 check "failing jobs: exit 1" [ $status -eq 1 ]
 check "failing job 2 named by line" grep -q "fail.jsonl:2: .*nowhere.json" err
-check "failing job 3 named by line" grep -q "fail.jsonl:3: method: unknown method 'photon'" err
+check "failing job 3 named by line" grep -q "fail.jsonl:3: method: unknown method \"photon\"" err
 check "the other jobs rendered" [ -s f/1.png ] && [ -s f/4.png ]
 check "summary counts failures" grep -q "4 jobs, 2 rendered, 2 failed" summary
 

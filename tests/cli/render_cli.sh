@@ -105,7 +105,7 @@ check "--reference-image size message names the file" grep -q "tiny.exr: is 20x1
 check "--search sideways exits 2" [ $? -eq 2 ]
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --refine polygon > /dev/null 2> "$WORK/err"
 check "--refine polygon exits 2" [ $? -eq 2 ]
-check "--refine polygon names the option" grep -q -- "refine: unknown refinement 'polygon'" "$WORK/err"
+check "--refine polygon names the option" grep -q -- "refine: unknown refinement \"polygon\"" "$WORK/err"
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --refraction prism > /dev/null 2> "$WORK/err"
 check "--refraction prism exits 2" [ $? -eq 2 ]
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --envmap-lookup up > /dev/null 2> "$WORK/err"

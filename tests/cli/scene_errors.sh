@@ -137,7 +137,7 @@ expect_rejected missing_scene "$WORK/nonexistent.json" render "$WORK/nonexistent
 # ---- Bad command lines ------------------------------------------------------------------
 
 expect_rejected unknown_option "--frobnicate" render "$GOOD" --method gpu --gl none --frobnicate
-expect_rejected bad_method "method: unknown method 'photon'" render "$GOOD" --method photon --gl none
+expect_rejected bad_method "method: unknown method \"photon\"" render "$GOOD" --method photon --gl none
 expect_rejected bad_cube_res "--cube-res" render "$GOOD" --method gpu --gl none --cube-res 0
 expect_rejected unknown_command "frobnicate" frobnicate "$GOOD"
 

@@ -679,6 +679,63 @@ TEST(SceneLoadMesh, BadObjIndicesAreErrors) {
   EXPECT_NE(m.find("scene.json: objects[0].file: "), std::string::npos) << m;
 }
 
+// ---- Input text in messages: cut short and escaped (issue 16) ---------------------------
+
+// True when `m` holds no control byte (a terminal would act on ESC, BEL, CSI, ...).
+bool no_control_bytes(const std::string& m) {
+  return std::none_of(m.begin(), m.end(), [](char c) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    return u < 0x20 || u == 0x7F;
+  });
+}
+
+TEST(SceneLoadMessages, UsemtlNameWithEscapesIsEscaped) {
+  TempDir dir;
+  dir.write("esc.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl \x1b]0;pwned\x07\x1b[31mred\nf 1 2 3\n");
+  const std::string m = load_error(with_objects(R"([{"type": "mesh", "file": "esc.obj"}])").str(), dir.path().string());
+  EXPECT_TRUE(no_control_bytes(m)) << m;
+  EXPECT_NE(m.find("scene.json: objects[0].file: mesh "), std::string::npos) << m;
+  EXPECT_NE(m.find("usemtl: material \"\\e]0;pwned\\x07\\e[31mred\" not found"), std::string::npos) << m;
+}
+
+TEST(SceneLoadMessages, LongUsemtlNameIsCut) {
+  TempDir dir;
+  dir.write("long.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl " + std::string(200000, 'm') + "\nf 1 2 3\n");
+  const std::string m = load_error(with_objects(R"([{"type": "mesh", "file": "long.obj"}])").str(), dir.path().string());
+  EXPECT_LT(m.size(), 300u + dir.path().string().size()) << m.substr(0, 300);
+  EXPECT_NE(m.find("\"... (200000 bytes) not found"), std::string::npos) << m.substr(0, 300);
+}
+
+TEST(SceneLoadMessages, MtlMaterialNameAndMeshPathAreEscaped) {
+  TempDir dir;
+  dir.write("m.mtl", "newmtl \x1b[2Jpaint\nKd -1 0 0\n");
+  dir.write("m\x1b[1m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl \x1b[2Jpaint\nf 1 2 3\n");
+  const std::string m = load_error(with_objects(R"([{"type": "mesh", "file": "m\u001b[1m.obj"}])").str(),
+                                   dir.path().string());
+  EXPECT_TRUE(no_control_bytes(m)) << m;
+  EXPECT_NE(m.find("m\\e[1m.obj\": material \"\\e[2Jpaint\": Kd must be finite and >= 0"), std::string::npos) << m;
+}
+
+TEST(SceneLoadMessages, HugeKeysAndValuesAreCut) {
+  const std::string big(5 << 20, 'k');
+  SceneText s;
+  s.extra = ",\n\"" + big + "\": 1";
+  std::string m = load_error(s.str());
+  EXPECT_EQ(m, "scene.json: [\"" + std::string(QUOTE_MAX_CHARS, 'k') + "\"... (5242880 bytes)]: unknown field "
+               "(known here: version, camera, background, ambient, lights, materials, objects, render)");
+  // A value of megabytes after "got".
+  m = load_error(with_objects(R"([{"type": ")" + big + R"("}])").str());
+  EXPECT_LT(m.size(), 300u) << m.substr(0, 300);
+  EXPECT_NE(m.find("objects[0].type: must be one of"), std::string::npos) << m;
+  m = load_error(with_objects(R"([{"type": "sphere", "center": [)" + std::string(1 << 20, '1') + R"(, 0]}])").str());
+  EXPECT_LT(m.size(), 300u) << m.substr(0, 300);
+  // A string left open: nlohmann's "last read" token is the whole rest of the file.
+  m = load_error("{\"version\": 1, \"x\": \"" + big);
+  EXPECT_LT(m.size(), 300u) << m.substr(0, 300);
+  EXPECT_EQ(m.rfind("scene.json:1:", 0), 0u) << m.substr(0, 300);
+  EXPECT_NE(m.find("(5242881 bytes)"), std::string::npos) << m.substr(0, 300);
+}
+
 // ---- Tessellation helpers --------------------------------------------------------------
 
 TEST(Tessellate, ClosedSurfaceNeedsConsistentOrientation) {
@@ -816,7 +873,7 @@ TEST(SceneLoadLimits, MeshOutsideTheRootIsRefusedWithItsField) {
   limits.root = (dir.path() / "root").string();
   const std::string root = fs::canonical(limits.root).string();
   EXPECT_EQ(limited_load_error(scene, limits),
-            scene + ": objects[0].file: '../../outside/cube.obj' resolves outside --root " + root);
+            scene + ": objects[0].file: \"../../outside/cube.obj\" resolves outside --root " + root);
   // Without a root the same scene loads.
   EXPECT_EQ(load_scene(scene).triangles->triangle_count(), 12u);
 }
@@ -829,7 +886,7 @@ TEST(SceneLoadLimits, SymlinkEscapingTheRootIsRefused) {
   const std::string scene = mesh_scene(dir, "../meshes/link.obj");
   LoadLimits limits;
   limits.root = (dir.path() / "root").string();
-  EXPECT_NE(limited_load_error(scene, limits).find("objects[0].file: '../meshes/link.obj' resolves outside --root"),
+  EXPECT_NE(limited_load_error(scene, limits).find("objects[0].file: \"../meshes/link.obj\" resolves outside --root"),
             std::string::npos);
 }
 
@@ -843,7 +900,7 @@ TEST(SceneLoadLimits, MtllibOutsideTheRootIsRefusedBeforeItIsRead) {
   LoadLimits limits;
   limits.root = (dir.path() / "root").string();
   const std::string m = limited_load_error(scene, limits);
-  EXPECT_NE(m.find(scene + ": objects[0].file: mtllib '../../outside/secret.mtl'"), std::string::npos) << m;
+  EXPECT_NE(m.find(scene + ": objects[0].file: mtllib \"../../outside/secret.mtl\""), std::string::npos) << m;
   EXPECT_NE(m.find("resolves outside --root"), std::string::npos) << m;
   // Without a root the MTL material is read.
   const SceneData s = load_scene(scene);
