@@ -231,7 +231,37 @@ class DocumentBuilder final : public nlohmann::json_sax<Json> {
   }
 };
 
+// Byte offset of the first '[' or '{' that opens level MAX_JSON_DEPTH + 1 (strings
+// skipped as JSON writes them), or npos. One pass over the bytes, no recursion: run before
+// the parser so that no value of such a document is ever built.
+size_t too_deep_at(const std::string& text) {
+  int depth = 0;
+  bool in_string = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') {
+        ++i;  // the escaped character, whatever it is
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > MAX_JSON_DEPTH) return i;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return std::string::npos;
+}
+
 Json parse_document(const std::string& text, const Source& src) {
+  const size_t deep = too_deep_at(text);
+  if (deep != std::string::npos) {
+    throw InputError(one_line(src.name + ":" + line_column(text, deep) + ": arrays and objects nested deeper than " +
+                              std::to_string(MAX_JSON_DEPTH) + " levels"));
+  }
   DocumentBuilder builder;
   const bool ok = Json::sax_parse(text, &builder, Json::input_format_t::json, true, false);
   if (builder.syntax_error) {

@@ -37,8 +37,12 @@ std::string index_path(const std::string& parent, size_t i);
 
 // ---- JSON text -> document ---------------------------------------------------------
 
-// The document of `text`; a syntax error or a repeated key throws InputError naming
-// FILE:LINE:COL or the key's path.
+// Arrays and objects nested deeper than this are refused before any value is built (a
+// scene needs 5 levels; nlohmann's serializer and our readers recurse once per level).
+constexpr int MAX_JSON_DEPTH = 64;
+
+// The document of `text`; a syntax error, nesting deeper than MAX_JSON_DEPTH or a repeated
+// key throws InputError naming FILE:LINE:COL or the key's path.
 Json parse_document(const std::string& text, const Source& src);
 
 // ---- Typed values ------------------------------------------------------------------

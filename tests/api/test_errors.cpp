@@ -35,6 +35,15 @@ TEST(ErrorsApi, BadSceneValueNamesItsFieldPath) {
   EXPECT_NE(message.find("bad.json"), std::string::npos) << message;
 }
 
+// 100,000 nested arrays (200 KB) used to overflow the stack (SIGSEGV); now an InputError
+// that names the line and column where the nesting goes too deep.
+TEST(ErrorsApi, DeeplyNestedSceneIsAnInputError) {
+  const std::string text = std::string(100000, '[') + std::string(100000, ']');
+  const std::string message = input_error_of([&] { Scene::from_json(text, "deep.json"); });
+  EXPECT_EQ(message.rfind("deep.json:1:65: ", 0), 0u) << message.substr(0, 200);
+  EXPECT_NE(message.find("nested deeper than 64 levels"), std::string::npos) << message.substr(0, 200);
+}
+
 TEST(ErrorsApi, CameraOverrideFovOutOfRange) {
   const Scene scene = Scene::from_json(tiny_scene_json(8, 8, 16));
   Renderer renderer(RendererOptions{"none", -1, 1});

@@ -125,6 +125,11 @@ expect_bad_scene bent_quad "bent_quad.json: objects[0].vertices: the 4 vertices 
 echo '{"version": 2, "camera": {"position": [0, 1, 5], "look_at": [0, 0, 0]}, "objects": []}' | scene version
 expect_bad_scene version "version.json: version: must be 1"
 
+# 100,000 nested arrays (200 KB, made here): once a stack overflow (SIGSEGV), now refused
+# where the nesting passes 64 levels.
+{ head -c 100000 /dev/zero | tr '\0' '['; head -c 100000 /dev/zero | tr '\0' ']'; } | scene deep
+expect_bad_scene deep "deep.json:1:65: arrays and objects nested deeper than 64 levels"
+
 # More memory than any machine here has: 32768^2 pixels and six 16384^2 faces (~176 GiB).
 available_kib=$(awk '/^MemAvailable:/ {print $2}' /proc/meminfo 2>/dev/null)
 if [ -n "$available_kib" ] && [ "$available_kib" -lt $((160 * 1024 * 1024)) ]; then

@@ -13,6 +13,7 @@
 #include <tuple>
 
 #include "base/error.hpp"
+#include "scene/scene_json.hpp"
 #include "scene/scene_load.hpp"
 #include "scene/tessellate.hpp"
 
@@ -263,6 +264,28 @@ TEST(SceneLoadErrors, InfiniteNumbersAreRejectedWithTheirPlace) {
                "scene.json: objects[0].vertices[2][2]: out of range");
   EXPECT_ERROR(with_objects(R"([{"type": "sphere", "center": [0,0,0], "radius": -1e39}])").str(),
                "objects[0].radius: out of range");
+}
+
+// Nesting is refused past MAX_JSON_DEPTH before any value is built: 100,000 levels (which
+// crashed nlohmann's recursive serializer) are a located one-line error like any other.
+TEST(SceneLoadErrors, DeepNestingIsRefusedWithItsPlace) {
+  using detail::MAX_JSON_DEPTH;
+  const std::string deep = "\n " + std::string(100000, '[') + std::string(100000, ']');
+  std::string m = load_error(deep);
+  EXPECT_EQ(m, "scene.json:2:" + std::to_string(2 + MAX_JSON_DEPTH) + ": arrays and objects nested deeper than " +
+                   std::to_string(MAX_JSON_DEPTH) + " levels");
+  EXPECT_EQ(load_error(std::string(100000, '[')).rfind("scene.json:1:65: arrays and objects nested deeper", 0), 0u);
+  std::string objects;
+  for (int i = 0; i < 100000; ++i) objects += "{\"a\": ";
+  EXPECT_EQ(load_error(objects + "1" + std::string(100000, '}')).rfind("scene.json:1:", 0), 0u);
+  // MAX_JSON_DEPTH levels are read (and refused for what they hold, not for their depth).
+  m = load_error(std::string(MAX_JSON_DEPTH, '[') + std::string(MAX_JSON_DEPTH, ']'));
+  EXPECT_EQ(m.rfind("scene.json: must be an object, got [[[[", 0), 0u) << m;
+  // Brackets inside strings, escaped quotes included, are not nesting.
+  SceneText s;
+  s.extra = ",\n\"\\\"" + std::string(1000, '[') + "\": 1";
+  m = load_error(s.str());
+  EXPECT_NE(m.find("unknown field"), std::string::npos) << m;
 }
 
 // ---- Value errors: FILE: path: ... ------------------------------------------------------
