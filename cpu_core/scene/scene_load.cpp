@@ -11,14 +11,11 @@
 #include "scene/scene_load.hpp"
 
 #include <cmath>
-#include <cerrno>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "base/error.hpp"
+#include "base/input_file.hpp"
 #include "base/memory.hpp"
 #include "scene/scene_load_state.hpp"
 #include "scene/tessellate.hpp"
@@ -353,15 +350,9 @@ SceneData load_scene(const std::string& path, const LoadLimits& limits) {
   if (!limits.root.empty() && !inside_root(canonical_root(limits.root), path)) {
     throw InputError(one_line(path + ": the scene file resolves outside --root " + canonical_root(limits.root)));
   }
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) throw InputError(one_line(path + ": cannot read scene: is a directory"));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(one_line(path + ": cannot read scene: " + std::strerror(errno)));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(one_line(path + ": cannot read scene: read error"));
+  const std::string text = read_input_file(path, limits.max_scene_bytes, "scene");
   const std::string dir = fs::path(path).parent_path().string();
-  return load_scene_text(text.str(), path, dir.empty() ? "." : dir, limits);
+  return load_scene_text(text, path, dir.empty() ? "." : dir, limits);
 }
 
 }  // namespace abcube

@@ -17,6 +17,14 @@ struct LoadLimits {
   // 0: no cap (beyond the loader's own). Otherwise a scene with more triangles is refused
   // with an InputError naming the count and the cap, before its triangles are made.
   uint64_t max_triangles = 0;
+  // Input files larger than these are refused before they are read (README "Errors and
+  // hostile input"): a scene file (and an MTL file) is text of kilobytes, a mesh can be
+  // gigabytes (a 1M-triangle OBJ is about 100 MB). A mesh file larger than the memory
+  // available is refused too: its triangles take more room than its text.
+  uint64_t max_scene_bytes = MAX_SCENE_BYTES;
+  uint64_t max_mesh_bytes = MAX_MESH_BYTES;
+  static constexpr uint64_t MAX_SCENE_BYTES = uint64_t{64} << 20;  // 64 MiB
+  static constexpr uint64_t MAX_MESH_BYTES = uint64_t{8} << 30;    // 8 GiB
 };
 
 // Parses, validates, tessellates and transforms. Throws InputError with one line that

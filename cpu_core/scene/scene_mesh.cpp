@@ -8,10 +8,13 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <utility>
 
 #include <tiny_obj_loader.h>
 
 #include "base/error.hpp"
+#include "base/input_file.hpp"
+#include "base/memory.hpp"
 #include "scene/scene_load_state.hpp"
 #include "scene/tessellate.hpp"
 
@@ -110,12 +113,13 @@ std::string resolve_mesh_path(const Source& src, const std::string& file) {
   return (p.is_absolute() ? p : fs::path(src.base_dir) / p).lexically_normal().string();
 }
 
-// tinyobjloader's MaterialFileReader, refusing an MTL file outside the root before it is
-// opened: the first such path is kept in `escaped` and the reader reports failure.
+// tinyobjloader's MaterialFileReader, refusing before it is opened an MTL file outside the
+// root (the first such name is kept in `escaped`) or one that is no regular file or larger
+// than `max_bytes` (kept in `unreadable`, with why); the reader then reports failure.
 class ConfinedMaterialReader final : public tinyobj::MaterialReader {
  public:
-  ConfinedMaterialReader(const std::string& base_dir, const std::string& root)
-      : files_(base_dir), base_dir_(base_dir), root_(root) {}
+  ConfinedMaterialReader(const std::string& base_dir, const std::string& root, uint64_t max_bytes)
+      : files_(base_dir), base_dir_(base_dir), root_(root), max_bytes_(max_bytes) {}
   bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
                   std::map<std::string, int>* by_name, std::string* warn, std::string* err) override {
     // The paths MaterialFileReader tries: each ':'-separated folder joined with `name`.
@@ -131,13 +135,25 @@ class ConfinedMaterialReader final : public tinyobj::MaterialReader {
         return false;
       }
     }
+    for (const std::string& t : tried) {
+      std::error_code ec;
+      if (!std::filesystem::exists(t, ec)) continue;  // MaterialFileReader tries the next
+      const std::string problem = input_file_problem(t, max_bytes_);
+      if (!problem.empty()) {
+        if (unreadable.first.empty()) unreadable = {name, problem};
+        return false;
+      }
+      break;  // the one MaterialFileReader opens
+    }
     return files_(name, materials, by_name, warn, err);
   }
   std::string escaped;
+  std::pair<std::string, std::string> unreadable;  // the name as written, and why
 
  private:
   tinyobj::MaterialFileReader files_;
   std::string base_dir_, root_;
+  uint64_t max_bytes_;
 };
 
 // What tinyobjloader read of one OBJ file and its MTL files.
@@ -156,12 +172,16 @@ ObjFile parse_obj(const LoadState& st, const std::string& path, const std::strin
   if (!in) fail(st.src, path, "cannot read mesh " + quote_path(resolved) + ": " + std::strerror(errno));
   const size_t slash = resolved.find_last_of("/\\");
   const std::string base_dir = slash == std::string::npos || slash == 0 ? "" : resolved.substr(0, slash) + "/";
-  ConfinedMaterialReader mtl(base_dir, st.root);
+  ConfinedMaterialReader mtl(base_dir, st.root, st.limits.max_scene_bytes);
   const bool ok = tinyobj::LoadObj(&obj.attrib, &obj.shapes, &obj.materials, &obj.warning, &obj.error, &in, &mtl,
                                    false /* triangulate: ear-clipped here, keeping the winding */, false);
   if (!mtl.escaped.empty()) {
     fail(st.src, path,
          "mtllib " + quote_path(mtl.escaped) + " of mesh " + quote_path(resolved) + " resolves outside --root " + st.root);
+  }
+  if (!mtl.unreadable.first.empty()) {
+    fail(st.src, path, "mtllib " + quote_path(mtl.unreadable.first) + " of mesh " + quote_path(resolved) + ": " +
+                           mtl.unreadable.second);
   }
   if (!ok) fail(st.src, path, "cannot parse mesh " + quote_path(resolved) + ": " + printable(find_line(obj.error, ""), 160));
   return obj;
@@ -215,11 +235,14 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
   if (file.empty()) fail(st.src, path, "must name an OBJ file, got \"\"");
   const std::string resolved = resolve_mesh_path(st.src, file);
   check_inside_root(st, path, file, resolved);
+  std::string problem = input_file_problem(resolved, st.limits.max_mesh_bytes);
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(resolved, ec)) {
-    const bool exists = std::filesystem::exists(resolved, ec);
-    fail(st.src, path, "cannot read mesh " + quote_path(resolved) + ": " + (exists ? "not a regular file" : "no such file"));
+  const uint64_t size = problem.empty() ? std::filesystem::file_size(resolved, ec) : 0;
+  const uint64_t available = problem.empty() ? available_memory_bytes() : 0;
+  if (problem.empty() && available > 0 && size > available) {
+    problem = "is " + format_bytes(size) + ", more than the " + format_bytes(available) + " of memory available";
   }
+  if (!problem.empty()) fail(st.src, path, "cannot read mesh " + quote_path(resolved) + ": " + problem);
   const ObjFile obj = parse_obj(st, path, resolved);
   check_triangle_cap(st, path, obj_triangle_count(obj));  // before anything is made
   if (use_mtl) {

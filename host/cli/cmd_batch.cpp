@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/error.hpp"
+#include "base/input_file.hpp"
 #include "base/statistics.hpp"
 #include "base/timer.hpp"
 #include "cli/cli_common.hpp"
@@ -28,6 +29,21 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+
+// A jobs file line holds one small JSON object; a longer line (/dev/zero has no line
+// break at all) is refused as soon as it passes this.
+constexpr size_t MAX_JOB_LINE_BYTES = size_t{1} << 20;
+
+// The next line of `in` without its line break, or false at the end of the file. Reads at
+// most MAX_JOB_LINE_BYTES + 1 bytes of it, so that the caller can refuse it.
+bool read_line(std::istream& in, std::string& text) {
+  text.clear();
+  for (int c = in.get(); c != std::char_traits<char>::eof(); c = in.get()) {
+    if (c == '\n' || text.size() > MAX_JOB_LINE_BYTES) return true;
+    text.push_back(static_cast<char>(c));
+  }
+  return !text.empty();
+}
 
 // One line of the jobs file, paths resolved against the file's folder.
 struct Job {
@@ -185,8 +201,11 @@ struct BatchCommand {
     std::vector<Job> mine;
     std::string text;
     size_t line = 0, index = 0;
-    while (std::getline(in, text)) {
+    while (read_line(in, text)) {
       ++line;
+      if (text.size() > MAX_JOB_LINE_BYTES) {
+        reader.fail(line, "longer than " + format_bytes(MAX_JOB_LINE_BYTES) + " (a job is one short JSON object)");
+      }
       if (text.find_first_not_of(" \t\r") == std::string::npos) continue;  // blank lines hold no job
       Job job = reader.read(text, line);
       if (index++ % shard_n == shard_i) mine.push_back(std::move(job));

@@ -59,6 +59,16 @@ check "not JSON: exit 2 naming line 2" [ $status -eq 2 ] && grep -q "bad2.jsonl:
 printf '{"out": "m/1.png"}\n' > bad3.jsonl
 "$ABCUBE" batch bad3.jsonl 2> err
 check "missing scene key named" grep -q 'bad3.jsonl:1: "scene": required' err
+# A jobs "file" with no line break (/dev/zero) is refused once its first line passes 1 MiB,
+# instead of being read until memory runs out.
+"$ABCUBE" batch /dev/zero 2> err; status=$?
+check "/dev/zero: exit 2 naming line 1" [ $status -eq 2 ] && grep -q "/dev/zero:1: longer than 1 MiB" err
+check "/dev/zero: one line" [ "$(wc -l < err)" -eq 1 ]
+# A job key holding terminal escapes is shown escaped.
+printf '{"\\u001b]0;pwned\\u0007": 1}\n' > esc.jsonl
+"$ABCUBE" batch esc.jsonl 2> err
+check "escaped job key" grep -qF 'esc.jsonl:1: "\e]0;pwned\x07": unknown key' err
+check "no control byte on stderr" [ -z "$(tr -d '\n' < err | tr -d '[:print:]')" ]
 
 # --- a failing job: its line on stderr, the others rendered, exit 1
 printf '{"scene": "cornell.json", "out": "f/1.png", "method": "raytrace"}\n{"scene": "nowhere.json", "out": "f/2.png"}\n{"scene": "cornell.json", "out": "f/3.png", "method": "photon"}\n{"scene": "cornell.json", "out": "f/4.png", "method": "raytrace", "camera": {"position": [0, 1, 0]}}\n' > fail.jsonl

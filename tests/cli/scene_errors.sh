@@ -55,6 +55,10 @@ expect_rejected() {
       problems+=("$target: stderr has $lines lines, expected exactly one")
     fi
     grep -qF -- "$expected" "$WORK/stderr" || problems+=("$target: stderr does not name '$expected'")
+    # Short whatever the input held, and nothing a terminal would act on (ESC, BEL, ...).
+    [ "$(wc -c < "$WORK/stderr")" -le 600 ] || problems+=("$target: stderr is $(wc -c < "$WORK/stderr") bytes long")
+    [ -z "$(tr -d '\n' < "$WORK/stderr" | LC_ALL=C tr -d '[:print:]')" ] ||
+      problems+=("$target: stderr holds control bytes")
     [ -s "$WORK/stdout" ] && problems+=("$target: wrote to stdout")
   done
   [ -e "$dir/new.png" ] && problems+=("new.png: output file was created")
@@ -129,6 +133,34 @@ expect_bad_scene version "version.json: version: must be 1"
 # where the nesting passes 64 levels.
 { head -c 100000 /dev/zero | tr '\0' '['; head -c 100000 /dev/zero | tr '\0' ']'; } | scene deep
 expect_bad_scene deep "deep.json:1:65: arrays and objects nested deeper than 64 levels"
+
+# Input files that are no regular files, or far larger than their kind's cap, are refused
+# before anything is read (the big ones are sparse: no disk is used).
+expect_rejected dev_zero "/dev/zero: cannot read scene: not a regular file (a character device)" \
+  render /dev/zero --method gpu --gl none
+truncate -s 65M "$WORK/huge.json"
+expect_bad_scene huge "huge.json: cannot read scene: is 65 MiB, over the cap of 64 MiB"
+echo "{$HEAD, \"objects\": [{\"type\": \"mesh\", \"file\": \"/dev/zero\"}]}" | scene zero_mesh
+expect_bad_scene zero_mesh "zero_mesh.json: objects[0].file: cannot read mesh \"/dev/zero\": not a regular file"
+truncate -s 9G "$WORK/huge.obj"
+echo "{$HEAD, \"objects\": [{\"type\": \"mesh\", \"file\": \"huge.obj\"}]}" | scene huge_mesh
+expect_bad_scene huge_mesh "huge_mesh.json: objects[0].file: cannot read mesh \"$WORK/huge.obj\": is 9 GiB, over the cap of 8 GiB"
+rm -f "$WORK/huge.obj" "$WORK/huge.json"
+ln -s /dev/zero "$WORK/zero.mtl"
+printf 'mtllib zero.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$WORK/zero_mtl.obj"
+echo "{$HEAD, \"objects\": [{\"type\": \"mesh\", \"file\": \"zero_mtl.obj\"}]}" | scene zero_mtl
+expect_bad_scene zero_mtl "zero_mtl.json: objects[0].file: mtllib \"zero.mtl\" of mesh \"$WORK/zero_mtl.obj\": not a regular file"
+
+# Hostile names from an OBJ: escape sequences are shown escaped, a 200,000-character name cut.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl \033]0;pwned\007\033[31mred\nf 1 2 3\n' > "$WORK/escape.obj"
+echo "{$HEAD, \"objects\": [{\"type\": \"mesh\", \"file\": \"escape.obj\"}]}" | scene usemtl_escape
+expect_bad_scene usemtl_escape 'usemtl: material "\e]0;pwned\x07\e[31mred" not found'
+{ printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl '; head -c 200000 /dev/zero | tr '\0' 'm'; printf '\nf 1 2 3\n'; } > "$WORK/long.obj"
+echo "{$HEAD, \"objects\": [{\"type\": \"mesh\", \"file\": \"long.obj\"}]}" | scene usemtl_long
+expect_bad_scene usemtl_long 'mmmmmmmm"... (200000 bytes) not found'
+# A 5 MB unknown key.
+{ printf '{"'; head -c 5000000 /dev/zero | tr '\0' 'k'; echo "\": 1, $HEAD, \"objects\": []}"; } | scene long_key
+expect_bad_scene long_key 'long_key.json: ["kkkkkkkk'
 
 # More memory than any machine here has: 32768^2 pixels and six 16384^2 faces (~176 GiB).
 available_kib=$(awk '/^MemAvailable:/ {print $2}' /proc/meminfo 2>/dev/null)

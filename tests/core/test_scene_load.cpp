@@ -2,6 +2,7 @@
 // the format's own example, one test per class of bad input (each message must name
 // its place), and known answers for the tessellated primitives and the transform.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,6 +14,7 @@
 #include <tuple>
 
 #include "base/error.hpp"
+#include "base/input_file.hpp"
 #include "scene/scene_json.hpp"
 #include "scene/scene_load.hpp"
 #include "scene/tessellate.hpp"
@@ -359,7 +361,7 @@ TEST(SceneLoadErrors, MissingMeshFileNamesFieldAndResolvedPath) {
   const std::string d =
       load_error(with_objects(R"([{"type": "mesh", "file": "meshes/folder.obj"}])").str(), dir.path().string());
   EXPECT_NE(d.find("objects[0].file: cannot read mesh"), std::string::npos) << d;
-  EXPECT_NE(d.find("not a regular file"), std::string::npos) << d;
+  EXPECT_NE(d.find("is a directory"), std::string::npos) << d;
   EXPECT_ERROR(with_objects(R"([{"type": "mesh", "file": ""}])").str(), "objects[0].file: must name an OBJ file");
 }
 
@@ -478,6 +480,63 @@ TEST(SceneLoadErrors, MissingSceneFileNamesIt) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()).rfind("/nonexistent/dir/scene.json: cannot read scene", 0), 0u) << e.what();
   }
+}
+
+// ---- Input files: regular files under their caps (issue 16) ----------------------------
+
+TEST(SceneLoadFiles, SceneThatIsNoRegularFileIsRefusedUnread) {
+  TempDir dir;
+  const std::string fifo = (dir.path() / "pipe.json").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::pair<std::string, std::string> cases[] = {
+      {"/dev/zero", "/dev/zero: cannot read scene: not a regular file (a character device)"},
+      {fifo, fifo + ": cannot read scene: not a regular file (a named pipe)"},  // opening it would block
+      {dir.path().string(), dir.path().string() + ": cannot read scene: is a directory"},
+      {(dir.path() / "none.json").string(), (dir.path() / "none.json").string() + ": cannot read scene: no such file"},
+  };
+  for (const auto& [path, expected] : cases) {
+    EXPECT_EQ(input_error([&] { load_scene(path); }, path), expected);
+  }
+}
+
+TEST(SceneLoadFiles, SizeCapsOfScenesAndMeshes) {
+  EXPECT_EQ(LoadLimits{}.max_scene_bytes, uint64_t{64} << 20);
+  EXPECT_EQ(LoadLimits{}.max_mesh_bytes, uint64_t{8} << 30);
+  TempDir dir;
+  dir.write("cube.obj", CUBE_OBJ);
+  const std::string scene =
+      dir.write("scene.json", with_objects(R"([{"type": "mesh", "file": "cube.obj", "material": "white"}])").str());
+  const uint64_t scene_bytes = fs::file_size(scene), mesh_bytes = fs::file_size(dir.path() / "cube.obj");
+  LoadLimits limits;
+  limits.max_scene_bytes = scene_bytes;  // at the cap: read
+  limits.max_mesh_bytes = mesh_bytes;
+  EXPECT_EQ(load_scene(scene, limits).triangles->triangle_count(), 12u);
+  limits.max_scene_bytes = scene_bytes - 1;
+  EXPECT_EQ(input_error([&] { load_scene(scene, limits); }, scene),
+            scene + ": cannot read scene: is " + format_bytes(scene_bytes) + ", over the cap of " +
+                format_bytes(scene_bytes - 1));
+  limits.max_scene_bytes = scene_bytes;
+  limits.max_mesh_bytes = 100;
+  EXPECT_EQ(input_error([&] { load_scene(scene, limits); }, scene),
+            scene + ": objects[0].file: cannot read mesh \"" + (dir.path() / "cube.obj").string() + "\": is " +
+                format_bytes(mesh_bytes) + ", over the cap of 100 bytes");
+  EXPECT_EQ(format_bytes(uint64_t{9} << 30), "9 GiB");
+  EXPECT_EQ(format_bytes((uint64_t{3} << 20) / 2), "1.5 MiB");
+}
+
+TEST(SceneLoadFiles, MeshAndMtlThatAreNoRegularFilesAreRefusedUnread) {
+  TempDir dir;
+  fs::create_symlink("/dev/zero", dir.path() / "zero.mtl");
+  dir.write("zero_mtl.obj", "mtllib zero.mtl\n" + std::string(CUBE_OBJ));
+  std::string m = load_error(with_objects(R"([{"type": "mesh", "file": "/dev/zero"}])").str(), dir.path().string());
+  EXPECT_EQ(m, "scene.json: objects[0].file: cannot read mesh \"/dev/zero\": not a regular file (a character device)");
+  m = load_error(with_objects(R"([{"type": "mesh", "file": "."}])").str(), dir.path().string());
+  EXPECT_NE(m.find("\": is a directory"), std::string::npos) << m;
+  // The MTL file is refused even when its materials are not used.
+  m = load_error(with_objects(R"([{"type": "mesh", "file": "zero_mtl.obj", "material": "white"}])").str(),
+                 dir.path().string());
+  EXPECT_NE(m.find("scene.json: objects[0].file: mtllib \"zero.mtl\" of mesh "), std::string::npos) << m;
+  EXPECT_NE(m.find(": not a regular file (a character device)"), std::string::npos) << m;
 }
 
 // ---- Geometry --------------------------------------------------------------------------
