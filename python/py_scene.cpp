@@ -2,6 +2,8 @@
 // (in memory), with the limits for untrusted scenes (include/abcube/scene.hpp).
 #include <string>
 
+#include <pybind11/stl.h>
+
 #include "py_convert.hpp"
 
 namespace abcube {
@@ -74,6 +76,8 @@ needs it. Made by load_scene, scene_from_dict or scene_from_json.)doc")
       .def_property_readonly("cube_resolution", &Scene::cube_resolution,
                              "render.cube_resolution N (texels per cube face edge).")
       .def_property_readonly("max_depth", &Scene::max_depth, "render.max_depth (bounces).")
+      .def_property_readonly("warnings", &Scene::warnings,
+                             "What loaded but is likely a mistake (a mesh without triangles), one line each.")
       .def("__repr__", &scene_repr);
 
   m.def("load_scene", &load_scene, py::arg("path"), py::arg("root") = py::none(),

@@ -102,6 +102,9 @@ struct SceneData {
   SharedTriangles triangles;
   RenderSettings render;
   size_t dropped_triangles = 0;  // zero-area or non-finite triangles dropped at load
+  // What loaded but is likely a mistake, one line each naming the place:
+  // "scene.json: objects[2].file: warning: mesh \"empty.obj\" has no triangles".
+  std::vector<std::string> warnings;
 
   Bounds bounds() const;
 };

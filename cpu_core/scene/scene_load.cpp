@@ -261,6 +261,7 @@ void read_object(LoadState& st, const Json& v, size_t index) {
     fail(st.src, path, "the scene would exceed " + std::to_string(MAX_TRIANGLES) + " triangles");
   }
   check_triangle_cap(st, path, local.triangle_count());
+  const size_t faces = local.triangle_count();
 
   TriangleSoup& soup = st.scene.triangles.edit();
   const uint32_t id = static_cast<uint32_t>(st.scene.objects.size());
@@ -273,6 +274,13 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   if (from_file) release_free_memory();  // the OBJ parser's many small blocks
   if (!material && per_face_materials) {
     obj.material = obj.triangle_count > 0 ? soup.material_id[obj.first_triangle] : default_material(st);
+  }
+  if (type == "mesh" && obj.triangle_count == 0) {
+    // Loads and renders (nothing), but an empty export or a wrong file is the likely cause.
+    const std::string file = quote_path(read_string(st.src, f.need("file"), f.at("file")));
+    st.scene.warnings.push_back(one_line(
+        st.src.name + ": " + f.at("file") + ": warning: mesh " + file + " has no triangles" +
+        (faces > 0 ? " of nonzero area (" + std::to_string(faces) + " dropped)" : "")));
   }
   // A closed surface has an inside; make its geometric normals point out of it.
   obj.closed = is_closed_surface(soup, obj.first_triangle, obj.triangle_count);

@@ -87,6 +87,10 @@ void write_outputs(const std::string& output, const RenderResult& result) {
   for (const auto& [name, image] : result.aovs) write_image(aov_path(output, name), image);
 }
 
+void print_warnings(const Scene& scene, const std::string& prefix) {
+  for (const std::string& w : scene.warnings()) std::fprintf(stderr, "%s%s\n", prefix.c_str(), one_line(w).c_str());
+}
+
 void check_output_path(const std::string& path, bool image) {
   if (path.empty()) return;
   if (image && !image_format_supported(path)) throw InputError(path + ": no image writer for this file extension");

@@ -45,6 +45,10 @@ std::function<void(const std::string&, double)> progress_printer();
 void write_outputs(const std::string& output, const RenderResult& result);
 std::string aov_path(const std::string& output, const std::string& aov);
 
+// The scene's warnings (Scene::warnings) on stderr, one line each after `prefix`. Called
+// once the work succeeded, so that a failure stays one line (cli.md).
+void print_warnings(const Scene& scene, const std::string& prefix);
+
 // Refuses before any work an output whose format has no writer or whose folder is missing.
 void check_output_path(const std::string& path, bool image);
 

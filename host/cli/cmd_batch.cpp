@@ -9,6 +9,7 @@
 #include <list>
 #include <memory>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -235,6 +236,7 @@ struct BatchCommand {
     const bool terminal = stderr_is_terminal();
     size_t done = 0, failed = 0, skipped = 0;
     std::vector<double> render_ms, overhead_ms;
+    std::set<std::string> warned;  // scenes whose warnings were printed
     for (const Job& job : jobs) {
       if (skip_existing && fs::exists(job.out) && (job.stats.empty() || fs::exists(job.stats))) {
         ++skipped;
@@ -249,6 +251,10 @@ struct BatchCommand {
           write_outputs(job.out, r);
           if (!job.stats.empty()) write_text_atomic(job.stats, r.stats.json + "\n");
           render_ms.push_back(ms_since(t0));
+          if (warned.insert(job.scene).second && !scene.warnings().empty()) {
+            if (terminal) std::fputc('\n', stderr);
+            print_warnings(scene, jobs_path + ":" + std::to_string(job.line) + ": ");
+          }
         } catch (const std::exception& e) {
           ++failed;
           if (terminal) std::fputc('\n', stderr);

@@ -60,6 +60,7 @@ struct CrosscheckCommand {
       j["gl"] = {{"path", ctx->info().api}, {"renderer", ctx->info().gl_renderer}};
       write_text_atomic(stats_path, j.dump(2) + "\n");
     }
+    print_warnings(loaded, "abcube: ");
     return r.pass ? 0 : 1;
   }
 };

@@ -21,6 +21,7 @@ CommandRun add_export_pov_command(CLI::App& app) {
   return [a] {
     const Scene scene = Scene::load(a->scene);
     write_text_atomic(a->output, export_pov(scene.data()));
+    print_warnings(scene, "abcube: ");
     return 0;
   };
 }

@@ -41,6 +41,7 @@ struct RenderCommand {
       stats["timings_ms"]["total"] = ms_since(start);
       write_text_atomic(stats_path, stats.dump(2) + "\n");
     }
+    print_warnings(s, "abcube: ");
     return 0;
   }
 };

@@ -40,6 +40,7 @@ std::string Scene::method() const { return method_name(state_->data.render.metho
 int Scene::cube_resolution() const { return state_->data.render.cube_resolution; }
 int Scene::max_depth() const { return state_->data.render.max_depth; }
 double Scene::load_ms() const { return state_->load_ms; }
+const std::vector<std::string>& Scene::warnings() const { return state_->data.warnings; }
 const SceneData& Scene::data() const { return state_->data; }
 const SceneCache& Scene::cache() const { return state_->cache; }
 

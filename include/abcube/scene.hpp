@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace abcube {
 
@@ -43,6 +44,10 @@ class Scene {
   int cube_resolution() const;       // render.cube_resolution (N)
   int max_depth() const;             // render.max_depth
   double load_ms() const;            // what loading took (parse, validate, tessellate)
+  // What loaded but is likely a mistake, one line each naming the place (a mesh without
+  // triangles: "scene.json: objects[2].file: warning: mesh \"empty.obj\" has no triangles").
+  // The CLI prints them on stderr; nothing else does.
+  const std::vector<std::string>& warnings() const;
 
   // The loaded data and its per-scene cache, for code built on the internal headers.
   const SceneData& data() const;

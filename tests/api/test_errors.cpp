@@ -1,5 +1,7 @@
 // Errors through the public API: each is the exception its kind promises (error.hpp),
 // with a message naming the place, never an exit or an abort.
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -42,6 +44,23 @@ TEST(ErrorsApi, DeeplyNestedSceneIsAnInputError) {
   const std::string message = input_error_of([&] { Scene::from_json(text, "deep.json"); });
   EXPECT_EQ(message.rfind("deep.json:1:65: ", 0), 0u) << message.substr(0, 200);
   EXPECT_NE(message.find("nested deeper than 64 levels"), std::string::npos) << message.substr(0, 200);
+}
+
+// An empty mesh is no error: Scene::warnings names it, and the scene renders.
+TEST(ErrorsApi, EmptyMeshIsAWarning) {
+  const std::string dir = std::string(ABCUBE_BINARY_DIR) + "/test_api_empty_mesh";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/empty.obj").close();
+  std::string json = tiny_scene_json(8, 8, 16);
+  const std::string objects = "\"objects\": [";
+  ASSERT_NE(json.find(objects), std::string::npos);
+  json.insert(json.find(objects) + objects.size(), R"({"type": "mesh", "file": "empty.obj"}, )");
+  const Scene scene = Scene::from_json(json, "s.json", dir);
+  ASSERT_EQ(scene.warnings().size(), 1u);
+  EXPECT_EQ(scene.warnings()[0], "s.json: objects[0].file: warning: mesh \"empty.obj\" has no triangles");
+  EXPECT_TRUE(Scene::from_json(tiny_scene_json(8, 8, 16)).warnings().empty());
+  Renderer renderer(RendererOptions{"none", -1, 1});
+  EXPECT_EQ(renderer.render(scene, small_options("raytrace", 8, 8, 16)).image.width, 8);
 }
 
 TEST(ErrorsApi, CameraOverrideFovOutOfRange) {

@@ -69,6 +69,13 @@ printf '{"\\u001b]0;pwned\\u0007": 1}\n' > esc.jsonl
 "$ABCUBE" batch esc.jsonl 2> err
 check "escaped job key" grep -qF 'esc.jsonl:1: "\e]0;pwned\x07": unknown key' err
 check "no control byte on stderr" [ -z "$(tr -d '\n' < err | tr -d '[:print:]')" ]
+# A scene with an empty mesh: its warning once, on the line of the first job that renders it.
+: > empty.obj
+printf '{"version": 1, "camera": {"position": [0, 1, 5], "look_at": [0, 0, 0], "width": 16, "height": 12}, "objects": [{"type": "mesh", "file": "empty.obj"}]}\n' > empty_mesh.json
+printf '{"scene": "empty_mesh.json", "out": "w/1.png", "method": "raytrace"}\n{"scene": "empty_mesh.json", "out": "w/2.png", "method": "raytrace"}\n' > warn.jsonl
+"$ABCUBE" batch warn.jsonl > /dev/null 2> err; status=$?
+check "empty mesh: exit 0, both rendered" [ $status -eq 0 ] && [ -s w/1.png ] && [ -s w/2.png ]
+check "empty mesh: one warning naming job line 1" [ "$(cat err)" = "warn.jsonl:1: empty_mesh.json: objects[0].file: warning: mesh \"empty.obj\" has no triangles" ]
 
 # --- a failing job: its line on stderr, the others rendered, exit 1
 printf '{"scene": "cornell.json", "out": "f/1.png", "method": "raytrace"}\n{"scene": "nowhere.json", "out": "f/2.png"}\n{"scene": "cornell.json", "out": "f/3.png", "method": "photon"}\n{"scene": "cornell.json", "out": "f/4.png", "method": "raytrace", "camera": {"position": [0, 1, 0]}}\n' > fail.jsonl

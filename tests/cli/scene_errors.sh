@@ -171,6 +171,23 @@ fi
 
 expect_rejected missing_scene "$WORK/nonexistent.json" render "$WORK/nonexistent.json" --method gpu --gl none
 
+# ---- Loads, with a warning ---------------------------------------------------------------
+
+# An empty OBJ is no error: the render succeeds (exit 0, image written) and stderr holds one
+# warning line naming the object's file field.
+: > "$WORK/empty.obj"
+echo "{$HEAD, \"objects\": [{\"type\": \"box\", \"min\": [0,0,0], \"max\": [1,1,1]}, {\"type\": \"mesh\", \"file\": \"empty.obj\"}]}" | scene empty_mesh
+"$ABCUBE" render "$WORK/empty_mesh.json" -o "$WORK/empty_mesh.png" --method raytrace > "$WORK/stdout" 2> "$WORK/stderr"
+status=$?
+expected="abcube: $WORK/empty_mesh.json: objects[1].file: warning: mesh \"empty.obj\" has no triangles"
+if [ "$status" -eq 0 ] && [ -s "$WORK/empty_mesh.png" ] && [ "$(cat "$WORK/stderr")" = "$expected" ] && [ ! -s "$WORK/stdout" ]; then
+  passed=$((passed + 1))
+  echo "ok   empty_mesh: $(cat "$WORK/stderr")"
+else
+  failed=$((failed + 1))
+  echo "FAIL empty_mesh: exit $status, stderr was: $(head -c 300 "$WORK/stderr" | tr '\n' '|')"
+fi
+
 # ---- Bad command lines ------------------------------------------------------------------
 
 expect_rejected unknown_option "--frobnicate" render "$GOOD" --method gpu --gl none --frobnicate

@@ -818,6 +818,28 @@ TEST(SceneLoadMessages, HugeKeysAndValuesAreCut) {
   EXPECT_NE(m.find("(5242881 bytes)"), std::string::npos) << m.substr(0, 300);
 }
 
+// An OBJ without triangles loads (it is an object with nothing to draw) with one warning
+// naming the object's file field; so does one whose faces all have zero area.
+TEST(SceneLoadMesh, MeshWithoutTrianglesLoadsWithAWarning) {
+  TempDir dir;
+  dir.write("empty.obj", "");
+  dir.write("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\n");
+  dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 3 2 1\n");
+  dir.write("cube.obj", CUBE_OBJ);
+  const SceneData s = load_text(with_objects(R"([{"type": "mesh", "file": "cube.obj"},
+      {"type": "mesh", "file": "empty.obj", "material": "white"}, {"type": "mesh", "file": "points.obj"},
+      {"type": "mesh", "file": "flat.obj"}])").str(), dir.path().string());
+  ASSERT_EQ(s.objects.size(), 4u);
+  EXPECT_EQ(s.objects[1].triangle_count, 0u);
+  EXPECT_EQ(s.triangles->triangle_count(), 12u);
+  const std::vector<std::string> expected = {
+      "scene.json: objects[1].file: warning: mesh \"empty.obj\" has no triangles",
+      "scene.json: objects[2].file: warning: mesh \"points.obj\" has no triangles",
+      "scene.json: objects[3].file: warning: mesh \"flat.obj\" has no triangles of nonzero area (2 dropped)"};
+  EXPECT_EQ(s.warnings, expected);
+  EXPECT_TRUE(load_text(SceneText().str()).warnings.empty());
+}
+
 // ---- Tessellation helpers --------------------------------------------------------------
 
 TEST(Tessellate, ClosedSurfaceNeedsConsistentOrientation) {

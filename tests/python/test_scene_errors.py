@@ -85,6 +85,17 @@ def test_mesh_relative_to_base_dir(tmp_path):
         abcube.scene_from_dict(scene, base_dir=str(tmp_path))
 
 
+def test_empty_mesh_loads_with_a_warning(tmp_path):
+    # An empty OBJ is no error: the scene loads, and Scene.warnings names the object's file.
+    (tmp_path / "empty.obj").write_text("")
+    scene = small_scene_dict()
+    mesh = next(i for i, o in enumerate(scene["objects"]) if o["type"] == "mesh")
+    scene["objects"][mesh]["file"] = "empty.obj"
+    loaded = abcube.scene_from_dict(scene, name="s.json", base_dir=str(tmp_path))
+    assert loaded.warnings == [f's.json: objects[{mesh}].file: warning: mesh "empty.obj" has no triangles']
+    assert abcube.scene_from_dict(small_scene_dict()).warnings == []
+
+
 def test_error_then_success(tmp_path):
     # The interpreter and the module survive errors: a good scene still loads and renders.
     for _ in range(20):
