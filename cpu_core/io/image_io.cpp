@@ -9,7 +9,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include "base/error.hpp"
@@ -73,6 +75,10 @@ void write_image(const std::string& path, const Image& image) {
   spec.attribute("oiio:ColorSpace", linear ? "linear" : "sRGB");
   // The bytes depend on the pixels only: OpenEXR and TIFF otherwise stamp the time.
   spec.attribute("DateTime", "");
+  const std::string format = out->format_name();
+  // OIIO 2.4's SGI writer leaves its 80-byte image name uninitialized (bytes of our heap
+  // in the file) unless it is given a nonempty one.
+  if (format == "sgi") spec.attribute("ImageDescription", "abcube");
   std::vector<float> pixels(image.data);
   if (!linear) {
     for (size_t k = 0; k < pixels.size(); ++k) {
@@ -81,8 +87,22 @@ void write_image(const std::string& path, const Image& image) {
     }
   }
   const std::string tmp = temporary_name(path);
-  bool ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, pixels.data());
+  // DPX records the name it is opened with: it is opened with the final name and writes
+  // through a proxy to the temporary file, so that its bytes do not hold the temporary's
+  // name (and the process id in it). Only DPX: OIIO 2.4's TIFF writer makes broken files
+  // through a file proxy.
+  std::unique_ptr<OIIO::Filesystem::IOFile> proxy;
+  if (format == "dpx") {
+    proxy = std::make_unique<OIIO::Filesystem::IOFile>(tmp, OIIO::Filesystem::IOProxy::Write);
+    if (!proxy->opened() || !out->set_ioproxy(proxy.get())) proxy.reset();
+  }
+  bool ok = (proxy || format != "dpx") && out->open(proxy ? path : tmp, spec) &&
+            out->write_image(OIIO::TypeDesc::FLOAT, pixels.data());
   ok = out->close() && ok;
+  if (proxy) {
+    ok = ok && std::fflush(proxy->handle()) == 0 && !std::ferror(proxy->handle());
+    proxy->close();
+  }
   if (!ok) {
     std::remove(tmp.c_str());
     std::string why = out->geterror();

@@ -140,5 +140,20 @@ check "info lists egl-surfaceless" grep -q "egl-surfaceless" "$WORK/info"
 check "info lists osmesa" grep -q "osmesa" "$WORK/info"
 check "info prints GL_RENDERER" grep -q "GL_RENDERER" "$WORK/info"
 
+# --- outputs are byte-reproducible: the same render written twice, by two processes more
+# than a second apart, gives the same bytes (no time stamp, no temporary name, no stray
+# header bytes). The only sleep of the suite: a DateTime attribute has one-second steps.
+mkdir -p "$WORK/repro"
+for e in exr tif dpx sgi png; do
+  "$ABCUBE" render "$WORK/small.json" -o "$WORK/repro/r.$e" --method raytrace 2> "$WORK/err" &&
+    mv "$WORK/repro/r.$e" "$WORK/repro/first.$e"
+  check "reproducible $e: first render ($(head -c 200 "$WORK/err"))" [ -s "$WORK/repro/first.$e" ]
+done
+sleep 1.1
+for e in exr tif dpx sgi png; do
+  "$ABCUBE" render "$WORK/small.json" -o "$WORK/repro/r.$e" --method raytrace 2> /dev/null
+  check "reproducible $e: same bytes a second later" cmp -s "$WORK/repro/r.$e" "$WORK/repro/first.$e"
+done
+
 echo "cli render_cli: $passed passed, $failed failed"
 [ $failed -eq 0 ]
