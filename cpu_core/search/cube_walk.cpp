@@ -57,7 +57,7 @@ void envelope_next(const FaceLines& f, int cur, double l, double end, double* fa
 CubeWalk::CubeWalk(const glm::dvec3& w, const glm::dvec3& d, int n, double l_max, double skip_radius,
                    uint32_t max_texels)
     : w_(w), d_(d), n_(n), l_max_(l_max),
-      cap_(max_texels ? max_texels : 16u * static_cast<uint32_t>(std::max(n, 1)) + 64u) {
+      cap_(max_texels ? max_texels : default_cap(n)) {
   ABCUBE_CHECK(n >= 1, "n = " + std::to_string(n));
   ABCUBE_CHECK(std::fabs(glm::length(d) - 1.0) < 1e-6,
                "direction must be unit, |d| = " + std::to_string(glm::length(d)));
@@ -93,14 +93,16 @@ CubeWalk::CubeWalk(const glm::dvec3& w, const glm::dvec3& d, int n, double l_max
   }
 }
 
-double CubeWalk::crossing(int axis, int boundary) const {
+double CubeWalk::raw_crossing(int axis, int boundary) const {
   // Plane n (A . X) - (2k - n) (F . X) = 0 through the centre: s or t = k / n on this face.
   const double u = 2.0 * boundary - n_;
   const double num = n_ * axis_w_[axis] - u * forward_w_;
   const double den = n_ * axis_d_[axis] - u * forward_d_;
   if (!(den * step_[axis] > 0.0)) return INF;  // moving away from (or along) this plane
-  return std::max(l_, -num / den);
+  return -num / den;
 }
+
+double CubeWalk::crossing(int axis, int boundary) const { return std::max(l_, raw_crossing(axis, boundary)); }
 
 void CubeWalk::next_crossing(int axis) {
   const int k = step_[axis] > 0 ? ij_[axis] + 1 : ij_[axis];
@@ -151,16 +153,21 @@ bool CubeWalk::start_face() {
   }
 }
 
+bool CubeWalk::on_face() {
+  if (done_) return false;
+  if (!face_active_) {
+    if (!start_face()) {
+      done_ = true;
+      return false;
+    }
+    face_active_ = true;
+  }
+  return true;
+}
+
 bool CubeWalk::next(WalkTexel* texel) {
   for (;;) {
-    if (done_) return false;
-    if (!face_active_) {
-      if (!start_face()) {
-        done_ = true;
-        return false;
-      }
-      face_active_ = true;
-    }
+    if (!on_face()) return false;
     if (++iterations_ > cap_) {
       aborted_ = done_ = true;
       return false;
@@ -186,6 +193,119 @@ bool CubeWalk::next(WalkTexel* texel) {
       return true;
     }
   }
+}
+
+bool CubeWalk::pending(WalkTexel* texel) {
+  if (!on_face()) return false;
+  texel->face = face_, texel->i = ij_[0], texel->j = ij_[1];
+  texel->l0 = l_;
+  texel->l1 = std::min({next_l_[0], next_l_[1], face_end_});
+  texel->after_gap = gap_pending_;
+  return true;
+}
+
+// The boundaries one axis may cross inside a square (SQUARE EXIT, header 5.): from its head
+// on, along its step, those of 1 .. n-1 up to the square's edge whose plane the ray reaches
+// (den of the step's sign: den is monotone along the boundaries, so they are a prefix).
+struct CubeWalk::AxisRun {
+  int first = 0;        // the head: the next boundary the axis crosses
+  int count = 0;        // boundaries first, first + step, ... the walk may cross in the square
+  bool exits = false;   // the last of them is the square's edge: crossing it leaves the square
+  double exit_l = INF;  // where it is crossed, max(l, r(last)), when it exits
+};
+
+// False when the run's crossings cannot be proven to increase along the walk (header 5.).
+bool CubeWalk::axis_run(int axis, int lo, int hi, AxisRun* run) const {
+  const int s = step_[axis];
+  *run = AxisRun{};
+  if (s == 0) return true;  // this index never changes on the face
+  const int head = s > 0 ? ij_[axis] + 1 : ij_[axis];
+  const int edge = s > 0 ? hi : lo;
+  const bool interior_edge = edge >= 1 && edge <= n_ - 1;
+  const int last = interior_edge ? edge : (s > 0 ? n_ - 1 : 1);
+  const int m = s > 0 ? last - head + 1 : head - last + 1;
+  run->first = head;
+  const auto den_at = [&](int b) { return n_ * axis_d_[axis] - (2.0 * b - n_) * forward_d_; };  // as raw_crossing
+  const auto reached = [&](int k) { return den_at(head + s * k) * s > 0.0; };
+  if (m <= 0 || !reached(0)) return true;  // nothing left to cross on this axis
+  int count = m;
+  if (!reached(m - 1)) {  // the reachable prefix ends inside: its first unreached boundary
+    int yes = 0, no = m - 1;
+    while (no - yes > 1) {
+      const int mid = yes + (no - yes) / 2;
+      (reached(mid) ? yes : no) = mid;
+    }
+    count = no;
+  }
+  run->count = count;
+  run->exits = interior_edge && count == m;
+  if (run->exits) run->exit_l = std::max(l_, raw_crossing(axis, head + s * (count - 1)));
+  if (count < 2) return true;
+  // Do the computed crossings increase along the walk? The exact gap between consecutive
+  // ones, 2 n |rate| / (den den'), against twice the roundings' bound on each (header 5.).
+  constexpr double EPS = std::numeric_limits<double>::epsilon() / 2;  // unit roundoff
+  const int b_last = head + s * (count - 1);
+  const double d0 = std::fabs(den_at(head)), d1 = std::fabs(den_at(b_last));
+  const double pn = n_ * (std::fabs(axis_w_[axis]) + std::fabs(forward_w_));  // >= |n A.W| + |u F.W|
+  const double pd = n_ * (std::fabs(axis_d_[axis]) + std::fabs(forward_d_));
+  const double den_min = std::min(d0, d1), den_max = std::max(d0, d1) + 4.0 * EPS * pd;
+  if (!(den_min > 64.0 * EPS * pd)) return false;
+  const double r_max = std::max(std::fabs(raw_crossing(axis, head)), std::fabs(raw_crossing(axis, b_last)));
+  const double error = 8.0 * EPS * ((pn + r_max * pd) / den_min + r_max);
+  const double ad_fw = axis_d_[axis] * forward_w_, aw_fd = axis_w_[axis] * forward_d_;
+  const double rate = (ad_fw - aw_fd) * s - 4.0 * EPS * (std::fabs(ad_fw) + std::fabs(aw_fd));
+  const double gap = 2.0 * n_ * rate / (den_max * den_max) * (1.0 - 8.0 * EPS);
+  return rate > 0.0 && gap > 4.0 * error;
+}
+
+// How many of the run's boundaries have their crossing at or before l (a prefix: they
+// increase): guessed from the point at l, then settled with the walk's own division.
+int CubeWalk::crossed_before(int axis, const AxisRun& run, double l) const {
+  if (run.count == 0) return 0;
+  const int s = step_[axis];
+  const double coord = 0.5 * ((axis_w_[axis] + l * axis_d_[axis]) / (forward_w_ + l * forward_d_) + 1.0) * n_;
+  const double guess = s > 0 ? std::floor(coord) - run.first + 1 : run.first - std::ceil(coord) + 1;
+  int k = std::isfinite(guess) ? static_cast<int>(std::clamp(guess, 0.0, static_cast<double>(run.count))) : 0;
+  while (k < run.count && raw_crossing(axis, run.first + s * k) <= l) ++k;
+  while (k > 0 && raw_crossing(axis, run.first + s * (k - 1)) > l) --k;
+  return k;
+}
+
+bool CubeWalk::square_exit(int i0, int j0, int size, SquareExit* exit) const {
+  if (done_ || !face_active_ || !can_jump()) return false;
+  const int origin[2] = {i0, j0};
+  AxisRun run[2];
+  for (int axis = 0; axis < 2; ++axis) {
+    if (!axis_run(axis, origin[axis], std::min(origin[axis] + size, n_), &run[axis])) return false;
+  }
+  const double l = std::min(run[0].exit_l, run[1].exit_l);
+  if (!(l < face_end_)) {  // the face segment ends first, inside the square
+    exit->face_ends = true;
+    exit->l_end = face_end_;
+    return true;
+  }
+  exit->face_ends = false;
+  exit->l_end = l;
+  int ij[2];
+  for (int axis = 0; axis < 2; ++axis) {
+    const bool leaves = run[axis].exits && run[axis].exit_l == l;  // both at once: a corner
+    ij[axis] = ij_[axis] + step_[axis] * (leaves ? run[axis].count : crossed_before(axis, run[axis], l));
+  }
+  exit->i = ij[0], exit->j = ij[1];
+  return true;
+}
+
+void CubeWalk::jump(const SquareExit& exit) {
+  // The square's texels of positive length take the after-gap mark, as next() would.
+  if (exit.face_ends || exit.l_end > l_) gap_pending_ = false;
+  if (exit.face_ends) {
+    face_active_ = false;
+    return;
+  }
+  ij_[0] = exit.i, ij_[1] = exit.j;
+  l_ = exit.l_end;
+  next_crossing(0);
+  next_crossing(1);
 }
 
 double texel_size_at(const glm::dvec3& x, int n) {

@@ -26,8 +26,10 @@
 //     not visited). A crossing computed behind the current l (rounding on a boundary) is
 //     taken at the current l. Texels whose interval has zero length are not reported (a
 //     ray along a seam or exactly through a corner touches them at one point only). Each
-//     step moves i or j one way only and the faces never repeat, so a walk has at most
-//     6 * 2n texels; max_texels (default 16 n + 64) is a safety cap, `aborted` says when it
+//     step moves i or j one way only and the faces never repeat (a face is convex on the
+//     sphere: the arc meets it once; the centre's gap may split one face in two segments),
+//     so a walk takes at most 6 * 2 (n - 1) steps and 7 face ends: 12 n - 5 iterations;
+//     max_texels (default 16 n + 64, never reached) is a safety cap, `aborted` says when it
 //     was hit.
 //  4. THE CENTRE. A ray whose line passes within r of C (closest approach h = |W x D| < r)
 //     skips the part inside the ball |X| < r: l in (l_c - sqrt(r^2 - h^2), l_c +
@@ -38,6 +40,24 @@
 //     resolved in double precision. The first texel after a skip has `after_gap` set.
 //     D . [[W]] = +1 needs no rule: no boundary plane is crossed, the walk is one texel.
 //     W = 0 (the ray starts at C): the walk is the one texel of D.
+//  5. SQUARE EXIT (the searches' HIERARCHICAL SKIP, search_scan.hpp): where the walk leaves
+//     an axis-aligned square of texels of the current face, computed without visiting its
+//     texels and EXACTLY as the steps of 2. would leave it (same texel, same l), or refused.
+//     Why it can be exact: with r_a(b) the unclamped parameter of boundary b on axis a (the
+//     division of 2.) and L the walk's l at the pending texel, the next crossing of axis a
+//     is always max(l, r_a(head)) (a crossing behind l is taken at l), so the walk is a
+//     merge of the two axes' crossings by value and l is the running maximum of the ones
+//     merged: boundary b is crossed at max(L, max of r_a over the boundaries up to b). When
+//     each axis's r_a increases along the walk, that is max(L, r_a(b)): the square is left
+//     at E = min over axes of max(L, r_a(exit boundary)), or by the face's end when that
+//     comes first, and an axis that does not leave there has crossed exactly its boundaries
+//     with r_a <= E (counted with the same division). That each r_a increases is proven,
+//     not assumed: exactly, consecutive crossings differ by 2 n |rate| / (den den') (the
+//     plane pencil is a Moebius map of the boundary), den monotone along the boundaries so
+//     the smallest gap is at an end of the run; the computed r_a are within a bound of the
+//     roundings (a few units in the last place of the terms, widened eightfold) of the exact
+//     ones; a run whose smallest gap is not more than twice that bound is refused, as is one
+//     whose den comes near 0 or a walk whose cap was lowered (the cap counts steps).
 //
 // Each reported texel has the exact parameter interval [l0, l1] the ray spends in its
 // frustum (l1 = +inf for the last texel of an unbounded ray); consecutive intervals meet
@@ -80,6 +100,27 @@ class CubeWalk {
   // caller knows that nothing it looks for lies on the rest of this face).
   void leave_face() { face_active_ = false; }
 
+  // HIERARCHICAL SKIP (search_scan.hpp). The pending texel: the one next() reports next
+  // (face, i, j and l0 = the walk's current l; l1 as far as known), starting the next face
+  // segment if need be (as next() would); false when the walk is over.
+  bool pending(WalkTexel* texel);
+  // Where the walk leaves the square of texels [i0, i0 + size) x [j0, j0 + size) (clipped to
+  // the face) that holds the pending texel, exactly as next() would leave it: the walk's l
+  // there and its next texel, or the end of the face segment inside the square. False when
+  // exactness cannot be guaranteed (SQUARE EXIT below): the caller then walks on.
+  struct SquareExit {
+    double l_end = 0;        // the texels of the square the walk passes lie in [l, l_end]
+    bool face_ends = false;  // the face segment ends inside the square (l_end = its end)
+    int i = 0, j = 0;        // else: the first texel after the square, entered at l_end
+  };
+  bool square_exit(int i0, int j0, int size, SquareExit* exit) const;
+  // Goes on from `exit` (of square_exit at the current pending texel): the walk's state is
+  // then the one next() reaches after the square's texels.
+  void jump(const SquareExit& exit);
+  // Whether square_exit may be used: the cap cannot stop the plain walk (3. above), so
+  // leaving texels out cannot change where it stops.
+  bool can_jump() const { return cap_ >= default_cap(n_); }
+
   bool aborted() const { return aborted_; }
   uint32_t texels() const { return texels_; }  // reported so far
   // The skipped parameter interval (gap_begin < gap_end) or an empty one.
@@ -87,9 +128,15 @@ class CubeWalk {
   double gap_end() const { return gap_end_; }
 
  private:
+  static uint32_t default_cap(int n) { return 16u * static_cast<uint32_t>(n > 1 ? n : 1) + 64u; }
   bool start_face();            // the next face segment of the current run; false at the end
+  bool on_face();               // a face segment started (the current or the next); false at the end
   void start_texel_on_face();   // entry texel and first crossings of the face segment
   double crossing(int axis, int boundary) const;  // l where the ray crosses a boundary plane
+  double raw_crossing(int axis, int boundary) const;  // the same, not clamped to l_ (INF: never)
+  struct AxisRun;
+  bool axis_run(int axis, int lo, int hi, AxisRun* run) const;
+  int crossed_before(int axis, const AxisRun& run, double l) const;
   void next_crossing(int axis);
 
   glm::dvec3 w_, d_;

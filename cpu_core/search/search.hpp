@@ -199,6 +199,7 @@ struct SearchOptions {
   double self_offset_texels = 0;            // W's own surface and points closer; 0 = the mode's default
   uint32_t max_texels = 0;                  // walk cap; 0 = CubeWalk's default
   bool side_structure = true;               // THE SIDE STRUCTURE answers what the map cannot hold
+  bool hierarchy = true;  // HIERARCHICAL SKIP (search_scan.hpp); off: the plain walk (same answers)
 };
 
 // The self offset `options` gives, in texels at W (its own, or the mode's default).
@@ -298,6 +299,21 @@ class SearchContext {
     const glm::vec2 z = block_bounds(face, i, j);
     return static_cast<double>(z.y) * z.y < dmin2 || static_cast<double>(z.x) * z.x > dmax2;
   }
+  // THE Z PYRAMID (HIERARCHICAL SKIP, search_scan.hpp): level 0 is the BLOCK BOUNDS; a node
+  // of level k + 1 holds the 2 x 2 nodes of level k under it (the smallest zmin and the
+  // largest zmax: (+inf, -inf) when empty), up to one node for the whole face. A node of
+  // level k covers the texels of a square BOUNDS_BLOCK << k a side (clipped to the face).
+  int pyramid_levels() const { return static_cast<int>(level_width_.size()); }
+  // The node of `level` holding texel (i, j): (min zmin, max zmax).
+  glm::vec2 node_bounds(int face, int level, int i, int j) const {
+    if (level == 0) return block_bounds(face, i, j);
+    const size_t k = static_cast<size_t>(level);
+    const size_t x = static_cast<size_t>(i / BOUNDS_BLOCK) >> k, y = static_cast<size_t>(j / BOUNDS_BLOCK) >> k;
+    return pyramid_[static_cast<size_t>(face)][level_offset_[k] + y * level_width_[k] + x];
+  }
+  // Bytes of the levels above the block bounds (all six faces), and of the block bounds.
+  size_t pyramid_bytes() const;
+  size_t block_bounds_bytes() const;
 
  private:
   const SceneData* scene_;
@@ -316,6 +332,12 @@ class SearchContext {
   std::array<RowBounds, 6> occupied_;
   int blocks_per_row_ = 0;
   std::array<std::vector<glm::vec2>, 6> block_z_;  // (min zmin, max zmax); empty: (+inf, -inf)
+  // THE Z PYRAMID's levels 1 and up, per face, one after the other: level k at
+  // level_offset_[k], level_width_[k] nodes a row (index 0: the block level's width).
+  std::array<std::vector<glm::vec2>, 6> pyramid_;
+  std::vector<size_t> level_offset_;
+  std::vector<size_t> level_width_;
+  void build_pyramid();
   void build_side_structure(const std::vector<uint8_t>& seen);
   glm::vec2 block_bounds(int face, int i, int j) const {
     return block_z_[static_cast<size_t>(face)][static_cast<size_t>(j / BOUNDS_BLOCK) * static_cast<size_t>(blocks_per_row_) +
@@ -335,7 +357,8 @@ struct SearchResult {
   double outside_texels = 0;   // crossing mode: X''s distance from its triangle, in texels
   bool side = false;           // answered by THE SIDE STRUCTURE (texel is then meaningless)
   CubeTexel texel{0, 0, 0};    // where the fragment was found
-  uint32_t texels_visited = 0;
+  uint32_t texels_visited = 0;    // texels the walk stepped on
+  uint32_t nodes_skipped = 0;     // pyramid nodes it stepped over (HIERARCHICAL SKIP)
   uint32_t fragments_tested = 0;  // z-interval tests
   uint32_t candidates = 0;        // fragments refined (z overlap, not own surface)
 };
@@ -349,6 +372,7 @@ struct ShadowResult {
   bool zero_area = false;         // the segment meets a zero-area surface and no side structure answered
   uint32_t side_blockers = 0;     // blockers found by THE SIDE STRUCTURE
   uint32_t texels_visited = 0;
+  uint32_t nodes_skipped = 0;
   uint32_t fragments_tested = 0;
   uint32_t candidates = 0;
   uint32_t threshold_rejections = 0;  // candidates refused by the tolerance / theta_max
@@ -385,10 +409,16 @@ void coincident_crossings(const SearchContext& ctx, const glm::dvec3& w, const g
 ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p,
                            const glm::dvec3& light_position, const SearchOptions& options = {});
 
+// Whether two searches gave the same answer bit for bit: every field but the walk's counts
+// of texels and nodes (HIERARCHICAL SKIP: on and off must agree).
+bool same_answer(const SearchResult& a, const SearchResult& b);
+bool same_answer(const ShadowResult& a, const ShadowResult& b);
+
 // Counters of one kind of search (issue item 10).
 struct SearchKindStats {
   uint64_t rays = 0;
   uint64_t texels = 0, max_texels = 0;  // texels visited: sum and max per ray
+  uint64_t nodes = 0;                   // pyramid nodes stepped over (HIERARCHICAL SKIP)
   uint64_t fragments = 0;               // z-interval tests
   uint64_t candidates = 0;              // fragments refined
   uint64_t hits = 0;                    // shadows: rays with a blocker
@@ -398,6 +428,7 @@ struct SearchKindStats {
   uint64_t side_hits = 0;               // answered by THE SIDE STRUCTURE; shadows: rays with a side blocker
   uint64_t aborted = 0;                 // walks stopped by the cap
   double mean_texels() const { return rays ? static_cast<double>(texels) / static_cast<double>(rays) : 0.0; }
+  double mean_nodes() const { return rays ? static_cast<double>(nodes) / static_cast<double>(rays) : 0.0; }
   void add(const SearchResult& r);
   void add(const ShadowResult& r);
   void merge(const SearchKindStats& o);

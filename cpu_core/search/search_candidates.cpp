@@ -207,6 +207,7 @@ SearchResult finish(const SearchContext& ctx, const SearchRay& q, const Candidat
     r.miss = MissReason::zero_area_surface;
   }
   r.texels_visited = counts.texels;
+  r.nodes_skipped = counts.nodes;
   r.fragments_tested = counts.fragments;
   r.candidates = counts.candidates;
   return r;

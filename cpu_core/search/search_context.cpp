@@ -74,7 +74,49 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube,
       rb.max_suffix[j - 1] = std::max(rb.max_suffix[j - 1], rb.max_suffix[j]);
     }
   }
+  build_pyramid();
   build_side_structure(seen);
+}
+
+// THE Z PYRAMID (search.hpp): each level from the 2 x 2 nodes of the one below, halving
+// (rounding up) until one node covers the face.
+void SearchContext::build_pyramid() {
+  level_width_.assign(1, static_cast<size_t>(blocks_per_row_));
+  level_offset_.assign(1, 0);
+  size_t total = 0;
+  while (level_width_.back() > 1) {
+    level_offset_.push_back(total);
+    level_width_.push_back((level_width_.back() + 1) / 2);
+    total += level_width_.back() * level_width_.back();
+  }
+  const float inf = std::numeric_limits<float>::infinity();
+  for (size_t f = 0; f < pyramid_.size(); ++f) {
+    pyramid_[f].assign(total, glm::vec2(inf, -inf));
+    for (size_t k = 1; k < level_width_.size(); ++k) {
+      const size_t below = level_width_[k - 1], width = level_width_[k];
+      const glm::vec2* from = k == 1 ? block_z_[f].data() : pyramid_[f].data() + level_offset_[k - 1];
+      glm::vec2* to = pyramid_[f].data() + level_offset_[k];
+      for (size_t y = 0; y < below; ++y) {
+        for (size_t x = 0; x < below; ++x) {
+          glm::vec2& z = to[(y / 2) * width + x / 2];
+          z.x = std::min(z.x, from[y * below + x].x);
+          z.y = std::max(z.y, from[y * below + x].y);
+        }
+      }
+    }
+  }
+}
+
+size_t SearchContext::pyramid_bytes() const {
+  size_t bytes = 0;
+  for (const auto& p : pyramid_) bytes += p.size() * sizeof(glm::vec2);
+  return bytes;
+}
+
+size_t SearchContext::block_bounds_bytes() const {
+  size_t bytes = 0;
+  for (const auto& b : block_z_) bytes += b.size() * sizeof(glm::vec2);
+  return bytes;
 }
 
 // THE SIDE STRUCTURE (search.hpp): the zero-area triangles and those without a fragment,

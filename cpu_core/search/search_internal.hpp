@@ -38,6 +38,7 @@ inline bool allowed(const SearchContext& ctx, const SearchRay& q, uint32_t objec
 // What the walk over the map saw of one ray.
 struct ScanCounts {
   uint32_t texels = 0, fragments = 0, candidates = 0;
+  uint32_t nodes = 0;  // pyramid nodes stepped over (HIERARCHICAL SKIP)
   bool aborted = false;
 };
 

@@ -185,6 +185,7 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
   res.aborted = counts.aborted;
   res.zero_area = !q.side && meets_zero_area(ctx, q, len);
   res.texels_visited = counts.texels;
+  res.nodes_skipped = counts.nodes;
   res.fragments_tested = counts.fragments;
   res.candidates = counts.candidates;
   return res;

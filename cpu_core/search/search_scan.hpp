@@ -58,6 +58,23 @@ class SquaredDistanceRange {
     const double dmin = lc == l0 ? at_l0 : (lc == l1 ? at_l1 : glm::dot(xc, xc));
     return {dmin, std::isinf(l1) ? INF : std::max(at_l0, at_l1)};
   }
+  // |X(l)|^2 as operator() computes it.
+  double at(double l) { return length2_at(l); }
+  // HIERARCHICAL SKIP: [lo, hi] holding every value operator() gives over sub-intervals of
+  // [l0, l1] (l0 >= 0), whatever the roundings. Each is |X(l)|^2 computed at some l in
+  // [l0, l1], within 8 eps S(l)^2 of the exact value (S(l) = |W|_1 + l |D|_1): above by
+  // convexity, max at an end plus that; below, the exact minimum over [l0, l1] (which the
+  // clamped closest point misses by at most 2e-6 |W|, D being unit to 1e-6: 5e-12 |W|^2)
+  // less the same; where l > 3 |W| the error is under 96 eps of the value itself. The
+  // widening below is each of those terms at least twentyfold.
+  glm::dvec2 widened(double l0, double l1) {
+    const glm::dvec2 r = (*this)(l0, l1);
+    const double wn = std::fabs(w_.x) + std::fabs(w_.y) + std::fabs(w_.z);
+    const double lc = std::clamp(closest_, l0, l1);
+    const double near = (wn + lc) * (wn + lc), far = (wn + l1) * (wn + l1);
+    const double lo = r.x * (1.0 - 1e-12) - 1e-12 * near - 1e-10 * wn * wn;
+    return {lo, std::isinf(l1) ? INF : r.y * (1.0 + 1e-12) + 1e-12 * far};
+  }
 
  private:
   double length2_at(double l) {
@@ -73,6 +90,42 @@ class SquaredDistanceRange {
   double cached_l_ = std::numeric_limits<double>::quiet_NaN(), cached_length2_ = 0;
 };
 
+// HIERARCHICAL SKIP (issue 14; maximum mipmaps, Tevs et al. 2008; hierarchical-Z tracing,
+// McGuire & Mara 2014, on the thesis's arc walk). Before the pending texel is visited, the
+// nodes of THE Z PYRAMID (search.hpp) holding it are tried, from one level above the last
+// success down to the block: a node is stepped over, the walk jumping to where it leaves the
+// node's square (CubeWalk::square_exit, exact), when it is empty or when the ray's squared
+// distance range over that stretch, widened against every rounding
+// (SquaredDistanceRange::widened), misses [zmin^2, zmax^2] of the node. Every texel of the
+// square would then have had its block passed by the BLOCK BOUNDS test (its block's bounds
+// lie in the node's, its range in the widened one), so no fragment is read or counted
+// either way: the answers, fragments tested and candidates are the plain walk's bit for
+// bit; only the texels visited fall (and the nodes stepped over are counted). A node whose
+// range holds |X(l0)| is not tried (it cannot pass), nor one whose exit the walk cannot
+// prove; the walk then descends or visits the texel.
+inline bool skip_node(const SearchContext& ctx, CubeWalk& walk, const WalkTexel& t, SquaredDistanceRange& distances2,
+                      int* level) {
+  const double at_l0 = distances2.at(t.l0);
+  for (int k = std::min(*level + 1, ctx.pyramid_levels() - 1); k >= 0; --k) {
+    const glm::vec2 z = ctx.node_bounds(t.face, k, t.i, t.j);
+    const bool empty = z.x > z.y;
+    const double zmin2 = static_cast<double>(z.x) * z.x, zmax2 = static_cast<double>(z.y) * z.y;
+    if (!empty && zmin2 <= at_l0 && at_l0 <= zmax2) continue;
+    const int size = SearchContext::BOUNDS_BLOCK << k;
+    CubeWalk::SquareExit exit;
+    if (!walk.square_exit(t.i / size * size, t.j / size * size, size, &exit)) continue;
+    if (!empty) {
+      const glm::dvec2 range2 = distances2.widened(t.l0, exit.l_end);
+      if (!(zmax2 < range2.x || zmin2 > range2.y)) continue;
+    }
+    walk.jump(exit);
+    *level = k;
+    return true;
+  }
+  *level = -1;
+  return false;
+}
+
 // Walks the ray's texels; for each texel calls on_fragment(texel, fragment, v) for every
 // fragment that passes the layer choice, the object restriction, the z-interval test
 // (thesis 7.5) and the own-surface test, then after_texel(texel, index) -> keep walking?
@@ -80,7 +133,8 @@ class SquaredDistanceRange {
 // EMPTY FACES. When the rest of the walk on a face can only meet empty lists
 // (SearchContext::empty_ahead), the walk goes on at the next face: nothing changes but the
 // texels counted as visited. Only while may_skip() holds: the crossing and thesis windows
-// count texels once they have a candidate.
+// count texels once they have a candidate. So does the HIERARCHICAL SKIP above (while
+// may_skip() holds after_texel keeps walking on a texel without candidates).
 template <class OnFragment, class AfterTexel, class MaySkip>
 ScanCounts scan(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o, OnFragment&& on_fragment,
                 AfterTexel&& after_texel, MaySkip&& may_skip) {
@@ -91,8 +145,18 @@ ScanCounts scan(const SearchContext& ctx, const SearchRay& q, const SearchOption
   // Only the thesis mode and the nearest layer look at the texel-centre direction.
   const bool need_v = o.mode == SearchMode::thesis || o.layers == SearchLayers::nearest;
   ScanCounts counts;
+  const bool hierarchy = o.hierarchy && walk.can_jump();
+  int level = ctx.pyramid_levels() - 1;  // HIERARCHICAL SKIP: the last level stepped over
   WalkTexel t;
-  while (walk.next(&t)) {
+  for (;;) {
+    if (hierarchy && may_skip()) {
+      if (!walk.pending(&t)) break;
+      if (skip_node(ctx, walk, t, distances2, &level)) {
+        ++counts.nodes;
+        continue;
+      }
+    }
+    if (!walk.next(&t)) break;
     ++counts.texels;
     const ABuffer& b = cube.faces[static_cast<size_t>(t.face)];
     glm::dvec2 range2(0.0);  // squared distances from the centre

@@ -1,6 +1,7 @@
 // Counters of the searches (search.hpp SearchKindStats, SearchStats), the options'
 // names and the self offset each mode defaults to.
 #include <algorithm>
+#include <cstring>
 
 #include "search/search.hpp"
 #include "base/enum_names.hpp"
@@ -37,12 +38,38 @@ const char* miss_reason_name(MissReason r) { return enum_name(MISS_REASON_NAMES,
 
 namespace {
 
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(const glm::dvec3& a, const glm::dvec3& b) {
+  return same_bits(a.x, b.x) && same_bits(a.y, b.y) && same_bits(a.z, b.z);
+}
+
+}  // namespace
+
+bool same_answer(const SearchResult& a, const SearchResult& b) {
+  return a.hit == b.hit && a.miss == b.miss && a.triangle == b.triangle && a.object_id == b.object_id &&
+         a.material_id == b.material_id && a.back_face == b.back_face && same_bits(a.point, b.point) &&
+         same_bits(a.distance, b.distance) && same_bits(a.angle, b.angle) &&
+         same_bits(a.outside_texels, b.outside_texels) && a.side == b.side && a.texel.face == b.texel.face &&
+         a.texel.i == b.texel.i && a.texel.j == b.texel.j && a.fragments_tested == b.fragments_tested &&
+         a.candidates == b.candidates;
+}
+
+bool same_answer(const ShadowResult& a, const ShadowResult& b) {
+  return same_bits(a.transmittance, b.transmittance) && a.blocked == b.blocked && a.blockers == b.blockers &&
+         a.first_blocker == b.first_blocker && a.aborted == b.aborted && a.zero_area == b.zero_area &&
+         a.side_blockers == b.side_blockers && a.fragments_tested == b.fragments_tested &&
+         a.candidates == b.candidates && a.threshold_rejections == b.threshold_rejections;
+}
+
+namespace {
+
 // The walk's counts, which every kind of result carries.
 template <class Result>
 void add_walk(SearchKindStats* s, const Result& r) {
   ++s->rays;
   s->texels += r.texels_visited;
   s->max_texels = std::max<uint64_t>(s->max_texels, r.texels_visited);
+  s->nodes += r.nodes_skipped;
   s->fragments += r.fragments_tested;
   s->candidates += r.candidates;
 }
@@ -76,6 +103,7 @@ void SearchKindStats::merge(const SearchKindStats& o) {
   rays += o.rays;
   texels += o.texels;
   max_texels = std::max(max_texels, o.max_texels);
+  nodes += o.nodes;
   fragments += o.fragments;
   candidates += o.candidates;
   hits += o.hits;

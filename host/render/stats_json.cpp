@@ -8,6 +8,7 @@ using nlohmann::json;
 
 json search_kind_json(const SearchKindStats& s) {
   return {{"rays", s.rays}, {"texels_mean", s.mean_texels()}, {"texels_max", s.max_texels},
+          {"nodes_mean", s.mean_nodes()},
           {"fragments_tested", s.fragments}, {"candidates", s.candidates}, {"hits", s.hits},
           {"misses", s.misses}, {"threshold_rejections", s.threshold_rejections},
           {"zero_area_misses", s.zero_area}, {"side_hits", s.side_hits}, {"aborted", s.aborted}};
