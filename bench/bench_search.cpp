@@ -196,10 +196,10 @@ Row measure(const SearchContext& ctx, const std::vector<ShadowRay>& rays, const 
 }
 
 void print_header() {
-  std::printf("%-36s %5s %-8s %-10s %4s %6s %6s %6s %6s %7s %6s %7s %6s %7s %9s %9s %9s %6s %9s %9s %9s %9s %6s %6s "
+  std::printf("%-36s %5s %-8s %-10s %4s %6s %6s %6s %6s %7s %6s %7s %6s %7s %6s %9s %9s %9s %6s %9s %9s %9s %9s %6s %6s "
               "%6s %5s %5s\n",
               "scene", "N", "mode", "kind", "hier", "rays", "hit%", "agree%", "same%", "texels", "nodes", "visits",
-              "max", "frags", "ns/ray", "min", "max", "x/2N", "EP mean", "EP p99", "EP max", "1/(2N^2)", ">bnd%",
+              "max", "frags", "cands", "ns/ray", "min", "max", "x/2N", "EP mean", "EP p99", "EP max", "1/(2N^2)", ">bnd%",
               "m:none", "m:thr", "m:0A", "m:cap");
 }
 
@@ -215,14 +215,14 @@ void print_row(const std::string& scene, int n, SearchMode mode, const std::stri
                   r.parallax.percentile(0.99), r.parallax.max(), 1.0 / (2.0 * n * n),
                   hits > 0 ? 100.0 * static_cast<double>(r.over_bound) / hits : 0.0);
   }
-  std::printf("%-36s %5d %-8s %-10s %4s %6llu %6.1f %6.1f %6.1f %7.1f %6.1f %7.1f %6llu %7.1f %9.0f %9.0f %9.0f %6s "
+  std::printf("%-36s %5d %-8s %-10s %4s %6llu %6.1f %6.1f %6.1f %7.1f %6.1f %7.1f %6llu %7.1f %6.1f %9.0f %9.0f %9.0f %6s "
               "%s %6llu %6llu %5llu %5llu\n",
               scene.c_str(), n, search_mode_name(mode), r.reflection ? "reflection" : "shadow", hier.c_str(),
               static_cast<unsigned long long>(r.stats.rays), 100.0 * static_cast<double>(r.stats.hits) / rays,
               100.0 * static_cast<double>(r.agree) / rays, 100.0 * static_cast<double>(r.same) / rays,
               r.stats.mean_texels(), r.stats.mean_nodes(), r.stats.mean_texels() + r.stats.mean_nodes(),
               static_cast<unsigned long long>(r.stats.max_texels), static_cast<double>(r.stats.fragments) / rays,
-              r.ns_median, r.ns_min, r.ns_max, ratio, errors,
+              static_cast<double>(r.stats.candidates) / rays, r.ns_median, r.ns_min, r.ns_max, ratio, errors,
               static_cast<unsigned long long>(r.stats.misses - r.stats.threshold_rejections - r.stats.zero_area -
                                               r.stats.aborted),
               static_cast<unsigned long long>(r.stats.threshold_rejections),

@@ -12,6 +12,19 @@
 // would keep (centre sample covered, nearest plane along the texel centre): the one-layer
 // Z-buffered map of Patow 1995 (thesis 7.4), same walk, same rules.
 //
+// HIERARCHICAL SKIP (SearchOptions::hierarchy, default on; search_scan.hpp skip_node).
+// THE Z PYRAMID (SearchContext::node_bounds) holds the smallest zmin and largest zmax of
+// the fragments under squares of 8, 16, ... texels up to a whole face (the BLOCK BOUNDS and
+// the levels above them: a third more bytes). Before it visits a texel the walk tries the
+// nodes holding it and steps over a whole node when the ray's distance range across it,
+// widened against every rounding, cannot meet the node's [zmin, zmax] (or it is empty),
+// landing on the very texel and l where the plain walk leaves the node (CubeWalk::
+// square_exit, exact or refused); it descends otherwise (maximum mipmaps, Tevs et al. 2008;
+// hierarchical-Z tracing, McGuire & Mara 2014). The texels stepped over are ones whose
+// lists the plain walk would not have read either, so the answers, fragments tested and
+// candidates are the same bit for bit (tests/core/test_search_hierarchy.cpp): only the
+// texels visited change (SearchResult::nodes_skipped counts the nodes). Off: the plain walk.
+//
 // MODE crossing (default). Each tested fragment is refined with its triangle's exact plane
 // (the fragment stores the triangle index): X' = X(l') where the ray meets the plane. Its
 // error is its distance e from the triangle (0 inside), in texels at X' (texel_size_at).
