@@ -14,6 +14,7 @@ Writes a markdown report (tables, commands, machine, load) to --out.
 Usage: hier_search.py --before OLD/abcube --after build/abcube [--bench-search build/bench/bench_search]
                       [--scenes A.json,B.json@320x320] [--sizes 128,256,512,1024,2048] [--repeat 3]
                       [--threads 2] [--rays 3000] [--runs 5] [--out bench/results/hier_search.md]
+                      [--lock /tmp/abcube.build.lock]
 A scene written SCENE@WxH is rendered at that size (a copy of its JSON with the camera's
 width and height changed, written next to the run's other files: scenes without mesh files).
 Python 3 standard library only.
@@ -31,7 +32,11 @@ import time
 KINDS = (("reflection", "refl"), ("refraction_exit", "refr"), ("shadow", "shadow"))
 
 
+LOCK = []  # ["flock", FILE] with --lock: each program run holds the machine's lock
+
+
 def run(cmd, check=True):
+    cmd = LOCK + cmd
     start = time.monotonic()
     p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     ms = (time.monotonic() - start) * 1e3
@@ -98,7 +103,10 @@ def main():
     ap.add_argument("--rays", type=int, default=3000, help="bench_search rays per scene and kind")
     ap.add_argument("--runs", type=int, default=5, help="bench_search timed runs per row")
     ap.add_argument("--out", default="bench/results/hier_search.md")
+    ap.add_argument("--lock", default="", help="run every program under flock LOCK (a machine shared by builds)")
     a = ap.parse_args()
+    if a.lock:
+        LOCK[:] = ["flock", a.lock]
     sizes = [int(v) for v in a.sizes.split(",")]
     work = tempfile.mkdtemp(prefix="hier_search.")
     load_start = os.getloadavg()
@@ -146,10 +154,13 @@ def main():
               "(stats texels_mean + nodes_mean). PSNR against the exact tracer's image of the same scene; "
               "images: `abcube compare --exact` of every pair of runs." % a.repeat, ""] + tables
     if a.bench_search:
-        scenes = [scene_file(s, work)[0] for s in a.scenes.split(",")]
-        p, _ = run([a.bench_search] + scenes + ["--sizes", a.sizes, "--modes", "crossing", "--rays", str(a.rays),
-                                               "--runs", str(a.runs)])
-        out = p.stdout.rstrip().replace(work + "/", "")  # the resized copies by their names
+        outs = []
+        for spec in a.scenes.split(","):  # one scene a run: the lock is held a few minutes at most
+            p, _ = run([a.bench_search, scene_file(spec, work)[0], "--sizes", a.sizes, "--modes", "crossing",
+                        "--rays", str(a.rays), "--runs", str(a.runs)])
+            outs.append(p.stdout.rstrip() if not outs else p.stdout.rstrip().split("\n", 2)[2])
+            print(outs[-1], flush=True)
+        out = "\n".join(outs).replace(work + "/", "")  # the resized copies by their names
         lines += ["## Search rays alone (`bench_search`, one thread, hierarchy off = the plain walk)", "",
                   "```", out, "```", ""]
     lines += ["Load average at end: %.2f" % os.getloadavg()[0], ""]

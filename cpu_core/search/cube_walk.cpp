@@ -93,11 +93,15 @@ CubeWalk::CubeWalk(const glm::dvec3& w, const glm::dvec3& d, int n, double l_max
   }
 }
 
+double CubeWalk::denominator(int axis, int boundary) const {
+  return n_ * axis_d_[axis] - (2.0 * boundary - n_) * forward_d_;
+}
+
 double CubeWalk::raw_crossing(int axis, int boundary) const {
   // Plane n (A . X) - (2k - n) (F . X) = 0 through the centre: s or t = k / n on this face.
   const double u = 2.0 * boundary - n_;
   const double num = n_ * axis_w_[axis] - u * forward_w_;
-  const double den = n_ * axis_d_[axis] - u * forward_d_;
+  const double den = denominator(axis, boundary);
   if (!(den * step_[axis] > 0.0)) return INF;  // moving away from (or along) this plane
   return -num / den;
 }
@@ -225,8 +229,7 @@ bool CubeWalk::axis_run(int axis, int lo, int hi, AxisRun* run) const {
   const int last = interior_edge ? edge : (s > 0 ? n_ - 1 : 1);
   const int m = s > 0 ? last - head + 1 : head - last + 1;
   run->first = head;
-  const auto den_at = [&](int b) { return n_ * axis_d_[axis] - (2.0 * b - n_) * forward_d_; };  // as raw_crossing
-  const auto reached = [&](int k) { return den_at(head + s * k) * s > 0.0; };
+  const auto reached = [&](int k) { return denominator(axis, head + s * k) * step_[axis] > 0.0; };  // as raw_crossing
   if (m <= 0 || !reached(0)) return true;  // nothing left to cross on this axis
   int count = m;
   if (!reached(m - 1)) {  // the reachable prefix ends inside: its first unreached boundary
@@ -245,7 +248,7 @@ bool CubeWalk::axis_run(int axis, int lo, int hi, AxisRun* run) const {
   // ones, 2 n |rate| / (den den'), against twice the roundings' bound on each (header 5.).
   constexpr double EPS = std::numeric_limits<double>::epsilon() / 2;  // unit roundoff
   const int b_last = head + s * (count - 1);
-  const double d0 = std::fabs(den_at(head)), d1 = std::fabs(den_at(b_last));
+  const double d0 = std::fabs(denominator(axis, head)), d1 = std::fabs(denominator(axis, b_last));
   const double pn = n_ * (std::fabs(axis_w_[axis]) + std::fabs(forward_w_));  // >= |n A.W| + |u F.W|
   const double pd = n_ * (std::fabs(axis_d_[axis]) + std::fabs(forward_d_));
   const double den_min = std::min(d0, d1), den_max = std::max(d0, d1) + 4.0 * EPS * pd;
@@ -293,6 +296,20 @@ bool CubeWalk::square_exit(int i0, int j0, int size, SquareExit* exit) const {
   }
   exit->i = ij[0], exit->j = ij[1];
   return true;
+}
+
+double CubeWalk::square_end(int i0, int j0, int size) const {
+  const int origin[2] = {i0, j0};
+  double l = face_end_;
+  for (int axis = 0; axis < 2; ++axis) {
+    const int s = step_[axis];
+    const int edge = s > 0 ? std::min(origin[axis] + size, n_) : origin[axis];
+    const int head = s > 0 ? ij_[axis] + 1 : ij_[axis];
+    // As axis_run: the edge is crossed if it is interior and its plane and the head's are reached.
+    if (s == 0 || edge < 1 || edge > n_ - 1 || !(denominator(axis, head) * step_[axis] > 0.0)) continue;
+    l = std::min(l, std::max(l_, raw_crossing(axis, edge)));
+  }
+  return l;
 }
 
 void CubeWalk::jump(const SquareExit& exit) {

@@ -114,6 +114,8 @@ class CubeWalk {
     int i = 0, j = 0;        // else: the first texel after the square, entered at l_end
   };
   bool square_exit(int i0, int j0, int size, SquareExit* exit) const;
+  // square_exit's l_end when it succeeds, without the proof (a cheap test first).
+  double square_end(int i0, int j0, int size) const;
   // Goes on from `exit` (of square_exit at the current pending texel): the walk's state is
   // then the one next() reaches after the square's texels.
   void jump(const SquareExit& exit);
@@ -134,6 +136,7 @@ class CubeWalk {
   void start_texel_on_face();   // entry texel and first crossings of the face segment
   double crossing(int axis, int boundary) const;  // l where the ray crosses a boundary plane
   double raw_crossing(int axis, int boundary) const;  // the same, not clamped to l_ (INF: never)
+  double denominator(int axis, int boundary) const;   // of raw_crossing: its sign says if the ray gets there
   struct AxisRun;
   bool axis_run(int axis, int lo, int hi, AxisRun* run) const;
   int crossed_before(int axis, const AxisRun& run, double l) const;

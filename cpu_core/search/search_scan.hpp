@@ -112,12 +112,13 @@ inline bool skip_node(const SearchContext& ctx, CubeWalk& walk, const WalkTexel&
     const double zmin2 = static_cast<double>(z.x) * z.x, zmax2 = static_cast<double>(z.y) * z.y;
     if (!empty && zmin2 <= at_l0 && at_l0 <= zmax2) continue;
     const int size = SearchContext::BOUNDS_BLOCK << k;
-    CubeWalk::SquareExit exit;
-    if (!walk.square_exit(t.i / size * size, t.j / size * size, size, &exit)) continue;
-    if (!empty) {
-      const glm::dvec2 range2 = distances2.widened(t.l0, exit.l_end);
+    const int i0 = t.i / size * size, j0 = t.j / size * size;
+    if (!empty) {  // the range up to square_exit's l_end, before its proof
+      const glm::dvec2 range2 = distances2.widened(t.l0, walk.square_end(i0, j0, size));
       if (!(zmax2 < range2.x || zmin2 > range2.y)) continue;
     }
+    CubeWalk::SquareExit exit;
+    if (!walk.square_exit(i0, j0, size, &exit)) continue;
     walk.jump(exit);
     *level = k;
     return true;

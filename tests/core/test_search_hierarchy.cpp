@@ -119,6 +119,7 @@ void check_jumps(const WalkRay& r, int n, std::mt19937_64& rng, WalkTotals* tota
     if (coin(rng) != 0) {
       if (walk.square_exit(i0, j0, size, &e)) {
         ++totals->jumps;
+        ASSERT_EQ(walk.square_end(i0, j0, size), e.l_end) << describe(r, n);
         const auto in_square = [&](const WalkTexel& t) {
           return t.face == pend.face && t.i >= i0 && t.i < i0 + size && t.j >= j0 && t.j < j0 + size;
         };
