@@ -12,11 +12,14 @@ the hierarchy changes no answer. Then, when --bench-search is given, runs bench_
 Writes a markdown report (tables, commands, machine, load) to --out.
 
 Usage: hier_search.py --before OLD/abcube --after build/abcube [--bench-search build/bench/bench_search]
-                      [--scenes A.json,B.json@320x320] [--sizes 128,256,512,1024,2048] [--repeat 3]
+                      [--scenes A.json,B.json@320x320] [--race room,outdoor] [--race-seed 1]
+                      [--sizes 128,256,512,1024,2048] [--repeat 3]
                       [--threads 2] [--rays 3000] [--runs 5] [--out bench/results/hier_search.md]
                       [--lock /tmp/abcube.build.lock]
 A scene written SCENE@WxH is rendered at that size (a copy of its JSON with the camera's
 width and height changed, written next to the run's other files: scenes without mesh files).
+--race adds bench/race_scenes.py's seeded scenes (room: the 320x320 room of chrome and glass
+spheres at max_depth 4 of issue 14; outdoor: terrain under a sky).
 Python 3 standard library only.
 """
 import argparse
@@ -97,6 +100,9 @@ def main():
     ap.add_argument("--bench-search", default="", help="bench_search of AFTER (optional)")
     ap.add_argument("--scenes", default="scenes/bench/spheres_terrain.json,scenes/cornell.json@320x320,"
                     "scenes/default.json")
+    ap.add_argument("--race", default="room,outdoor",
+                    help="also bench/race_scenes.py's templates (seeded; empty: none)")
+    ap.add_argument("--race-seed", type=int, default=1)
     ap.add_argument("--sizes", default="128,256,512,1024,2048")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--threads", type=int, default=2)
@@ -115,7 +121,12 @@ def main():
              "Machine: %s, %d cores (shared with other work: timings are noisy), %s; load average at start %.2f"
              % (platform.node(), os.cpu_count(), platform.platform(), load_start[0]), ""]
     tables = []
-    for spec in a.scenes.split(","):
+    specs = [s for s in a.scenes.split(",") if s]
+    if a.race:
+        p, _ = run([sys.executable, os.path.join(os.path.dirname(os.path.abspath(__file__)), "race_scenes.py"),
+                    "--out", work, "--seed", str(a.race_seed), "--templates", a.race])
+        specs += p.stdout.split()
+    for spec in specs:
         scene, label = scene_file(spec, work)
         ref = os.path.join(work, "ref.exr")
         run([a.after, "render", scene, "-o", ref, "--method", "raytrace", "--threads", str(a.threads), "--gl", "none"])
@@ -155,7 +166,7 @@ def main():
               "images: `abcube compare --exact` of every pair of runs." % a.repeat, ""] + tables
     if a.bench_search:
         outs = []
-        for spec in a.scenes.split(","):  # one scene a run: the lock is held a few minutes at most
+        for spec in specs:  # one scene a run: the lock is held a few minutes at most
             p, _ = run([a.bench_search, scene_file(spec, work)[0], "--sizes", a.sizes, "--modes", "crossing",
                         "--rays", str(a.rays), "--runs", str(a.runs)])
             outs.append(p.stdout.rstrip() if not outs else p.stdout.rstrip().split("\n", 2)[2])
