@@ -93,6 +93,29 @@ def fmt_psnr(v):
     return "-" if v is None else ("inf" if v == "inf" or v == float("inf") else "%.2f" % float(v))
 
 
+def search_summary(bench_output):
+    """bench_search's rows -> a markdown table: per scene, N and kind, visits, fragments and
+    ns per ray with the hierarchy off and on."""
+    rows = {}
+    for line in bench_output.splitlines():
+        f = line.split()
+        if len(f) < 20 or line.startswith("#") or f[0] == "scene":
+            continue
+        scene, n, kind, hier = f[0], int(f[1]), f[3], f[4]
+        rows.setdefault((scene, n, kind), {})[hier] = {"visits": float(f[11]), "frags": float(f[13]),
+                                                       "ns": float(f[15]), "ns_min": float(f[16])}
+    out = ["| scene | N | kind | visits/ray off | on | x | fragments tested/ray (both) | ns/ray off [min] | "
+           "on [min] | x |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for (scene, n, kind), r in rows.items():
+        if "off" not in r or "on" not in r:
+            continue
+        a, b = r["off"], r["on"]
+        out.append("| %s | %d | %s | %.1f | %.1f | %.1f | %.1f | %.0f [%.0f] | %.0f [%.0f] | %.2f |" % (
+            os.path.basename(scene), n, kind, a["visits"], b["visits"], a["visits"] / b["visits"], b["frags"],
+            a["ns"], a["ns_min"], b["ns"], b["ns_min"], a["ns"] / b["ns"]))
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--before", required=True, help="abcube without the hierarchical skip")
@@ -173,7 +196,8 @@ def main():
             print(outs[-1], flush=True)
         out = "\n".join(outs).replace(work + "/", "")  # the resized copies by their names
         lines += ["## Search rays alone (`bench_search`, one thread, hierarchy off = the plain walk)", "",
-                  "```", out, "```", ""]
+                  "Median of %d runs over the same %d rays per scene and kind; x = off / on." % (a.runs, a.rays), ""]
+        lines += search_summary(out) + ["", "bench_search's output:", "", "```", out, "```", ""]
     lines += ["Load average at end: %.2f" % os.getloadavg()[0], ""]
     with open(a.out, "w") as f:
         f.write("\n".join(lines))
