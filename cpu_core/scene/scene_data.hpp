@@ -43,6 +43,9 @@ struct Material {
   double transmit = 0.0;  // kt, refractive weight
   double ior = 1.0;
   double opacity = 1.0;   // coverage transparency, blended by the A-buffer resolve
+  // Base colour texture: the image file, resolved (empty: none). The diffuse colour at a
+  // point is color times the texture at the point's uv (TriangleSoup::uvs).
+  std::string texture;
 };
 
 struct SceneObject {
@@ -57,9 +60,12 @@ struct SceneObject {
 // Every object's triangles, unindexed, world space. Triangle i owns entries 3i..3i+2
 // of positions and normals; normals are unit (flat ones repeated when the surface has
 // no smooth normals). The winding gives the geometric normal cross(b-a, c-a).
+// `uvs` is empty when no object has texture coordinates; otherwise it runs beside
+// positions (3 per triangle), (0, 0) on triangles that have none.
 struct TriangleSoup {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;
+  std::vector<glm::vec2> uvs;
   std::vector<uint32_t> object_id;    // per triangle, index into SceneData::objects
   std::vector<uint32_t> material_id;  // per triangle, index into SceneData::materials
   size_t triangle_count() const { return object_id.size(); }

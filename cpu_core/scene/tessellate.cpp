@@ -321,9 +321,13 @@ size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t obj
     const size_t room = std::max(need + need / 2, 2 * soup->object_id.size());  // untouched room costs no memory
     soup->positions.reserve(3 * room);
     soup->normals.reserve(3 * room);
+    if (!local.uvs.empty() || !soup->uvs.empty()) soup->uvs.reserve(3 * room);
     soup->object_id.reserve(room);
     soup->material_id.reserve(room);
   }
+  // The first object with texture coordinates gives the objects before it (0, 0).
+  if (!local.uvs.empty() && soup->uvs.empty()) soup->uvs.assign(soup->positions.size(), glm::vec2(0.0f));
+  const bool store_uvs = !soup->uvs.empty();
   size_t dropped = 0;
   for (size_t t = 0; t < local.triangle_count(); ++t) {
     glm::vec3 f[3];
@@ -352,6 +356,7 @@ size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t obj
     for (int k = 0; k < 3; ++k) {
       soup->positions.push_back(f[k]);
       soup->normals.push_back(glm::vec3(n[k]));
+      if (store_uvs) soup->uvs.push_back(glm::vec2(local.uv(3 * t + static_cast<size_t>(order[k]))));
     }
     soup->object_id.push_back(object_id);
     soup->material_id.push_back(mat < 0 ? material : static_cast<uint32_t>(mat));
@@ -429,6 +434,7 @@ void flip_winding(TriangleSoup* soup, size_t first, size_t count) {
   for (size_t t = first; t < first + count; ++t) {
     std::swap(soup->positions[3 * t + 1], soup->positions[3 * t + 2]);
     std::swap(soup->normals[3 * t + 1], soup->normals[3 * t + 2]);
+    if (!soup->uvs.empty()) std::swap(soup->uvs[3 * t + 1], soup->uvs[3 * t + 2]);
     const glm::vec3 a = soup->positions[3 * t];
     const glm::vec3 g = glm::cross(soup->positions[3 * t + 1] - a, soup->positions[3 * t + 2] - a);
     for (int k = 0; k < 3; ++k) {

@@ -19,18 +19,28 @@ namespace abcube {
 // or holds one entry per triangle, -1 meaning the object's own material.
 // Indexed (OBJ files, whose corners share vertices): when `indexed`, corner c is positions[position_index[c]] with normal normals[normal_index[c]] (a zero
 // normal for NO_NORMAL), so a shared vertex is held once.
+// Texture coordinates: `uvs` is empty (none) or, like normals, one per corner, or indexed
+// by `uv_index` (NO_UV: that corner has none, (0, 0)). u runs right and v up the image,
+// as in OBJ's vt; a loader whose format runs v down (glTF) stores 1 - v.
 struct LocalMesh {
   std::vector<glm::dvec3> positions;
   std::vector<glm::dvec3> normals;
+  std::vector<glm::dvec2> uvs;
   std::vector<int> material;
   static constexpr uint32_t NO_NORMAL = 0xffffffffu;
+  static constexpr uint32_t NO_UV = 0xffffffffu;
   bool indexed = false;
-  std::vector<uint32_t> position_index, normal_index;
+  std::vector<uint32_t> position_index, normal_index, uv_index;
   size_t triangle_count() const { return (indexed ? position_index.size() : positions.size()) / 3; }
   const glm::dvec3& position(size_t corner) const { return positions[indexed ? position_index[corner] : corner]; }
   glm::dvec3 normal(size_t corner) const {
     if (!indexed) return normals[corner];
     return normal_index[corner] == NO_NORMAL ? glm::dvec3(0.0) : normals[normal_index[corner]];
+  }
+  glm::dvec2 uv(size_t corner) const {
+    if (uvs.empty()) return glm::dvec2(0.0);
+    if (!indexed) return uvs[corner];
+    return uv_index[corner] == NO_UV ? glm::dvec2(0.0) : uvs[uv_index[corner]];
   }
 };
 
