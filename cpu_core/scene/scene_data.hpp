@@ -43,8 +43,9 @@ struct Material {
   double transmit = 0.0;  // kt, refractive weight
   double ior = 1.0;
   double opacity = 1.0;   // coverage transparency, blended by the A-buffer resolve
-  // Base colour texture: the image file, resolved (empty: none). The diffuse colour at a
-  // point is color times the texture at the point's uv (TriangleSoup::uvs).
+  // Base colour texture: the image file, resolved (empty: none), or "#embedded/I" for
+  // SceneData::embedded_images[I]. The diffuse colour at a point is color times the
+  // texture at the point's uv (TriangleSoup::uvs).
   std::string texture;
 };
 
@@ -89,6 +90,14 @@ class SharedTriangles {
   std::shared_ptr<TriangleSoup> soup_;
 };
 
+// An image carried inside a scene's own files (a glTF data: URI or a .glb buffer view),
+// still encoded (PNG, JPEG, ...). The bytes are shared between copies of a SceneData.
+struct EmbeddedImage {
+  std::string name;       // for messages: "box.glb: images[0]"
+  std::string mime_type;  // as the file declares it, may be empty
+  std::shared_ptr<const std::vector<unsigned char>> bytes;
+};
+
 struct RenderSettings {
   Method method = Method::abuffer;
   int cube_resolution = 512;
@@ -106,6 +115,7 @@ struct SceneData {
   std::vector<Material> materials;
   std::vector<SceneObject> objects;
   SharedTriangles triangles;
+  std::vector<EmbeddedImage> embedded_images;  // named by Material::texture "#embedded/I"
   RenderSettings render;
   size_t dropped_triangles = 0;  // zero-area or non-finite triangles dropped at load
   // What loaded but is likely a mistake, one line each naming the place:
