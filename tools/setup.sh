@@ -2,6 +2,8 @@
 # Installs the Debian packages abcube needs (idempotent; skips what is present).
 # GL headers come from glad (generated at configure time); libEGL and libOSMesa are
 # opened at run time, so only their run-time packages are needed.
+# clang-14, its sanitizer run-times, libFuzzer and llvm-symbolizer (llvm-14) build and run
+# the fuzz harnesses (tools/fuzz.sh); assimp-testmodels' OBJ and MTL files seed them.
 # Run as root, or with sudo available. Safe to run many times.
 set -euo pipefail
 
@@ -13,6 +15,7 @@ PACKAGES=(
   nlohmann-json3-dev libtinyobjloader-dev libembree-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev
   python3-dev pybind11-dev python3-numpy python3-pytest python3-distributed
+  clang-14 libclang-rt-14-dev libfuzzer-14-dev llvm-14 assimp-testmodels
   povray
 )
 

@@ -1,0 +1,46 @@
+// A main for the fuzz harnesses in the ordinary build (no libFuzzer): runs
+// LLVMFuzzerTestOneInput once on each file named, or on each file of each folder named
+// (sorted), and prints how many ran. The ctest tests fuzz.replay.* run it on the seeds
+// and on every input that once crashed (tests/fuzz/regressions/), so that a fixed crash
+// stays fixed. A failed check aborts (fuzz_checks.hpp); no input at all is an error too.
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
+
+int main(int argc, char** argv) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> files;
+  for (int i = 1; i < argc; ++i) {
+    const fs::path p(argv[i]);
+    if (fs::is_directory(p)) {
+      for (const auto& e : fs::recursive_directory_iterator(p)) {
+        if (e.is_regular_file()) files.push_back(e.path());
+      }
+    } else if (fs::is_regular_file(p)) {
+      files.push_back(p);
+    } else {
+      std::fprintf(stderr, "fuzz_replay: %s: no such file or folder\n", argv[i]);
+      return 2;
+    }
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) {
+    std::fprintf(stderr, "fuzz_replay: no input files\n");
+    return 2;
+  }
+  for (const fs::path& f : files) {
+    std::ifstream in(f, std::ios::binary);
+    const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::fprintf(stderr, "%s\n", f.string().c_str());
+    LLVMFuzzerTestOneInput(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
+  }
+  std::printf("fuzz_replay: %zu inputs, every check passed\n", files.size());
+  return 0;
+}

@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# Runs the libFuzzer harnesses of tests/fuzz (README "Robustness") for SECONDS each
+# (default 60), one after the other, each on one core.
+#   tools/fuzz.sh [SECONDS] [HARNESS...]     HARNESS: scene_json obj batch_jobs (default all)
+# Builds build-fuzz with clang-14 (address and undefined-behaviour checks, ABCUBE_FUZZ=ON),
+# seeds each harness with its committed seeds (tests/fuzz/corpus), the inputs that once
+# crashed (tests/fuzz/regressions), the repository's scenes and meshes and, when installed,
+# the OBJ/MTL files of assimp-testmodels. What a run finds new is kept in
+# build-fuzz/corpus/HARNESS and seeds the next run. A crash, a leak, a failed check or an
+# input slower than 10 s: exit 1, the input saved as build-fuzz/artifacts/HARNESS/crash-*
+# (copy it into tests/fuzz/regressions/HARNESS/ with the fix, README "Robustness").
+# For hours: tools/fuzz.sh 14400 obj (or run build-fuzz/tests/fuzz/fuzz_obj with -jobs=N -workers=N).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SECONDS_EACH=${1:-60}
+shift || true
+HARNESSES=("$@")
+[[ ${#HARNESSES[@]} -gt 0 ]] || HARNESSES=(scene_json obj batch_jobs)
+BUILD=${ABCUBE_FUZZ_BUILD:-build-fuzz}
+
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$PWD}
+if [[ ! -f $BUILD/build.ninja ]]; then
+  CC=clang-14 CXX=clang++-14 cmake -S . -B "$BUILD" -G Ninja -DABCUBE_FUZZ=ON -DABCUBE_BUILD_TESTS=OFF \
+    -DABCUBE_BUILD_BENCH=OFF > "$BUILD.configure.log" 2>&1 || { cat "$BUILD.configure.log"; exit 1; }
+fi
+cmake --build "$BUILD" --target "${HARNESSES[@]/#/fuzz_}"
+
+# One OBJ as the obj harness's input: the file, and after a line "#MTL" the MTL file its
+# first mtllib names (renamed in.mtl, the name the harness writes it under).
+obj_seed() {
+  local obj=$1 out=$2 mtl
+  mtl=$(sed -n 's/^mtllib[[:space:]]\{1,\}\([^[:space:]]*\).*$/\1/p' "$obj" | head -1)
+  if [[ -n $mtl && -f $(dirname "$obj")/$mtl ]]; then
+    { sed 's/^mtllib[[:space:]].*$/mtllib in.mtl/' "$obj"; printf '\n#MTL\n'; cat "$(dirname "$obj")/$mtl"; } > "$out"
+  else
+    cp "$obj" "$out"
+  fi
+}
+
+seeds() {  # HARNESS FOLDER: fills FOLDER with the inputs gathered from installed files
+  local name=$1 dir=$2 f
+  rm -rf "$dir"
+  mkdir -p "$dir"
+  case $name in
+    scene_json)
+      for f in scenes/*.json scenes/bench/*.json tests/golden/*.json tests/hard/regressions/*.json; do
+        cp "$f" "$dir/${f//\//_}"
+      done ;;
+    obj)
+      for f in scenes/*/*.obj /usr/share/assimp/models/OBJ/*.obj /usr/share/assimp/models/invalid/*.obj; do
+        if [[ -f $f ]]; then obj_seed "$f" "$dir/${f//\//_}"; fi
+      done ;;
+    batch_jobs) ;;
+  esac
+}
+
+export ASAN_OPTIONS=${ASAN_OPTIONS:-abort_on_error=1:detect_leaks=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+status=0
+summary=()
+for name in "${HARNESSES[@]}"; do
+  corpus=$BUILD/corpus/$name
+  artifacts=$BUILD/artifacts/$name
+  mkdir -p "$corpus" "$artifacts"
+  seeds "$name" "$BUILD/seeds/$name"
+  inputs=("$corpus" tests/fuzz/corpus/$name "$BUILD/seeds/$name")
+  [[ -d tests/fuzz/regressions/$name ]] && inputs+=(tests/fuzz/regressions/$name)
+  log=$BUILD/fuzz_$name.log
+  echo "fuzz: $name for ${SECONDS_EACH} s (log $log)"
+  rc=0
+  "$BUILD/tests/fuzz/fuzz_$name" -max_total_time="$SECONDS_EACH" -rss_limit_mb=2048 -timeout=10 -max_len=65536 \
+    -print_final_stats=1 -artifact_prefix="$artifacts/" "${inputs[@]}" > "$log" 2>&1 || rc=$?
+  runs=$(sed -n 's/^stat::number_of_executed_units:[[:space:]]*//p' "$log" | tail -1)
+  corpus_size=$(find "$corpus" -type f | wc -l)
+  if [[ $rc -ne 0 ]]; then
+    status=1
+    tail -n 60 "$log"
+    echo "fuzz: $name FAILED (exit $rc); input: $(ls -t "$artifacts" | head -1 | sed "s|^|$artifacts/|")"
+    summary+=("$name: FAILED after ${runs:-?} inputs")
+  else
+    summary+=("$name: ${runs:-?} inputs in ${SECONDS_EACH} s, no failure; corpus $corpus_size files")
+  fi
+done
+printf 'fuzz: %s\n' "${summary[@]}"
+exit $status
