@@ -275,11 +275,13 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   if (!material && per_face_materials) {
     obj.material = obj.triangle_count > 0 ? soup.material_id[obj.first_triangle] : default_material(st);
   }
-  if (type == "mesh" && obj.triangle_count == 0) {
-    // Loads and renders (nothing), but an empty export or a wrong file is the likely cause.
-    const std::string file = quote_path(read_string(st.src, f.need("file"), f.at("file")));
+  if (obj.triangle_count == 0) {
+    // Loads and renders (nothing), but an empty export, a wrong file or a mistyped vertex
+    // is the likely cause.
+    const bool mesh = type == "mesh";
+    const std::string what = mesh ? "mesh " + quote_path(read_string(st.src, f.need("file"), f.at("file"))) : type;
     st.scene.warnings.push_back(one_line(
-        st.src.name + ": " + f.at("file") + ": warning: mesh " + file + " has no triangles" +
+        st.src.name + ": " + (mesh ? f.at("file") : path) + ": warning: " + what + " has no triangles" +
         (faces > 0 ? " of nonzero area (" + std::to_string(faces) + " dropped)" : "")));
   }
   // A closed surface has an inside; make its geometric normals point out of it.

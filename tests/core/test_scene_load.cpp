@@ -840,6 +840,18 @@ TEST(SceneLoadMesh, MeshWithoutTrianglesLoadsWithAWarning) {
   EXPECT_TRUE(load_text(SceneText().str()).warnings.empty());
 }
 
+// So does a primitive whose triangles all have zero area (found by tests/fuzz: it loaded
+// with nothing to draw and no word).
+TEST(SceneLoadMesh, FlatPrimitiveLoadsWithAWarning) {
+  const SceneData s = load_text(with_objects(R"([{"type": "sphere", "center": [0, 0, 0], "radius": 1},
+      {"type": "quad", "vertices": [[0, 0, 0], [1, 0, 0], [1, 0, 0], [0, 0, 0]]}])").str());
+  ASSERT_EQ(s.objects.size(), 2u);
+  EXPECT_EQ(s.objects[1].triangle_count, 0u);
+  const std::vector<std::string> expected = {
+      "scene.json: objects[1]: warning: quad has no triangles of nonzero area (2 dropped)"};
+  EXPECT_EQ(s.warnings, expected);
+}
+
 // ---- Tessellation helpers --------------------------------------------------------------
 
 TEST(Tessellate, ClosedSurfaceNeedsConsistentOrientation) {
