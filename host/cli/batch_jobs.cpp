@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <array>
+#include <climits>
+#include <cstdint>
 #include <filesystem>
 #include <utility>
 
@@ -41,7 +43,7 @@ class JobReader {
     json j;
     try {
       j = json::parse(text);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {  // a syntax error, or a number past a double's range (out_of_range)
       fail(line, "not JSON: " + printable(e.what(), 240));
     }
     if (!j.is_object()) fail(line, "a job must be a JSON object");
@@ -64,7 +66,9 @@ class JobReader {
   }
 
   int integer(const json& v, size_t line, const std::string& key) const {
-    if (!v.is_number_integer()) fail(line, "\"" + key + "\": must be an integer");
+    const bool fits = v.is_number_unsigned() ? v.get<uint64_t>() <= uint64_t{INT_MAX}
+                      : v.is_number_integer() && v.get<int64_t>() >= INT_MIN && v.get<int64_t>() <= INT_MAX;
+    if (!fits) fail(line, "\"" + key + "\": must be an integer (32 bits)");
     return v.get<int>();
   }
 

@@ -56,6 +56,14 @@ check "malformed: one line" [ "$(wc -l < err)" -eq 1 ]
 printf '{"scene": "cornell.json", "out": "m/1.png"}\nnot json\n' > bad2.jsonl
 "$ABCUBE" batch bad2.jsonl 2> err; status=$?
 check "not JSON: exit 2 naming line 2" [ $status -eq 2 ] && grep -q "bad2.jsonl:2: not JSON" err
+# Numbers past a double (found by tests/fuzz: exit 1 with nlohmann's message, no line) and
+# integers past 32 bits (used to wrap: 4294967808 rendered at 512) are malformed lines.
+printf '{"scene": "cornell.json", "out": "m/1.png", "cube_res": 1e999}\n' > big1.jsonl
+"$ABCUBE" batch big1.jsonl 2> err; status=$?
+check "number overflow: exit 2 naming line 1" [ $status -eq 2 ] && grep -q "big1.jsonl:1: not JSON" err
+printf '{"scene": "cornell.json", "out": "m/1.png", "cube_res": 4294967808}\n' > big2.jsonl
+"$ABCUBE" batch big2.jsonl 2> err; status=$?
+check "integer past 32 bits: exit 2 naming line 1" [ $status -eq 2 ] && grep -q 'big2.jsonl:1: "cube_res": must be an integer' err
 printf '{"out": "m/1.png"}\n' > bad3.jsonl
 "$ABCUBE" batch bad3.jsonl 2> err
 check "missing scene key named" grep -q 'bad3.jsonl:1: "scene": required' err
