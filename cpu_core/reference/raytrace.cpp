@@ -217,11 +217,12 @@ glm::dvec3 RayTracer::shade(const Hit& hit, const Hit& far, const glm::dvec3& di
   // Local Phong term with shadows (shading.hpp; thesis ch. 6).
   const glm::dvec3 v = -dir;
   const glm::dvec3 n = face_forward(hit.shading_normal, v);
-  glm::dvec3 c = phong_ambient(m, scene_->ambient);
+  const glm::dvec3 od = diffuse_color(*scene_, hit.triangle, hit.barycentric);
+  glm::dvec3 c = phong_ambient(m, scene_->ambient, od);
   for (const PointLight& light : scene_->lights) {
     const glm::dvec3 to_light = light.position - hit.point;
     if (to_light == glm::dvec3(0.0)) continue;  // a light on the surface has no direction
-    const glm::dvec3 lit = phong_light(m, n, v, glm::normalize(to_light), light.color);
+    const glm::dvec3 lit = phong_light(m, n, v, glm::normalize(to_light), light.color, od);
     if (lit == glm::dvec3(0.0)) continue;
     c += lit * light_visibility(hit, light, counts);
   }

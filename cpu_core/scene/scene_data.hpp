@@ -11,6 +11,8 @@
 
 namespace abcube {
 
+class TextureSet;  // scene/texture.hpp
+
 enum class Method { abuffer, zbuffer, envmap, raytrace, gpu };
 const char* method_name(Method m);
 // Parses a method name; returns false for an unknown one.
@@ -116,6 +118,9 @@ struct SceneData {
   std::vector<SceneObject> objects;
   SharedTriangles triangles;
   std::vector<EmbeddedImage> embedded_images;  // named by Material::texture "#embedded/I"
+  // The materials' textures, decoded when the scene loaded (scene/texture.hpp); null when
+  // no material has one. Shared between copies.
+  std::shared_ptr<const TextureSet> textures;
   RenderSettings render;
   size_t dropped_triangles = 0;  // zero-area or non-finite triangles dropped at load
   // What loaded but is likely a mistake, one line each naming the place:

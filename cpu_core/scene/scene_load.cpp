@@ -218,6 +218,21 @@ LocalMesh read_geometry(LoadState& st, const Fields& f, const std::string& type,
   return read_obj(st, f, !has_material);
 }
 
+// Whether an object of material `material` (or per-triangle `per_face` ones, -1 for its
+// own) samples a texture anywhere.
+bool uses_texture(const SceneData& scene, uint32_t material, const std::vector<int>& per_face) {
+  const auto textured = [&](uint32_t m) { return m < scene.materials.size() && !scene.materials[m].texture.empty(); };
+  if (per_face.empty()) return textured(material);
+  std::vector<bool> seen(scene.materials.size() + 1, false);
+  for (const int m : per_face) {
+    const uint32_t id = m < 0 ? material : static_cast<uint32_t>(m);
+    if (id < seen.size() && seen[id]) continue;
+    if (textured(id)) return true;
+    if (id < seen.size()) seen[id] = true;
+  }
+  return false;
+}
+
 void read_object(LoadState& st, const Json& v, size_t index) {
   const std::string path = index_path("objects", index);
   if (!v.is_object()) fail(st.src, path, "must be an object, got " + describe(v));
@@ -257,6 +272,12 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   LocalMesh local = read_geometry(st, f, type, material != nullptr);
   // Without a "material", a primitive gets the default and a mesh its per-face MTL ones.
   if (!material && local.material.empty()) obj.material = default_material(st);
+  // Texture coordinates are kept only where a texture is sampled: untextured scenes keep
+  // the soup without them (memory, and the GL vertex buffer).
+  if (!uses_texture(st.scene, obj.material, local.material)) {
+    local.uvs = {};
+    local.uv_index = {};
+  }
   if (st.scene.triangles->triangle_count() + local.triangle_count() > MAX_TRIANGLES) {
     fail(st.src, path, "the scene would exceed " + std::to_string(MAX_TRIANGLES) + " triangles");
   }
@@ -298,8 +319,13 @@ void read_materials(LoadState& st, const Json& v) {
     const std::string path = member_path("materials", entry.key());
     if (entry.key().empty()) fail(st.src, path, "a material name must not be empty");
     const Fields f(st.src, entry.value(), path,
-                   {"color", "ambient", "diffuse", "specular", "shininess", "reflect", "transmit", "ior", "opacity"});
-    st.material_by_name[entry.key()] = add_material(st, read_material(f, entry.key()));
+                   {"color", "ambient", "diffuse", "specular", "shininess", "reflect", "transmit", "ior", "opacity",
+                    "texture"});
+    Material m = read_material(f, entry.key());
+    if (const Json* t = f.find("texture")) {
+      m.texture = texture_file(st, f.at("texture"), "", read_string(st.src, *t, f.at("texture")), st.src.base_dir);
+    }
+    st.material_by_name[entry.key()] = add_material(st, std::move(m));
   }
 }
 
@@ -330,13 +356,14 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
                                                {"type", "position", "color", "cast_shadows"})));
     }
   }
-  LoadState st{src, scene, limits, root, {}, {}, -1};
+  LoadState st{src, scene, limits, root, {}, {}, -1, {}};
   if (const Json* materials = top.find("materials")) read_materials(st, *materials);
   const Json& objects = read_array(src, top.need("objects"), "objects");
   for (size_t i = 0; i < objects.size(); ++i) read_object(st, objects[i], i);
   if (const Json* render = top.find("render")) {
     scene.render = read_render(Fields(src, *render, "render", {"method", "cube_resolution", "max_depth", "fresnel", "error_target"}));
   }
+  load_textures(st);
   return scene;
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 #include <cstdint>
 #include <map>
+#include <utility>
 #include <string>
 
 #include "scene/scene_data.hpp"
@@ -26,6 +27,9 @@ struct LoadState {
   std::map<std::string, uint32_t> material_by_name;
   std::map<std::string, uint32_t> mtl_materials;
   int default_material = -1;
+  // Each texture file a material names (resolved), with where it was named for messages:
+  // the field path and a prefix ("" or "\"a.mtl\":12: map_Kd ").
+  std::map<std::string, std::pair<std::string, std::string>> texture_place;
 };
 
 uint32_t add_material(LoadState& st, Material m);
@@ -44,6 +48,19 @@ bool inside_root(const std::string& root, const std::string& file);
 // Refuses `file` (as written at `path` of the scene) when it resolves outside the root.
 void check_inside_root(const LoadState& st, const std::string& path, const std::string& file,
                        const std::string& resolved);
+
+// A texture file named `file` at `path` of the scene (`where` prefixes the messages, see
+// LoadState::texture_place), relative to `base_dir`: refused (InputError) when it resolves
+// outside the root or is no readable regular file under MAX_TEXTURE_FILE_BYTES. Returns
+// the resolved path and remembers where it was named for load_textures.
+constexpr uint64_t MAX_TEXTURE_FILE_BYTES = uint64_t{256} << 20;  // 256 MiB
+std::string texture_file(LoadState& st, const std::string& path, const std::string& where, const std::string& file,
+                         const std::string& base_dir);
+
+// Decodes every texture the materials name (files and SceneData::embedded_images) into
+// SceneData::textures; an image that cannot be read or decoded is an InputError naming
+// where the scene named it and why.
+void load_textures(LoadState& st);
 
 // A mesh object's triangles from a Wavefront OBJ. With `use_mtl`, its MTL materials
 // become scene materials named "FILE:NAME", and faces without one get the default.

@@ -22,11 +22,34 @@ namespace abcube::detail {
 
 namespace {
 
+// The 1-based line of `key` (e.g. "map_Kd") in material `material` of the MTL file `file`,
+// or 0 when it cannot be found (for messages only).
+size_t mtl_line(const std::string& file, const std::string& material, const std::string& key) {
+  std::ifstream in(file);
+  bool inside = false;
+  size_t number = 0;
+  for (std::string line; std::getline(in, line);) {
+    ++number;
+    std::istringstream words(line);
+    std::string first, rest;
+    words >> first;
+    if (first == "newmtl") {
+      std::getline(words >> std::ws, rest);
+      while (!rest.empty() && (rest.back() == '\r' || rest.back() == ' ')) rest.pop_back();
+      inside = rest == material;
+    } else if (inside && first == key) {
+      return number;
+    }
+  }
+  return 0;
+}
+
 // The format's material from an MTL entry: Kd -> color, mean of Ks -> specular,
 // Ns -> shininess, d -> opacity, Ni -> ior (Ni below 1, which exporters write for
-// "unset", is taken as 1). `where` prefixes messages.
-Material convert_mtl(const LoadState& st, const std::string& path, const std::string& where,
-                     const tinyobj::material_t& in, const std::string& name) {
+// "unset", is taken as 1), map_Kd -> texture (relative to the MTL file `mtl_file`).
+// `where` prefixes messages.
+Material convert_mtl(LoadState& st, const std::string& path, const std::string& where,
+                     const tinyobj::material_t& in, const std::string& name, const std::string& mtl_file) {
   Material m;
   m.name = name;
   m.color = glm::dvec3(in.diffuse[0], in.diffuse[1], in.diffuse[2]);
@@ -45,18 +68,26 @@ Material convert_mtl(const LoadState& st, const std::string& path, const std::st
   if (!(m.shininess >= 0 && std::isfinite(m.shininess))) bad("Ns must be finite and >= 0", m.shininess);
   if (!(m.opacity >= 0 && m.opacity <= 1)) bad("d must be in [0, 1]", m.opacity);
   if (!std::isfinite(m.ior)) bad("Ni must be finite", m.ior);
+  if (!in.diffuse_texname.empty()) {
+    const size_t line = mtl_line(mtl_file, in.name, "map_Kd");
+    const std::string at = quote_path(mtl_file) + (line > 0 ? ":" + std::to_string(line) : "") + ": map_Kd ";
+    m.texture = texture_file(st, path, at, in.diffuse_texname, std::filesystem::path(mtl_file).parent_path().string());
+  }
   return m;
 }
 
 // Scene material index for each MTL material of an OBJ, made once per file.
 std::vector<uint32_t> mtl_material_ids(LoadState& st, const std::string& path, const std::string& file,
-                                       const std::string& resolved, const std::vector<tinyobj::material_t>& materials) {
+                                       const std::string& resolved, const std::vector<tinyobj::material_t>& materials,
+                                       const std::map<std::string, std::string>& mtl_file_of) {
   std::vector<uint32_t> ids;
   for (const tinyobj::material_t& mtl : materials) {
     const std::string key = resolved + '\n' + mtl.name;
     auto it = st.mtl_materials.find(key);
     if (it == st.mtl_materials.end()) {
-      const uint32_t id = add_material(st, convert_mtl(st, path, resolved, mtl, file + ":" + mtl.name));
+      const auto from = mtl_file_of.find(mtl.name);
+      const std::string mtl_file = from == mtl_file_of.end() ? resolved : from->second;
+      const uint32_t id = add_material(st, convert_mtl(st, path, resolved, mtl, file + ":" + mtl.name, mtl_file));
       it = st.mtl_materials.emplace(key, id).first;
     }
     ids.push_back(it->second);
@@ -88,8 +119,8 @@ std::string missing_material_message(const std::string& line) {
   return m.empty() ? printable(line) : m;
 }
 
-// Appends one OBJ face (already validated) to `out` (indexed, positions and normals
-// already copied from the file's), triangulating polygons.
+// Appends one OBJ face (already validated) to `out` (indexed, positions, normals and
+// texture coordinates already copied from the file's), triangulating polygons.
 void add_obj_face(const tinyobj::index_t* corners, size_t n, int material, LocalMesh* out) {
   std::vector<glm::dvec3> p(n);
   bool smooth = true;
@@ -102,6 +133,9 @@ void add_obj_face(const tinyobj::index_t* corners, size_t n, int material, Local
       const tinyobj::index_t& c = corners[static_cast<size_t>(k)];
       out->position_index.push_back(static_cast<uint32_t>(c.vertex_index));
       out->normal_index.push_back(smooth ? static_cast<uint32_t>(c.normal_index) : LocalMesh::NO_NORMAL);  // flat
+      if (!out->uvs.empty()) {
+        out->uv_index.push_back(c.texcoord_index >= 0 ? static_cast<uint32_t>(c.texcoord_index) : LocalMesh::NO_UV);
+      }
     }
     out->material.push_back(material);
   }
@@ -135,6 +169,7 @@ class ConfinedMaterialReader final : public tinyobj::MaterialReader {
         return false;
       }
     }
+    std::string opened;
     for (const std::string& t : tried) {
       std::error_code ec;
       if (!std::filesystem::exists(t, ec)) continue;  // MaterialFileReader tries the next
@@ -143,12 +178,17 @@ class ConfinedMaterialReader final : public tinyobj::MaterialReader {
         if (unreadable.first.empty()) unreadable = {name, problem};
         return false;
       }
+      opened = t;
       break;  // the one MaterialFileReader opens
     }
-    return files_(name, materials, by_name, warn, err);
+    const size_t before = materials->size();
+    const bool ok = files_(name, materials, by_name, warn, err);
+    for (size_t i = before; i < materials->size(); ++i) file_of.emplace((*materials)[i].name, opened);
+    return ok;
   }
   std::string escaped;
   std::pair<std::string, std::string> unreadable;  // the name as written, and why
+  std::map<std::string, std::string> file_of;      // each material's MTL file (its map_Kd is relative to it)
 
  private:
   tinyobj::MaterialFileReader files_;
@@ -161,6 +201,7 @@ struct ObjFile {
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
+  std::map<std::string, std::string> mtl_file_of;  // material name -> the MTL file it came from
   std::string warning, error;
 };
 
@@ -183,6 +224,7 @@ ObjFile parse_obj(const LoadState& st, const std::string& path, const std::strin
     fail(st.src, path, "mtllib " + quote_path(mtl.unreadable.first) + " of mesh " + quote_path(resolved) + ": " +
                            mtl.unreadable.second);
   }
+  obj.mtl_file_of = std::move(mtl.file_of);
   if (!ok) fail(st.src, path, "cannot parse mesh " + quote_path(resolved) + ": " + printable(find_line(obj.error, ""), 160));
   return obj;
 }
@@ -249,10 +291,12 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
     const std::string missing = find_line(obj.warning, "not found");
     if (!missing.empty()) fail(st.src, path, "mesh " + quote_path(resolved) + ": " + missing_material_message(missing));
   }
-  const std::vector<uint32_t> mtl_ids = use_mtl ? mtl_material_ids(st, path, file, resolved, obj.materials) : std::vector<uint32_t>{};
+  const std::vector<uint32_t> mtl_ids = use_mtl ? mtl_material_ids(st, path, file, resolved, obj.materials, obj.mtl_file_of)
+                                                 : std::vector<uint32_t>{};
   const tinyobj::attrib_t& a = obj.attrib;
   const int vertex_count = static_cast<int>(a.vertices.size() / 3);
   const int normal_count = static_cast<int>(a.normals.size() / 3);
+  const int uv_count = static_cast<int>(a.texcoords.size() / 2);
   LocalMesh m;
   m.indexed = true;
   m.positions.reserve(static_cast<size_t>(vertex_count));
@@ -263,9 +307,17 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
   for (size_t v = 0; v < static_cast<size_t>(normal_count); ++v) {
     m.normals.emplace_back(a.normals[3 * v], a.normals[3 * v + 1], a.normals[3 * v + 2]);
   }
+  m.uvs.reserve(static_cast<size_t>(uv_count));
+  for (size_t v = 0; v < static_cast<size_t>(uv_count); ++v) {
+    m.uvs.emplace_back(a.texcoords[2 * v], a.texcoords[2 * v + 1]);
+    if (!std::isfinite(m.uvs.back().x) || !std::isfinite(m.uvs.back().y)) {
+      fail(st.src, path, "mesh " + quote_path(resolved) + ": vt " + std::to_string(v + 1) + " is not finite");
+    }
+  }
   const uint64_t triangles = obj_triangle_count(obj);
   m.position_index.reserve(3 * triangles);
   m.normal_index.reserve(3 * triangles);
+  if (uv_count > 0) m.uv_index.reserve(3 * triangles);
   m.material.reserve(triangles);
   for (const tinyobj::shape_t& shape : obj.shapes) {
     size_t offset = 0;
@@ -275,7 +327,7 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
       offset += n;
       for (size_t k = 0; k < n; ++k) {
         if (corners[k].vertex_index < 0 || corners[k].vertex_index >= vertex_count ||
-            corners[k].normal_index >= normal_count) {
+            corners[k].normal_index >= normal_count || corners[k].texcoord_index >= uv_count) {
           fail(st.src, path,
                "mesh " + quote_path(resolved) + ": face of shape " + quote(shape.name) + " has an index out of range");
         }

@@ -23,6 +23,16 @@ void push_triangle(LocalMesh* m, const glm::dvec3& a, const glm::dvec3& b, const
   m->positions.push_back(c);
 }
 
+void push_uvs(LocalMesh* m, const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
+  m->uvs.push_back(a);
+  m->uvs.push_back(b);
+  m->uvs.push_back(c);
+}
+
+// A quad's corners 0..3 span the texture's square counter-clockwise from (0, 0).
+constexpr double QUAD_UV[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+glm::dvec2 quad_uv(int corner) { return {QUAD_UV[corner][0], QUAD_UV[corner][1]}; }
+
 // Rounds to float, out of line: GCC 12 -O3 (SLP vectorizer) inlined into append_triangles
 // once kept the double x and y where they were rounded, converted back (the soup's
 // normals then differed from the positions' by an ulp; tests/golden caught it).
@@ -158,6 +168,7 @@ std::vector<uint32_t> first_equal(size_t n, Hash&& hash, Equal&& equal, Skip&& s
 LocalMesh tessellate_triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
   LocalMesh m;
   push_triangle(&m, a, b, c);
+  push_uvs(&m, {0, 0}, {1, 0}, {0, 1});
   return m;
 }
 
@@ -180,14 +191,18 @@ bool tessellate_quad(const std::array<glm::dvec3, 4>& v, LocalMesh* out) {
   auto agrees = [&](int a, int b, int c) {
     return glm::dot(glm::cross(v[b] - v[a], v[c] - v[a]), n) >= 0.0;
   };
+  const auto push = [&](int a, int b, int c) {
+    push_triangle(out, v[a], v[b], v[c]);
+    push_uvs(out, quad_uv(a), quad_uv(b), quad_uv(c));
+  };
   if (agrees(0, 1, 2) && agrees(0, 2, 3)) {
-    push_triangle(out, v[0], v[1], v[2]);
-    push_triangle(out, v[0], v[2], v[3]);
+    push(0, 1, 2);
+    push(0, 2, 3);
     return true;
   }
   if (agrees(1, 2, 3) && agrees(1, 3, 0)) {
-    push_triangle(out, v[1], v[2], v[3]);
-    push_triangle(out, v[1], v[3], v[0]);
+    push(1, 2, 3);
+    push(1, 3, 0);
     return true;
   }
   return false;
@@ -211,7 +226,9 @@ LocalMesh tessellate_box(const glm::dvec3& lo, const glm::dvec3& hi) {
     glm::dvec3 q[4];
     for (int i = 0; i < 4; ++i) q[i] = corner(f[i][0], f[i][1], f[i][2]);
     push_triangle(&m, q[0], q[1], q[2]);
+    push_uvs(&m, quad_uv(0), quad_uv(1), quad_uv(2));
     push_triangle(&m, q[0], q[2], q[3]);
+    push_uvs(&m, quad_uv(0), quad_uv(2), quad_uv(3));
   }
   return m;
 }
@@ -228,10 +245,14 @@ LocalMesh tessellate_sphere(const glm::dvec3& center, double radius, int segment
   LocalMesh m;
   m.positions.reserve(3 * sphere_triangle_count(segments));
   m.normals.reserve(3 * sphere_triangle_count(segments));
+  m.uvs.reserve(3 * sphere_triangle_count(segments));
+  // Latitude-longitude uvs: u = j / segments around from +x towards +z (1 on the seam's
+  // far side), v = 1 at the +y pole down to 0 at the -y pole.
   auto corner = [&](int k, int j) {
     const glm::dvec3 d = sphere_direction(k, j, rings, segments);
     m.positions.push_back(center + radius * d);
     m.normals.push_back(d);
+    m.uvs.emplace_back(static_cast<double>(j) / segments, 1.0 - static_cast<double>(k) / rings);
   };
   // Around +x on the equator, j grows towards +z and k towards -y, so (k,j), (k,j+1),
   // (k+1,j) winds counter-clockwise seen from outside.
@@ -326,8 +347,9 @@ size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t obj
     soup->material_id.reserve(room);
   }
   // The first object with texture coordinates gives the objects before it (0, 0).
-  if (!local.uvs.empty() && soup->uvs.empty()) soup->uvs.assign(soup->positions.size(), glm::vec2(0.0f));
-  const bool store_uvs = !soup->uvs.empty();
+  // (Tested on the soup's size, not its emptiness: the first object of all has no objects before it.)
+  const bool store_uvs = !local.uvs.empty() || !soup->uvs.empty();
+  if (store_uvs && soup->uvs.size() < soup->positions.size()) soup->uvs.resize(soup->positions.size(), glm::vec2(0.0f));
   size_t dropped = 0;
   for (size_t t = 0; t < local.triangle_count(); ++t) {
     glm::vec3 f[3];

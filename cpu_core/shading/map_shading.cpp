@@ -57,11 +57,9 @@ SurfacePoint surface_point(const SceneData& scene, uint32_t triangle, const glm:
   const glm::dvec3 ng = glm::cross(b - a, c - a);
   const double area2 = glm::dot(ng, ng);
   sp.geometric_normal = area2 > 0.0 ? ng / std::sqrt(area2) : glm::dvec3(0, 0, 1);
-  // Barycentric weights of the point's projection on the plane (Ericson 2005, 3.4).
-  const double wa = glm::dot(glm::cross(b - point, c - point), ng) / area2;
-  const double wb = glm::dot(glm::cross(c - point, a - point), ng) / area2;
-  const glm::dvec3 n = wa * glm::dvec3(t.normals[base]) + wb * glm::dvec3(t.normals[base + 1]) +
-                       (1.0 - wa - wb) * glm::dvec3(t.normals[base + 2]);
+  const glm::dvec3 w = barycentric_weights(t, triangle, point);
+  const glm::dvec3 n = w.x * glm::dvec3(t.normals[base]) + w.y * glm::dvec3(t.normals[base + 1]) +
+                       w.z * glm::dvec3(t.normals[base + 2]);
   const double len = glm::length(n);
   sp.shading_normal = len > 0.0 && std::isfinite(len) ? n / len : sp.geometric_normal;
   return sp;
@@ -106,7 +104,8 @@ glm::dvec3 MapShader::shade(const Crossed& cr, const glm::dvec3& dir, int depth,
   }
   const glm::dvec3 v = -dir;
   const glm::dvec3 n = face_forward(sp.shading_normal, v);
-  glm::dvec3 c = phong_ambient(m, scene_.ambient) + lights(sp, v, n, stats);
+  const glm::dvec3 od = diffuse_color_at(scene_, sp.triangle, sp.point);
+  glm::dvec3 c = phong_ambient(m, scene_.ambient, od) + lights(sp, v, n, od, stats);
   const SecondaryWeights w = secondary_weights(
       m, scene_.render.fresnel, dir,
       transmission_between(dir, sp.geometric_normal, sp.shading_normal, cr.itf.n_from, cr.itf.n_to),
@@ -125,14 +124,14 @@ glm::dvec3 MapShader::visibility(const glm::dvec3& p, const PointLight& light, M
   return s.transmittance;
 }
 
-glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n,
+glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n, const glm::dvec3& od,
                              MapShadingStats* stats) const {
   const Material& m = scene_.materials[sp.material];
   glm::dvec3 c(0.0);
   for (const PointLight& light : scene_.lights) {
     const glm::dvec3 to_light = light.position - sp.point;
     if (to_light == glm::dvec3(0.0)) continue;
-    const glm::dvec3 lit = phong_light(m, n, v, glm::normalize(to_light), light.color);
+    const glm::dvec3 lit = phong_light(m, n, v, glm::normalize(to_light), light.color, od);
     if (lit == glm::dvec3(0.0)) continue;
     if (!light.cast_shadows) {
       if (options_.walk_all_shadows) {
@@ -309,7 +308,8 @@ glm::dvec3 MapShader::envmap_texel(int face, int i, int j) const {
     const Material& m = scene_.materials[sp.material];
     const glm::dvec3 v = glm::normalize(cube_.centre - p);
     const glm::dvec3 nn = face_forward(sp.shading_normal, v);
-    return ShadedFragment{phong_ambient(m, scene_.ambient) + lights(sp, v, nn, nullptr), m.opacity};
+    const glm::dvec3 od = diffuse_color_at(scene_, sp.triangle, p);
+    return ShadedFragment{phong_ambient(m, scene_.ambient, od) + lights(sp, v, nn, od, nullptr), m.opacity};
   };
   const SampleDepth depth{&buffer.view, &*scene_.triangles, i, j};
   return pack_under_mask(buffer.list(i, j), FULL_MASK, shade_fragment, *scene_.triangles, scene_.background, nullptr,

@@ -155,7 +155,7 @@ class MapShader {
   Ray transmitted_ray(const Crossed& c, const Transmission& tr, MediumStack* stack) const;
   glm::dvec3 trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, const MediumStack& stack,
                    MapShadingStats* stats, SearchResult* found) const;
-  glm::dvec3 lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n,
+  glm::dvec3 lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n, const glm::dvec3& od,
                     MapShadingStats* stats) const;
   glm::dvec3 visibility(const glm::dvec3& p, const PointLight& light, MapShadingStats* stats) const;
   glm::dvec3 reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,

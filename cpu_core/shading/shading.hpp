@@ -4,7 +4,9 @@
 //     + sum over lights l:  S_l * I_l * ( kd * Od * max(0, N.L) + ks * max(0, R.V)^n )
 //     + kr * C_reflected + kt * C_transmitted
 //
-// Od = material colour, Ia = scene ambient, I_l = light colour (no distance attenuation),
+// Od = the diffuse colour at the point: material colour times its base-colour texture at
+// the point's uv (diffuse_color in scene/texture.hpp; the material colour alone without
+// one; the functions below take it as `od`, m.color when not given), Ia = scene ambient, I_l = light colour (no distance attenuation),
 // L = unit vector to the light, V = unit vector to the viewer, R = reflect(-L, N).
 // N is the shading normal turned to face the viewer (two-sided lighting), so a surface
 // seen from behind is lit like its front. S_l in [0, 1] is the light's visibility: 1 when
@@ -20,6 +22,7 @@
 #include <glm/glm.hpp>
 
 #include "scene/scene_data.hpp"
+#include "scene/texture.hpp"
 #include "scene/tie_rule.hpp"
 
 namespace abcube {
@@ -30,17 +33,20 @@ inline glm::dvec3 face_forward(const glm::dvec3& n, const glm::dvec3& v) {
 }
 
 // Ambient term alone: ka * Ia * Od.
+inline glm::dvec3 phong_ambient(const Material& m, const glm::dvec3& ambient, const glm::dvec3& od) {
+  return m.ambient * ambient * od;
+}
 inline glm::dvec3 phong_ambient(const Material& m, const glm::dvec3& ambient) {
-  return m.ambient * ambient * m.color;
+  return phong_ambient(m, ambient, m.color);
 }
 
 // One light's diffuse + specular contribution before visibility (S_l = 1).
 // n must already face the viewer (face_forward), all vectors unit.
 inline glm::dvec3 phong_light(const Material& m, const glm::dvec3& n, const glm::dvec3& v,
-                              const glm::dvec3& to_light, const glm::dvec3& light_color) {
+                              const glm::dvec3& to_light, const glm::dvec3& light_color, const glm::dvec3& od) {
   const double ndotl = glm::dot(n, to_light);
   if (ndotl <= 0.0) return glm::dvec3(0.0);
-  glm::dvec3 c = m.diffuse * ndotl * m.color;
+  glm::dvec3 c = m.diffuse * ndotl * od;
   if (m.specular > 0.0) {
     const glm::dvec3 r = 2.0 * ndotl * n - to_light;  // reflect(-L, N)
     const double rdotv = glm::dot(r, v);
@@ -48,19 +54,28 @@ inline glm::dvec3 phong_light(const Material& m, const glm::dvec3& n, const glm:
   }
   return light_color * c;
 }
+inline glm::dvec3 phong_light(const Material& m, const glm::dvec3& n, const glm::dvec3& v,
+                              const glm::dvec3& to_light, const glm::dvec3& light_color) {
+  return phong_light(m, n, v, to_light, light_color, m.color);
+}
 
 // The local Phong colour at p with geometric/shading normal n seen from `eye`,
 // every light fully visible (no shadows): what the GPU Z-buffer pass computes.
 inline glm::dvec3 phong_local(const Material& m, const glm::dvec3& p, const glm::dvec3& n_in,
                               const glm::dvec3& eye, const glm::dvec3& ambient,
-                              const std::vector<PointLight>& lights) {
+                              const std::vector<PointLight>& lights, const glm::dvec3& od) {
   const glm::dvec3 v = glm::normalize(eye - p);
   const glm::dvec3 n = face_forward(glm::normalize(n_in), v);
-  glm::dvec3 c = phong_ambient(m, ambient);
+  glm::dvec3 c = phong_ambient(m, ambient, od);
   for (const PointLight& l : lights) {
-    c += phong_light(m, n, v, glm::normalize(l.position - p), l.color);
+    c += phong_light(m, n, v, glm::normalize(l.position - p), l.color, od);
   }
   return c;
+}
+inline glm::dvec3 phong_local(const Material& m, const glm::dvec3& p, const glm::dvec3& n_in,
+                              const glm::dvec3& eye, const glm::dvec3& ambient,
+                              const std::vector<PointLight>& lights) {
+  return phong_local(m, p, n_in, eye, ambient, lights, m.color);
 }
 
 // Mirror direction of incident direction i about unit normal n: i - 2 (n.i) n.
@@ -172,7 +187,8 @@ inline SecondaryWeights secondary_weights(const Material& m, bool fresnel, const
 }
 
 // Light let through by one surface crossing the shadow segment P..L (rule "shadows";
-// shadow rays are not refracted):  (1 - op) + op * kt * Od, component-wise.
+// shadow rays are not refracted):  (1 - op) + op * kt * Od, component-wise. Od is the
+// material colour here, untextured (a limit: README "Textures"), on every path alike.
 // An opaque blocker (kt = 0, op = 1) gives 0; a refractive one (op = 1) gives kt * Od;
 // a coverage-transparent one (kt = 0) gives 1 - op. S_l is the product over every
 // crossing, so a closed glass object between P and L counts twice (entry and exit).

@@ -21,7 +21,8 @@ PixelShader local_phong_shader(const SceneData& scene, const ABuffer& buffer) {
   return [&scene, &buffer](const Fragment& f, int x, int y) {
     const Material& m = scene.materials[scene.triangles->material_id[f.triangle()]];
     const glm::dvec3 p = fragment_point(buffer, *scene.triangles, f, x, y);
-    return ShadedFragment{phong_local(m, p, f.shading_normal(), scene.camera.position, scene.ambient, scene.lights),
+    const glm::dvec3 od = diffuse_color_at(scene, f.triangle(), p);
+    return ShadedFragment{phong_local(m, p, f.shading_normal(), scene.camera.position, scene.ambient, scene.lights, od),
                           m.opacity};
   };
 }

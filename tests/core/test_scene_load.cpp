@@ -1023,6 +1023,58 @@ TEST(SceneLoadLimits, MtllibOutsideTheRootIsRefusedBeforeItIsRead) {
   EXPECT_EQ(s.materials[s.objects[0].material].color, glm::dvec3(1, 0, 0));
 }
 
+// Textures under --root (README "Textures"): a scene material's texture, an MTL map_Kd
+// and a symbolic link inside the root that points out of it; refused before the image is
+// read (the file outside holds no image: its content would show in a decode error).
+std::string textured_scene(const TempDir& dir, const std::string& texture) {
+  SceneText t;
+  t.materials = R"({"white": {"color": [0.8, 0.8, 0.8], "texture": ")" + texture + R"("}})";
+  return dir.write("root/scenes/scene.json", t.str());
+}
+
+TEST(SceneLoadLimits, TextureOutsideTheRootIsRefusedWithItsField) {
+  TempDir dir;
+  dir.write("outside/secret.png", "SECRET CONTENT");
+  const std::string scene = textured_scene(dir, "../../outside/secret.png");
+  LoadLimits limits;
+  limits.root = (dir.path() / "root").string();
+  const std::string root = fs::canonical(limits.root).string();
+  const std::string m = limited_load_error(scene, limits);
+  EXPECT_EQ(m, scene + ": materials.white.texture: \"../../outside/secret.png\" resolves outside --root " + root);
+  // Without a root it is read (and is no image): the content never shows in the message.
+  const std::string open = limited_load_error(scene, LoadLimits{});
+  EXPECT_NE(open.find("materials.white.texture: cannot decode texture"), std::string::npos) << open;
+  EXPECT_EQ(open.find("SECRET"), std::string::npos) << open;
+}
+
+TEST(SceneLoadLimits, MtlMapKdOutsideTheRootIsRefusedWithItsLine) {
+  TempDir dir;
+  dir.write("outside/secret.png", "SECRET CONTENT");
+  const std::string mtl = dir.write("root/meshes/cube.mtl", "newmtl red\nKd 1 0 0\nmap_Kd ../../outside/secret.png\n");
+  dir.write("root/meshes/cube.obj", "mtllib cube.mtl\nusemtl red\n" + std::string(CUBE_OBJ));
+  const std::string scene = dir.write("root/scenes/scene.json",
+                                      with_objects(R"([{"type": "mesh", "file": "../meshes/cube.obj"}])").str());
+  LoadLimits limits;
+  limits.root = (dir.path() / "root").string();
+  const std::string m = limited_load_error(scene, limits);
+  EXPECT_EQ(m, scene + ": objects[0].file: \"" + fs::path(mtl).lexically_normal().string() +
+                   "\":3: map_Kd \"../../outside/secret.png\" resolves outside --root " +
+                   fs::canonical(limits.root).string());
+}
+
+TEST(SceneLoadLimits, TextureSymlinkEscapingTheRootIsRefused) {
+  TempDir dir;
+  dir.write("outside/secret.png", "SECRET CONTENT");
+  fs::create_directories(dir.path() / "root" / "textures");
+  fs::create_symlink(dir.path() / "outside" / "secret.png", dir.path() / "root" / "textures" / "link.png");
+  const std::string scene = textured_scene(dir, "../textures/link.png");
+  LoadLimits limits;
+  limits.root = (dir.path() / "root").string();
+  const std::string m = limited_load_error(scene, limits);
+  EXPECT_NE(m.find("materials.white.texture: \"../textures/link.png\" resolves outside --root"), std::string::npos) << m;
+  EXPECT_EQ(m.find("SECRET"), std::string::npos) << m;
+}
+
 TEST(SceneLoadLimits, SceneFileOutsideTheRootIsRefused) {
   TempDir dir;
   const std::string scene = dir.write("elsewhere/scene.json", SceneText().str());
