@@ -3,7 +3,7 @@
 struct MaterialGpu {
   vec4 color_ambient;  // rgb = Od, a = ka
   vec4 coefficients;   // x = kd, y = ks, z = shininess n, w = kr (reflect)
-  vec4 transmission;   // x = kt (transmit), y = ior, z = opacity, w unused
+  vec4 transmission;   // x = kt (transmit), y = ior, z = opacity, w = texture (-1: none)
 };
 struct LightGpu {
   vec4 position;  // xyz relative to the pass centre (the eye); w = shadow-map layer, -1 = none
@@ -36,3 +36,29 @@ uniform samplerCubeArray u_shadow_peel_maps[MAX_SHADOW_PEELS];
 // The environment cube map around the eye (Blinn & Newell 1976), for kr and kt lookups.
 uniform bool u_environment;
 uniform samplerCube u_environment_map;
+
+// Base-colour textures (README "Textures"; cpu_core/scene/texture.hpp THE RULE): Od =
+// colour * texture(uv), linear RGB, repeat, trilinear over GL's mipmaps. The images are
+// grouped by size into up to MAX_TEXTURE_ARRAYS 2D arrays (gl_passes.cpp); a material's
+// transmission.w = array + MAX_TEXTURE_ARRAYS * layer. Each array is sampled in its own
+// branch with the derivatives taken outside it (uniform control flow), so the index need
+// not be uniform.
+const int MAX_TEXTURE_ARRAYS = 4;  // gl_passes.hpp MAX_TEXTURE_ARRAYS
+uniform sampler2DArray u_textures[MAX_TEXTURE_ARRAYS];
+// True: level 0 only (zero derivatives), the CPU's point sample (abcube crosscheck).
+uniform bool u_texture_level0;
+
+vec3 diffuse_color(MaterialGpu m, vec2 uv) {
+  vec2 dx = dFdx(uv), dy = dFdy(uv);
+  if (u_texture_level0) dx = dy = vec2(0.0);
+  float code = m.transmission.w;
+  if (code < 0.0) return m.color_ambient.rgb;
+  int array = int(code) % MAX_TEXTURE_ARRAYS;
+  vec3 coordinate = vec3(uv, float(int(code) / MAX_TEXTURE_ARRAYS));
+  vec3 t = vec3(1.0);
+  if (array == 0) t = textureGrad(u_textures[0], coordinate, dx, dy).rgb;
+  else if (array == 1) t = textureGrad(u_textures[1], coordinate, dx, dy).rgb;
+  else if (array == 2) t = textureGrad(u_textures[2], coordinate, dx, dy).rgb;
+  else t = textureGrad(u_textures[3], coordinate, dx, dy).rgb;
+  return m.color_ambient.rgb * t;
+}

@@ -25,11 +25,11 @@ vec3 light_visibility(int i, vec3 p, vec3 n) {
   return s;
 }
 
-vec3 phong_local(MaterialGpu m, vec3 p, vec3 n_in) {
+// od: the diffuse colour at the point (diffuse_color in common_scene.glsl).
+vec3 phong_local(MaterialGpu m, vec3 p, vec3 n_in, vec3 od) {
   vec3 v = normalize(-p);
   vec3 n = normalize(n_in);
   if (dot(n, v) < 0.0) n = -n;
-  vec3 od = m.color_ambient.rgb;
   vec3 c = m.color_ambient.a * u_ambient * od;
   for (int i = 0; i < u_light_count; ++i) {
     vec3 l = normalize(lights[i].position.xyz - p);

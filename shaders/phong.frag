@@ -7,6 +7,7 @@ in vec3 v_relative;
 in vec3 v_normal;
 flat in uint v_object;
 flat in uint v_material;
+in vec2 v_uv;
 
 uniform int u_peel;            // 0: the nearest surface; k >= 1: the k-th behind it
 uniform sampler2D u_previous;  // layer k - 1: (distance, triangle) per sample
@@ -15,6 +16,8 @@ layout(location = 0) out vec4 o_color;
 layout(location = 1) out vec2 o_layer;  // (distance, triangle) of this sample's surface
 
 void main() {
+  // Before any discard: the texture's derivatives need the whole quad of fragments.
+  vec3 od = diffuse_color(materials[v_material], v_uv);
   float d = length(v_relative);
   float id = float(gl_PrimitiveID);
   if (u_peel > 0) {
@@ -22,6 +25,6 @@ void main() {
     if (isinf(previous.r) || d < previous.r || (d == previous.r && id <= previous.g)) discard;
   }
   MaterialGpu m = materials[v_material];
-  o_color = vec4(phong_local(m, v_relative, v_normal) + environment_terms(m, v_relative, v_normal), m.transmission.z);
+  o_color = vec4(phong_local(m, v_relative, v_normal, od) + environment_terms(m, v_relative, v_normal), m.transmission.z);
   o_layer = vec2(d, id);
 }

@@ -4,6 +4,7 @@ layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in uint a_object;
 layout(location = 3) in uint a_material;
+layout(location = 4) in vec2 a_uv;  // texture coordinates (v up); (0, 0) when the scene has none
 
 uniform mat4 u_clip;
 uniform vec3 u_center;
@@ -15,6 +16,7 @@ out vec3 v_relative;  // position relative to the eye, interpolated perspective-
 out vec3 v_normal;
 flat out uint v_object;
 flat out uint v_material;
+out vec2 v_uv;
 
 void main() {
   gl_Position = u_clip * vec4(a_position, 1.0);
@@ -23,4 +25,5 @@ void main() {
   v_normal = a_normal;
   v_object = a_object;
   v_material = a_material;
+  v_uv = a_uv;
 }

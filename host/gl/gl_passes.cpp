@@ -12,6 +12,7 @@
 #include "raster/samples.hpp"
 #include "base/error.hpp"
 #include "base/timer.hpp"
+#include "scene/texture.hpp"
 #include "scene/tie_rule.hpp"
 #include "shading/shading.hpp"
 
@@ -25,6 +26,9 @@ constexpr int CAMERA_TILE = 2048;
 // then the camera's previous layer.
 constexpr GLenum PEEL_UNIT = 3;
 constexpr GLenum CAMERA_PREVIOUS_UNIT = PEEL_UNIT + MAX_SHADOW_PEELS;
+// Then the base-colour texture arrays (16 units in all: GL 4.5's minimum for a fragment shader).
+constexpr GLenum TEXTURE_UNIT = CAMERA_PREVIOUS_UNIT + 1;
+static_assert(TEXTURE_UNIT + MAX_TEXTURE_ARRAYS <= 16, "texture units");
 
 
 struct Vertex {
@@ -158,12 +162,26 @@ GlScene::GlScene(const SceneData& scene) : scene_(scene) {
   glVertexAttribIPointer(2, 1, GL_UNSIGNED_INT, sizeof(Vertex), offset(offsetof(Vertex, object)));
   glVertexAttribIPointer(3, 1, GL_UNSIGNED_INT, sizeof(Vertex), offset(offsetof(Vertex, material)));
   for (GLuint a = 0; a < 4; ++a) glEnableVertexAttribArray(a);
+  // Texture coordinates: their own buffer, straight from the soup, only when it has them.
+  if (!t.uvs.empty()) {
+    glGenBuffers(1, &uv_vbo_);
+    glBindBuffer(GL_ARRAY_BUFFER, uv_vbo_);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(t.uvs.size() * sizeof(glm::vec2)), t.uvs.data(),
+                 GL_STATIC_DRAW);
+    glVertexAttribPointer(4, 2, GL_FLOAT, GL_FALSE, sizeof(glm::vec2), nullptr);
+    glEnableVertexAttribArray(4);
+  } else {
+    glDisableVertexAttribArray(4);
+    glVertexAttrib2f(4, 0.f, 0.f);
+  }
 
+  const std::vector<float> texture_codes = upload_textures();
   std::vector<MaterialGpu> materials;
-  for (const Material& m : scene.materials) {
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
     materials.push_back({{float(m.color.r), float(m.color.g), float(m.color.b), float(m.ambient)},
                          {float(m.diffuse), float(m.specular), float(m.shininess), float(m.reflect)},
-                         {float(m.transmit), float(m.ior), float(m.opacity), 0.f}});
+                         {float(m.transmit), float(m.ior), float(m.opacity), texture_codes[i]}});
   }
   if (materials.empty()) materials.push_back({});
   glGenBuffers(1, &materials_);
@@ -184,8 +202,75 @@ GlScene::GlScene(const SceneData& scene) : scene_(scene) {
   timings_.upload_ms = ms_since(t0);
 }
 
+std::vector<float> GlScene::upload_textures() {
+  std::vector<float> code(scene_.materials.size(), -1.f);
+  if (!scene_.textures) return code;
+  const std::vector<TextureImage>& images = scene_.textures->images();
+  // Size classes in the order the images come; each image's array and layer.
+  std::vector<std::pair<int, int>> sizes;
+  std::vector<std::vector<size_t>> members;
+  std::vector<int> array_of(images.size()), layer_of(images.size());
+  for (size_t i = 0; i < images.size(); ++i) {
+    const std::pair<int, int> size{images[i].width, images[i].height};
+    size_t a = static_cast<size_t>(std::find(sizes.begin(), sizes.end(), size) - sizes.begin());
+    if (a == sizes.size()) {
+      sizes.push_back(size);
+      members.emplace_back();
+    }
+    array_of[i] = static_cast<int>(a);
+    layer_of[i] = static_cast<int>(members[a].size());
+    members[a].push_back(i);
+  }
+  if (sizes.size() > static_cast<size_t>(MAX_TEXTURE_ARRAYS)) {
+    throw RuntimeFailure("the GL passes take textures of at most " + std::to_string(MAX_TEXTURE_ARRAYS) +
+                         " different sizes, the scene has " + std::to_string(sizes.size()));
+  }
+  texture_arrays_.assign(sizes.size(), 0);
+  glGenTextures(static_cast<GLsizei>(sizes.size()), texture_arrays_.data());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  std::vector<float> flipped;
+  for (size_t a = 0; a < sizes.size(); ++a) {
+    const int w = sizes[a].first, h = sizes[a].second;
+    if (w > max_size_ || h > max_size_) {
+      throw RuntimeFailure("texture of " + std::to_string(w) + "x" + std::to_string(h) + " exceeds GL_MAX_TEXTURE_SIZE " +
+                           std::to_string(max_size_));
+    }
+    int levels = 1;
+    while ((std::max(w, h) >> levels) > 0) ++levels;
+    glBindTexture(GL_TEXTURE_2D_ARRAY, texture_arrays_[a]);
+    glTexStorage3D(GL_TEXTURE_2D_ARRAY, levels, GL_RGB32F, w, h, static_cast<GLsizei>(members[a].size()));
+    for (size_t k = 0; k < members[a].size(); ++k) {
+      const TextureImage& image = images[members[a][k]];
+      // GL's row 0 is t = 0, the image's bottom (v = 0): rows upside down.
+      flipped.resize(image.rgb.size());
+      const size_t row = 3 * static_cast<size_t>(w);
+      for (int y = 0; y < h; ++y) {
+        std::memcpy(&flipped[static_cast<size_t>(h - 1 - y) * row], &image.rgb[static_cast<size_t>(y) * row],
+                    row * sizeof(float));
+      }
+      glTexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, 0, 0, static_cast<GLint>(k), w, h, 1, GL_RGB, GL_FLOAT, flipped.data());
+    }
+    glGenerateMipmap(GL_TEXTURE_2D_ARRAY);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  }
+  glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+  for (size_t m = 0; m < code.size(); ++m) {
+    const int image = scene_.textures->image_of(static_cast<uint32_t>(m));
+    if (image >= 0) {
+      code[m] = float(array_of[static_cast<size_t>(image)] + MAX_TEXTURE_ARRAYS * layer_of[static_cast<size_t>(image)]);
+    }
+  }
+  check_gl("texture upload");
+  return code;
+}
+
 GlScene::~GlScene() {
   target_.reset();
+  glDeleteTextures(static_cast<GLsizei>(texture_arrays_.size()), texture_arrays_.data());
+  glDeleteBuffers(1, &uv_vbo_);
   const GLuint textures[] = {shadow_maps_, environment_};
   glDeleteTextures(2, textures);
   glDeleteTextures(static_cast<GLsizei>(shadow_peels_.size()), shadow_peels_.data());
@@ -265,6 +350,14 @@ void GlScene::bind_lookups(const GlProgram& program, bool with_environment) {
   glUniform1i(program.uniform("u_lookup"), lookup_ == EnvmapLookup::bisector ? 1 : lookup_ == EnvmapLookup::position ? 2 : 0);
   glUniform1i(program.uniform("u_fresnel"), fresnel_);
   glUniform1i(program.uniform("u_environment_map"), 2);
+  GLint texture_units[MAX_TEXTURE_ARRAYS];
+  for (int k = 0; k < MAX_TEXTURE_ARRAYS; ++k) {
+    texture_units[k] = static_cast<GLint>(TEXTURE_UNIT) + k;
+    glActiveTexture(GL_TEXTURE0 + TEXTURE_UNIT + static_cast<GLenum>(k));
+    glBindTexture(GL_TEXTURE_2D_ARRAY, static_cast<size_t>(k) < texture_arrays_.size() ? texture_arrays_[static_cast<size_t>(k)] : 0);
+  }
+  glUniform1iv(program.uniform("u_textures"), MAX_TEXTURE_ARRAYS, texture_units);
+  glUniform1i(program.uniform("u_texture_level0"), texture_level0_);
   glActiveTexture(GL_TEXTURE2);
   glBindTexture(GL_TEXTURE_CUBE_MAP, environment ? environment_ : 0);
   glActiveTexture(GL_TEXTURE0);

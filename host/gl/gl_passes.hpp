@@ -38,6 +38,12 @@ constexpr int MAX_CAMERA_LAYERS = 16;
 // its masks.
 enum class CameraSamples { pixel_centre, mask_4x8 };
 
+// Base-colour textures on the GPU: the scene's images (scene/texture.hpp, linear RGB) are
+// uploaded once per GlScene as RGB32F 2D arrays with GL's mipmaps, one array per distinct
+// image size, at most this many sizes (common_scene.glsl; more is a RuntimeFailure naming
+// the limit). The uvs go in a vertex buffer of their own, made only when the scene has them.
+constexpr int MAX_TEXTURE_ARRAYS = 4;
+
 // Value of a prepass texel that no surface covers.
 constexpr float NO_DISTANCE = INFINITY;
 constexpr uint32_t NO_OBJECT = 0xffffffffu;
@@ -93,6 +99,11 @@ class GlScene {
     fresnel_ = fresnel;
   }
 
+  // Textures sampled at level 0 with zero derivatives (bilinear), as the CPU's point
+  // samples, instead of trilinear over the pass's footprint: `abcube crosscheck` compares
+  // the lookups, not the two filters.
+  void set_texture_level0(bool on) { texture_level0_ = on; }
+
   const GpuTimings& timings() const { return timings_; }
   double near_distance() const { return near_; }
   int max_size() const { return max_size_; }
@@ -107,7 +118,9 @@ class GlScene {
   Target& target(int width, int height, bool distance_pass);
 
   const SceneData& scene_;
-  GLuint vao_ = 0, vbo_ = 0, materials_ = 0, lights_ = 0;
+  GLuint vao_ = 0, vbo_ = 0, uv_vbo_ = 0, materials_ = 0, lights_ = 0;
+  std::vector<GLuint> texture_arrays_;  // by size class; the material's code names array and layer
+  std::vector<float> upload_textures();  // per material: -1, or array + MAX_TEXTURE_ARRAYS * layer
   GLuint shadow_maps_ = 0, environment_ = 0, lookup_fbo_ = 0, lookup_depth_ = 0;
   std::vector<GLuint> shadow_peels_;  // one cube-map array (a layer per light and face) per peel
   bool shadow_peels_capped_ = false;
@@ -123,6 +136,7 @@ class GlScene {
   int n_of_lookup_ = 0;
   EnvmapLookup lookup_ = EnvmapLookup::reflected;
   bool fresnel_ = false;  // the lookup target's size (bind_lookup_target)
+  bool texture_level0_ = false;
   std::unique_ptr<GlProgram> distance_program_, phong_program_, shadow_program_;
   std::unique_ptr<Target> target_;
   GpuTimings timings_;

@@ -111,6 +111,7 @@ void compare_camera(const SceneData& scene, int threads, GlScene& gl, Crosscheck
 CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const CrosscheckTolerances& tol) {
   CrosscheckResult r;
   GlScene gl(scene);
+  gl.set_texture_level0(true);  // the CPU's point samples (README "Textures")
   compare_cube(scene, n, threads, gl, &r);
   compare_camera(scene, threads, gl, &r);
   const double mismatch =

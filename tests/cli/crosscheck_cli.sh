@@ -11,7 +11,7 @@ WORK=$(mktemp -d "${TMPDIR:-/tmp}/abcube_crosscheck.XXXXXX")
 trap 'rm -rf "$WORK"' EXIT
 passed=0
 failed=0
-for scene in default hidden_point cornell shadows; do
+for scene in default hidden_point cornell shadows textured; do
   for gl in egl osmesa; do
     if "$ABCUBE" crosscheck "$REPO/scenes/$scene.json" --cube-res 96 --gl "$gl" --stats "$WORK/$scene.json" \
         > "$WORK/out" 2>&1; then

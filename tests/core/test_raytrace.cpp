@@ -904,7 +904,8 @@ TEST(Raytrace, EmbreeTracerMatchesThePreEmbreeImagesOnEveryRepositoryScene) {
   std::vector<std::filesystem::path> scenes;
   for (const char* dir : {"scenes", "scenes/bench"}) {
     for (const auto& e : std::filesystem::directory_iterator(root / dir)) {
-      if (e.path().extension() == ".json") scenes.push_back(e.path());
+      // textured.json is newer than the Embree change: no image from before it exists.
+      if (e.path().extension() == ".json" && e.path().stem() != "textured") scenes.push_back(e.path());
     }
   }
   std::sort(scenes.begin(), scenes.end());

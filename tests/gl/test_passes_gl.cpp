@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "scene/camera.hpp"
+#include "scene/scene_load.hpp"
 #include "raster/cube_map.hpp"
 #include "gl/gl_passes.hpp"
 #include "gl_test_support.hpp"
@@ -219,6 +220,68 @@ TEST(ZbufferGl, CubeColourMatchesCpuShading) {
     }
   }
   EXPECT_LT(worst, 2e-3);
+}
+
+}  // namespace
+}  // namespace abcube
+
+namespace abcube {
+namespace {
+
+// Base-colour textures on the GPU (common_scene.glsl diffuse_color) against the CPU's rule
+// (scene/texture.hpp diffuse_color_at) at pixel centres, on the tile mesh (vt 0..2: the
+// wrap is crossed): with the textures at level 0 (the CPU's point sample, as `abcube
+// crosscheck` samples them) every pixel agrees; with GL's trilinear mipmaps (the `gpu`
+// method) the far part, where a pixel spans more than a texel, is filtered: close on
+// average, not per pixel.
+TEST(ZbufferGl, TexturedFloorMatchesCpuShading) {
+  test::test_context();
+  const std::string text = R"({"version": 1, "camera": {"position": [0, 1.2, 1.6], "look_at": [0, 0, -0.2], "fov_y": 50,
+      "width": 96, "height": 72}, "ambient": [0.2, 0.2, 0.2], "lights": [{"type": "point", "position": [1, 2, 1]}],
+      "materials": {"t": {"color": [1, 0.8, 0.9], "texture": "textures/checker.png", "specular": 0.2}},
+      "objects": [{"type": "mesh", "file": "meshes/tile.obj", "material": "t"}]})";
+  const SceneData s = load_scene_text(text, "floor.json", std::string(ABCUBE_SOURCE_DIR) + "/scenes");
+  ASSERT_TRUE(s.textures);
+  GlScene gl(s);
+  const Image trilinear = gl.camera_color(s.camera);
+  gl.set_texture_level0(true);
+  const Image img = gl.camera_color(s.camera);
+  const CameraFrame f = make_camera_frame(s.camera);
+  double worst = 0, spread = 0, trilinear_sum = 0, trilinear_worst = 0;
+  int checked = 0;
+  glm::dvec3 lo(1e9), hi(-1e9);
+  for (int y = 0; y < s.camera.height; ++y) {
+    for (int x = 0; x < s.camera.width; ++x) {
+      const glm::dvec3 d = f.direction(x + 0.5, y + 0.5);
+      if (d.y >= -1e-3) continue;
+      const glm::dvec3 p = f.eye + (-f.eye.y / d.y) * d;
+      if (std::abs(p.x) > 0.97 || std::abs(p.z) > 0.97) continue;  // the tile's floor face, away from its edges
+      // Its two triangles: the one under p.
+      uint32_t tri = 0;
+      for (uint32_t t = 0; t < 2; ++t) {
+        const glm::dvec3 w = barycentric_weights(*s.triangles, t, p);
+        if (w.x >= -1e-9 && w.y >= -1e-9 && w.z >= -1e-9) tri = t;
+      }
+      const glm::dvec3 od = diffuse_color_at(s, tri, p);
+      const glm::dvec3 expected = phong_local(s.materials[0], p, glm::dvec3(0, 1, 0), f.eye, s.ambient, s.lights, od);
+      const glm::vec3 got = img.rgb(x, y);
+      for (int c = 0; c < 3; ++c) {
+        worst = std::max(worst, std::abs(got[c] - expected[c]));
+        const double d = std::abs(trilinear.rgb(x, y)[c] - expected[c]);
+        trilinear_sum += d;
+        trilinear_worst = std::max(trilinear_worst, d);
+      }
+      lo = glm::min(lo, od);
+      hi = glm::max(hi, od);
+      ++checked;
+    }
+  }
+  spread = hi.r - lo.r;
+  EXPECT_GT(checked, 2000);
+  EXPECT_GT(spread, 0.3) << "the texture varies over the floor";
+  EXPECT_LT(worst, 4e-3);
+  EXPECT_LT(trilinear_sum / (3.0 * checked), 0.02);
+  EXPECT_GT(trilinear_worst, worst) << "the mipmaps are used";
 }
 
 }  // namespace
