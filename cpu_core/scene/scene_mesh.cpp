@@ -95,13 +95,22 @@ std::vector<uint32_t> mtl_material_ids(LoadState& st, const std::string& path, c
   return ids;
 }
 
-// First line of a tinyobjloader message that contains `needle`, or "".
-std::string find_line(const std::string& text, const char* needle) {
+// The distinct lines of a tinyobjloader message that contain `needle`.
+std::vector<std::string> find_lines(const std::string& text, const char* needle) {
+  std::vector<std::string> lines;
   std::istringstream in(text);
   for (std::string line; std::getline(in, line);) {
-    if (line.find(needle) != std::string::npos) return line;
+    if (line.find(needle) != std::string::npos && std::find(lines.begin(), lines.end(), line) == lines.end()) {
+      lines.push_back(line);  // once: tinyobjloader repeats a name at each use
+    }
   }
-  return "";
+  return lines;
+}
+
+// First line of a tinyobjloader message that contains `needle`, or "".
+std::string find_line(const std::string& text, const char* needle) {
+  const std::vector<std::string> lines = find_lines(text, needle);
+  return lines.empty() ? "" : lines.front();
 }
 
 // tinyobjloader's warning of a material it did not find, the name it holds quoted:
@@ -139,12 +148,6 @@ void add_obj_face(const tinyobj::index_t* corners, size_t n, int material, Local
     }
     out->material.push_back(material);
   }
-}
-
-std::string resolve_mesh_path(const Source& src, const std::string& file) {
-  namespace fs = std::filesystem;
-  const fs::path p(file);
-  return (p.is_absolute() ? p : fs::path(src.base_dir) / p).lexically_normal().string();
 }
 
 // tinyobjloader's MaterialFileReader, refusing before it is opened an MTL file outside the
@@ -240,6 +243,12 @@ uint64_t obj_triangle_count(const ObjFile& obj) {
 
 }  // namespace
 
+std::string resolve_mesh_path(const Source& src, const std::string& file) {
+  namespace fs = std::filesystem;
+  const fs::path p(file);
+  return (p.is_absolute() ? p : fs::path(src.base_dir) / p).lexically_normal().string();
+}
+
 std::string canonical_root(const std::string& root) {
   std::error_code ec;
   const std::filesystem::path p = std::filesystem::canonical(root, ec);
@@ -288,8 +297,16 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
   const ObjFile obj = parse_obj(st, path, resolved);
   check_triangle_cap(st, path, obj_triangle_count(obj));  // before anything is made
   if (use_mtl) {
-    const std::string missing = find_line(obj.warning, "not found");
-    if (!missing.empty()) fail(st.src, path, "mesh " + quote_path(resolved) + ": " + missing_material_message(missing));
+    // A missing MTL file or material is what Assimp, Blender and three.js forgive: the faces
+    // get the default material, and one warning line names the first (and counts the rest).
+    std::vector<std::string> missing = find_lines(obj.warning, "not found");
+    if (!missing.empty()) {
+      std::string more;
+      if (missing.size() > 1) more = " (and " + std::to_string(missing.size() - 1) + " more)";
+      st.scene.warnings.push_back(one_line(st.src.name + ": " + path + ": warning: mesh " + quote_path(file) + ": " +
+                                           missing_material_message(missing.front()) + more +
+                                           "; the default material is used"));
+    }
   }
   const std::vector<uint32_t> mtl_ids = use_mtl ? mtl_material_ids(st, path, file, resolved, obj.materials, obj.mtl_file_of)
                                                  : std::vector<uint32_t>{};
@@ -323,6 +340,10 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
     size_t offset = 0;
     for (size_t face = 0; face < shape.mesh.num_face_vertices.size(); ++face) {
       const size_t n = shape.mesh.num_face_vertices[face];
+      if (n < 3) {
+        fail(st.src, path, "mesh " + quote_path(resolved) + ": face " + std::to_string(face + 1) + " of shape " +
+                               quote(shape.name) + " has " + std::to_string(n) + " corners (a face needs 3 or more)");
+      }
       const tinyobj::index_t* corners = &shape.mesh.indices[offset];
       offset += n;
       for (size_t k = 0; k < n; ++k) {
