@@ -12,7 +12,7 @@ PACKAGES=(
   libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6
   libglm-dev python3-glad
   libopenimageio-dev openimageio-tools
-  nlohmann-json3-dev libtinyobjloader-dev libembree-dev
+  nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libembree-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev
   python3-dev pybind11-dev python3-numpy python3-pytest python3-distributed
   clang-14 libclang-rt-14-dev libfuzzer-14-dev llvm-14 assimp-testmodels

@@ -17,6 +17,7 @@
 #include "base/error.hpp"
 #include "base/input_file.hpp"
 #include "base/memory.hpp"
+#include "scene/framing.hpp"
 #include "scene/scene_load_state.hpp"
 #include "scene/tessellate.hpp"
 
@@ -61,31 +62,53 @@ constexpr double MAX_QUAD_PLANARITY_ERROR = 1e-6;   // relative to the quad's di
 
 // ---- Sections ----------------------------------------------------------------------
 
-Camera read_camera(const Fields& f) {
-  Camera c;
-  c.position = f.vec3("position");
-  c.look_at = f.vec3("look_at");
+// The camera section; with "frame": "all" its position and look_at are placed once the
+// objects are loaded (frame_camera), along "direction".
+struct CameraSection {
+  Camera camera;
+  bool frame = false;
+  glm::dvec3 direction = DEFAULT_FRAME_DIRECTION;
+};
+
+CameraSection read_camera(const Fields& f) {
+  CameraSection section;
+  Camera& c = section.camera;
+  const Source& src = f.src();
+  if (const Json* frame = f.find("frame")) {
+    const std::string what = read_string(src, *frame, f.at("frame"));
+    if (what != "all") fail(src, f.at("frame"), "must be \"all\" (the whole scene), got " + describe(*frame));
+    for (const char* key : {"position", "look_at"}) {
+      if (f.find(key)) fail(src, f.at(key), "must not be given with \"frame\" (framing places the camera)");
+    }
+    section.frame = true;
+    section.direction = f.vec3("direction", section.direction);
+    if (!(glm::length(section.direction) > 0)) fail(src, f.at("direction"), "must be nonzero, got " + describe(section.direction));
+  } else {
+    if (f.find("direction")) fail(src, f.at("direction"), "is read only with \"frame\": \"all\"");
+    c.position = f.vec3("position");
+    c.look_at = f.vec3("look_at");
+  }
   c.up = f.vec3("up", c.up);
   c.fov_y_deg = f.number("fov_y", c.fov_y_deg);
   c.width = f.integer("width", c.width, 1, MAX_IMAGE_SIDE);
   c.height = f.integer("height", c.height, 1, MAX_IMAGE_SIDE);
-  const Source& src = f.src();
   if (!(c.fov_y_deg > 0 && c.fov_y_deg < 180)) {
     fail(src, f.at("fov_y"), "must be > 0 and < 180 (degrees), got " + format_number(c.fov_y_deg));
   }
+  const double up_length = glm::length(c.up);
+  if (!(up_length > 0)) fail(src, f.at("up"), "must be nonzero, got " + describe(c.up));
+  if (section.frame) return section;  // up parallel to direction: frame_camera picks another
   const glm::dvec3 view = c.look_at - c.position;
   const double scale = std::max(glm::length(c.position), glm::length(c.look_at));
   if (!(glm::length(view) > 1e-12 * scale)) {
     fail(src, f.at("look_at"), "must differ from camera.position, got " + describe(c.look_at));
   }
-  const double up_length = glm::length(c.up);
-  if (!(up_length > 0)) fail(src, f.at("up"), "must be nonzero, got " + describe(c.up));
   // sin of the angle between up and the view direction
   if (!(glm::length(glm::cross(glm::normalize(view), c.up / up_length)) > 1e-6)) {
     fail(src, f.at("up"), "must not be parallel to the view direction (look_at - position), got " +
                               describe(c.up));
   }
-  return c;
+  return section;
 }
 
 PointLight read_light(const Fields& f) {
@@ -207,7 +230,8 @@ LocalMesh read_sphere(const LoadState& st, const Fields& f) {
 }
 
 // Triangles of one object in object space, by type.
-LocalMesh read_geometry(LoadState& st, const Fields& f, const std::string& type, bool has_material) {
+LocalMesh read_geometry(LoadState& st, const Fields& f, const std::string& type, bool has_material,
+                        GltfExtras* extras) {
   if (type == "triangle") {
     const std::vector<glm::dvec3> p = read_points(f, "vertices", 3);
     return tessellate_triangle(p[0], p[1], p[2]);
@@ -215,6 +239,7 @@ LocalMesh read_geometry(LoadState& st, const Fields& f, const std::string& type,
   if (type == "quad") return read_quad(f);
   if (type == "box") return read_box(f);
   if (type == "sphere") return read_sphere(st, f);
+  if (type == "gltf") return read_gltf(st, f, !has_material, extras);
   return read_obj(st, f, !has_material);
 }
 
@@ -248,8 +273,11 @@ void read_object(LoadState& st, const Json& v, size_t index) {
     known = {"type", "center", "radius", "segments", "material", "transform"};
   } else if (type == "mesh") {
     known = {"type", "file", "material", "transform"};
+  } else if (type == "gltf") {
+    known = {"type", "file", "material", "transform", "use_camera"};
   } else {
-    fail(st.src, member_path(path, "type"), "must be one of triangle, quad, box, sphere, mesh, got " + describe(*type_it));
+    fail(st.src, member_path(path, "type"),
+         "must be one of triangle, quad, box, sphere, mesh, gltf, got " + describe(*type_it));
   }
   const Fields f(st.src, v, path, known);
 
@@ -269,7 +297,9 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   if (const Json* t = f.find("transform")) {
     transform = read_transform(Fields(st.src, *t, f.at("transform"), {"translate", "rotate_deg", "scale"}));
   }
-  LocalMesh local = read_geometry(st, f, type, material != nullptr);
+  GltfExtras extras;
+  const bool use_camera = f.find("use_camera") && read_bool(st.src, *f.find("use_camera"), f.at("use_camera"));
+  LocalMesh local = read_geometry(st, f, type, material != nullptr, &extras);
   // Without a "material", a primitive gets the default and a mesh its per-face MTL ones.
   if (!material && local.material.empty()) obj.material = default_material(st);
   // Texture coordinates are kept only where a texture is sampled: untextured scenes keep
@@ -287,7 +317,20 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   TriangleSoup& soup = st.scene.triangles.edit();
   const uint32_t id = static_cast<uint32_t>(st.scene.objects.size());
   obj.first_triangle = static_cast<uint32_t>(soup.triangle_count());
-  st.scene.dropped_triangles += append_triangles(local, make_affine_map(transform), id, obj.material, &soup);
+  const AffineMap map = make_affine_map(transform);
+  st.scene.dropped_triangles += append_triangles(local, map, id, obj.material, &soup);
+  for (PointLight light : extras.lights) {
+    light.position = map.point(light.position);
+    st.scene.lights.push_back(light);
+  }
+  if (use_camera && extras.has_camera && !st.file_camera) {
+    Camera c;
+    c.position = map.point(extras.camera_position);
+    c.look_at = map.point(extras.camera_look_at);
+    c.up = map.linear * extras.camera_up;
+    c.fov_y_deg = extras.camera_fov_y_deg;
+    st.file_camera = c;
+  }
   obj.triangle_count = static_cast<uint32_t>(soup.triangle_count() - obj.first_triangle);
   const bool per_face_materials = !local.material.empty();
   const bool from_file = local.indexed;
@@ -299,10 +342,12 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   if (obj.triangle_count == 0) {
     // Loads and renders (nothing), but an empty export, a wrong file or a mistyped vertex
     // is the likely cause.
-    const bool mesh = type == "mesh";
-    const std::string what = mesh ? "mesh " + quote_path(read_string(st.src, f.need("file"), f.at("file"))) : type;
+    const bool from_file = type == "mesh" || type == "gltf";
+    const std::string what =
+        from_file ? (type == "gltf" ? "glTF " : "mesh ") + quote_path(read_string(st.src, f.need("file"), f.at("file")))
+                  : type;
     st.scene.warnings.push_back(one_line(
-        st.src.name + ": " + (mesh ? f.at("file") : path) + ": warning: " + what + " has no triangles" +
+        st.src.name + ": " + (from_file ? f.at("file") : path) + ": warning: " + what + " has no triangles" +
         (faces > 0 ? " of nonzero area (" + std::to_string(faces) + " dropped)" : "")));
   }
   // A closed surface has an inside; make its geometric normals point out of it.
@@ -343,8 +388,10 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
   }
   SceneData scene;
   scene.file = src.name;
-  scene.camera = read_camera(Fields(src, top.need("camera"), "camera",
-                                    {"position", "look_at", "up", "fov_y", "width", "height"}));
+  const CameraSection camera = read_camera(Fields(src, top.need("camera"), "camera",
+                                                  {"position", "look_at", "up", "fov_y", "width", "height", "frame",
+                                                   "direction"}));
+  scene.camera = camera.camera;
   scene.background = top.vec3("background", scene.background);
   check_non_negative(src, "background", scene.background);
   scene.ambient = top.vec3("ambient", scene.ambient);
@@ -360,6 +407,19 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
   if (const Json* materials = top.find("materials")) read_materials(st, *materials);
   const Json& objects = read_array(src, top.need("objects"), "objects");
   for (size_t i = 0; i < objects.size(); ++i) read_object(st, objects[i], i);
+  if (camera.frame) {
+    scene.camera = frame_camera(scene.bounds(), camera.direction, scene.camera);
+    // A framed scene without lights of its own (no "lights", none in its glTF files) is lit
+    // from the frame; an explicit "lights": [] stays dark.
+    if (scene.lights.empty() && !top.find("lights")) scene.lights = frame_lights(scene.bounds(), scene.camera);
+  }
+  if (st.file_camera) {  // a gltf object's "use_camera": its first perspective camera
+    const Camera& c = *st.file_camera;
+    scene.camera.position = c.position;
+    scene.camera.look_at = c.look_at;
+    scene.camera.up = c.up;
+    scene.camera.fov_y_deg = c.fov_y_deg;
+  }
   if (const Json* render = top.find("render")) {
     scene.render = read_render(Fields(src, *render, "render", {"method", "cube_resolution", "max_depth", "fresnel", "error_target"}));
   }
@@ -382,11 +442,54 @@ SceneData load_scene_text(const std::string& text, const std::string& name, cons
 
 SceneData load_scene(const std::string& path) { return load_scene(path, LoadLimits{}); }
 
+namespace {
+
+// The model file's kind by its extension (any case): "gltf", "mesh" or "" (a scene file).
+std::string model_kind(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".gltf" || ext == ".glb") return "gltf";
+  if (ext == ".obj") return "mesh";
+  return "";
+}
+
+// A model file given where a scene is expected: the scene of that one model, framed, lit
+// from the frame, 640 x 480 (README "Models and framing"). Messages name the model file
+// itself ("box.gltf: meshes[0]...") rather than the scene made for it.
+SceneData load_model_as_scene(const std::string& path, const std::string& kind, const LoadLimits& limits) {
+  namespace fs = std::filesystem;
+  const std::string file = fs::path(path).filename().string();
+  Json object = {{"type", kind}, {"file", file}};
+  if (kind == "gltf") object["use_camera"] = true;
+  const Json doc = {{"version", 1},
+                    {"camera", {{"frame", "all"}, {"width", 640}, {"height", 480}}},
+                    {"objects", Json::array({object})}};
+  const std::string dir = fs::path(path).parent_path().string();
+  const std::string ours = path + ": objects[0].file: ", theirs = path + ": ";
+  const auto rename = [&](std::string m) {
+    if (m.rfind(ours, 0) == 0) m = theirs + m.substr(ours.size());
+    const std::string again = theirs + quote_path(file) + ": ";  // the glTF loader names its file
+    if (m.rfind(again, 0) == 0) m = theirs + m.substr(again.size());
+    return m;
+  };
+  try {
+    SceneData scene = load_scene_text(doc.dump(), path, dir.empty() ? "." : dir, limits);
+    for (std::string& w : scene.warnings) w = rename(w);
+    return scene;
+  } catch (const InputError& e) {
+    throw InputError(rename(e.what()));
+  }
+}
+
+}  // namespace
+
 SceneData load_scene(const std::string& path, const LoadLimits& limits) {
   namespace fs = std::filesystem;
   if (!limits.root.empty() && !inside_root(canonical_root(limits.root), path)) {
     throw InputError(one_line(path + ": the scene file resolves outside --root " + canonical_root(limits.root)));
   }
+  const std::string kind = model_kind(path);
+  if (!kind.empty()) return load_model_as_scene(path, kind, limits);
   const std::string text = read_input_file(path, limits.max_scene_bytes, "scene");
   const std::string dir = fs::path(path).parent_path().string();
   return load_scene_text(text, path, dir.empty() ? "." : dir, limits);

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <map>
 #include <utility>
+#include <optional>
 #include <string>
 
 #include "scene/scene_data.hpp"
@@ -30,6 +31,8 @@ struct LoadState {
   // Each texture file a material names (resolved), with where it was named for messages:
   // the field path and a prefix ("" or "\"a.mtl\":12: map_Kd ").
   std::map<std::string, std::pair<std::string, std::string>> texture_place;
+  // The first perspective camera of a gltf object with "use_camera" (world space).
+  std::optional<Camera> file_camera;
 };
 
 uint32_t add_material(LoadState& st, Material m);
@@ -61,9 +64,27 @@ std::string texture_file(LoadState& st, const std::string& path, const std::stri
 // SceneData::textures; an image that cannot be read or decoded is an InputError naming
 // where the scene named it and why.
 void load_textures(LoadState& st);
+// A file path of the scene (absolute, or relative to its folder), made absolute or joined.
+std::string resolve_mesh_path(const Source& src, const std::string& file);
 
 // A mesh object's triangles from a Wavefront OBJ. With `use_mtl`, its MTL materials
 // become scene materials named "FILE:NAME", and faces without one get the default.
 LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl);
+
+// What a glTF file holds besides triangles, in the file's space (before the object's
+// transform): KHR_lights_punctual point lights (colour already intensity / d^2, see
+// scene_gltf.cpp) and the first perspective camera of its node hierarchy.
+struct GltfExtras {
+  std::vector<PointLight> lights;
+  bool has_camera = false;
+  glm::dvec3 camera_position{0.0}, camera_look_at{0.0}, camera_up{0.0};
+  double camera_fov_y_deg = 60;
+};
+
+// A gltf object's triangles (scene_gltf.cpp): every triangle primitive of the file's scene,
+// its node transforms applied. With `use_materials`, its materials become scene materials
+// named "FILE:NAME" (primitives without one get the default); warnings for what is not
+// rendered go to SceneData::warnings.
+LocalMesh read_gltf(LoadState& st, const Fields& f, bool use_materials, GltfExtras* extras);
 
 }  // namespace abcube::detail
