@@ -82,7 +82,8 @@ needs it. Made by load_scene, scene_from_dict or scene_from_json.)doc")
 
   m.def("load_scene", &load_scene, py::arg("path"), py::arg("root") = py::none(),
         py::arg("max_triangles") = 0,
-        R"doc(Loads a scene file. Untrusted scenes: `root` confines every file the scene
+        R"doc(Loads a scene file, or a model file (.gltf, .glb, .obj: the model alone, framed and
+lit, 640 x 480, its own camera if it has one; README "Models"). Untrusted scenes: `root` confines every file the scene
 references to that folder, `max_triangles` (> 0) caps its size; both are refused before
 anything is allocated. A bad scene raises SceneError naming the place
 ("scene.json:12:5: ..." or "scene.json: objects[3].radius: ...").)doc");

@@ -10,9 +10,10 @@
 
 namespace abcube {
 
-// The view direction "frame" uses when none is given: from the front (+z) towards -z,
-// slightly from above.
-inline const glm::dvec3 DEFAULT_FRAME_DIRECTION{0.0, -0.35, -1.0};
+// The view direction "frame" uses when none is given: from the front (+z), right (+x) and
+// above, towards -z: a three-quarter view, so that a flat model in any axis plane is seen
+// face on enough (from straight ahead, a model in a plane x = c is seen edge on).
+inline const glm::dvec3 DEFAULT_FRAME_DIRECTION{-0.5, -0.4, -1.0};
 
 // `camera` (its fov_y, width, height and up kept) looking along `direction` at the centre of
 // `bounds`, from the nearest distance at which all 8 corners of the bounds project inside

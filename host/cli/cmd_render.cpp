@@ -51,7 +51,7 @@ struct RenderCommand {
 CommandRun add_render_command(CLI::App& app) {
   auto c = std::make_shared<RenderCommand>();
   CLI::App* cmd = app.add_subcommand("render", "render a scene into an image (PNG, EXR, TIFF, ... by extension)");
-  cmd->add_option("SCENE", c->scene, "scene file (../shared/scene-format.md)")->required();
+  cmd->add_option("SCENE", c->scene, "scene file (../shared/scene-format.md), or a model file (.gltf, .glb, .obj) rendered framed and lit")->required();
   cmd->add_option("-o,--output", c->output, "output image, written atomically");
   cmd->add_option("--stats", c->stats_path, "stats JSON: plan, per-pass ms, counts, memory, GL path, errors");
   cmd->add_option("--timeout", c->timeout_s, "stop the render past this many seconds, 0 = no limit (exit 1)")

@@ -27,6 +27,8 @@ struct SceneLimits {
 // once (each with its own Renderer).
 class Scene {
  public:
+  // A model file (.gltf, .glb, .obj) loads as the scene of that model alone, framed and lit
+  // (README "Models: glTF 2.0, OBJ and framing").
   // Throws InputError with one line naming the place ("FILE:LINE:COL: ..." for JSON
   // syntax, "FILE: objects[3].radius: ..." for values, a file outside limits.root, ...).
   static Scene load(const std::string& path, const SceneLimits& limits = {});
