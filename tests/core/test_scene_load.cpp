@@ -1186,9 +1186,7 @@ TEST(SceneLoadGltf, NodeTransformsAndTexcoordsReachTheSoup) {
   ASSERT_EQ(s.triangles->triangle_count(), 2u);
   EXPECT_NEAR(glm::distance(corner(s, 0, 1), glm::dvec3(5, 2, 0)), 0.0, 1e-6);
   EXPECT_NEAR(glm::distance(corner(s, 0, 2), glm::dvec3(3, 2, 0)), 0.0, 1e-6);
-  ASSERT_EQ(s.triangles->uvs.size(), 6u);
-  EXPECT_EQ(s.triangles->uvs[1], glm::vec2(1, 1));  // glTF (1, 0): v runs down, stored 1 - v
-  EXPECT_EQ(s.triangles->uvs[2], glm::vec2(1, 0));
+  EXPECT_TRUE(s.triangles->uvs.empty());  // untextured: uvs are not kept
   EXPECT_NEAR(geometric_normal(s, 0).z, 1.0, 1e-9);  // counter-clockwise seen from +z
   EXPECT_EQ(s.materials[s.triangles->material_id[0]].name, "(default)");
   EXPECT_TRUE(s.warnings.empty());
@@ -1286,7 +1284,12 @@ TEST(SceneLoadGltf, GlbImagesAreKeptEncoded) {
   QuadGltf g;
   g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])";
   g.primitive_extra = R"(, "material": 0)";
-  const std::string png = "\x89PNG\r\n\x1a\n-not-really-an-image";
+  // A 1 x 1 PNG.
+  const std::string png(
+      "\x89\x50\x4e\x47\x0d\x0a\x1a\x0a\x00\x00\x00\x0d\x49\x48\x44\x52\x00\x00\x00\x01\x00\x00\x00\x01\x08\x06"
+      "\x00\x00\x00\x1f\x15\xc4\x89\x00\x00\x00\x0d\x49\x44\x41\x54\x78\xda\x63\x64\x60\xf8\x5f\x0f\x00\x02"
+      "\x87\x01\x80\xeb\x47\xba\x92\x00\x00\x00\x00\x49\x45\x4e\x44\xae\x42\x60\x82",
+      70);
   g.buffer_uri = "";
   std::string json = g.str();
   // One buffer, the GLB's BIN chunk, with the image's bytes after the geometry.
@@ -1307,6 +1310,9 @@ TEST(SceneLoadGltf, GlbImagesAreKeptEncoded) {
   EXPECT_EQ(s.embedded_images[0].mime_type, "image/png");
   EXPECT_EQ(std::string(s.embedded_images[0].bytes->begin(), s.embedded_images[0].bytes->end()), png);
   EXPECT_EQ(s.materials[s.triangles->material_id[0]].texture, "#embedded/0");
+  ASSERT_EQ(s.triangles->uvs.size(), 6u);
+  EXPECT_EQ(s.triangles->uvs[1], glm::vec2(1, 1));  // glTF (1, 0): v runs down, stored 1 - v
+  EXPECT_EQ(s.triangles->uvs[2], glm::vec2(1, 0));
 }
 
 // Issue 18: what a glTF names must resolve inside --root (symbolic links followed); the
