@@ -47,7 +47,13 @@ TEST(ResourcesApi, ThreeHundredRendersHoldNoMore) {
   ASSERT_GT(rss_at_50, 0u) << "no /proc/self/status";
   const double growth_mb = (static_cast<double>(rss) - static_cast<double>(rss_at_50)) / (1024.0 * 1024.0);
   std::printf("RSS %+.2f MB, descriptors %+d from render 50 to 300\n", growth_mb, fds - fds_at_50);
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer keeps freed blocks in quarantine (256 MB) to catch their later use,
+  // so the resident memory says nothing here; LeakSanitizer checks for leaks at exit instead.
+  std::printf("AddressSanitizer build: RSS growth not checked\n");
+#else
   EXPECT_LE(growth_mb, 8.0);
+#endif
   EXPECT_EQ(fds, fds_at_50);
 }
 

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# The checked builds of README "Robustness", each in its own build folder with gcc:
+#   tools/sanitize.sh asan   AddressSanitizer + UndefinedBehaviorSanitizer (build-asan): every
+#                            target but the benchmarks and the Python module, the ctest suite
+#                            but two long repetitive tests (below)
+#   tools/sanitize.sh tsan   ThreadSanitizer (build-tsan): test_core, its multi-threaded tests
+# Any report fails the run (exit 1): undefined behaviour stops the program, and the
+# suppressions in tools/sanitizers/ each say why they are there.
+# Extra arguments go to ctest (e.g. -R fuzz). ABCUBE_SANITIZE_BUILD_ONLY=1 builds only.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+kind=${1:-}
+shift || true
+supp=$PWD/tools/sanitizers
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$PWD}
+
+configure() {  # FOLDER SANITIZERS
+  if [[ ! -f $1/build.ninja ]]; then
+    cmake -S . -B "$1" -G Ninja -DABCUBE_SANITIZE="$2" -DABCUBE_BUILD_BENCH=OFF \
+      > "$1.configure.log" 2>&1 || { cat "$1.configure.log"; exit 1; }
+  fi
+}
+
+case $kind in
+  asan)
+    configure build-asan address,undefined
+    cmake --build build-asan
+    [[ ${ABCUBE_SANITIZE_BUILD_ONLY:-0} == 1 ]] && exit 0
+    export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1
+    export LSAN_OPTIONS=suppressions=$supp/lsan.supp:print_suppressions=0
+    export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:suppressions=$supp/ubsan.supp
+    # Left out, to keep CI inside its time (the ordinary build runs them): the two tests
+    # that repeat one path many times, 100 EGL Renderers opened and closed (151 s under
+    # ASan; every GL test opens one) and the 22 generated hard scenes (160 s; their code is
+    # the renders of cli.golden_cli and the core tests).
+    ctest --test-dir build-asan --output-on-failure -j2 -E '^(RendererApi\.HundredEglRenderersInARow|hard\.generated)$' "$@"
+    ;;
+  tsan)
+    configure build-tsan thread
+    cmake --build build-tsan --target test_core
+    [[ ${ABCUBE_SANITIZE_BUILD_ONLY:-0} == 1 ]] && exit 0
+    export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1:suppressions=$supp/tsan.supp
+    # The tests that run more than one thread (the parallel loop of cpu_core/base/parallel.hpp):
+    # the A-buffer build and resolve, the searches, the tracer, the thread-count determinism tests.
+    ctest --test-dir build-tsan --output-on-failure -j2 -L core -R "$(cat "$supp/tsan_tests.txt" | grep -v '^#' | paste -sd'|')" "$@"
+    ;;
+  *)
+    echo "usage: tools/sanitize.sh asan|tsan [ctest arguments]" >&2
+    exit 2
+    ;;
+esac
