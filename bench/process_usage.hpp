@@ -19,6 +19,25 @@ inline uint64_t resident_bytes() {
   return 0;
 }
 
+// VmHWM of /proc/self/status in bytes: the peak resident set since the process started or
+// since reset_peak_resident(); 0 where /proc is missing.
+inline uint64_t peak_resident_bytes() {
+  std::ifstream in("/proc/self/status");
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::strtoull(line.c_str() + 6, nullptr, 10) * 1024;
+  }
+  return 0;
+}
+
+// Resets VmHWM to the present resident set (Linux 4.0: "5" to /proc/self/clear_refs);
+// false where that is not possible.
+inline bool reset_peak_resident() {
+  std::ofstream out("/proc/self/clear_refs");
+  out << "5";
+  out.flush();
+  return static_cast<bool>(out);
+}
+
 // Entries of /proc/self/fd, less the one the listing itself holds open; -1 without /proc.
 inline int open_descriptors() {
   DIR* dir = opendir("/proc/self/fd");

@@ -10,33 +10,34 @@ namespace abcube {
 
 namespace {
 
-SceneLimits limits_arg(const py::handle& root, const py::handle& max_triangles) {
+SceneLimits limits_arg(const py::handle& root, const py::handle& max_triangles, const py::handle& max_memory_mib) {
   SceneLimits limits;
   if (!root.is_none()) limits.root = path_arg(root, "root");
   limits.max_triangles = unsigned_arg(max_triangles, "max_triangles");
+  limits.max_memory_mib = unsigned_arg(max_memory_mib, "max_memory_mib");
   return limits;
 }
 
-Scene load_scene(const py::handle& path, const py::handle& root,
-                 const py::handle& max_triangles) {
+Scene load_scene(const py::handle& path, const py::handle& root, const py::handle& max_triangles,
+                 const py::handle& max_memory_mib) {
   const std::string file = path_arg(path, "load_scene: path");
-  const SceneLimits limits = limits_arg(root, max_triangles);
+  const SceneLimits limits = limits_arg(root, max_triangles, max_memory_mib);
   py::gil_scoped_release release;
   return Scene::load(file, limits);
 }
 
 Scene scene_from_json(const py::handle& text, const py::handle& name, const py::handle& base_dir,
-                      const py::handle& root, const py::handle& max_triangles) {
+                      const py::handle& root, const py::handle& max_triangles, const py::handle& max_memory_mib) {
   const std::string json_text = string_arg(text, "scene_from_json: text");
   const std::string scene_name = string_arg(name, "name");
   const std::string dir = path_arg(base_dir, "base_dir");
-  const SceneLimits limits = limits_arg(root, max_triangles);
+  const SceneLimits limits = limits_arg(root, max_triangles, max_memory_mib);
   py::gil_scoped_release release;
   return Scene::from_json(json_text, scene_name, dir, limits);
 }
 
 Scene scene_from_dict(const py::handle& scene, const py::handle& name, const py::handle& base_dir,
-                      const py::handle& root, const py::handle& max_triangles) {
+                      const py::handle& root, const py::handle& max_triangles, const py::handle& max_memory_mib) {
   // Python's json writes the text; NaN and infinity are refused here (not JSON), the rest is
   // validated by the loader, whose messages name the field path.
   if (!py::isinstance<py::dict>(scene)) {
@@ -50,7 +51,7 @@ Scene scene_from_dict(const py::handle& scene, const py::handle& name, const py:
     if (!e.matches(PyExc_ValueError) && !e.matches(PyExc_TypeError)) throw;
     throw InputError(string_arg(name, "name") + ": not a JSON scene: " + std::string(py::str(e.value())));
   }
-  return scene_from_json(text, name, base_dir, root, max_triangles);
+  return scene_from_json(text, name, base_dir, root, max_triangles, max_memory_mib);
 }
 
 std::string scene_repr(const Scene& s) {
@@ -81,20 +82,22 @@ needs it. Made by load_scene, scene_from_dict or scene_from_json.)doc")
       .def("__repr__", &scene_repr);
 
   m.def("load_scene", &load_scene, py::arg("path"), py::arg("root") = py::none(),
-        py::arg("max_triangles") = 0,
+        py::arg("max_triangles") = 0, py::arg("max_memory_mib") = 0,
         R"doc(Loads a scene file, or a model file (.gltf, .glb, .obj: the model alone, framed and
 lit, 640 x 480, its own camera if it has one; README "Models"). Untrusted scenes: `root` confines every file the scene
-references to that folder, `max_triangles` (> 0) caps its size; both are refused before
-anything is allocated. A bad scene raises SceneError naming the place
+references to that folder, `max_triangles` (> 0) caps its size, `max_memory_mib` (> 0, else
+the memory available) the memory its triangles may take (170 bytes each); all are refused
+before anything is allocated. A bad scene raises SceneError naming the place
 ("scene.json:12:5: ..." or "scene.json: objects[3].radius: ...").)doc");
   m.def("scene_from_dict", &scene_from_dict, py::arg("scene"), py::arg("name") = "<dict>",
         py::arg("base_dir") = ".", py::arg("root") = py::none(), py::arg("max_triangles") = 0,
+        py::arg("max_memory_mib") = 0,
         R"doc(A scene from a dict in the scene file's format. `name` stands for the file in
 messages ("<dict>: objects[0].radius: ..."); relative mesh paths resolve against
 `base_dir`. Raises SceneError as load_scene does.)doc");
   m.def("scene_from_json", &scene_from_json, py::arg("text"), py::arg("name") = "<json>",
         py::arg("base_dir") = ".", py::arg("root") = py::none(), py::arg("max_triangles") = 0,
-        "A scene from JSON text; as scene_from_dict.");
+        py::arg("max_memory_mib") = 0, "A scene from JSON text; as scene_from_dict.");
 }
 
 }  // namespace abcube

@@ -11,6 +11,7 @@
 #include "scene/tie_rule.hpp"
 #include "base/memory.hpp"
 #include "base/timer.hpp"
+#include "scene/scene_load.hpp"
 #include "base/parallel.hpp"
 
 namespace abcube {
@@ -43,7 +44,6 @@ glm::dvec3 decode_octahedral(uint32_t code) {
   return glm::normalize(n);
 }
 
-uint64_t default_max_memory_bytes() { return available_memory_bytes() / 2; }
 
 namespace {
 
@@ -230,9 +230,13 @@ void compact(ViewBuild* vb) {
 
 std::string mib(uint64_t bytes) { return std::to_string((bytes + MIB - 1) / MIB); }
 
-[[noreturn]] void over_budget(const char* what, uint64_t need, const std::string& detail, uint64_t budget) {
-  throw InputError(std::string(what) + " needs " + mib(need) + " MiB (" + detail + "), above --max-memory " +
-                   mib(budget) + " MiB");
+// The A-buffer's estimate `need` with the rest of the render's, against the budget.
+void check_budget(const char* what, uint64_t need, const std::string& detail, const ABufferOptions& o,
+                  uint64_t budget) {
+  if (need <= budget && o.reserved_bytes <= budget - need) return;
+  const std::string beside = o.reserved_bytes > 0 ? " beside " + mib(o.reserved_bytes) + " MiB for the rest of the render" : "";
+  throw InputError(std::string(what) + " needs " + mib(need) + " MiB (" + detail + ")" + beside + ", " +
+                   budget_words(budget, o.max_memory_bytes > 0));
 }
 
 void check_options(const ABufferOptions& o) {
@@ -294,7 +298,6 @@ std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView>
                                  const ABufferOptions& options, ABufferStats* stats) {
   const Clock::time_point start = Clock::now();
   const TriangleSoup& soup = *scene.triangles;
-  const uint64_t budget = options.max_memory_bytes > 0 ? options.max_memory_bytes : default_max_memory_bytes();
   std::vector<ViewBuild> views(rasters.size());
   std::vector<Band> bands;
   uint64_t index_bytes = 0;
@@ -303,7 +306,8 @@ std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView>
     index_bytes += (2 * rasters[v].pixel_count() + 1) * sizeof(uint32_t);
     for (int y = 0; y < rasters[v].height; y += BAND_ROWS) bands.push_back({v, y, std::min(y + BAND_ROWS, rasters[v].height)});
   }
-  if (index_bytes > budget) over_budget(what, index_bytes, "its per-pixel index alone", budget);
+  const uint64_t budget = memory_budget_bytes(options.max_memory_bytes);
+  check_budget(what, index_bytes, "its per-pixel index alone", options, budget);
   const int threads = thread_count(options.threads, bands.size());
 
   parallel_for(views.size(), threads, [&](size_t v, int) { bin_view(soup, &views[v]); });
@@ -314,10 +318,8 @@ std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView>
   uint64_t bin_bytes = 0;
   for (const ViewBuild& vb : views) bin_bytes += vb.bins.size() * sizeof(BinEntry);
   const uint64_t estimate = raw * sizeof(Fragment) + index_bytes + bin_bytes;
-  if (estimate > budget) {
-    over_budget(what, estimate, std::to_string(raw) + " fragments at " + std::to_string(sizeof(Fragment)) + " bytes",
-                budget);
-  }
+  check_budget(what, estimate, std::to_string(raw) + " fragments at " + std::to_string(sizeof(Fragment)) + " bytes",
+               options, budget);
   for (ViewBuild& vb : views) {
     vb.cursor.assign(vb.view.pixel_count(), 0);
     vb.fragments.resize(vb.offsets.back());

@@ -112,12 +112,13 @@ struct ABufferOptions {
   int threads = 0;                // 0 = std::thread::hardware_concurrency()
   double near_distance = 0;       // 0 = default_near_distance(farthest vertex from the centre)
   uint32_t max_layers = 0;        // 0 = keep every layer
-  uint64_t max_memory_bytes = 0;  // 0 = default_max_memory_bytes()
+  // The render's memory budget (--max-memory), 0 = the memory available
+  // (memory_budget_bytes, scene_load.hpp); the A-buffer may take what `reserved_bytes`, the
+  // rest of the render's estimate (estimate_render_bytes, an A-buffer built before), leaves.
+  uint64_t max_memory_bytes = 0;
+  uint64_t reserved_bytes = 0;
   bool merge = true;              // false keeps one fragment per triangle and pixel (tests)
 };
-
-// A safe share of the machine: half of available_memory_bytes().
-uint64_t default_max_memory_bytes();
 
 struct ABufferStats {
   uint64_t fragments = 0;                  // stored, after merging and the cap
@@ -143,7 +144,8 @@ struct ABufferStats {
 
 // The cube A-buffer of `scene` around `centre` (the environment map; design.md), n x n
 // per face. Throws InputError for n < 1, a bad option, or when the estimate exceeds the
-// budget: "cube A-buffer needs N MiB (F fragments at 20 bytes), above --max-memory M MiB".
+// budget: "cube A-buffer needs N MiB (F fragments at 20 bytes) beside R MiB for the rest of
+// the render, above --max-memory M MiB" (or "the M MiB of memory available").
 CubeABuffer build_cube_abuffer(const SceneData& scene, const glm::dvec3& centre, int n,
                                const ABufferOptions& options = {}, ABufferStats* stats = nullptr);
 

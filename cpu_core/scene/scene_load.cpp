@@ -46,6 +46,12 @@ void check_triangle_cap(const LoadState& st, const std::string& path, uint64_t a
     fail(st.src, path, "the scene would have " + std::to_string(total) + " triangles, over the cap of " +
                            std::to_string(cap) + " (max_triangles)");
   }
+  if (st.memory_budget > 0 && total > st.memory_budget / SCENE_TRIANGLE_BYTES) {
+    const uint64_t mib = (total * SCENE_TRIANGLE_BYTES + (uint64_t{1} << 20) - 1) >> 20;
+    fail(st.src, path, "the scene would have " + std::to_string(total) + " triangles, an estimated " +
+                           std::to_string(mib) + " MiB at " + std::to_string(SCENE_TRIANGLE_BYTES) + " bytes each, " +
+                           budget_words(st.memory_budget, st.limits.max_memory_bytes > 0));
+  }
 }
 
 }  // namespace detail
@@ -403,7 +409,7 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
                                                {"type", "position", "color", "cast_shadows"})));
     }
   }
-  LoadState st{src, scene, limits, root, {}, {}, -1, {}};
+  LoadState st{src, scene, limits, root, {}, {}, -1, {}, {}, memory_budget_bytes(limits.max_memory_bytes)};
   if (const Json* materials = top.find("materials")) read_materials(st, *materials);
   const Json& objects = read_array(src, top.need("objects"), "objects");
   for (size_t i = 0; i < objects.size(); ++i) read_object(st, objects[i], i);

@@ -17,6 +17,10 @@ struct LoadLimits {
   // 0: no cap (beyond the loader's own). Otherwise a scene with more triangles is refused
   // with an InputError naming the count and the cap, before its triangles are made.
   uint64_t max_triangles = 0;
+  // The whole render's memory budget (--max-memory), 0: the memory available
+  // (available_memory_bytes). A scene whose triangles alone would exceed it, at
+  // SCENE_TRIANGLE_BYTES each, is refused as max_triangles is, before they are made.
+  uint64_t max_memory_bytes = 0;
   // Input files larger than these are refused before they are read (README "Errors and
   // hostile input"): a scene file (and an MTL file) is text of kilobytes, a mesh can be
   // gigabytes (a 1M-triangle OBJ is about 100 MB). A mesh file larger than the memory
@@ -41,10 +45,25 @@ SceneData load_scene_text(const std::string& text, const std::string& name, cons
 SceneData load_scene_text(const std::string& text, const std::string& name, const std::string& base_dir,
                           const LoadLimits& limits);
 
-// Bytes a render of this scene needs at its camera size and cube resolution (images,
-// cube faces, triangles); throws InputError naming the sizes when it exceeds
-// `budget_bytes` (pass available_memory_bytes()).
+// Peak resident bytes a triangle of scene data costs above the process's own, whatever the
+// method (the soup, the mesh neighbours, the tracer's tree and its build): measured by
+// bench/memory.py on 440k- and 1M-triangle meshes (bench/results/memory.txt: at most 168),
+// rounded up.
+constexpr uint64_t SCENE_TRIANGLE_BYTES = 170;
+
+// The memory a render may use: `max_memory_bytes` when it is set (--max-memory), else the
+// memory available (available_memory_bytes: MemAvailable, or less under a cgroup limit).
+uint64_t memory_budget_bytes(uint64_t max_memory_bytes);
+
+// "above --max-memory M MiB" or "above the M MiB of memory available", for messages.
+std::string budget_words(uint64_t budget_bytes, bool capped);
+
+// Bytes a render of this scene needs at its camera size and cube resolution (images and
+// their per-pixel indices, cube faces, triangles, the gpu method's GL copies and shadow
+// maps) beside its A-buffers' fragments, which are counted when they are built (the
+// A-buffer gets what is left of the budget). Throws InputError naming the sizes when it
+// exceeds `budget_bytes`; `capped` says whether that is --max-memory.
 uint64_t estimate_render_bytes(const SceneData& scene);
-void check_render_size(const SceneData& scene, uint64_t budget_bytes);
+void check_render_size(const SceneData& scene, uint64_t budget_bytes, bool capped);
 
 }  // namespace abcube

@@ -33,6 +33,8 @@ struct LoadState {
   std::map<std::string, std::pair<std::string, std::string>> texture_place;
   // The first perspective camera of a gltf object with "use_camera" (world space).
   std::optional<Camera> file_camera;
+  // memory_budget_bytes(limits.max_memory_bytes), read once when loading starts.
+  uint64_t memory_budget = 0;
 };
 
 uint32_t add_material(LoadState& st, Material m);
@@ -40,8 +42,9 @@ uint32_t add_material(LoadState& st, Material m);
 uint32_t default_material(LoadState& st);
 
 // Refuses (InputError naming `path`, the count and the cap) a scene that would hold more
-// than LoadLimits::max_triangles once `adding` more triangles are appended. Called before
-// they are made.
+// than LoadLimits::max_triangles once `adding` more triangles are appended, or whose
+// triangles would then need more than the memory budget at SCENE_TRIANGLE_BYTES each.
+// Called before they are made.
 void check_triangle_cap(const LoadState& st, const std::string& path, uint64_t adding);
 
 // The canonical form of LoadLimits::root (InputError when it is not a folder).

@@ -289,9 +289,9 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
   std::string problem = input_file_problem(resolved, st.limits.max_mesh_bytes);
   std::error_code ec;
   const uint64_t size = problem.empty() ? std::filesystem::file_size(resolved, ec) : 0;
-  const uint64_t available = problem.empty() ? available_memory_bytes() : 0;
-  if (problem.empty() && available > 0 && size > available) {
-    problem = "is " + format_bytes(size) + ", more than the " + format_bytes(available) + " of memory available";
+  if (problem.empty() && st.memory_budget > 0 && size > st.memory_budget) {
+    problem = "is " + format_bytes(size) + ", more than the " + format_bytes(st.memory_budget) +
+              (st.limits.max_memory_bytes > 0 ? " of --max-memory" : " of memory available");
   }
   if (!problem.empty()) fail(st.src, path, "cannot read mesh " + quote_path(resolved) + ": " + problem);
   const ObjFile obj = parse_obj(st, path, resolved);

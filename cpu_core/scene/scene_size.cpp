@@ -2,6 +2,7 @@
 #include <string>
 
 #include "base/error.hpp"
+#include "base/memory.hpp"
 #include "scene/scene_json.hpp"
 #include "scene/scene_load.hpp"
 
@@ -9,39 +10,54 @@ namespace abcube {
 
 namespace {
 
-// Bytes per unit of work, for the estimate: a camera pixel holds its colour and A-buffer
-// fragment headroom; a cube texel its distance and fragment headroom. A triangle: the peak
-// resident bytes a triangle of scene data costs above the process's own, measured by
-// bench/memory.py on 440k- and 1M-triangle meshes (bench/results/memory.txt, the exact
-// tracer and the side structure on Embree: at most 168 for raytrace, abuffer, zbuffer and
-// envmap; the soup's 80 of it), rounded up; the gpu method adds the GL vertex buffer
-// (3 vertices of 32 bytes, gl_passes.cpp) and what llvmpipe holds while it draws them
-// (about 90 more, measured from /proc/self/statm around the first draw); gpu measured
-// 380 a triangle at 1M triangles (marginal 230).
+constexpr uint64_t MIB = uint64_t{1} << 20;
+
+// Bytes per unit of work, beside the A-buffers' fragments: a camera pixel holds its colour
+// and the A-buffer's per-pixel index (offsets and counts) with room for the AOVs and the
+// reference image; a cube texel its distance, the A-buffer's index, the block bounds and
+// pyramid of the searches (or the gpu method's cube textures). A triangle:
+// SCENE_TRIANGLE_BYTES, and the gpu method adds the GL vertex buffer (3 vertices of 32
+// bytes, gl_passes.cpp) and what llvmpipe holds while it draws them (about 90 more,
+// measured from /proc/self/statm around the first draw; gpu measured 380 a triangle at 1M
+// triangles, marginal 230). A shadow-casting light under gpu: a cube map of N x N floats.
 constexpr uint64_t PIXEL_BYTES = 3 * sizeof(float) + 64;
 constexpr uint64_t TEXEL_BYTES = 64;
-constexpr uint64_t TRIANGLE_BYTES = 170;
 constexpr uint64_t GL_TRIANGLE_BYTES = 3 * 32 + 90;
-static_assert(TRIANGLE_BYTES >= 6 * sizeof(glm::vec3) + 2 * sizeof(uint32_t), "the soup alone");
+constexpr uint64_t GL_SHADOW_TEXEL_BYTES = 6 * sizeof(float);  // six faces
+static_assert(SCENE_TRIANGLE_BYTES >= 6 * sizeof(glm::vec3) + 2 * sizeof(uint32_t), "the soup alone");
+
+std::string mib(uint64_t bytes) { return std::to_string((bytes + MIB - 1) / MIB); }
 
 }  // namespace
+
+uint64_t memory_budget_bytes(uint64_t max_memory_bytes) {
+  return max_memory_bytes > 0 ? max_memory_bytes : available_memory_bytes();
+}
+
+std::string budget_words(uint64_t budget_bytes, bool capped) {
+  return capped ? "above --max-memory " + std::to_string(budget_bytes / MIB) + " MiB"
+                : "above the " + std::to_string(budget_bytes / MIB) + " MiB of memory available";
+}
 
 uint64_t estimate_render_bytes(const SceneData& scene) {
   const uint64_t pixels = static_cast<uint64_t>(scene.camera.width) * static_cast<uint64_t>(scene.camera.height);
   const uint64_t n = static_cast<uint64_t>(scene.render.cube_resolution);
-  const uint64_t per_triangle = TRIANGLE_BYTES + (scene.render.method == Method::gpu ? GL_TRIANGLE_BYTES : 0);
-  return pixels * PIXEL_BYTES + 6 * n * n * TEXEL_BYTES + scene.triangles->triangle_count() * per_triangle;
+  const bool gpu = scene.render.method == Method::gpu;
+  uint64_t shadow_lights = 0;
+  for (const PointLight& l : scene.lights) shadow_lights += l.cast_shadows ? 1 : 0;
+  const uint64_t per_triangle = SCENE_TRIANGLE_BYTES + (gpu ? GL_TRIANGLE_BYTES : 0);
+  return pixels * PIXEL_BYTES + 6 * n * n * TEXEL_BYTES + scene.triangles->triangle_count() * per_triangle +
+         (gpu ? shadow_lights * n * n * GL_SHADOW_TEXEL_BYTES : 0);
 }
 
-void check_render_size(const SceneData& scene, uint64_t budget_bytes) {
+void check_render_size(const SceneData& scene, uint64_t budget_bytes, bool capped) {
   const uint64_t need = estimate_render_bytes(scene);
   if (need <= budget_bytes) return;
-  constexpr uint64_t MIB = uint64_t{1} << 20;
-  throw InputError(one_line(scene.file + ": render: estimated " + std::to_string((need + MIB - 1) / MIB) +
-                            " MiB for " + std::to_string(scene.camera.width) + "x" +
-                            std::to_string(scene.camera.height) + " and cube " +
-                            std::to_string(scene.render.cube_resolution) + " exceeds available memory " +
-                            std::to_string(budget_bytes / MIB) + " MiB"));
+  throw InputError(one_line(scene.file + ": render: estimated " + mib(need) + " MiB for " +
+                            std::to_string(scene.camera.width) + "x" + std::to_string(scene.camera.height) +
+                            ", cube " + std::to_string(scene.render.cube_resolution) + " and " +
+                            std::to_string(scene.triangles->triangle_count()) + " triangles (before the A-buffers' "
+                            "fragments), " + budget_words(budget_bytes, capped)));
 }
 
 }  // namespace abcube

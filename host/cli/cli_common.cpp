@@ -47,8 +47,14 @@ void RenderFlags::add_to(CLI::App* cmd) {
   cmd->add_flag("--fresnel", [this](int64_t) { options.fresnel = true; }, "Schlick weights for kr and kt");
   cmd->add_option("--max-layers", options.max_layers, "A-buffer layers kept per list, 0 = all")
       ->capture_default_str()->check(CLI::Range(0, 1 << 20));
-  cmd->add_option("--max-memory", options.max_memory_mib, "A-buffer memory budget, MiB, 0 = what the machine has")
-      ->capture_default_str()->check(CLI::Range(uint64_t{0}, uint64_t{1} << 30));
+  cmd->add_option_function<uint64_t>(
+         "--max-memory",
+         [this](uint64_t mib) {
+           options.max_memory_mib = mib;
+           limits.max_memory_mib = mib;  // the scene's triangles are checked as they load
+         },
+         "the whole render's memory budget (scene, A-buffers, maps, images), MiB, 0 = the memory available")
+      ->default_str("0")->check(CLI::Range(uint64_t{0}, uint64_t{1} << 30));
   cmd->add_option("--max-pixels", options.max_pixels, "refuse a larger camera image, pixels, 0 = no cap")
       ->capture_default_str();
   cmd->add_option("--max-triangles", limits.max_triangles, "refuse a scene with more triangles, 0 = no cap")

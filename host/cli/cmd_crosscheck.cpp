@@ -31,7 +31,7 @@ struct CrosscheckCommand {
     const Scene loaded = Scene::load(scene_path);
     SceneData scene = loaded.data();  // shares the triangles
     if (cube_res > 0) scene.render.cube_resolution = cube_res;
-    check_render_size(scene, available_memory_bytes());
+    check_render_size(scene, memory_budget_bytes(0), false);
 
     std::string log;
     auto ctx = open_gl_context(choice, device, &log);

@@ -123,7 +123,9 @@ Image render_map_method(MethodContext& mc) {
   stats["timings_ms"]["map_setup"] = ms_since(t0);
   t0 = Clock::now();
   ABufferStats as;
-  const ABuffer camera = build_camera_abuffer(scene, r.abuffer, &as);
+  ABufferOptions camera_options = r.abuffer;  // the cube A-buffer is held while it is built
+  camera_options.reserved_bytes += cs.bytes_total;
+  const ABuffer camera = build_camera_abuffer(scene, camera_options, &as);
   stats["timings_ms"]["camera_abuffer"] = ms_since(t0);
   t0 = Clock::now();
   MapShadingStats ms;

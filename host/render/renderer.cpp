@@ -141,12 +141,15 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   r.map.search.side_structure = o.side_structure;
   r.abuffer.max_layers = o.max_layers;
   if (o.max_memory_mib > (uint64_t{1} << 30)) throw InputError("max-memory: must be at most 2^30 MiB");
-  r.abuffer.max_memory_bytes = o.max_memory_mib << 20;
+  r.abuffer.max_memory_bytes = o.max_memory_mib << 20;  // the whole render's budget
   for (const std::string& a : o.aovs) {
     if (!aov_known(a)) throw InputError("aovs: unknown AOV " + quote(a) + " (" + aov_names() + ")");
   }
   r.aovs = o.aovs;
-  check_render_size(*view, available_memory_bytes());
+  // Everything but the A-buffers' fragments, from the declared sizes, before any pass; the
+  // A-buffers get what is left when they have counted their fragments.
+  check_render_size(*view, memory_budget_bytes(r.abuffer.max_memory_bytes), o.max_memory_mib > 0);
+  r.abuffer.reserved_bytes = estimate_render_bytes(*view);
   return r;
 }
 

@@ -1,6 +1,7 @@
 // abcube::Scene: one loaded scene and its per-scene cache, shared by its copies.
 #include <abcube/scene.hpp>
 
+#include "base/error.hpp"
 #include "base/timer.hpp"
 #include "render/scene_state.hpp"
 #include "scene/scene_load.hpp"
@@ -13,6 +14,8 @@ LoadLimits load_limits(const SceneLimits& limits) {
   LoadLimits l;
   l.root = limits.root;
   l.max_triangles = limits.max_triangles;
+  if (limits.max_memory_mib > (uint64_t{1} << 30)) throw InputError("max-memory: must be at most 2^30 MiB");
+  l.max_memory_bytes = limits.max_memory_mib << 20;
   return l;
 }
 

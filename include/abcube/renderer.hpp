@@ -65,7 +65,7 @@ struct RenderOptions {
   std::string resolve = "exact";     // intersecting fragments: exact (priority masks) | thesis (Vis_front)
   bool side_structure = true;        // searches also test the triangles the map cannot hold (false: --map-only)
   uint32_t max_layers = 0;       // A-buffer layers kept per list (0 = all)
-  uint64_t max_memory_mib = 0;   // A-buffer budget, MiB (0 = what the machine has)
+  uint64_t max_memory_mib = 0;   // the whole render's memory budget, MiB (0 = the memory available)
   uint64_t max_pixels = 0;       // refuse a camera image larger than this (0 = no cap)
   CameraOverride camera;
   // Extra per-pixel outputs, each an Image in RenderResult::aovs, from the eye ray through

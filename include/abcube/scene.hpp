@@ -16,6 +16,9 @@ class SceneCache;   // its per-scene search and tracer data (cpu_core/shading/sc
 struct SceneLimits {
   std::string root;            // every file the scene references must resolve inside it ("" = anywhere)
   uint64_t max_triangles = 0;  // 0 = no cap beyond the machine's memory
+  // The memory budget the scene's triangles must fit, MiB (0 = the memory available, as
+  // RenderOptions::max_memory_mib): refused at load, before they are made.
+  uint64_t max_memory_mib = 0;
 };
 
 // A validated, tessellated scene in world space. Cheap to copy: copies share one loaded

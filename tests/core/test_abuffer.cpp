@@ -281,9 +281,22 @@ TEST(ABuffer, RefusesAboveTheMemoryBudgetWithTheEstimate) {
                                " fragments at 20 bytes\\), above --max-memory [0-9]+ MiB$";
     EXPECT_TRUE(std::regex_search(msg, std::regex(expect))) << msg;
   }
+  // What the rest of the render holds counts against the same budget.
+  o.max_memory_bytes = st.estimated_bytes + 1000;
+  o.reserved_bytes = 1000;
+  EXPECT_NO_THROW(build_cube_abuffer(s, s.camera.position, 64, o));
+  o.reserved_bytes = 1001;
+  try {
+    build_cube_abuffer(s, s.camera.position, 64, o);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_TRUE(std::regex_search(msg, std::regex(" fragments at 20 bytes\\) beside 1 MiB for the rest of the render, "
+                                                  "above --max-memory [0-9]+ MiB$"))) << msg;
+  }
+  o.reserved_bytes = 0;
   o.max_memory_bytes = 1024;  // not even the per-pixel index fits
   EXPECT_THROW(build_camera_abuffer(s, o), InputError);
-  EXPECT_GE(default_max_memory_bytes(), 1u);
 }
 
 TEST(ABuffer, LayerCapKeepsTheFrontAndCountsTheRest) {

@@ -895,20 +895,29 @@ TEST(SceneLoadMemory, EstimateAndBudget) {
   // bytes a triangle measured by bench/memory.py (168, bench/results/memory.txt).
   EXPECT_GT(bytes, 64u * 48 * 12 + 6u * 100 * 100 * 4 + 960u * 168);
   EXPECT_LT(bytes, uint64_t{64} << 20);
-  EXPECT_NO_THROW(check_render_size(s, bytes));
-  try {
-    check_render_size(s, bytes - 1);
-    FAIL() << "no error";
-  } catch (const InputError& e) {
-    const std::string m = e.what();
-    EXPECT_EQ(m.rfind("scene.json: render: estimated ", 0), 0u) << m;
-    EXPECT_NE(m.find("for 64x48 and cube 100 exceeds available memory"), std::string::npos) << m;
+  EXPECT_NO_THROW(check_render_size(s, bytes, true));
+  for (const bool capped : {true, false}) {
+    try {
+      check_render_size(s, bytes - 1, capped);
+      FAIL() << "no error";
+    } catch (const InputError& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(m.rfind("scene.json: render: estimated ", 0), 0u) << m;
+      EXPECT_NE(m.find("for 64x48, cube 100 and 960 triangles"), std::string::npos) << m;
+      EXPECT_NE(m.find(capped ? "above --max-memory " : "of memory available"), std::string::npos) << m;
+    }
   }
   // The gpu method counts the GL vertex buffer too (3 vertices of 32 bytes a triangle)
   // and what llvmpipe holds while drawing (about 90).
   SceneData gpu = s;
   gpu.render.method = Method::gpu;
-  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90));
+  // and a cube shadow map of N x N floats per shadow-casting light (the scene has one).
+  ASSERT_EQ(gpu.lights.size(), 1u);
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90) + 6u * 100 * 100 * 4);
+  gpu.lights.push_back(gpu.lights.front());
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90) + 2 * 6u * 100 * 100 * 4);
+  gpu.lights.back().cast_shadows = false;
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90) + 6u * 100 * 100 * 4);
   // A huge cube map is refused by its estimate, not by an allocation failure.
   text.render = R"({"cube_resolution": 16384})";
   EXPECT_GT(estimate_render_bytes(load_text(text.str())), uint64_t{6} * 16384 * 16384 * 32);
