@@ -5,6 +5,7 @@
 #include "cli/cli_common.hpp"
 #include "base/parallel.hpp"
 #include "gl/gl_context.hpp"
+#include "gl/gl_passes.hpp"
 
 namespace abcube {
 
@@ -24,6 +25,7 @@ void print_context(const char* label, const GlContext* ctx, const std::string& w
   std::printf("    GL_VERSION:    %s\n", i.gl_version.c_str());
   std::printf("    GL_RENDERER:   %s\n", i.gl_renderer.c_str());
   std::printf("    GL_VENDOR:     %s\n", i.gl_vendor.c_str());
+  std::printf("    shadow-casting lights (gpu): %d\n", gl_shadow_light_limit());
 }
 
 }  // namespace

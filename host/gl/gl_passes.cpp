@@ -368,6 +368,23 @@ void GlScene::drop_environment() {
   environment_ = 0;
 }
 
+int gl_shadow_light_limit() {
+  GLint layers = 0;
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &layers);
+  return std::max(layers, 0) / CUBE_FACES;
+}
+
+void check_gl_limits(const SceneData& scene) {
+  size_t casting = 0;
+  for (const PointLight& l : scene.lights) casting += l.cast_shadows ? 1 : 0;
+  const int limit = gl_shadow_light_limit();
+  if (casting > static_cast<size_t>(limit)) {
+    throw InputError(scene.file + ": lights: " + std::to_string(casting) + " cast shadows; --method gpu holds the shadow maps "
+                     "of at most " + std::to_string(limit) + " here (GL_MAX_ARRAY_TEXTURE_LAYERS " +
+                     std::to_string(limit * CUBE_FACES) + " / 6 faces): set \"cast_shadows\": false on some, or use a CPU method");
+  }
+}
+
 int GlScene::build_shadow_maps(int n) {
   shadow_layer_.assign(scene_.lights.size(), -1);
   int layers = 0;

@@ -48,6 +48,13 @@ constexpr int MAX_TEXTURE_ARRAYS = 4;
 constexpr float NO_DISTANCE = INFINITY;
 constexpr uint32_t NO_OBJECT = 0xffffffffu;
 
+// Refuses (InputError naming the count and the limit) a scene the current GL context cannot
+// draw under the gpu method: more shadow-casting lights than a cube-map array of shadow
+// maps holds (GL_MAX_ARRAY_TEXTURE_LAYERS / 6: 341 on llvmpipe, 341 or 2730 on NVIDIA).
+void check_gl_limits(const SceneData& scene);
+// That limit: shadow-casting lights the current GL context holds for the gpu method.
+int gl_shadow_light_limit();
+
 // The scene uploaded to the current GL context. Needs a current GL 4.5 context for its
 // whole life (gl_context.hpp).
 class GlScene {

@@ -300,6 +300,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
       }
       stats["gl"] = gl_json(ctx);
       stats["timings_ms"]["gl_init"] = first_open ? ms_since(t0) : 0.0;
+      check_gl_limits(view);  // before the upload
       bool uploaded = false;
       mc.gl_scene = &impl_->gl_scene_for(scene, &uploaded);
       if (!uploaded) mc.gl_before = mc.gl_scene->timings();  // else its upload is this render's
