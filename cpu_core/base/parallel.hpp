@@ -1,11 +1,14 @@
 // A plain parallel loop: items handed to std::threads dynamically, the calling thread
 // working too, the first exception rethrown after every thread has stopped. A render's
-// time limit (RenderTimeout) is checked before every item: see ScopedDeadline.
+// time limit (RenderTimeout) and a request to stop (Interrupted) are checked before every
+// item: see ScopedDeadline.
 #pragma once
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstddef>
+#include <cstdio>
 #include <exception>
 #include <string>
 #include <thread>
@@ -22,17 +25,40 @@ inline int thread_count(int requested, size_t items) {
   return static_cast<int>(std::clamp<size_t>(static_cast<size_t>(n), 1, std::max<size_t>(items, 1)));
 }
 
+// A request to stop every render of the process (request_stop, renderer.hpp: a signal
+// handler may make it, so it is a lock-free atomic with no dynamic initialisation). 0: none;
+// else the number given, usually the signal. Checked wherever a deadline is.
+inline std::atomic<int>& stop_request() {
+  static std::atomic<int> request{0};
+  return request;
+}
+
+// Throws Interrupted when a stop was requested.
+inline void check_stop_request() {
+  if (const int s = stop_request().load(std::memory_order_relaxed)) {
+    throw Interrupted(s == SIGINT ? "interrupted (SIGINT)" : s == SIGTERM ? "terminated (SIGTERM)"
+                                                                          : "stopped (signal " + std::to_string(s) + ")",
+                      s);
+  }
+}
+
 // A render's time limit. The thread that starts a render installs one for the render's
 // length (ScopedDeadline); every parallel_for started under it, on that thread or on its
-// workers, checks it before each item and throws RenderTimeout past it. The one piece of
-// per-thread state in the library, scoped to one render call.
+// workers, checks it before each item and throws RenderTimeout past it (and Interrupted
+// when a stop was requested, limit or none). The one piece of per-thread state in the
+// library, scoped to one render call.
 struct Deadline {
   std::chrono::steady_clock::time_point at;
   double seconds = 0;  // the limit as given, for the message
+  bool passed() const { return std::chrono::steady_clock::now() > at; }
   void check() const {
-    if (std::chrono::steady_clock::now() > at) {
-      throw RenderTimeout("render stopped: over its time limit of " + std::to_string(seconds) + " s");
-    }
+    if (passed()) throw RenderTimeout("timed out after " + format_seconds(seconds) + " s");
+  }
+  // "2", "0.5", "1e-06": the limit as a person wrote it.
+  static std::string format_seconds(double s) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", s);
+    return text;
   }
 };
 
@@ -53,8 +79,10 @@ class ScopedDeadline {
   const Deadline* previous_;
 };
 
-// Throws RenderTimeout when this thread's render is over its limit (no-op without one).
+// Throws Interrupted when a stop was requested, RenderTimeout when this thread's render is
+// over its limit.
 inline void check_deadline() {
+  check_stop_request();
   if (const Deadline* d = current_deadline()) d->check();
 }
 
@@ -68,6 +96,7 @@ void parallel_for(size_t count, int threads, Fn&& fn) {
     const ScopedDeadline scope(deadline);  // the workers inherit the caller's limit
     try {
       for (size_t i = next++; i < count; i = next++) {
+        check_stop_request();
         if (deadline) deadline->check();
         fn(i, worker);
       }

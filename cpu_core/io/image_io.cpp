@@ -15,6 +15,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "base/error.hpp"
+#include "base/temporary_file.hpp"
 
 namespace abcube {
 
@@ -40,22 +41,6 @@ std::string lower_extension(const std::string& path) {
 bool is_float_format(const std::string& path) {
   const std::string e = lower_extension(path);
   return e == ".exr" || e == ".hdr" || e == ".pfm";
-}
-
-// A temporary name beside `path` that keeps its extension (OpenImageIO picks by it).
-std::string temporary_name(const std::string& path) {
-  const fs::path p(path);
-  const std::string name = "." + p.stem().string() + ".tmp" + std::to_string(getpid()) +
-                           p.extension().string();
-  return (p.parent_path() / name).string();
-}
-
-void rename_into_place(const std::string& tmp, const std::string& path) {
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string why = std::strerror(errno);
-    std::remove(tmp.c_str());
-    throw RuntimeFailure(path + ": cannot write: " + why);
-  }
 }
 
 }  // namespace
@@ -86,7 +71,8 @@ void write_image(const std::string& path, const Image& image) {
       pixels[k] = alpha ? std::clamp(pixels[k], 0.f, 1.f) : srgb_encode(pixels[k]);
     }
   }
-  const std::string tmp = temporary_name(path);
+  TemporaryFile temporary(path);
+  const std::string& tmp = temporary.path();
   // DPX records the name it is opened with: it is opened with the final name and writes
   // through a proxy to the temporary file, so that its bytes do not hold the temporary's
   // name (and the process id in it). Only DPX: OIIO 2.4's TIFF writer makes broken files
@@ -104,12 +90,11 @@ void write_image(const std::string& path, const Image& image) {
     proxy->close();
   }
   if (!ok) {
-    std::remove(tmp.c_str());
     std::string why = out->geterror();
     if (why.empty()) why = "write failed";
     throw RuntimeFailure(path + ": cannot write image: " + why);
   }
-  rename_into_place(tmp, path);
+  temporary.commit();
 }
 
 Image read_image(const std::string& path) {
@@ -140,18 +125,15 @@ Image read_image(const std::string& path) {
 }
 
 void write_text_atomic(const std::string& path, const std::string& text) {
-  const std::string tmp = temporary_name(path);
+  TemporaryFile temporary(path);
   {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    std::ofstream f(temporary.path(), std::ios::binary | std::ios::trunc);
     if (!f) throw RuntimeFailure(path + ": cannot write: " + std::strerror(errno));
     f << text;
-    f.flush();
-    if (!f) {
-      std::remove(tmp.c_str());
-      throw RuntimeFailure(path + ": cannot write: " + std::strerror(errno));
-    }
+    f.close();
+    if (!f) throw RuntimeFailure(path + ": cannot write: " + std::strerror(errno));
   }
-  rename_into_place(tmp, path);
+  temporary.commit();
 }
 
 }  // namespace abcube

@@ -11,6 +11,7 @@
 #include <embree3/rtcore.h>
 
 #include "base/error.hpp"
+#include "base/parallel.hpp"
 #include "scene/tie_rule.hpp"
 
 namespace abcube {
@@ -35,6 +36,13 @@ std::string embree_error(RTCDevice device) {
 void check_embree(RTCDevice device, const char* what) {
   const std::string e = embree_error(device);
   if (!e.empty()) throw RuntimeFailure(std::string("embree: ") + what + ": " + e);
+}
+
+// Embree's build monitor (called from its worker threads now and then): false cancels the
+// build, when the render that asked for it is over its time limit or a stop was requested.
+bool build_may_go_on(void* deadline, double /*done*/) {
+  if (stop_request().load(std::memory_order_relaxed) != 0) return false;
+  return !deadline || !static_cast<const Deadline*>(deadline)->passed();
 }
 
 // One device for the process (Embree's thread pool and settings), made on first use.
@@ -291,10 +299,12 @@ void Bvh::build() {
   rtcCommitGeometry(geometry);
   rtcAttachGeometry(scene, geometry);
   rtcReleaseGeometry(geometry);
+  rtcSetSceneProgressMonitorFunction(scene, build_may_go_on, const_cast<Deadline*>(current_deadline()));
   rtcCommitScene(scene);
   const std::string e = embree_error(device);
   if (!e.empty()) {
     rtcReleaseScene(scene);
+    check_deadline();  // a cancelled build: RenderTimeout or Interrupted
     throw RuntimeFailure("embree: building the tree over " + std::to_string(n) + " triangles: " + e);
   }
   scene_ = scene;

@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 
 #include "base/error.hpp"
@@ -97,13 +99,35 @@ void print_warnings(const Scene& scene, const std::string& prefix) {
   for (const std::string& w : scene.warnings()) std::fprintf(stderr, "%s%s\n", prefix.c_str(), one_line(w).c_str());
 }
 
+namespace {
+
+// Why files cannot be made in `folder` (the temporary of an atomic write goes beside the
+// output), or "".
+std::string folder_problem(const std::filesystem::path& folder) {
+  const std::string f = folder.empty() ? "." : folder.string();
+  if (!std::filesystem::is_directory(folder.empty() ? "." : folder)) return "folder " + quote_path(f) + " is no folder";
+  if (access(f.c_str(), W_OK | X_OK) != 0) return "folder " + quote_path(f) + " is not writable (" + std::strerror(errno) + ")";
+  return "";
+}
+
+}  // namespace
+
 void check_output_path(const std::string& path, bool image) {
   if (path.empty()) return;
   if (image && !image_format_supported(path)) throw InputError(path + ": no image writer for this file extension");
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  if (!dir.empty() && !std::filesystem::is_directory(dir)) {
-    throw InputError(path + ": folder " + dir.string() + " does not exist");
+  if (!dir.empty() && !std::filesystem::exists(dir)) {
+    throw InputError(path + ": folder " + quote_path(dir.string()) + " does not exist");
   }
+  const std::string problem = folder_problem(dir);
+  if (!problem.empty()) throw InputError(path + ": " + problem);
+}
+
+std::string creatable_output_problem(const std::string& path) {
+  std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  while (!dir.empty() && !std::filesystem::exists(dir, ec) && dir.has_relative_path()) dir = dir.parent_path();
+  return folder_problem(dir);
 }
 
 }  // namespace abcube

@@ -49,7 +49,11 @@ std::string aov_path(const std::string& output, const std::string& aov);
 // once the work succeeded, so that a failure stays one line (cli.md).
 void print_warnings(const Scene& scene, const std::string& prefix);
 
-// Refuses before any work an output whose format has no writer or whose folder is missing.
+// Refuses before any work an output whose format has no writer or whose folder is missing
+// or not writable (InputError naming the output and the folder).
 void check_output_path(const std::string& path, bool image);
+// For an output whose missing folders will be made (batch): why that cannot work (the
+// nearest existing folder on its path is no folder, or not writable), or "".
+std::string creatable_output_problem(const std::string& path);
 
 }  // namespace abcube

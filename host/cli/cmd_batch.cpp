@@ -17,6 +17,7 @@
 
 #include "base/error.hpp"
 #include "base/input_file.hpp"
+#include "base/parallel.hpp"
 #include "base/statistics.hpp"
 #include "base/timer.hpp"
 #include "cli/batch_jobs.hpp"
@@ -104,13 +105,32 @@ struct BatchCommand {
     const auto [shard_i, shard_n] = parse_shard();
     const RenderOptions base = flags.render_options();
     const std::vector<Job> jobs = read_jobs(shard_i, shard_n);
+    for (const Job& job : jobs) {  // before anything renders, as a malformed line
+      for (const auto& [key, out] : {std::pair<const char*, const std::string*>{"out", &job.out}, {"stats", &job.stats}}) {
+        const std::string problem = out->empty() ? "" : creatable_output_problem(*out);
+        if (!problem.empty()) {
+          throw InputError(jobs_path + ":" + std::to_string(job.line) + ": \"" + key + "\": " + quote_path(*out) + ": " + problem);
+        }
+      }
+    }
     Renderer renderer(flags.renderer);
     SceneShelf scenes(std::max<size_t>(scene_cache, 1), flags.limits);
     const bool terminal = stderr_is_terminal();
     size_t done = 0, failed = 0, skipped = 0;
     std::vector<double> render_ms, overhead_ms;
     std::set<std::string> warned;  // scenes whose warnings were printed
+    // SIGINT or SIGTERM (a stop request): the job under way leaves nothing, the batch ends
+    // here, and --skip-existing resumes it.
+    auto stopped = [&] {
+      if (terminal) std::fputc('\n', stderr);
+      std::fprintf(stderr, "%s: stopped after %zu of %zu jobs (%zu rendered); rerun with --skip-existing to resume\n",
+                   jobs_path.c_str(), done, jobs.size(), render_ms.size());
+    };
     for (const Job& job : jobs) {
+      if (stop_requested()) {
+        stopped();
+        check_stop_request();
+      }
       if (skip_existing && fs::exists(job.out) && (job.stats.empty() || fs::exists(job.stats))) {
         ++skipped;
       } else {
@@ -128,6 +148,9 @@ struct BatchCommand {
             if (terminal) std::fputc('\n', stderr);
             print_warnings(scene, jobs_path + ":" + std::to_string(job.line) + ": ");
           }
+        } catch (const Interrupted&) {
+          stopped();
+          throw;
         } catch (const std::exception& e) {
           ++failed;
           if (terminal) std::fputc('\n', stderr);

@@ -1,5 +1,6 @@
 // abcube: headless hybrid renderer. Subcommands: render, batch, compare, info,
 // export-pov, crosscheck (../shared/cli.md); one CLI11 parser, --help on each.
+#include <csignal>
 #include <cstdio>
 #include <string>
 
@@ -8,7 +9,36 @@
 
 #include "base/error.hpp"
 #include "base/memory.hpp"
+#include "base/parallel.hpp"
+#include "base/temporary_file.hpp"
 #include "cli/cli_common.hpp"
+
+namespace {
+
+// SIGINT and SIGTERM (README "Faults survived"): the first asks the work to stop at its
+// next check (the render throws Interrupted, no output is put in place, the temporaries
+// are removed by their owners, exit 128 + signal); a second one removes the temporary
+// files at once and ends the process by the signal's default action.
+volatile std::sig_atomic_t stop_signals_seen = 0;
+
+extern "C" void on_stop_signal(int signal) {
+  if (stop_signals_seen++ == 0) {
+    abcube::request_stop(signal);
+    return;
+  }
+  abcube::remove_temporary_files_now();
+  std::signal(signal, SIG_DFL);
+  std::raise(signal);
+}
+
+void install_stop_handlers() {
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  for (const int s : {SIGINT, SIGTERM}) sigaction(s, &action, nullptr);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace abcube;
@@ -54,8 +84,15 @@ int main(int argc, char** argv) {
     if (sub == chosen) break;
     ++index;
   }
+  install_stop_handlers();
   try {
-    return runs[index]();
+    const int status = runs[index]();
+    // A stop asked after the last check: the work is done and whole, but the process was told to stop.
+    abcube::check_stop_request();
+    return status;
+  } catch (const Interrupted& e) {
+    std::fprintf(stderr, "abcube: %s\n", one_line(e.what(), "; ").c_str());
+    return 128 + e.signal;
   } catch (const InputError& e) {
     std::fprintf(stderr, "abcube: %s\n", one_line(e.what(), "; ").c_str());
     return 2;

@@ -265,6 +265,10 @@ std::string Renderer::gl_renderer() const { return impl_->gl ? impl_->gl->info()
 
 uint64_t Renderer::renders() const { return impl_->renders; }
 
+void request_stop(int signal) { stop_request().store(signal > 0 ? signal : 1, std::memory_order_relaxed); }
+void clear_stop_request() { stop_request().store(0, std::memory_order_relaxed); }
+bool stop_requested() { return stop_request().load(std::memory_order_relaxed) != 0; }
+
 RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) {
   const std::lock_guard<std::mutex> lock(impl_->mutex);
   const Clock::time_point start = Clock::now();

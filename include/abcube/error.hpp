@@ -24,6 +24,13 @@ struct RenderTimeout : RuntimeFailure {
   using RuntimeFailure::RuntimeFailure;
 };
 
+// Work stopped because the process was asked to stop (request_stop in renderer.hpp: the
+// CLI's SIGINT and SIGTERM handlers). `signal` is the number given to request_stop.
+struct Interrupted : RuntimeFailure {
+  Interrupted(const std::string& what, int signal_number) : RuntimeFailure(what), signal(signal_number) {}
+  int signal;
+};
+
 // A failed internal check: a bug in abcube, never the input's fault. Thrown, not aborted,
 // so that a host program or an interpreter survives it; the message names the check, its
 // file and line, and its operands.

@@ -37,6 +37,15 @@ namespace abcube {
 // "abcube X.Y.Z" (and " (git COMMIT)" when built from a git checkout).
 std::string version_string();
 
+// Asks every render of the process to stop at its next check (before each tile, row or
+// pass: the checks of RenderOptions::timeout_s): each throws Interrupted(signal), and an
+// image being written is not put in place (its temporary is removed). Async-signal-safe:
+// made for a SIGINT or SIGTERM handler (the CLI's, README "Faults survived"). Renders
+// started later stop at once too, until clear_stop_request().
+void request_stop(int signal);
+void clear_stop_request();
+bool stop_requested();
+
 // Replaces only the keys given; the rest come from the scene's camera. Validated as the
 // scene file's camera is (fov_y in (0, 180) degrees, sizes >= 1, up not along the view).
 struct CameraOverride {
