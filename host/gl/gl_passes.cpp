@@ -1,5 +1,7 @@
 #include "gl/gl_passes.hpp"
 
+#include "base/parallel.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,6 +13,7 @@
 #include "raster/cube_map.hpp"
 #include "raster/samples.hpp"
 #include "base/error.hpp"
+#include "base/parallel.hpp"
 #include "base/timer.hpp"
 #include "scene/texture.hpp"
 #include "scene/tie_rule.hpp"
@@ -396,7 +399,7 @@ int GlScene::build_shadow_maps(int n) {
   if (shadow_maps_ != 0 && shadow_n_ == n) return layers;
   const Clock::time_point t0 = Clock::now();
   if (n > max_size_) throw RuntimeFailure("shadow map " + std::to_string(n) + " exceeds GL_MAX_TEXTURE_SIZE");
-  shadow_n_ = n;
+  shadow_n_ = 0;  // the maps count as built (and are kept) only once they are whole
   glDeleteTextures(1, &shadow_maps_);
   glGenTextures(1, &shadow_maps_);
   glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, shadow_maps_);
@@ -413,6 +416,7 @@ int GlScene::build_shadow_maps(int n) {
   peel_translucent_casters(n, layers);
   glFinish();
   check_gl("cube shadow maps");
+  shadow_n_ = n;
   timings_.shadow_maps_ms += ms_since(t0);
   return layers;
 }
@@ -427,6 +431,7 @@ void GlScene::draw_shadow_casters(GLuint maps) {
     shadow_program_->use();
     glUniform1f(shadow_program_->uniform("u_light_layer"), float(shadow_layer_[i]));
     for (int face = 0; face < CUBE_FACES; ++face) {
+      check_deadline();  // a render's time limit, or a stop request, between passes
       glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, maps, 0, 6 * shadow_layer_[i] + face);
       glDrawBuffers(1, buffers);
       clear_lookup_target(n_of_lookup_, true);
@@ -454,6 +459,7 @@ void GlScene::peel_translucent_casters(int n, int layers) {
   glUniform1i(shadow_program_->uniform("u_opaque"), 1);
   glUniform1i(shadow_program_->uniform("u_previous"), static_cast<GLint>(PEEL_UNIT));
   for (int k = 0; k <= MAX_SHADOW_PEELS; ++k) {
+    check_deadline();
     GLuint peel = 0;
     glGenTextures(1, &peel);
     glActiveTexture(GL_TEXTURE0);
@@ -504,6 +510,7 @@ void GlScene::build_environment(const glm::dvec3& center, int n) {
   bind_lookups(*phong_program_, false);  // no environment inside the environment
   const GLenum buffers[] = {GL_COLOR_ATTACHMENT0};
   for (int face = 0; face < CUBE_FACES; ++face) {
+    check_deadline();
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
                            GL_TEXTURE_CUBE_MAP_POSITIVE_X + static_cast<GLenum>(face), environment_, 0);
     glDrawBuffers(1, buffers);
@@ -545,6 +552,7 @@ void GlScene::cube_distance(const glm::dvec3& center, int n, CubeImage* distance
   *distance = CubeImage(n, 1);
   if (ids) ids->n = n;
   for (int face = 0; face < CUBE_FACES; ++face) {
+    check_deadline();
     Clock::time_point t0 = Clock::now();
     t.clear(scene_.background);
     draw(*distance_program_, face_clip_matrix(face, center, near_), center);
@@ -571,6 +579,7 @@ CubeImage GlScene::cube_color(const glm::dvec3& center, int n) {
   bind_lookups(*phong_program_, false);
   std::vector<float> rgba(static_cast<size_t>(n) * n * 4);
   for (int face = 0; face < CUBE_FACES; ++face) {
+    check_deadline();
     Clock::time_point t0 = Clock::now();
     t.clear(scene_.background);
     draw(*phong_program_, face_clip_matrix(face, center, near_), center);
@@ -624,6 +633,7 @@ Image GlScene::camera_color(const Camera& camera, CameraSamples samples) {
   // coordinates scaled and shifted so that the tile fills the viewport (one tile: identity).
   for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
     for (int64_t x0 = 0; x0 < full_w; x0 += tile_w) {
+      check_deadline();
       glm::mat4 tile(1.f);
       tile[0][0] = float(double(full_w) / tile_w);
       tile[3][0] = float(-double(full_w) / tile_w * (double(2 * x0 + tile_w) / double(full_w) - 1.0));

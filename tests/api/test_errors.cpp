@@ -95,6 +95,27 @@ TEST(ErrorsApi, TimeoutStopsALongRender) {
   EXPECT_EQ(r.image.width, 8);
 }
 
+// A gpu render stopped by its limit (at the first check: inside the shadow maps) leaves the
+// Renderer's GL scene as good as new: the next render equals a new Renderer's, byte for byte.
+TEST(ErrorsApi, GpuTimeoutLeavesTheGlSceneWhole) {
+  const Scene scene = Scene::from_json(tiny_scene_json(32, 24, 32));
+  Renderer renderer;
+  RenderOptions o;
+  o.method = "gpu";
+  o.timeout_s = 1e-9;
+  try {
+    renderer.render(scene, o);
+    FAIL() << "no timeout";
+  } catch (const RenderTimeout&) {
+  } catch (const RuntimeFailure& e) {
+    GTEST_SKIP() << "no GL here: " << e.what();
+  }
+  o.timeout_s = 0;
+  const RenderResult after = renderer.render(scene, o);
+  Renderer fresh;
+  EXPECT_TRUE(images_equal(after.image, fresh.render(scene, o).image));
+}
+
 TEST(ErrorsApi, GpuWithoutGlIsInputError) {
   const Scene scene = Scene::from_json(tiny_scene_json(8, 8, 16));
   Renderer renderer(RendererOptions{"none", -1, 1});

@@ -55,22 +55,26 @@ check "malformed: nothing rendered" [ ! -e m/1.png ]
 check "malformed: one line" [ "$(wc -l < err)" -eq 1 ]
 printf '{"scene": "cornell.json", "out": "m/1.png"}\nnot json\n' > bad2.jsonl
 "$ABCUBE" batch bad2.jsonl 2> err; status=$?
-check "not JSON: exit 2 naming line 2" [ $status -eq 2 ] && grep -q "bad2.jsonl:2: not JSON" err
+check "not JSON: exit 2 naming line 2" [ $status -eq 2 ]
+check "not JSON: exit 2 naming line 2 (2)" grep -q "bad2.jsonl:2: not JSON" err
 # Numbers past a double (found by tests/fuzz: exit 1 with nlohmann's message, no line) and
 # integers past 32 bits (used to wrap: 4294967808 rendered at 512) are malformed lines.
 printf '{"scene": "cornell.json", "out": "m/1.png", "cube_res": 1e999}\n' > big1.jsonl
 "$ABCUBE" batch big1.jsonl 2> err; status=$?
-check "number overflow: exit 2 naming line 1" [ $status -eq 2 ] && grep -q "big1.jsonl:1: not JSON" err
+check "number overflow: exit 2 naming line 1" [ $status -eq 2 ]
+check "number overflow: exit 2 naming line 1 (2)" grep -q "big1.jsonl:1: not JSON" err
 printf '{"scene": "cornell.json", "out": "m/1.png", "cube_res": 4294967808}\n' > big2.jsonl
 "$ABCUBE" batch big2.jsonl 2> err; status=$?
-check "integer past 32 bits: exit 2 naming line 1" [ $status -eq 2 ] && grep -q 'big2.jsonl:1: "cube_res": must be an integer' err
+check "integer past 32 bits: exit 2 naming line 1" [ $status -eq 2 ]
+check "integer past 32 bits: exit 2 naming line 1 (2)" grep -q 'big2.jsonl:1: "cube_res": must be an integer' err
 printf '{"out": "m/1.png"}\n' > bad3.jsonl
 "$ABCUBE" batch bad3.jsonl 2> err
 check "missing scene key named" grep -q 'bad3.jsonl:1: "scene": required' err
 # A jobs "file" with no line break (/dev/zero) is refused once its first line passes 1 MiB,
 # instead of being read until memory runs out.
 "$ABCUBE" batch /dev/zero 2> err; status=$?
-check "/dev/zero: exit 2 naming line 1" [ $status -eq 2 ] && grep -q "/dev/zero:1: longer than 1 MiB" err
+check "/dev/zero: exit 2 naming line 1" [ $status -eq 2 ]
+check "/dev/zero: exit 2 naming line 1 (2)" grep -q "/dev/zero:1: longer than 1 MiB" err
 check "/dev/zero: one line" [ "$(wc -l < err)" -eq 1 ]
 # A job key holding terminal escapes is shown escaped.
 printf '{"\\u001b]0;pwned\\u0007": 1}\n' > esc.jsonl
@@ -82,7 +86,9 @@ check "no control byte on stderr" [ -z "$(tr -d '\n' < err | tr -d '[:print:]')"
 printf '{"version": 1, "camera": {"position": [0, 1, 5], "look_at": [0, 0, 0], "width": 16, "height": 12}, "objects": [{"type": "mesh", "file": "empty.obj"}]}\n' > empty_mesh.json
 printf '{"scene": "empty_mesh.json", "out": "w/1.png", "method": "raytrace"}\n{"scene": "empty_mesh.json", "out": "w/2.png", "method": "raytrace"}\n' > warn.jsonl
 "$ABCUBE" batch warn.jsonl > /dev/null 2> err; status=$?
-check "empty mesh: exit 0, both rendered" [ $status -eq 0 ] && [ -s w/1.png ] && [ -s w/2.png ]
+check "empty mesh: exit 0, both rendered" [ $status -eq 0 ]
+check "empty mesh: exit 0, both rendered (2)" [ -s w/1.png ]
+check "empty mesh: exit 0, both rendered (3)" [ -s w/2.png ]
 check "empty mesh: one warning naming job line 1" [ "$(cat err)" = "warn.jsonl:1: empty_mesh.json: objects[0].file: warning: mesh \"empty.obj\" has no triangles" ]
 
 # --- a failing job: its line on stderr, the others rendered, exit 1
@@ -91,7 +97,8 @@ printf '{"scene": "cornell.json", "out": "f/1.png", "method": "raytrace"}\n{"sce
 check "failing jobs: exit 1" [ $status -eq 1 ]
 check "failing job 2 named by line" grep -q "fail.jsonl:2: .*nowhere.json" err
 check "failing job 3 named by line" grep -q "fail.jsonl:3: method: unknown method \"photon\"" err
-check "the other jobs rendered" [ -s f/1.png ] && [ -s f/4.png ]
+check "the other jobs rendered" [ -s f/1.png ]
+check "the other jobs rendered (2)" [ -s f/4.png ]
 check "summary counts failures" grep -q "4 jobs, 2 rendered, 2 failed" summary
 
 # --- shards make the whole batch; --skip-existing resumes
@@ -104,7 +111,21 @@ rm out/c.png
 check "--skip-existing renders only the missing job" grep -q "5 jobs, 1 rendered, 0 failed, 4 skipped" s2
 check "the missing job is back, same bytes" cmp -s out/c.png rc.png
 "$ABCUBE" batch jobs.jsonl --shard 2/2 2> err; status=$?
-check "--shard 2/2: exit 2" [ $status -eq 2 ] && grep -q -- "--shard" err
+check "--shard 2/2: exit 2" [ $status -eq 2 ]
+check "--shard 2/2: exit 2 (2)" grep -q -- "--shard" err
+
+# --- --job-timeout: the middle job (cornell traced at 512 x 512, seconds) is stopped past 1 s
+# with its line; the quick jobs before and after it render; it leaves no output.
+printf '%s\n' '{"scene": "hidden_point.json", "out": "t/1.png", "method": "raytrace", "camera": {"width": 32, "height": 24}}' \
+  '{"scene": "cornell.json", "out": "t/2.png", "method": "raytrace", "camera": {"width": 512, "height": 512}}' \
+  '{"scene": "hidden_point.json", "out": "t/3.png", "method": "raytrace", "camera": {"width": 32, "height": 24}}' > timeout.jsonl
+"$ABCUBE" batch timeout.jsonl --job-timeout 1 > summary 2> err; status=$?
+check "job timeout: exit 1" [ $status -eq 1 ]
+check "job timeout: 'JOBS:2: timed out after 1 s'" [ "$(cat err)" = "timeout.jsonl:2: timed out after 1 s" ]
+check "job timeout: the jobs around it rendered" test -s t/1.png -a -s t/3.png
+check "job timeout: the stopped job left no output" test ! -e t/2.png
+check "job timeout: no temporary file" [ -z "$(find . -name '.*.tmp*' -print -quit)" ]
+check "job timeout: summary" grep -q "3 jobs, 2 rendered, 1 failed" summary
 
 echo "cli batch_cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
