@@ -45,11 +45,27 @@ bool build_may_go_on(void* deadline, double /*done*/) {
   return !deadline || !static_cast<const Deadline*>(deadline)->passed();
 }
 
+// Under ThreadSanitizer the tree is built on the calling thread alone: Debian's libembree3
+// and libtbb are not instrumented, so TSan cannot see the synchronisation of TBB's workers
+// and reports the tree's blocks (made on a worker, freed by the caller) and our bounds
+// callback (run on a worker) as races (tools/sanitizers/tsan.supp). The queries, made from
+// abcube's own threads, are still checked; the answers do not depend on the build threads.
+#if defined(__SANITIZE_THREAD__)
+#define ABCUBE_EMBREE_THREADS ",threads=1"
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define ABCUBE_EMBREE_THREADS ",threads=1"
+#endif
+#endif
+#ifndef ABCUBE_EMBREE_THREADS
+#define ABCUBE_EMBREE_THREADS ""
+#endif
+
 // One device for the process (Embree's thread pool and settings), made on first use.
 // Leaves of up to 4 user primitives: 27 instead of 80 bytes a triangle, as fast.
 RTCDevice embree_device() {
   struct Device {
-    RTCDevice device = rtcNewDevice("verbose=0,object_accel_max_leaf_size=4");
+    RTCDevice device = rtcNewDevice("verbose=0,object_accel_max_leaf_size=4" ABCUBE_EMBREE_THREADS);
     ~Device() { rtcReleaseDevice(device); }
   };
   static const Device d;
