@@ -125,6 +125,28 @@ glm::dvec3 pack_under_mask(FragmentList list, CoverageMask search, const Fragmen
   return pack(list, search, shade, triangles, background, scratch ? scratch : &local, depth);
 }
 
+void visible_triangles(const ABuffer& camera, const TriangleSoup& triangles, int x, int y,
+                       uint32_t out[MASK_SAMPLES]) {
+  const FragmentList list = camera.list(x, y);
+  const SampleDepth depth{&camera.view, &triangles, x, y};
+  for (int k = 0; k < MASK_SAMPLES; ++k) {
+    const CoverageMask bit = CoverageMask{1} << k;
+    const Fragment* seen = nullptr;
+    for (const Fragment& f : list) {
+      if (!(f.mask & bit)) continue;
+      if (!seen) {
+        seen = &f;
+      } else if (f.zmin > seen->zmax) {
+        break;  // the rest lie behind
+      } else if (triangles.object_id[f.triangle()] != triangles.object_id[seen->triangle()] &&
+                 depth.nearer(*seen, f, bit)) {
+        seen = &f;  // overlapping in depth, and its plane met first on this sample's ray
+      }
+    }
+    out[k] = seen ? seen->triangle() : NO_SAMPLE_TRIANGLE;
+  }
+}
+
 int resolve_workers(const ABuffer& camera, const ResolveOptions& options) {
   if (options.threads < 0) throw InputError("resolve: threads must be >= 0, got " + std::to_string(options.threads));
   return thread_count(options.threads, static_cast<size_t>(camera.height()));

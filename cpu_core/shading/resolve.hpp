@@ -117,4 +117,14 @@ int resolve_workers(const ABuffer& camera, const ResolveOptions& options);
 Image resolve_image_per_worker(const ABuffer& camera, const TriangleSoup& triangles, const WorkerPixelShader& shade,
                                const glm::dvec3& background, const ResolveOptions& options = {});
 
+// What each of the 32 samples of pixel (x, y) sees: the triangle of the nearest surface
+// covering it (NO_SAMPLE_TRIANGLE where none), by the list's coverage masks and, where
+// fragments of different objects overlap in depth, the EXACT PRIORITY MASKS rule (each
+// sample's own eye ray, THE TIE RULE): the GPU's Z-buffer at the same sample positions
+// sees the same surfaces (`abcube crosscheck`, sample by sample). Opacity is not applied:
+// this is visibility.
+constexpr uint32_t NO_SAMPLE_TRIANGLE = 0xffffffffu;
+void visible_triangles(const ABuffer& camera, const TriangleSoup& triangles, int x, int y,
+                       uint32_t out[MASK_SAMPLES]);
+
 }  // namespace abcube

@@ -20,7 +20,7 @@ namespace abcube {
 namespace {
 
 struct CrosscheckCommand {
-  std::string scene_path, stats_path, gl = "auto";
+  std::string scene_path, stats_path, samples_image, gl = "auto";
   int cube_res = 0, device = -1, threads = 0;
 
   int run() const {
@@ -28,6 +28,7 @@ struct CrosscheckCommand {
     if (!parse_gl_choice(gl, &choice)) throw InputError("--gl: unknown path " + quote(gl));
     if (choice == GlChoice::none) throw InputError("--gl none: the cross-check compares GL with the CPU");
     check_output_path(stats_path, false);
+    check_output_path(samples_image, true);
     const Scene loaded = Scene::load(scene_path);
     SceneData scene = loaded.data();  // shares the triangles
     if (cube_res > 0) scene.render.cube_resolution = cube_res;
@@ -52,6 +53,10 @@ struct CrosscheckCommand {
     std::printf("camera interior pixels: %zu of %zu, RMSE %.2e (<= %.0e), max abs %.2e (<= %.2e)\n",
                 r.interior_pixels, r.pixels, r.interior_rmse, tol.interior_rmse, r.interior_max_abs,
                 tol.interior_max_abs);
+    std::printf("camera samples: %zu, same object %zu (agreement %.6f >= %.4f), GPU only %zu, CPU only %zu, "
+                "other object %zu\n",
+                r.samples, r.samples_same, r.sample_agreement, tol.sample_agreement_min, r.samples_gpu_only,
+                r.samples_cpu_only, r.samples_other_object);
     std::printf("time: GPU prepass %.1f ms, CPU cube A-buffer %.1f ms (%llu fragments)\n", r.gpu_ms, r.cpu_ms,
                 static_cast<unsigned long long>(r.fragments));
     std::printf("%s\n", r.pass ? "PASS" : ("FAIL: " + r.failures).c_str());
@@ -60,6 +65,7 @@ struct CrosscheckCommand {
       j["gl"] = {{"path", ctx->info().api}, {"renderer", ctx->info().gl_renderer}};
       write_text_atomic(stats_path, j.dump(2) + "\n");
     }
+    if (!samples_image.empty()) write_image(samples_image, r.sample_disagreement);
     print_warnings(loaded, "abcube: ");
     return r.pass ? 0 : 1;
   }
@@ -78,6 +84,8 @@ CommandRun add_crosscheck_command(CLI::App& app) {
   cmd->add_option("--threads", c->threads, "worker threads, 0 = every core")->capture_default_str()
       ->check(CLI::Range(0, 4096));
   cmd->add_option("--stats", c->stats_path, "figures and tolerances as JSON");
+  cmd->add_option("--samples-image", c->samples_image,
+                  "per pixel, the share of its 32 camera samples where GPU and CPU see different objects");
   return [c] { return c->run(); };
 }
 

@@ -63,6 +63,18 @@ void set_pass_state() {
   glDisable(GL_BLEND);
 }
 
+// The clip coordinates of the full sample grid (full_w x full_h, GL window coordinates, y
+// up) scaled and shifted so that the tile at (x0, y0), tile_w x tile_h, fills the viewport
+// (one tile: identity).
+glm::mat4 tile_matrix(int64_t full_w, int64_t full_h, int64_t x0, int64_t y0, int tile_w, int tile_h) {
+  glm::mat4 tile(1.f);
+  tile[0][0] = float(double(full_w) / tile_w);
+  tile[3][0] = float(-double(full_w) / tile_w * (double(2 * x0 + tile_w) / double(full_w) - 1.0));
+  tile[1][1] = float(double(full_h) / tile_h);
+  tile[3][1] = float(-double(full_h) / tile_h * (double(2 * y0 + tile_h) / double(full_h) - 1.0));
+  return tile;
+}
+
 }  // namespace
 
 // One framebuffer: distance (R32F) + object id (R32UI), or colour (RGBA32F); depth 32F.
@@ -572,6 +584,34 @@ void GlScene::cube_distance(const glm::dvec3& center, int n, CubeImage* distance
   check_gl("cube distance prepass");
 }
 
+std::vector<uint32_t> GlScene::camera_objects(const Camera& camera) {
+  const int64_t full_w = int64_t{camera.width} * MASK_COLUMNS, full_h = int64_t{camera.height} * MASK_ROWS;
+  const int64_t tile_max = std::min(CAMERA_TILE, max_size_);
+  const int tile_w = static_cast<int>(std::min(full_w, tile_max)), tile_h = static_cast<int>(std::min(full_h, tile_max));
+  Target& t = target(tile_w, tile_h, true);
+  const double aspect = static_cast<double>(camera.width) / camera.height;
+  const glm::mat4 clip = camera_clip_matrix(camera.position, camera.look_at, camera.up,
+                                            glm::radians(camera.fov_y_deg), aspect, near_);
+  std::vector<uint32_t> out(static_cast<size_t>(full_w * full_h), NO_OBJECT), tile_ids(size_t(tile_w) * size_t(tile_h));
+  for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
+    for (int64_t x0 = 0; x0 < full_w; x0 += tile_w) {
+      check_deadline();
+      t.clear(scene_.background);
+      draw(*distance_program_, tile_matrix(full_w, full_h, x0, y0, tile_w, tile_h) * clip, camera.position);
+      t.read(1, GL_RED_INTEGER, GL_UNSIGNED_INT, tile_ids.data());
+      // GL's row 0 is the bottom; the grid's row 0 is the top.
+      for (int64_t gy = 0; gy < tile_h && y0 + gy < full_h; ++gy) {
+        for (int64_t gx = 0; gx < tile_w && x0 + gx < full_w; ++gx) {
+          out[static_cast<size_t>((full_h - 1 - (y0 + gy)) * full_w + x0 + gx)] =
+              tile_ids[static_cast<size_t>(gy * tile_w + gx)];
+        }
+      }
+    }
+  }
+  check_gl("camera object ids");
+  return out;
+}
+
 CubeImage GlScene::cube_color(const glm::dvec3& center, int n) {
   Target& t = target(n, n, false);
   CubeImage out(n, 3);
@@ -629,16 +669,11 @@ Image GlScene::camera_color(const Camera& camera, CameraSamples samples) {
   const glm::dvec3 bg = scene_.background;
   camera_layers_ = 0;
   camera_layers_capped_ = false;
-  // Tile (x0, y0) in GL window coordinates of the full sample grid (y up): the clip
-  // coordinates scaled and shifted so that the tile fills the viewport (one tile: identity).
+  // Tile (x0, y0) in GL window coordinates of the full sample grid (y up).
   for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
     for (int64_t x0 = 0; x0 < full_w; x0 += tile_w) {
       check_deadline();
-      glm::mat4 tile(1.f);
-      tile[0][0] = float(double(full_w) / tile_w);
-      tile[3][0] = float(-double(full_w) / tile_w * (double(2 * x0 + tile_w) / double(full_w) - 1.0));
-      tile[1][1] = float(double(full_h) / tile_h);
-      tile[3][1] = float(-double(full_h) / tile_h * (double(2 * y0 + tile_h) / double(full_h) - 1.0));
+      const glm::mat4 tile = tile_matrix(full_w, full_h, x0, y0, tile_w, tile_h);
       std::fill(colour.begin(), colour.end(), 0.0);
       std::fill(through.begin(), through.end(), 1.0);
       for (int layer = 0; layer < (transparent ? MAX_CAMERA_LAYERS : 1); ++layer) {

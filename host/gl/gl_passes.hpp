@@ -78,6 +78,11 @@ class GlScene {
   // the columns and 4x the rows, in tiles, and averages each pixel's 32 samples.
   Image camera_color(const Camera& camera, CameraSamples samples = CameraSamples::pixel_centre);
 
+  // The object id the Z-buffer sees at each of the camera's 4x8 samples per pixel
+  // (samples.hpp): (8 width) x (4 height) values, row 0 at the top, NO_OBJECT where none.
+  // Pixel (x, y), sample k is at row 4 y + k / 8, column 8 x + k % 8.
+  std::vector<uint32_t> camera_objects(const Camera& camera);
+
   // One cube shadow map per light with cast_shadows, at n x n per face; later colour passes
   // are shadowed by them (the CPU's rule "shadows", shading.hpp): the distance to the
   // nearest opaque caster, and the translucent casters in front of it peeled into up to

@@ -5,6 +5,7 @@
 
 #include "base/statistics.hpp"
 #include "raster/abuffer.hpp"
+#include "raster/samples.hpp"
 #include "scene/camera.hpp"
 #include "raster/cube_map.hpp"
 #include "io/image_io.hpp"
@@ -104,6 +105,37 @@ void compare_camera(const SceneData& scene, int threads, GlScene& gl, Crosscheck
     }
   }
   if (r->interior_pixels > 0) r->interior_rmse = std::sqrt(sum_sq / (3.0 * double(r->interior_pixels)));
+
+  // Visibility, sample by sample: the GPU's object ids at the 4x8 sample grid against the
+  // A-buffer's nearest surface per sample.
+  const std::vector<uint32_t> gpu_ids = gl.camera_objects(scene.camera);
+  const TriangleSoup& soup = *scene.triangles;
+  const int64_t grid_w = int64_t{camera.width()} * MASK_COLUMNS;
+  r->sample_disagreement = Image(camera.width(), camera.height(), 1);
+  uint32_t seen[MASK_SAMPLES];
+  for (int y = 0; y < camera.height(); ++y) {
+    for (int x = 0; x < camera.width(); ++x) {
+      visible_triangles(camera, soup, x, y, seen);
+      int differ = 0;
+      for (int k = 0; k < MASK_SAMPLES; ++k) {
+        const int64_t gy = int64_t{y} * MASK_ROWS + k / MASK_COLUMNS, gx = int64_t{x} * MASK_COLUMNS + k % MASK_COLUMNS;
+        const uint32_t g = gpu_ids[static_cast<size_t>(gy * grid_w + gx)];
+        const uint32_t c = seen[k] == NO_SAMPLE_TRIANGLE ? NO_OBJECT : soup.object_id[seen[k]];
+        ++r->samples;
+        if (g == c) {
+          ++r->samples_same;
+          continue;
+        }
+        ++differ;
+        if (c == NO_OBJECT) ++r->samples_gpu_only;
+        else if (g == NO_OBJECT) ++r->samples_cpu_only;
+        else ++r->samples_other_object;
+      }
+      r->sample_disagreement.data[static_cast<size_t>(y) * static_cast<size_t>(camera.width()) + static_cast<size_t>(x)] =
+          float(differ) / float(MASK_SAMPLES);
+    }
+  }
+  if (r->samples > 0) r->sample_agreement = double(r->samples_same) / double(r->samples);
 }
 
 }  // namespace
@@ -125,6 +157,7 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   fail(mismatch > tol.coverage_mismatch_max, "coverage mismatch");
   fail(r.interior_rmse > tol.interior_rmse, "camera interior RMSE");
   fail(r.interior_max_abs > tol.interior_max_abs, "camera interior max abs");
+  fail(r.sample_agreement < tol.sample_agreement_min, "camera sample agreement");
   r.pass = r.failures.empty();
   return r;
 }
@@ -140,9 +173,13 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
                 {"fragments", r.fragments}}},
       {"camera", {{"pixels", r.pixels}, {"interior_pixels", r.interior_pixels}, {"interior_rmse", r.interior_rmse},
                   {"interior_max_abs", r.interior_max_abs}}},
+      {"camera_samples", {{"samples", r.samples}, {"same_object", r.samples_same},
+                          {"gpu_only", r.samples_gpu_only}, {"cpu_only", r.samples_cpu_only},
+                          {"other_object", r.samples_other_object}, {"agreement", r.sample_agreement}}},
       {"tolerances", {{"distance_rel_median", tol.distance_median_rel}, {"distance_rel_p99", tol.distance_p99_rel},
                       {"same_object_min", tol.same_object_min}, {"coverage_mismatch_max", tol.coverage_mismatch_max},
-                      {"interior_rmse", tol.interior_rmse}, {"interior_max_abs", tol.interior_max_abs}}},
+                      {"interior_rmse", tol.interior_rmse}, {"interior_max_abs", tol.interior_max_abs},
+                      {"sample_agreement_min", tol.sample_agreement_min}}},
       {"pass", r.pass},
       {"failures", r.failures}};
 }

@@ -29,6 +29,7 @@ struct CrosscheckTolerances {
   double coverage_mismatch_max = 0.01;    // share of texels covered on one path only
   double interior_rmse = 5e-4;            // camera view, displayed values, interior pixels
   double interior_max_abs = 4.0 / 255.0;
+  double sample_agreement_min = 0.9999;   // camera samples where GPU and CPU see the same object (or none)
 };
 
 struct CrosscheckResult {
@@ -45,6 +46,13 @@ struct CrosscheckResult {
   // intersecting it) of the CPU A-buffer image against the GL Z-buffer image.
   size_t pixels = 0, interior_pixels = 0;
   double interior_rmse = 0, interior_max_abs = 0;
+  // Camera visibility sample by sample (issue 19 part 1): at each of the 4x8 samples of
+  // every pixel, the object the GPU's Z-buffer sees against the one the CPU A-buffer's masks
+  // and exact priority masks say is nearest (resolve.hpp visible_triangles).
+  size_t samples = 0, samples_same = 0, samples_gpu_only = 0, samples_cpu_only = 0, samples_other_object = 0;
+  double sample_agreement = 0;
+  // Per pixel, how many of its 32 samples disagree (an image for `crosscheck --samples-image`).
+  Image sample_disagreement;
   double gpu_ms = 0, cpu_ms = 0;  // prepass vs cube A-buffer build
   uint64_t fragments = 0;
   bool pass = false;
