@@ -51,6 +51,9 @@ LENS_METHODS = ("thick_lens", "thin_lens")
 DEFAULT_SIZES = [64, 128, 256, 512, 1024, 2048]
 QUICK_SIZES = [64, 128, 256]
 QUICK_SCENES = ["scenes/hidden_point.json", "scenes/cornell.json"]
+# A real model in a room with a mirror and glass (issue 15 part 6; its model comes with
+# assimp-testmodels, installed by tools/setup.sh).
+MODEL_SCENES = ["scenes/models/engine_room.json"]
 THESIS_SIZES = [100, 200, 300]
 THESIS_FIGURES = {100: 5e-5, 200: 1.25e-5, 300: 5.5e-6}  # thesis 9.3.4, as printed
 THESIS_SCENES = ("hidden_point", "cornell")
@@ -867,7 +870,8 @@ def parse_args(argv):
         a.scenes = [os.path.join(REPO, s) for s in QUICK_SCENES]
     else:
         a.scenes = sorted(glob.glob(os.path.join(REPO, "scenes", "*.json"))) + \
-            sorted(glob.glob(os.path.join(REPO, "scenes", "bench", "*.json")))
+            sorted(glob.glob(os.path.join(REPO, "scenes", "bench", "*.json"))) + \
+            [os.path.join(REPO, s) for s in MODEL_SCENES]
     try:
         a.sizes = [int(s) for s in a.sizes.split(",") if s] if a.sizes else (QUICK_SIZES if a.quick else DEFAULT_SIZES)
     except ValueError:
