@@ -31,7 +31,8 @@ cat > "$WORK/jobs.jsonl" <<'EOF2'
 {"scene": "cornell.json", "out": "out/e.png", "method": "gpu"}
 EOF2
 "$ABCUBE" batch "$WORK/jobs.jsonl" --gl egl > "$WORK/summary" 2> "$WORK/err"
-check "batch exits 0 ($(cat "$WORK/err"))" [ $? -eq 0 ]
+status=$?
+check "batch exits 0 ($(cat "$WORK/err"))" [ $status -eq 0 ]
 check "summary counts 5 rendered" grep -q "5 jobs, 5 rendered, 0 failed, 0 skipped; 2 scenes loaded" "$WORK/summary"
 cd "$WORK" || exit 1
 "$ABCUBE" render cornell.json -o ra.png --method abuffer

@@ -50,7 +50,8 @@ done
 for t in 1 2 7; do
   sed "s|\"THREADS/|\"t$t/|" "$WORK/jobs.jsonl" > "$WORK/jobs_$t.jsonl"
   "$ABCUBE" batch "$WORK/jobs_$t.jsonl" --threads $t > "$WORK/batch_$t.out" 2> "$WORK/batch_$t.err"
-  check "batch at $t threads exits 0 ($(grep -v warning "$WORK/batch_$t.err" | head -2))" [ $? -eq 0 ]
+  status=$?
+  check "batch at $t threads exits 0 ($(grep -v warning "$WORK/batch_$t.err" | head -2))" [ $status -eq 0 ]
 done
 
 differ=0

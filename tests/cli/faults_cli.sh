@@ -146,7 +146,8 @@ check "SIGTERM during a batch: no temporary" no_temporaries "$WORK/batch"
 written=$(ls "$WORK/batch/out" | wc -l)
 check "SIGTERM during a batch: stopped before the end ($written of 6 written)" [ "$written" -lt 6 ]
 "$ABCUBE" batch "$WORK/batch/jobs.jsonl" --skip-existing > "$WORK/out" 2> "$WORK/err"
-check "the batch resumes with --skip-existing: exit 0 ($(cat "$WORK/err"))" [ $? -eq 0 ]
+status=$?
+check "the batch resumes with --skip-existing: exit 0 ($(cat "$WORK/err"))" [ $status -eq 0 ]
 check "the resumed batch skipped what was written" grep -q ", $written skipped;" "$WORK/out"
 mkdir -p "$WORK/whole"
 sed 's|"out/|"../whole/|' "$WORK/batch/jobs.jsonl" > "$WORK/batch/whole.jsonl"
@@ -172,7 +173,8 @@ if [ $MOUNTS = yes ] && hide libEGL.so.1; then
   check "no libEGL: --gl egl exits 1 (got $status)" [ $status -eq 1 ]
   check "no libEGL: one line naming libEGL" line_has "libEGL.so.1"
   "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --method gpu > /dev/null 2> "$WORK/err"
-  check "no libEGL: --gl auto falls back to OSMesa ($(cat "$WORK/err"))" [ $? -eq 0 ]
+  status=$?
+  check "no libEGL: --gl auto falls back to OSMesa ($(cat "$WORK/err"))" [ $status -eq 0 ]
   if hide libOSMesa.so.8; then
     "$ABCUBE" info > "$WORK/info" 2> "$WORK/err"
     check "no GL: info exits 0" [ $? -eq 0 ]
@@ -275,14 +277,16 @@ json.dump({"version": 1, "camera": {"position": [0, 1, -3], "look_at": [0, 0, 0]
 PY
   done
   "$ABCUBE" render "$WORK/lights_$limit.json" -o "$WORK/lights.png" --method gpu > /dev/null 2> "$WORK/err"
-  check "gpu renders $limit shadow-casting lights ($(cat "$WORK/err"))" [ $? -eq 0 ]
+  status=$?
+  check "gpu renders $limit shadow-casting lights ($(cat "$WORK/err"))" [ $status -eq 0 ]
   "$ABCUBE" render "$WORK/lights_$((limit + 1)).json" -o "$WORK/lights_over.png" --method gpu > /dev/null 2> "$WORK/err"
   status=$?
   check "gpu refuses $((limit + 1)) shadow-casting lights with exit 2 (got $status)" [ $status -eq 2 ]
   check "the refusal names the count and the limit" line_has "lights: $((limit + 1)) cast shadows; .* at most $limit here (GL_MAX_ARRAY_TEXTURE_LAYERS"
   check "nothing written" test ! -e "$WORK/lights_over.png"
   "$ABCUBE" render "$WORK/lights_$((limit + 1)).json" -o "$WORK/lights_cpu.png" --method abuffer > /dev/null 2> "$WORK/err"
-  check "abuffer renders them ($(cat "$WORK/err"))" [ $? -eq 0 ]
+  status=$?
+  check "abuffer renders them ($(cat "$WORK/err"))" [ $status -eq 0 ]
 else
   skip "GL limits (no GL path here)"
 fi

@@ -18,7 +18,8 @@ while read -r name scene args; do
   # shellcheck disable=SC2086
   "$ABCUBE" render "$scene" -o "$WORK/$name.png" $args 2> "$WORK/err" &&
     "$ABCUBE" render "$scene" -o "$WORK/$name.exr" $args 2>> "$WORK/err"
-  check "$name renders ($(head -c 300 "$WORK/err"))" [ $? -eq 0 ]
+  status=$?
+  check "$name renders ($(head -c 300 "$WORK/err"))" [ $status -eq 0 ]
   check "$name: same PNG bytes" cmp -s "$WORK/$name.png" "$name.png"
   check "$name: same EXR floats" "$ABCUBE" compare --exact "$WORK/$name.exr" "$name.exr" > /dev/null
 done < cases.txt

@@ -81,7 +81,8 @@ at_least_30() {
 }
 at_least_30 "$WORK/gpu0.exr" "$WORK/ab0.exr" "glass ball"
 "$ABCUBE" render "$WORK/veil.json" -o "$WORK/veil_gpu0.exr" --method gpu --max-depth 0 --stats "$WORK/v.json" 2> "$WORK/err"
-check "gpu draws a veil ($(cat "$WORK/err"))" [ $? -eq 0 ]
+status=$?
+check "gpu draws a veil ($(cat "$WORK/err"))" [ $status -eq 0 ]
 check "gpu peels the veil's layers" grep -q '"camera_layers": [2-9]' "$WORK/v.json"
 "$ABCUBE" render "$WORK/veil.json" -o "$WORK/veil_ab0.exr" --method abuffer --max-depth 0 2> /dev/null
 at_least_30 "$WORK/veil_gpu0.exr" "$WORK/veil_ab0.exr" "veil ball"

@@ -26,7 +26,8 @@ JSON
 for gl in egl osmesa egl-surfaceless auto; do
   out="$WORK/gpu_$gl.png"
   "$ABCUBE" render "$WORK/small.json" -o "$out" --method gpu --gl "$gl" --stats "$WORK/s_$gl.json" 2> "$WORK/err"
-  check "gpu --gl $gl exits 0 ($(cat "$WORK/err"))" [ $? -eq 0 ]
+  status=$?
+  check "gpu --gl $gl exits 0 ($(cat "$WORK/err"))" [ $status -eq 0 ]
   check "gpu --gl $gl writes the image" [ -s "$out" ]
   check "stats of --gl $gl name a GL path" grep -q '"path": "egl\|"path": "osmesa' "$WORK/s_$gl.json"
   check "stats of --gl $gl hold the renderer" grep -q '"renderer": "' "$WORK/s_$gl.json"
@@ -36,7 +37,8 @@ check "--gl osmesa stats say osmesa" grep -q '"path": "osmesa"' "$WORK/s_osmesa.
 
 # --- the two APIs draw the same picture
 "$ABCUBE" compare "$WORK/gpu_egl.png" "$WORK/gpu_osmesa.png" --fail 0.004 > "$WORK/cmp" 2>&1
-check "egl and osmesa images agree ($(tail -1 "$WORK/cmp"))" [ $? -eq 0 ]
+status=$?
+check "egl and osmesa images agree ($(tail -1 "$WORK/cmp"))" [ $status -eq 0 ]
 
 # --- a forced path that fails is an error naming the reason, and leaves old outputs alone
 printf 'old image' > "$WORK/keep.png"
@@ -66,7 +68,8 @@ check "--stats error leaves no image" [ ! -e "$WORK/x.png" ]
 # --- the exact tracer with --reference, no GL needed
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/rt.exr" --method raytrace --gl none --threads 2 \
   --reference --stats "$WORK/rt.json" 2> "$WORK/err"
-check "raytrace exits 0 ($(cat "$WORK/err"))" [ $? -eq 0 ]
+status=$?
+check "raytrace exits 0 ($(cat "$WORK/err"))" [ $status -eq 0 ]
 check "raytrace writes EXR" [ -s "$WORK/rt.exr" ]
 check "raytrace stats count rays" grep -q '"primary_rays": 55296' "$WORK/rt.json"
 check "reference of raytrace is itself" grep -q '"psnr_db": "inf"' "$WORK/rt.json"
@@ -81,7 +84,8 @@ for v in "abuffer" "abuffer --search thesis --theta-max 1" "zbuffer" "envmap --e
   name=$(echo "$v" | tr ' ' '_')
   "$ABCUBE" render "$WORK/small.json" -o "$WORK/m_$name.png" --method $v --cube-res 64 --stats "$WORK/m_$name.json" \
     --reference 2> "$WORK/err"
-  check "--method $v exits 0 ($(cat "$WORK/err"))" [ $? -eq 0 ]
+  status=$?
+  check "--method $v exits 0 ($(cat "$WORK/err"))" [ $status -eq 0 ]
   check "--method $v counts shadow searches" grep -q '"shadow": {' "$WORK/m_$name.json"
   check "--method $v reports Error_Parallax" grep -q '"error_parallax"' "$WORK/m_$name.json"
 done

@@ -49,7 +49,8 @@ script=$(printf '%s\n' "$block" | tail -n +4 | sed "s|/srv/abcube-ro|$WORK/ro|g"
   printf '%s\n' "$script"
 } > "$WORK/block.sh"
 bash "$WORK/block.sh" > "$WORK/out" 2> "$WORK/err"
-check "the block runs as written ($(tail -2 "$WORK/err"))" [ $? -eq 0 ]
+status=$?
+check "the block runs as written ($(tail -2 "$WORK/err"))" [ $status -eq 0 ]
 check "it rendered job42" test -s "$WORK/renders/job42.png"
 check "the render is owned by nobody" [ "$(stat -c %U "$WORK/renders/job42.png")" = nobody ]
 
