@@ -198,7 +198,7 @@ void print_timed(const TimedRenders& t, const Options& o) {
               t.finished);
   for (auto [method, v] : t.overshoot_ms) {
     std::sort(v.begin(), v.end());
-    auto at = [&](double q) { return v[std::min(v.size() - 1, static_cast<size_t>(q * v.size()))]; };
+    auto at = [&](double q) { return v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())))]; };
     std::printf("  %-9s %4zu, past the limit by %.2f ms median, %.2f p90, %.2f max\n", method.c_str(), v.size(), at(0.5),
                 at(0.9), v.back());
   }

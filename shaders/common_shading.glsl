@@ -2,20 +2,35 @@
 //   C = ka Ia Od + sum_l S_l I_l (kd Od max(0, N.L) + ks max(0, R.V)^n),  R = reflect(-L, N),
 // with N turned to face the viewer (two-sided lighting). p is relative to the eye.
 
-// S_l from the light's cube shadow maps (rule "shadows", as the CPU's shadow search): 0 if
-// p is farther from the light than the nearest opaque surface the map stored in that
-// direction, plus a bias of u_shadow_bias_texels texels (a texel at distance d is about
-// u_shadow_texel * d wide), grown at grazing light; else the product of the transmittances
-// of the translucent layers nearer to the light than p (less the same bias).
+// Shadow volumes (gl_camera_exact.cpp): per camera sample, one bit per light (the light's
+// color.w, -1: none) saying whether an opaque blocker lies between the surface and the
+// light, counted exactly by depth-fail (shadow_volume.frag). Camera passes only.
+uniform bool u_volumes;
+uniform usampler2D u_volume_mask;
+
+// S_l (rule "shadows", as the CPU's shadow search and the exact tracer): 0 when an opaque
+// blocker lies between p and the light: from the shadow volumes' mask when the light has a
+// bit in it, else from its cube shadow map (p farther from the light than the nearest opaque
+// surface the map stored in that direction, plus a bias of u_shadow_bias_texels texels, a
+// texel at distance d being about u_shadow_texel * d wide, grown at grazing light); then the
+// product of the transmittances of the translucent layers nearer to the light than p (less
+// the same bias).
 vec3 light_visibility(int i, vec3 p, vec3 n) {
   float layer = lights[i].position.w;
-  if (!u_shadows || layer < 0.0) return vec3(1.0);
+  float bit = lights[i].color.w;
+  bool volume = u_volumes && bit >= 0.0;
+  if (!volume && (!u_shadows || layer < 0.0)) return vec3(1.0);
+  if (volume) {
+    int b = int(bit);
+    uvec4 mask = texelFetch(u_volume_mask, ivec2(gl_FragCoord.xy), 0);
+    if ((mask[b / 32] & (1u << uint(b % 32))) != 0u) return vec3(0.0);
+    if (!u_shadows || layer < 0.0) return vec3(1.0);
+  }
   vec3 d = p - lights[i].position.xyz;
   float dist = length(d);
-  float stored = texture(u_shadow_maps, vec4(d, layer)).r;
   float slope = max(abs(dot(n, d / dist)), 0.2);
   float bias = u_shadow_bias_texels * u_shadow_texel * dist / slope;
-  if (dist > stored + bias) return vec3(0.0);
+  if (!volume && dist > texture(u_shadow_maps, vec4(d, layer)).r + bias) return vec3(0.0);
   vec3 s = vec3(1.0);
   for (int k = 0; k < u_shadow_peels; ++k) {
     vec4 crossing = texture(u_shadow_peel_maps[k], vec4(d, layer));
@@ -56,6 +71,9 @@ vec3 phong_local(MaterialGpu m, vec3 p, vec3 n_in, vec3 od) {
 // on the incident side: this one interface is always entered).
 uniform int u_lookup;
 uniform bool u_fresnel;
+// True in the camera pass of gl_camera_exact.cpp: a planar mirror whose virtual view was
+// drawn (portal != 0) gets its reflection from it, not from the environment map.
+uniform bool u_portals_exact;
 
 vec3 lookup_direction(vec3 p, vec3 r) {
   vec3 w = normalize(p);
@@ -66,8 +84,8 @@ vec3 lookup_direction(vec3 p, vec3 r) {
   return u_lookup == 2 ? w : r;
 }
 
-vec3 environment_terms(MaterialGpu m, vec3 p, vec3 n_in) {
-  float kr = m.coefficients.w, kt = m.transmission.x;
+vec3 environment_terms(MaterialGpu m, vec3 p, vec3 n_in, uint portal) {
+  float kr = (u_portals_exact && portal != 0u) ? 0.0 : m.coefficients.w, kt = m.transmission.x;
   if (!u_environment || (kr <= 0.0 && kt <= 0.0)) return vec3(0.0);
   vec3 i = normalize(p);
   vec3 n = normalize(n_in);

@@ -25,6 +25,7 @@ void main() {
     if (isinf(previous.r) || d < previous.r || (d == previous.r && id <= previous.g)) discard;
   }
   MaterialGpu m = materials[v_material];
-  o_color = vec4(phong_local(m, v_relative, v_normal, od) + environment_terms(m, v_relative, v_normal), m.transmission.z);
+  o_color = vec4(phong_local(m, v_relative, v_normal, od) + environment_terms(m, v_relative, v_normal, 0u),
+                 m.transmission.z);
   o_layer = vec2(d, id);
 }

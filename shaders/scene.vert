@@ -1,29 +1,45 @@
 // Every pass draws the scene's triangles with this stage. u_clip is cube_map.hpp's
 // face_clip_matrix or camera_clip_matrix (infinite reversed-Z); u_center is the eye.
-layout(location = 0) in vec3 a_position;
+// u_model places virtual objects (the reflections of the planar mirrors a view has passed
+// through, gl_camera_exact.cpp; the identity otherwise), and gl_ClipDistance[0] keeps what
+// lies on u_clip_plane's positive side (the mirror's front) when GL_CLIP_DISTANCE0 is on.
+// The shadow volumes (shadow_volume.frag) come through here too, with points at infinity
+// (w = 0): gl_Position is invariant, so a volume's near cap and the surface it caps get the
+// same depth at every sample.
+layout(location = 0) in vec4 a_position;  // the scene's buffer gives xyz: w = 1
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in uint a_object;
 layout(location = 3) in uint a_material;
 layout(location = 4) in vec2 a_uv;  // texture coordinates (v up); (0, 0) when the scene has none
+layout(location = 5) in uint a_portal;    // planar reflector + 1 (planar_reflectors.hpp); 0: none
+layout(location = 6) in uint a_reversed;  // shadow volumes: the face's outward orientation is against its winding
 
 uniform mat4 u_clip;
+uniform mat4 u_model;
+uniform vec4 u_clip_plane;
 uniform vec3 u_center;
 // THE TIE RULE (cpu_core/scene/tie_rule.hpp): window depth near/w scaled by
 // 1 + u_tie_step (object + 1), so at equal depth the later object passes GL_GREATER.
 uniform float u_tie_step;
 
+invariant gl_Position;
 out vec3 v_relative;  // position relative to the eye, interpolated perspective-correctly
 out vec3 v_normal;
 flat out uint v_object;
 flat out uint v_material;
 out vec2 v_uv;
+flat out uint v_portal;
+flat out uint v_reversed;
 
 void main() {
-  gl_Position = u_clip * vec4(a_position, 1.0);
+  gl_Position = u_clip * (u_model * a_position);
   gl_Position.z *= 1.0 + u_tie_step * float(a_object + 1u);
-  v_relative = a_position - u_center;
+  gl_ClipDistance[0] = dot(u_clip_plane, vec4(a_position.xyz, 1.0));
+  v_relative = a_position.xyz - u_center;
   v_normal = a_normal;
   v_object = a_object;
   v_material = a_material;
   v_uv = a_uv;
+  v_portal = a_portal;
+  v_reversed = a_reversed;
 }

@@ -46,6 +46,14 @@ void RenderFlags::add_to(CLI::App* cmd) {
       ->capture_default_str();
   cmd->add_flag("--map-only", [this](int64_t) { options.side_structure = false; },
                 "searches see only the map: no side structure for triangles it cannot hold");
+  cmd->add_option("--gpu-mirrors", options.gpu_mirrors,
+                  "gpu: planar mirrors by the stencil test (exact) | envmap (the cube texture, as before)")
+      ->capture_default_str();
+  cmd->add_option("--gpu-shadows", options.gpu_shadows, "gpu: shadow volumes (exact) | maps (cube shadow maps)")
+      ->capture_default_str();
+  cmd->add_option("--gpu-max-views", options.gpu_max_views,
+                  "gpu: mirror views drawn per camera tile, at most (a mirror past it shows the cube texture)")
+      ->capture_default_str()->check(CLI::Range(0, 1 << 20));
   cmd->add_flag("--fresnel", [this](int64_t) { options.fresnel = true; }, "Schlick weights for kr and kt");
   cmd->add_option("--max-layers", options.max_layers, "A-buffer layers kept per list, 0 = all")
       ->capture_default_str()->check(CLI::Range(0, 1 << 20));

@@ -1,11 +1,8 @@
 #include "gl/gl_passes.hpp"
 
-#include "base/parallel.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <algorithm>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -15,6 +12,7 @@
 #include "base/error.hpp"
 #include "base/parallel.hpp"
 #include "base/timer.hpp"
+#include "gl/gl_passes_internal.hpp"
 #include "scene/texture.hpp"
 #include "scene/tie_rule.hpp"
 #include "shading/shading.hpp"
@@ -22,17 +20,6 @@
 namespace abcube {
 
 namespace {
-
-// The camera pass renders at most this many samples a side at once (tiles beyond).
-constexpr int CAMERA_TILE = 2048;
-// Texture units: 1 the opaque shadow maps, 2 the environment, 3.. the translucent peels,
-// then the camera's previous layer.
-constexpr GLenum PEEL_UNIT = 3;
-constexpr GLenum CAMERA_PREVIOUS_UNIT = PEEL_UNIT + MAX_SHADOW_PEELS;
-// Then the base-colour texture arrays (16 units in all: GL 4.5's minimum for a fragment shader).
-constexpr GLenum TEXTURE_UNIT = CAMERA_PREVIOUS_UNIT + 1;
-static_assert(TEXTURE_UNIT + MAX_TEXTURE_ARRAYS <= 16, "texture units");
-
 
 struct Vertex {
   float position[3];
@@ -52,93 +39,7 @@ struct LightGpu {
   float color[4];
 };
 
-// The state every pass relies on: infinite reversed-Z (cube_map.hpp: depth in [0, 1], 1 at
-// the near plane, GL_GREATER), no culling (the map holds every surface), no blending.
-void set_pass_state() {
-  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_GREATER);
-  glDepthMask(GL_TRUE);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_BLEND);
-}
-
-// The clip coordinates of the full sample grid (full_w x full_h, GL window coordinates, y
-// up) scaled and shifted so that the tile at (x0, y0), tile_w x tile_h, fills the viewport
-// (one tile: identity).
-glm::mat4 tile_matrix(int64_t full_w, int64_t full_h, int64_t x0, int64_t y0, int tile_w, int tile_h) {
-  glm::mat4 tile(1.f);
-  tile[0][0] = float(double(full_w) / tile_w);
-  tile[3][0] = float(-double(full_w) / tile_w * (double(2 * x0 + tile_w) / double(full_w) - 1.0));
-  tile[1][1] = float(double(full_h) / tile_h);
-  tile[3][1] = float(-double(full_h) / tile_h * (double(2 * y0 + tile_h) / double(full_h) - 1.0));
-  return tile;
-}
-
 }  // namespace
-
-// One framebuffer: distance (R32F) + object id (R32UI), or colour (RGBA32F); depth 32F.
-struct GlScene::Target {
-  int width = 0, height = 0;
-  bool distance_pass = false;
-  GLuint fbo = 0, color0 = 0, color1 = 0, depth = 0;
-
-  Target(int w, int h, bool distance) : width(w), height(h), distance_pass(distance) {
-    glGenFramebuffers(1, &fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    auto make = [&](GLenum format, GLenum attachment) {
-      GLuint tex = 0;
-      glGenTextures(1, &tex);
-      glBindTexture(GL_TEXTURE_2D, tex);
-      glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
-      glFramebufferTexture2D(GL_FRAMEBUFFER, attachment, GL_TEXTURE_2D, tex, 0);
-      return tex;
-    };
-    color0 = make(distance ? GL_R32F : GL_RGBA32F, GL_COLOR_ATTACHMENT0);
-    color1 = make(distance ? GL_R32UI : GL_RG32F, GL_COLOR_ATTACHMENT1);
-    depth = make(GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT);
-    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    glDrawBuffers(2, buffers);
-    const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    if (status != GL_FRAMEBUFFER_COMPLETE) {
-      throw RuntimeFailure("framebuffer " + std::to_string(w) + "x" + std::to_string(h) +
-                           " incomplete (status " + std::to_string(status) + ")");
-    }
-  }
-  ~Target() {
-    const GLuint textures[] = {color0, color1, depth};
-    glDeleteTextures(3, textures);
-    glDeleteFramebuffers(1, &fbo);
-  }
-
-  // Binds the target, sets the state every pass relies on, and clears it.
-  void clear(const glm::dvec3& background) const {
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glViewport(0, 0, width, height);
-    set_pass_state();
-    const float zero_depth = 0.f;  // reversed Z: 0 is infinitely far
-    glClearBufferfv(GL_DEPTH, 0, &zero_depth);
-    if (distance_pass) {
-      const float far[4] = {NO_DISTANCE, 0, 0, 0};
-      const GLuint none[4] = {NO_OBJECT, 0, 0, 0};
-      glClearBufferfv(GL_COLOR, 0, far);
-      glClearBufferuiv(GL_COLOR, 1, none);
-    } else {
-      const float bg[4] = {float(background.x), float(background.y), float(background.z), 1.f};
-      const float none[4] = {NO_DISTANCE, -1.f, 0, 0};
-      glClearBufferfv(GL_COLOR, 0, bg);
-      glClearBufferfv(GL_COLOR, 1, none);
-    }
-  }
-
-  // Reads attachment `index` into `out` (`components` values per texel, GL row order).
-  void read(int index, GLenum format, GLenum type, void* out) const {
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
-    glReadBuffer(GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(index));
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, width, height, format, type, out);
-  }
-};
 
 GlScene::GlScene(const SceneData& scene) : scene_(scene) {
   const Clock::time_point t0 = Clock::now();
@@ -172,6 +73,7 @@ GlScene::GlScene(const SceneData& scene) : scene_(scene) {
                     static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data());
   }
   const auto offset = [](size_t bytes) { return reinterpret_cast<const void*>(bytes); };
+  glBindBuffer(GL_ARRAY_BUFFER, vbo_);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), offset(offsetof(Vertex, position)));
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), offset(offsetof(Vertex, normal)));
   glVertexAttribIPointer(2, 1, GL_UNSIGNED_INT, sizeof(Vertex), offset(offsetof(Vertex, object)));
@@ -190,6 +92,32 @@ GlScene::GlScene(const SceneData& scene) : scene_(scene) {
     glVertexAttrib2f(4, 0.f, 0.f);
   }
 
+  // Planar reflectors (the exact camera pass): a reflector id per vertex, and each one's
+  // triangles as a range of an index buffer, both kept with the vertex array.
+  reflectors_ = find_planar_reflectors(scene);
+  if (!reflectors_.reflectors.empty()) {
+    std::vector<uint32_t> ids(t.positions.size()), indices;
+    for (size_t v = 0; v < ids.size(); ++v) ids[v] = reflectors_.reflector_of_triangle[v / 3];
+    glGenBuffers(1, &portal_vbo_);
+    glBindBuffer(GL_ARRAY_BUFFER, portal_vbo_);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(ids.size() * sizeof(uint32_t)), ids.data(), GL_STATIC_DRAW);
+    glVertexAttribIPointer(5, 1, GL_UNSIGNED_INT, sizeof(uint32_t), nullptr);
+    glEnableVertexAttribArray(5);
+    for (const PlanarReflector& r : reflectors_.reflectors) {
+      portal_ranges_.emplace_back(indices.size(), 3 * r.triangles.size());
+      for (const uint32_t tri : r.triangles) {
+        for (uint32_t k = 0; k < 3; ++k) indices.push_back(3 * tri + k);
+      }
+    }
+    glGenBuffers(1, &portal_ebo_);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, portal_ebo_);  // kept by the vertex array
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(uint32_t)), indices.data(),
+                 GL_STATIC_DRAW);
+  } else {
+    glDisableVertexAttribArray(5);
+  }
+  glVertexAttribI1ui(5, 0);  // the generic values of the arrays left off: no reflector, no reversal
+  glVertexAttribI1ui(6, 0);
   const std::vector<float> texture_codes = upload_textures();
   std::vector<MaterialGpu> materials;
   for (size_t i = 0; i < scene.materials.size(); ++i) {
@@ -212,6 +140,11 @@ GlScene::GlScene(const SceneData& scene) : scene_(scene) {
       std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "phong.frag"});
   shadow_program_ = std::make_unique<GlProgram>(std::vector<const char*>{"scene.vert"},
                                                 std::vector<const char*>{"common_scene.glsl", "shadow_caster.frag"});
+  // Every sampler of the phong program on a unit of its own type (two sampler types on one
+  // unit is an error at draw time, even when one is never read).
+  phong_program_->use();
+  glUniform1i(phong_program_->uniform("u_previous"), static_cast<GLint>(CAMERA_PREVIOUS_UNIT));
+  glUniform1i(phong_program_->uniform("u_volume_mask"), static_cast<GLint>(VOLUME_MASK_UNIT));
   glFinish();
   check_gl("scene upload");
   timings_.upload_ms = ms_since(t0);
@@ -284,6 +217,12 @@ std::vector<float> GlScene::upload_textures() {
 
 GlScene::~GlScene() {
   target_.reset();
+  exact_buffers_.reset();
+  glDeleteBuffers(1, &portal_vbo_);
+  glDeleteBuffers(1, &portal_ebo_);
+  glDeleteBuffers(1, &recursed_);
+  glDeleteBuffers(static_cast<GLsizei>(volume_vbos_.size()), volume_vbos_.data());
+  glDeleteVertexArrays(static_cast<GLsizei>(volume_vaos_.size()), volume_vaos_.data());
   glDeleteTextures(static_cast<GLsizei>(texture_arrays_.size()), texture_arrays_.data());
   glDeleteBuffers(1, &uv_vbo_);
   const GLuint textures[] = {shadow_maps_, environment_};
@@ -316,8 +255,9 @@ void GlScene::upload_lights(const glm::dvec3& center) {
     const PointLight& l = scene_.lights[i];
     const glm::dvec3 p = l.position - center;
     const float layer = i < shadow_layer_.size() ? float(shadow_layer_[i]) : -1.f;
+    const float bit = i < volume_bit_.size() ? float(volume_bit_[i]) : -1.f;  // set by the exact camera pass
     lights.push_back({{float(p.x), float(p.y), float(p.z), layer},
-                      {float(l.color.r), float(l.color.g), float(l.color.b), 0.f}});
+                      {float(l.color.r), float(l.color.g), float(l.color.b), bit}});
   }
   if (lights.empty()) lights.push_back({});
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, lights_);
@@ -326,8 +266,34 @@ void GlScene::upload_lights(const glm::dvec3& center) {
 }
 
 void GlScene::draw(const GlProgram& program, const glm::mat4& clip, const glm::dvec3& center) {
+  MirrorView view;
+  view.eye = center;
+  draw_scene(program, clip, view);
+}
+
+void GlScene::draw_scene(const GlProgram& program, const glm::mat4& clip, const MirrorView& view) {
+  set_view(program, clip, view);
+  glBindVertexArray(vao_);
+  if (vertex_count_ > 0) glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
+}
+
+void GlScene::draw_reflector(const GlProgram& program, const glm::mat4& clip, const MirrorView& view, size_t r) {
+  set_view(program, clip, view);
+  glBindVertexArray(vao_);
+  const auto [first, count] = portal_ranges_[r];
+  glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(count), GL_UNSIGNED_INT,
+                 reinterpret_cast<const void*>(first * sizeof(uint32_t)));
+}
+
+void GlScene::set_view(const GlProgram& program, const glm::mat4& clip, const MirrorView& view) {
+  const glm::dvec3& center = view.eye;
   program.use();
   glUniformMatrix4fv(program.uniform("u_clip"), 1, GL_FALSE, &clip[0][0]);
+  const glm::mat4 model(view.model);
+  glUniformMatrix4fv(program.uniform("u_model"), 1, GL_FALSE, &model[0][0]);
+  glUniform4f(program.uniform("u_clip_plane"), float(view.plane.x), float(view.plane.y), float(view.plane.z),
+              float(view.plane.w));
+  glUniform1ui(program.uniform("u_skip_portal"), view.skip);
   glUniform3f(program.uniform("u_center"), float(center.x), float(center.y), float(center.z));
   // tie_rule.hpp; not in the shadow passes, whose casters all count and whose translucent
   // peels order equal depths by triangle (shadow_caster.frag), GL_GREATER's draw order.
@@ -338,8 +304,6 @@ void GlScene::draw(const GlProgram& program, const glm::mat4& clip, const glm::d
   glUniform1i(program.uniform("u_light_count"), static_cast<GLint>(scene_.lights.size()));
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, materials_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, lights_);
-  glBindVertexArray(vao_);
-  if (vertex_count_ > 0) glDrawArrays(GL_TRIANGLES, 0, vertex_count_);
 }
 
 // Binds the shadow maps (unit 1) and, if asked and built, the environment map (unit 2).
@@ -639,6 +603,7 @@ CubeImage GlScene::cube_color(const glm::dvec3& center, int n) {
 
 Image GlScene::camera_color(const Camera& camera, CameraSamples samples) {
   const bool mask = samples == CameraSamples::mask_4x8;
+  if (mask && plan_exact_camera()) return camera_color_exact(camera);
   const int64_t sx = mask ? MASK_COLUMNS : 1, sy = mask ? MASK_ROWS : 1;
   const int64_t full_w = camera.width * sx, full_h = camera.height * sy;
   const int64_t tile_max = std::min(CAMERA_TILE, max_size_);

@@ -8,6 +8,7 @@
 
 #include "gl/gl_program.hpp"
 #include "io/image.hpp"
+#include "scene/planar_reflectors.hpp"
 #include "scene/scene_data.hpp"
 #include "shading/map_shading.hpp"
 
@@ -43,6 +44,35 @@ enum class CameraSamples { pixel_centre, mask_4x8 };
 // image size, at most this many sizes (common_scene.glsl; more is a RuntimeFailure naming
 // the limit). The uvs go in a vertex buffer of their own, made only when the scene has them.
 constexpr int MAX_TEXTURE_ARRAYS = 4;
+
+// What the camera pass renders exactly where the GPU can (issue 19; gl_camera_exact.cpp, README
+// "The gpu method at its best"): planar mirrors by virtual objects and the stencil test
+// (course notes 4.1.2; Kilgard 1999), recursively to max_depth; hard shadows of opaque
+// blockers by shadow volumes counted depth-fail (course notes 3.3; Everitt & Kilgard 2002).
+// What it cannot (curved mirrors, refraction, coverage transparency, more than
+// MAX_VOLUME_LIGHTS lights) keeps the cube maps: the environment map and the shadow maps.
+constexpr int MAX_VOLUME_LIGHTS = 128;  // bits of the mask (RGBA32UI)
+struct ExactCameraOptions {
+  bool planar_mirrors = false;  // stencil portals for planar_reflectors.hpp's mirrors
+  bool shadow_volumes = false;  // shadow volumes for the shadow-casting lights
+  int max_depth = 0;            // mirror bounces, as render.max_depth
+  // Mirror views drawn per camera tile, at most; a mirror seen past that falls back to the
+  // environment map (and is counted).
+  int max_views = 256;
+};
+struct ExactCameraStats {
+  bool mirrors = false, volumes = false;  // what the last camera pass used
+  std::string mirrors_why, volumes_why;   // why not, when asked but not used
+  size_t reflectors = 0;                  // planar reflectors in the scene
+  uint64_t curved_reflective_triangles = 0;
+  uint64_t mirror_views = 0;              // virtual views drawn (every tile, every level)
+  uint64_t mirror_views_empty = 0;        // mirrors drawn but covering no sample
+  uint64_t mirror_views_over_budget = 0;  // mirrors shown through the environment map instead
+  int deepest_level = 0;
+  int volume_lights = 0;
+  uint64_t volume_triangles = 0;          // over every volume light
+  double volume_build_ms = 0;
+};
 
 // Value of a prepass texel that no surface covers.
 constexpr float NO_DISTANCE = INFINITY;
@@ -111,6 +141,12 @@ class GlScene {
     fresnel_ = fresnel;
   }
 
+  // The exact camera pass (ExactCameraOptions): later camera_color calls use it where it
+  // applies; exact_camera_stats() says what the last one did.
+  void set_exact_camera(const ExactCameraOptions& options) { exact_ = options; }
+  const ExactCameraStats& exact_camera_stats() const { return exact_stats_; }
+  const PlanarReflectors& planar_reflectors() const { return reflectors_; }
+
   // Textures sampled at level 0 with zero derivatives (bilinear), as the CPU's point
   // samples, instead of trilinear over the pass's footprint: `abcube crosscheck` compares
   // the lookups, not the two filters.
@@ -122,7 +158,20 @@ class GlScene {
 
  private:
   struct Target;
+  struct ExactBuffers;
+  struct MirrorView;
   void draw(const GlProgram& program, const glm::mat4& clip, const glm::dvec3& center);
+  // The view's uniforms (clip, model, eye, clip plane, mirror left out) set on `program`.
+  void set_view(const GlProgram& program, const glm::mat4& clip, const MirrorView& view);
+  void draw_scene(const GlProgram& program, const glm::mat4& clip, const MirrorView& view);
+  void draw_reflector(const GlProgram& program, const glm::mat4& clip, const MirrorView& view, size_t r);
+  Image camera_color_exact(const Camera& camera);
+  bool plan_exact_camera();  // what the next camera pass can do exactly (exact_stats_)
+  void render_view(const glm::mat4& clip, const MirrorView& view, int* views_left);
+  void count_volumes(const glm::mat4& clip, const MirrorView& view);
+  void fill_region(int level, const glm::vec4& colour);
+  void build_volumes();
+  std::string exact_mirrors_why_not() const;
   void bind_lookups(const GlProgram& program, bool with_environment);
   void bind_lookup_target(int n);
   void clear_lookup_target(int n, bool distance);
@@ -152,6 +201,22 @@ class GlScene {
   std::unique_ptr<GlProgram> distance_program_, phong_program_, shadow_program_;
   std::unique_ptr<Target> target_;
   GpuTimings timings_;
+  // The exact camera pass: the planar reflectors, each one's triangles as an index range of
+  // portal_ebo_, the per-vertex reflector ids (portal_vbo_); the shadow volumes, one vertex
+  // buffer per volume light (its index in volume_lights_ is its bit); its programs and buffers.
+  ExactCameraOptions exact_;
+  ExactCameraStats exact_stats_;
+  PlanarReflectors reflectors_;
+  GLuint portal_vbo_ = 0, portal_ebo_ = 0;
+  std::vector<std::pair<size_t, size_t>> portal_ranges_;  // first index, count
+  bool volumes_built_ = false;
+  std::vector<int> volume_lights_;        // light index per bit
+  std::vector<int> volume_bit_;           // per light: its bit, or -1
+  std::vector<GLuint> volume_vaos_, volume_vbos_;
+  std::vector<GLsizei> volume_vertices_;
+  std::unique_ptr<GlProgram> exact_program_, fill_program_, fill_mask_program_, volume_program_, mask_program_;
+  GLuint recursed_ = 0;  // per view: which mirrors had their view drawn (camera_exact.frag)
+  std::unique_ptr<ExactBuffers> exact_buffers_;
 };
 
 }  // namespace abcube

@@ -60,6 +60,7 @@ Image render_gpu(MethodContext& mc) {
   }
   stats["plan"]["mode"] = mc.request.plan_everything ? "everything" : "needed";
   gl.set_environment_lookup(mc.request.map.lookup, scene.render.fresnel);
+  gl.set_exact_camera(mc.request.gpu);
   check_deadline();
   // The camera view at the A-buffer's 4x8 sample positions, box-filtered as its resolve
   // weighs the masks: the same edges as abuffer (issue 12 part 4).
@@ -78,6 +79,25 @@ Image render_gpu(MethodContext& mc) {
   stats["counts"]["camera_samples_per_pixel"] = MASK_SAMPLES;
   stats["counts"]["camera_layers"] = gl.camera_layers();  // > 1: coverage transparency peeled
   stats["counts"]["camera_layers_capped"] = gl.camera_layers_capped();
+  // What the camera pass rendered exactly (issue 19): per kind of surface, the path it took.
+  const ExactCameraStats& ex = gl.exact_camera_stats();
+  stats["gpu_paths"] = {
+      {"planar_mirrors", {{"technique", ex.mirrors ? "stencil" : "environment_map"},
+                          {"why", ex.mirrors ? "exact: virtual views through the stencil test, to max_depth"
+                                             : mc.request.gpu.planar_mirrors ? ex.mirrors_why : "asked: --gpu-mirrors envmap"},
+                          {"reflectors", ex.reflectors}, {"views", ex.mirror_views}, {"views_empty", ex.mirror_views_empty},
+                          {"views_over_budget", ex.mirror_views_over_budget}, {"max_views_per_tile", mc.request.gpu.max_views},
+                          {"deepest_level", ex.deepest_level}}},
+      {"curved_mirrors_and_refraction", {{"technique", needed ? "environment_map" : "none"},
+                                         {"curved_reflective_triangles", ex.curved_reflective_triangles},
+                                         {"why", "approximate: Blinn-Newell lookups in the cube texture around the eye"}}},
+      {"shadows", {{"technique", ex.volumes ? "shadow_volumes" : maps > 0 ? "shadow_maps" : "none"},
+                   {"why", ex.volumes ? "exact: depth-fail counting of every opaque blocker's prism"
+                                      : mc.request.gpu.shadow_volumes ? ex.volumes_why : "asked: --gpu-shadows maps"},
+                   {"volume_lights", ex.volumes ? ex.volume_lights : 0},
+                   {"volume_triangles", ex.volumes ? ex.volume_triangles : 0},
+                   {"translucent_casters", maps > 0 && gl.shadow_peels() > 0 ? "shadow maps' peeled layers" : "none"}}}};
+  if (ex.volumes) stats["timings_ms"]["shadow_volumes_build"] = ex.volume_build_ms;
   stats["plan"]["passes"] = passes;
   stats["plan"]["skipped"] = skipped;
   return image;

@@ -26,6 +26,7 @@ struct RenderRequest {
   ABufferOptions abuffer;       // threads, layer cap, memory budget
   MapShadingOptions map;        // search mode, refinement, theta_max, refraction, envmap lookup
   std::vector<std::string> aovs;
+  ExactCameraOptions gpu;       // the gpu method's exact camera pass (gl_passes.hpp)
 };
 
 // What every method's passes read and write.

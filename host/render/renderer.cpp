@@ -139,6 +139,17 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   }
   r.map.exact_priority = o.resolve == "exact";
   r.map.search.side_structure = o.side_structure;
+  if (o.gpu_mirrors != "stencil" && o.gpu_mirrors != "envmap") {
+    throw InputError("gpu-mirrors: unknown technique " + quote(o.gpu_mirrors) + " (stencil, envmap)");
+  }
+  if (o.gpu_shadows != "volumes" && o.gpu_shadows != "maps") {
+    throw InputError("gpu-shadows: unknown technique " + quote(o.gpu_shadows) + " (volumes, maps)");
+  }
+  if (o.gpu_max_views < 0) throw InputError("gpu-max-views: must be >= 0, got " + std::to_string(o.gpu_max_views));
+  r.gpu.planar_mirrors = o.gpu_mirrors == "stencil";
+  r.gpu.shadow_volumes = o.gpu_shadows == "volumes";
+  r.gpu.max_views = o.gpu_max_views;
+  r.gpu.max_depth = view->render.max_depth;
   r.abuffer.max_layers = o.max_layers;
   if (o.max_memory_mib > (uint64_t{1} << 30)) throw InputError("max-memory: must be at most 2^30 MiB");
   r.abuffer.max_memory_bytes = o.max_memory_mib << 20;  // the whole render's budget
@@ -381,6 +392,12 @@ void refuse_unused_options(const Scene& scene, const RenderOptions& o) {
   }
   if (o.envmap_lookup != defaults.envmap_lookup && m != Method::envmap && m != Method::gpu) {
     refuse("envmap-lookup", "environment map lookups: envmap, gpu");
+  }
+  if (m != Method::gpu) {
+    const char* gpu = "the GPU's camera pass: gpu";
+    if (o.gpu_mirrors != defaults.gpu_mirrors) refuse("gpu-mirrors", gpu);
+    if (o.gpu_shadows != defaults.gpu_shadows) refuse("gpu-shadows", gpu);
+    if (o.gpu_max_views != defaults.gpu_max_views) refuse("gpu-max-views", gpu);
   }
 }
 

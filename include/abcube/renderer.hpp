@@ -73,6 +73,9 @@ struct RenderOptions {
   std::string envmap_lookup = "R";   // R | bisector | position (envmap method)
   std::string resolve = "exact";     // intersecting fragments: exact (priority masks) | thesis (Vis_front)
   bool side_structure = true;        // searches also test the triangles the map cannot hold (false: --map-only)
+  std::string gpu_mirrors = "stencil";  // gpu: planar mirrors by the stencil test | envmap (every mirror from the cube texture)
+  std::string gpu_shadows = "volumes";  // gpu: shadow volumes | maps (cube shadow maps)
+  int gpu_max_views = 256;              // gpu: mirror views drawn per camera tile, at most
   uint32_t max_layers = 0;       // A-buffer layers kept per list (0 = all)
   uint64_t max_memory_mib = 0;   // the whole render's memory budget, MiB (0 = the memory available)
   uint64_t max_pixels = 0;       // refuse a camera image larger than this (0 = no cap)

@@ -1,0 +1,69 @@
+#include "scene/planar_reflectors.hpp"
+
+#include <cmath>
+
+namespace abcube {
+
+namespace {
+
+// Whether material m reflects as a plain mirror: kr > 0, no refraction, opaque.
+bool mirror_material(const Material& m) { return m.reflect > 0.0 && m.transmit == 0.0 && m.opacity == 1.0; }
+
+}  // namespace
+
+PlanarReflectors find_planar_reflectors(const SceneData& scene) {
+  const TriangleSoup& soup = *scene.triangles;
+  PlanarReflectors out;
+  out.reflector_of_triangle.assign(soup.triangle_count(), 0);
+  // The reflectors of the object being read (the soup keeps an object's triangles together,
+  // and every object's triangles are searched among its own reflectors only).
+  size_t object_first = 0;
+  uint32_t object = UINT32_MAX;
+  for (uint32_t t = 0; t < soup.triangle_count(); ++t) {
+    const Material& m = scene.materials[soup.material_id[t]];
+    if (!mirror_material(m)) continue;
+    if (soup.object_id[t] != object) {
+      object = soup.object_id[t];
+      object_first = out.reflectors.size();
+    }
+    const size_t v = 3 * static_cast<size_t>(t);
+    const glm::dvec3 a(soup.positions[v]), b(soup.positions[v + 1]), c(soup.positions[v + 2]);
+    const glm::dvec3 cross = glm::cross(b - a, c - a);
+    const double length = glm::length(cross);
+    if (!(length > 0.0) || !std::isfinite(length)) continue;  // no plane: draws nothing
+    const glm::dvec3 n = cross / length;
+    bool flat = true;
+    for (size_t k = 0; k < 3 && flat; ++k) {
+      const glm::dvec3 s(soup.normals[v + k]);
+      flat = 1.0 - std::fabs(glm::dot(glm::normalize(s), n)) <= FLAT_COSINE_TOLERANCE;
+    }
+    if (!flat) {
+      ++out.curved_triangles;
+      continue;
+    }
+    const double magnitude = std::fmax(std::fmax(std::fabs(a.x), std::fabs(a.y)), std::fabs(a.z)) + 1e-300;
+    const double offset = -glm::dot(n, a);
+    size_t r = object_first;
+    for (; r < out.reflectors.size(); ++r) {
+      const PlanarReflector& p = out.reflectors[r];
+      if (p.material != soup.material_id[t]) continue;
+      const double cosine = glm::dot(p.normal, n);
+      if (1.0 - std::fabs(cosine) > FLAT_COSINE_TOLERANCE) continue;
+      const double o = cosine > 0 ? offset : -offset;
+      if (std::fabs(o - p.offset) <= PLANE_RELATIVE * magnitude) break;
+    }
+    if (r == out.reflectors.size()) {
+      PlanarReflector p;
+      p.normal = n;
+      p.offset = offset;
+      p.object = object;
+      p.material = soup.material_id[t];
+      out.reflectors.push_back(p);
+    }
+    out.reflectors[r].triangles.push_back(t);
+    out.reflector_of_triangle[t] = static_cast<uint32_t>(r + 1);
+  }
+  return out;
+}
+
+}  // namespace abcube

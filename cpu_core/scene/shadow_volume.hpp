@@ -1,0 +1,48 @@
+// The shadow volume of a point light (issue 19 part 3; course notes 3.3; Everitt & Kilgard
+// 2002, "Practical and Robust Stenciled Shadow Volumes"): what the gpu method counts, per
+// camera sample, to decide whether an opaque blocker lies between the sample's point and
+// the light, exactly where shadow maps compare depths at a texel's resolution.
+//
+// Every blocker triangle (opaque: blocker_transmittance 0; its plane not through the light,
+// plane_holds_light) bounds the prism of points behind it as seen from the light: its near
+// cap (the triangle), its far cap (its corners pushed to infinity along the light's rays:
+// homogeneous w = 0), and one side per edge (the edge and its two rays to infinity). Each
+// prism is closed and oriented outward (near cap towards the light), so along any ray the
+// faces it crosses are entries and exits in turn: depth-fail counting (+1 per back face,
+// -1 per front face behind or at the visible surface) gives the number of prisms that hold
+// the surface point, whichever side of the volumes the eye is on. Open surfaces (a quad)
+// need nothing special: their triangles are prisms like any other. Two sides on one edge
+// with opposite directions (two neighbours oriented alike, the inside of a mesh) are the
+// same quad traversed both ways: they cancel on every ray and are left out.
+//
+// The near caps keep their triangle's vertex order (a flag says when their orientation is
+// reversed): the GL draws them with the same vertices, in the same order, as the surface
+// itself, so a cap and its surface have the same depth at every sample and a lit point of a
+// blocker counts its own cap (-1) against the exit of its own prism (+1).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene/scene_data.hpp"
+
+namespace abcube {
+
+struct ShadowVolumeVertex {
+  glm::vec4 position;  // w = 1: a point; w = 0: a direction from the light (a point at infinity)
+  uint32_t object;     // the caster's object (THE TIE RULE's depth scaling of near caps, tie_rule.hpp)
+  uint32_t reversed;   // 1: the face's outward orientation is opposite to its winding
+};
+
+struct ShadowVolume {
+  std::vector<ShadowVolumeVertex> vertices;  // triangles, three vertices each
+  uint64_t blockers = 0;          // triangles that cast (prisms)
+  uint64_t sides = 0;             // side quads kept
+  uint64_t sides_cancelled = 0;   // side quads left out in cancelling pairs
+};
+
+// The volume of the light at `light` over the scene's blockers.
+ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light);
+
+}  // namespace abcube

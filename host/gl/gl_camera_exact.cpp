@@ -1,0 +1,401 @@
+// The camera pass of the gpu method where the GPU is exact (issue 19; gl_passes.hpp
+// ExactCameraOptions, README "The gpu method at its best").
+//
+// PLANAR MIRRORS (course notes 4.1.2; Kilgard 1999, "Improving shadows and reflections via
+// the stencil buffer"). The stencil value of a sample is the mirror level of the view it
+// shows. A view of level L is drawn where the stencil is L. Then, for each planar reflector
+// of the scene (planar_reflectors.hpp) while L < max_depth:
+//   1. mark: the reflector's own triangles, where they are the visible surface (depth
+//      EQUAL: the same vertex stage, invariant), raise the stencil to L + 1 (an occlusion
+//      query skips a mirror that covers no sample);
+//   2. clear that region: depth to the far plane, colour to the background;
+//   3. draw the level L + 1 view there: the scene reflected about the mirror's plane
+//      (model = model_L * R, R the reflection), only what lies in front of the mirror
+//      (gl_ClipDistance on the mirror's plane, turned towards the eye), the mirror itself
+//      left out, each point shaded as seen from the eye reflected (R eye_L), recursively;
+//   4. composite: the reflector drawn again over its region with its local shading, blended
+//      C = C_local + kr * C_behind (glBlendFunc(ONE, CONSTANT_COLOR), constant kr: a planar
+//      reflector neither refracts nor is transparent, so its weights are its material's),
+//      its depth written back and the stencil lowered to L.
+// This is Whitted's mirror term at the camera's own samples: the virtual view behind a
+// mirror is what the reflected rays of those samples meet (their depth is the unfolded path
+// length; gl_ClipDistance drops what lies between the mirror and the reflected eye). A
+// reflector's views at level max_depth show its local colour only, as the tracer's rays at
+// the depth limit. Past ExactCameraOptions::max_views views a tile, a mirror shows the
+// environment map instead (counted in the stats).
+//
+// SHADOW VOLUMES (course notes 3.3; Everitt & Kilgard 2002, shadow_volume.hpp). Before a
+// view's colour: its depth alone, then per volume light the count of its volume's faces
+// behind or at the visible surface (+1 back, -1 front) in the view's region, and the
+// light's bit set in the mask where the count is not 0. The colour pass (depth GEQUAL: the
+// same surfaces) reads the mask: S_l = 0 where the bit is set (common_shading.glsl). Virtual
+// views count the volumes through their own model matrix, unclipped: each prism stays
+// closed, so the count is the number of prisms holding the reflected point.
+#include <glad/gl.h>
+
+#include <algorithm>
+#include <string>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "base/error.hpp"
+#include "base/parallel.hpp"
+#include "base/timer.hpp"
+#include "gl/gl_passes.hpp"
+#include "gl/gl_passes_internal.hpp"
+#include "raster/cube_map.hpp"
+#include "raster/samples.hpp"
+#include "scene/shadow_volume.hpp"
+
+namespace abcube {
+
+namespace {
+
+// The reflection about the plane dot(n, x) + d = 0 (n unit), as a 4x4 matrix.
+glm::dmat4 reflection_matrix(const glm::dvec3& n, double d) {
+  glm::dmat4 r(1.0);
+  for (int c = 0; c < 3; ++c) {
+    for (int k = 0; k < 3; ++k) r[c][k] -= 2.0 * n[k] * n[c];
+    r[3][c] = -2.0 * d * n[c];
+  }
+  return r;
+}
+
+// The stencil test of a view of level L: draw where the stencil is L, change nothing.
+void stencil_level(int level) {
+  glEnable(GL_STENCIL_TEST);
+  glStencilFunc(GL_EQUAL, level, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+  glStencilMask(0xff);
+}
+
+}  // namespace
+
+std::string GlScene::exact_mirrors_why_not() const {
+  if (reflectors_.reflectors.empty()) return "no planar reflector";
+  if (exact_.max_depth <= 0) return "max_depth 0: no reflected ray";
+  return "";
+}
+
+bool GlScene::plan_exact_camera() {
+  ExactCameraStats& s = exact_stats_;
+  s.mirrors = s.volumes = false;
+  s.mirrors_why = s.volumes_why = "";
+  s.mirror_views = s.mirror_views_empty = s.mirror_views_over_budget = 0;
+  s.deepest_level = 0;
+  s.reflectors = reflectors_.reflectors.size();
+  s.curved_reflective_triangles = reflectors_.curved_triangles;
+  if (!exact_.planar_mirrors && !exact_.shadow_volumes) return false;
+  std::string both;
+  for (const uint32_t id : scene_.triangles->material_id) {
+    if (scene_.materials[id].opacity < 1.0) both = "coverage transparency (the peeled camera pass)";
+  }
+  GLint units = 0, dual = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &units);
+  glGetIntegerv(GL_MAX_DUAL_SOURCE_DRAW_BUFFERS, &dual);
+  if (units <= static_cast<GLint>(VOLUME_MASK_UNIT) || dual < 1) {
+    both = "this GL offers " + std::to_string(units) + " texture units and " + std::to_string(dual) +
+           " dual-source draw buffers (17 and 1 needed)";
+  }
+  bool casts = false;
+  for (const PointLight& l : scene_.lights) casts = casts || l.cast_shadows;
+  if (exact_.planar_mirrors) {
+    s.mirrors_why = both.empty() ? exact_mirrors_why_not() : both;
+    s.mirrors = s.mirrors_why.empty();
+  }
+  if (exact_.shadow_volumes) {
+    s.volumes_why = !both.empty() ? both : casts ? "" : "no light casts shadows";
+    s.volumes = s.volumes_why.empty();
+  }
+  return s.mirrors || s.volumes;
+}
+
+void GlScene::build_volumes() {
+  if (volumes_built_) return;
+  volumes_built_ = true;
+  const Clock::time_point t0 = Clock::now();
+  volume_bit_.assign(scene_.lights.size(), -1);
+  for (size_t i = 0; i < scene_.lights.size() && volume_lights_.size() < size_t{MAX_VOLUME_LIGHTS}; ++i) {
+    if (!scene_.lights[i].cast_shadows) continue;
+    volume_bit_[i] = static_cast<int>(volume_lights_.size());
+    volume_lights_.push_back(static_cast<int>(i));
+    const ShadowVolume v = build_shadow_volume(scene_, scene_.lights[i].position);
+    GLuint vao = 0, vbo = 0;
+    glGenVertexArrays(1, &vao);
+    glBindVertexArray(vao);
+    glGenBuffers(1, &vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, vbo);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.vertices.size() * sizeof(ShadowVolumeVertex)),
+                 v.vertices.data(), GL_STATIC_DRAW);
+    const auto offset = [](size_t bytes) { return reinterpret_cast<const void*>(bytes); };
+    glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, sizeof(ShadowVolumeVertex), offset(offsetof(ShadowVolumeVertex, position)));
+    glVertexAttribIPointer(2, 1, GL_UNSIGNED_INT, sizeof(ShadowVolumeVertex), offset(offsetof(ShadowVolumeVertex, object)));
+    glVertexAttribIPointer(6, 1, GL_UNSIGNED_INT, sizeof(ShadowVolumeVertex), offset(offsetof(ShadowVolumeVertex, reversed)));
+    for (const GLuint a : {0u, 2u, 6u}) glEnableVertexAttribArray(a);
+    volume_vaos_.push_back(vao);
+    volume_vbos_.push_back(vbo);
+    volume_vertices_.push_back(static_cast<GLsizei>(v.vertices.size()));
+    exact_stats_.volume_triangles += v.vertices.size() / 3;
+  }
+  glBindVertexArray(vao_);
+  exact_stats_.volume_lights = static_cast<int>(volume_lights_.size());
+  exact_stats_.volume_build_ms = ms_since(t0);
+  check_gl("shadow volumes upload");
+}
+
+// Fills the region of stencil level `level` of the bound framebuffer's first attachment
+// with `colour` and its depth with the far plane (fill.vert).
+void GlScene::fill_region(int level, const glm::vec4& colour) {
+  fill_program_->use();
+  glUniform4f(fill_program_->uniform("u_fill"), colour.r, colour.g, colour.b, colour.a);
+  stencil_level(level);
+  glDepthFunc(GL_ALWAYS);
+  glDepthMask(GL_TRUE);
+  glBindVertexArray(vao_);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDepthFunc(GL_GREATER);
+}
+
+// The view's shadow mask: for each volume light, its depth-fail count in the view's region
+// (the view's depth is drawn), and its bit where that count is not 0.
+void GlScene::count_volumes(const glm::mat4& clip, const MirrorView& view) {
+  ExactBuffers& b = *exact_buffers_;
+  const GLenum one[] = {GL_COLOR_ATTACHMENT0};
+  // The mask's region cleared.
+  glBindFramebuffer(GL_FRAMEBUFFER, b.mask_fbo);
+  glDrawBuffers(1, one);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  stencil_level(view.level);
+  glDisable(GL_DEPTH_TEST);
+  fill_mask_program_->use();
+  glBindVertexArray(vao_);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  for (size_t bit = 0; bit < volume_lights_.size(); ++bit) {
+    // The count's region cleared, then the volume's faces behind or at the surface added.
+    glBindFramebuffer(GL_FRAMEBUFFER, b.count_fbo);
+    glDrawBuffers(1, one);
+    glDisable(GL_DEPTH_TEST);
+    fill_program_->use();
+    glUniform4f(fill_program_->uniform("u_fill"), 0.f, 0.f, 0.f, 0.f);
+    glBindVertexArray(vao_);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LEQUAL);  // reversed Z: at or behind the stored surface
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE);
+    MirrorView unclipped = view;
+    unclipped.plane = glm::dvec4(0.0, 0.0, 0.0, 1.0);
+    unclipped.skip = 0;
+    set_view(*volume_program_, clip, unclipped);
+    glBindVertexArray(volume_vaos_[bit]);
+    glDrawArrays(GL_TRIANGLES, 0, volume_vertices_[bit]);
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_GREATER);
+    // Its bit where the count is not 0.
+    glBindFramebuffer(GL_FRAMEBUFFER, b.mask_fbo);
+    glDrawBuffers(1, one);
+    glDisable(GL_DEPTH_TEST);
+    glEnable(GL_COLOR_LOGIC_OP);
+    glLogicOp(GL_OR);
+    mask_program_->use();
+    glUniform1i(mask_program_->uniform("u_bit"), static_cast<GLint>(bit));
+    glUniform1i(mask_program_->uniform("u_count"), 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, b.count);
+    glBindVertexArray(vao_);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glDisable(GL_COLOR_LOGIC_OP);
+  }
+  glEnable(GL_DEPTH_TEST);
+  glBindVertexArray(vao_);
+}
+
+void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* views_left) {
+  check_deadline();
+  exact_stats_.deepest_level = std::max(exact_stats_.deepest_level, view.level);
+  Target& t = *target_;
+  const GLenum colour[] = {GL_COLOR_ATTACHMENT0};
+  auto bind_target = [&] {
+    glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+    glDrawBuffers(1, colour);
+    if (view.level > 0) glEnable(GL_CLIP_DISTANCE0); else glDisable(GL_CLIP_DISTANCE0);
+  };
+  // 1. The view's depth.
+  bind_target();
+  stencil_level(view.level);
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  glDepthFunc(GL_GREATER);
+  draw_scene(*distance_program_, clip, view);
+
+  // 2. The views behind the mirrors it shows, each drawn into the mirror's region.
+  std::vector<uint32_t> recursed(reflectors_.reflectors.size() + 1, 0);
+  if (exact_stats_.mirrors && view.level < exact_.max_depth) {
+    GLuint query = 0;
+    glGenQueries(1, &query);
+    for (size_t r = 0; r < reflectors_.reflectors.size(); ++r) {
+      const PlanarReflector& mirror = reflectors_.reflectors[r];
+      const uint32_t id = static_cast<uint32_t>(r + 1);
+      const double side = mirror.side(view.eye);
+      if (id == view.skip || side == 0.0) continue;  // the mirror seen through; one seen edge-on covers nothing
+      // Mark where it is the visible surface: stencil L -> L + 1 (over the budget: only asked).
+      const bool budget = *views_left > 0;
+      glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+      glDepthMask(GL_FALSE);
+      glDepthFunc(GL_EQUAL);
+      glStencilFunc(GL_EQUAL, view.level, 0xff);
+      glStencilOp(GL_KEEP, GL_KEEP, budget ? GL_INCR : GL_KEEP);
+      glBeginQuery(GL_ANY_SAMPLES_PASSED, query);
+      draw_reflector(*distance_program_, clip, view, r);
+      glEndQuery(GL_ANY_SAMPLES_PASSED);
+      glDepthMask(GL_TRUE);
+      glDepthFunc(GL_GREATER);
+      GLuint marked = 0;
+      glGetQueryObjectuiv(query, GL_QUERY_RESULT, &marked);
+      if (!marked) {
+        ++exact_stats_.mirror_views_empty;
+        continue;
+      }
+      if (!budget) {  // this mirror shows the environment map, as the envmap method would
+        ++exact_stats_.mirror_views_over_budget;
+        continue;
+      }
+      --*views_left;
+      ++exact_stats_.mirror_views;
+      recursed[id] = 1;
+      // Its region cleared to the background at the far plane, then the view behind it.
+      glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+      fill_region(view.level + 1, glm::vec4(glm::vec3(scene_.background), 1.f));
+      MirrorView behind;
+      behind.level = view.level + 1;
+      const glm::dmat4 reflect = reflection_matrix(mirror.normal, mirror.offset);
+      behind.model = view.model * reflect;
+      behind.eye = glm::dvec3(reflect * glm::dvec4(view.eye, 1.0));
+      behind.plane = (side > 0 ? 1.0 : -1.0) * glm::dvec4(mirror.normal, mirror.offset);
+      behind.skip = id;
+      render_view(clip, behind, views_left);
+      // The mirror's depth back over its region, and the stencil back to L.
+      bind_target();
+      glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+      glStencilFunc(GL_EQUAL, view.level + 1, 0xff);
+      glStencilOp(GL_KEEP, GL_KEEP, GL_DECR);
+      glDepthFunc(GL_ALWAYS);
+      draw_reflector(*distance_program_, clip, view, r);
+      glDepthFunc(GL_GREATER);
+      stencil_level(view.level);
+    }
+    glDeleteQueries(1, &query);
+  }
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+
+  // 3. The view's shadow mask, from its depth.
+  const bool volumes = exact_stats_.volumes && !volume_lights_.empty();
+  if (volumes) count_volumes(clip, view);
+
+  // 4. Its colour: the visible surfaces (depth GEQUAL), a mirror drawn behind blended over.
+  bind_target();
+  stencil_level(view.level);
+  glDepthFunc(GL_GEQUAL);
+  upload_lights(view.eye);
+  glBindBuffer(GL_SHADER_STORAGE_BUFFER, recursed_);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(recursed.size() * sizeof(uint32_t)), recursed.data(),
+               GL_STREAM_DRAW);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, recursed_);
+  exact_program_->use();
+  glUniform1i(exact_program_->uniform("u_volumes"), volumes);
+  glUniform1i(exact_program_->uniform("u_environment"), environment_ != 0 && view.level < exact_.max_depth);
+  glActiveTexture(GL_TEXTURE0 + VOLUME_MASK_UNIT);
+  glBindTexture(GL_TEXTURE_2D, volumes ? exact_buffers_->mask : 0);
+  glActiveTexture(GL_TEXTURE0);
+  glEnable(GL_BLEND);
+  glBlendEquation(GL_FUNC_ADD);
+  glBlendFunc(GL_ONE, GL_SRC1_COLOR);
+  draw_scene(*exact_program_, clip, view);
+  glDisable(GL_BLEND);
+  glDepthFunc(GL_GREATER);
+}
+
+Image GlScene::camera_color_exact(const Camera& camera) {
+  const int64_t full_w = int64_t{camera.width} * MASK_COLUMNS, full_h = int64_t{camera.height} * MASK_ROWS;
+  const int64_t tile_max = std::min(CAMERA_TILE, max_size_);
+  const int tile_w = static_cast<int>(std::min(full_w, tile_max)), tile_h = static_cast<int>(std::min(full_h, tile_max));
+  Target& t = target(tile_w, tile_h, false);
+  if (!exact_program_) {
+    exact_program_ = std::make_unique<GlProgram>(
+        std::vector<const char*>{"scene.vert"},
+        std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "camera_exact.frag"});
+    exact_program_->use();
+    glUniform1i(exact_program_->uniform("u_volume_mask"), static_cast<GLint>(VOLUME_MASK_UNIT));
+    fill_program_ = std::make_unique<GlProgram>(std::vector<const char*>{"fill.vert"}, std::vector<const char*>{"fill.frag"});
+    fill_mask_program_ =
+        std::make_unique<GlProgram>(std::vector<const char*>{"fill.vert"}, std::vector<const char*>{"fill_mask.frag"});
+    volume_program_ = std::make_unique<GlProgram>(std::vector<const char*>{"scene.vert"},
+                                                  std::vector<const char*>{"shadow_volume.frag"});
+    mask_program_ =
+        std::make_unique<GlProgram>(std::vector<const char*>{"fill.vert"}, std::vector<const char*>{"volume_mask.frag"});
+    glGenBuffers(1, &recursed_);
+  }
+  if (exact_stats_.volumes) {
+    if (!volumes_built_) build_volumes();
+    if (!exact_buffers_ || exact_buffers_->width != tile_w || exact_buffers_->height != tile_h) {
+      exact_buffers_.reset();
+      exact_buffers_ = std::make_unique<ExactBuffers>(t);
+    }
+  }
+  bind_lookups(*exact_program_, true);
+  exact_program_->use();
+  glUniform1i(exact_program_->uniform("u_portals_exact"), 1);
+  const double aspect = static_cast<double>(camera.width) / camera.height;
+  const glm::mat4 clip = camera_clip_matrix(camera.position, camera.look_at, camera.up,
+                                            glm::radians(camera.fov_y_deg), aspect, near_);
+  const size_t tile_samples = static_cast<size_t>(tile_w) * static_cast<size_t>(tile_h);
+  std::vector<float> rgba(tile_samples * 4);
+  std::vector<double> sum(static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height) * 3, 0.0);
+  for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
+    for (int64_t x0 = 0; x0 < full_w; x0 += tile_w) {
+      check_deadline();
+      Clock::time_point t0 = Clock::now();
+      t.clear(scene_.background);
+      MirrorView camera_view;
+      camera_view.eye = camera.position;
+      int views_left = exact_.max_views;
+      render_view(tile_matrix(full_w, full_h, x0, y0, tile_w, tile_h) * clip, camera_view, &views_left);
+      glDisable(GL_STENCIL_TEST);
+      glDisable(GL_CLIP_DISTANCE0);
+      glFinish();
+      timings_.camera_ms += ms_since(t0);
+      t0 = Clock::now();
+      t.read(0, GL_RGBA, GL_FLOAT, rgba.data());
+      // GL's row 0 is the bottom; the image's row 0 is the top. Box filter of the 32 samples.
+      for (int64_t gy = 0; gy < tile_h && y0 + gy < full_h; ++gy) {
+        const size_t row = static_cast<size_t>((full_h - 1 - (y0 + gy)) / MASK_ROWS);
+        for (int64_t gx = 0; gx < tile_w && x0 + gx < full_w; ++gx) {
+          const size_t k = static_cast<size_t>(gy) * static_cast<size_t>(tile_w) + static_cast<size_t>(gx);
+          double* dst = &sum[(row * static_cast<size_t>(camera.width) + static_cast<size_t>((x0 + gx) / MASK_COLUMNS)) * 3];
+          for (int c = 0; c < 3; ++c) dst[c] += rgba[4 * k + static_cast<size_t>(c)];
+        }
+      }
+      timings_.readback_ms += ms_since(t0);
+    }
+  }
+  // The state the other passes expect back (Mesa refuses a draw to two buffers while the
+  // blend function names the second source, even with blending off).
+  glActiveTexture(GL_TEXTURE0 + VOLUME_MASK_UNIT);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  glActiveTexture(GL_TEXTURE0);
+  glBlendFunc(GL_ONE, GL_ZERO);
+  glLogicOp(GL_COPY);
+  glStencilFunc(GL_ALWAYS, 0, 0xff);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, 0);
+  camera_layers_ = 1;
+  camera_layers_capped_ = false;
+  Image out(camera.width, camera.height, 3);
+  for (size_t k = 0; k < sum.size(); ++k) out.data[k] = static_cast<float>(sum[k] / MASK_SAMPLES);
+  check_gl("exact camera pass");
+  return out;
+}
+
+}  // namespace abcube

@@ -1,0 +1,173 @@
+// Internal to the GL passes (gl_passes.cpp, gl_camera_exact.cpp): texture units, the pass
+// state, the framebuffers, the views of the exact camera pass.
+#pragma once
+#include <glad/gl.h>
+
+#include <cstdint>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "base/error.hpp"
+#include "gl/gl_passes.hpp"
+
+namespace abcube {
+
+// The camera pass renders at most this many samples a side at once (tiles beyond).
+constexpr int CAMERA_TILE = 2048;
+// Texture units: 1 the opaque shadow maps, 2 the environment, 3.. the translucent peels,
+// then the camera's previous layer.
+constexpr GLenum PEEL_UNIT = 3;
+constexpr GLenum CAMERA_PREVIOUS_UNIT = PEEL_UNIT + MAX_SHADOW_PEELS;
+// Then the base-colour texture arrays (16 units in all: GL 4.5's minimum for a fragment shader).
+constexpr GLenum TEXTURE_UNIT = CAMERA_PREVIOUS_UNIT + 1;
+static_assert(TEXTURE_UNIT + MAX_TEXTURE_ARRAYS <= 16, "texture units");
+// The shadow volumes' mask in the camera pass: unit 16 (llvmpipe and NVIDIA offer 32; the
+// exact pass checks GL_MAX_TEXTURE_IMAGE_UNITS).
+constexpr GLenum VOLUME_MASK_UNIT = 16;
+
+// The state every pass relies on: infinite reversed-Z (cube_map.hpp: depth in [0, 1], 1 at
+// the near plane, GL_GREATER), no culling (the map holds every surface), no blending.
+// And none of the exact camera pass's (gl_camera_exact.cpp): no stencil test, no clip
+// distance, no logic op, every colour channel written (a pass it left midway, stopped by a
+// time limit, leaves no trace).
+inline void set_pass_state() {
+  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glBlendFunc(GL_ONE, GL_ZERO);
+  glDisable(GL_STENCIL_TEST);
+  glDisable(GL_CLIP_DISTANCE0);
+  glDisable(GL_COLOR_LOGIC_OP);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+}
+
+// The clip coordinates of the full sample grid (full_w x full_h, GL window coordinates, y
+// up) scaled and shifted so that the tile at (x0, y0), tile_w x tile_h, fills the viewport
+// (one tile: identity).
+inline glm::mat4 tile_matrix(int64_t full_w, int64_t full_h, int64_t x0, int64_t y0, int tile_w, int tile_h) {
+  glm::mat4 tile(1.f);
+  tile[0][0] = float(double(full_w) / tile_w);
+  tile[3][0] = float(-double(full_w) / tile_w * (double(2 * x0 + tile_w) / double(full_w) - 1.0));
+  tile[1][1] = float(double(full_h) / tile_h);
+  tile[3][1] = float(-double(full_h) / tile_h * (double(2 * y0 + tile_h) / double(full_h) - 1.0));
+  return tile;
+}
+
+// One framebuffer: distance (R32F) + object id (R32UI), or colour (RGBA32F); depth 32F with
+// 8 stencil bits (the mirror levels of gl_camera_exact.cpp).
+struct GlScene::Target {
+  int width = 0, height = 0;
+  bool distance_pass = false;
+  GLuint fbo = 0, color0 = 0, color1 = 0, depth = 0;
+
+  Target(int w, int h, bool distance) : width(w), height(h), distance_pass(distance) {
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    auto make = [&](GLenum format, GLenum attachment) {
+      GLuint tex = 0;
+      glGenTextures(1, &tex);
+      glBindTexture(GL_TEXTURE_2D, tex);
+      glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
+      glFramebufferTexture2D(GL_FRAMEBUFFER, attachment, GL_TEXTURE_2D, tex, 0);
+      return tex;
+    };
+    color0 = make(distance ? GL_R32F : GL_RGBA32F, GL_COLOR_ATTACHMENT0);
+    color1 = make(distance ? GL_R32UI : GL_RG32F, GL_COLOR_ATTACHMENT1);
+    depth = make(GL_DEPTH32F_STENCIL8, GL_DEPTH_STENCIL_ATTACHMENT);
+    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, buffers);
+    const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+      throw RuntimeFailure("framebuffer " + std::to_string(w) + "x" + std::to_string(h) +
+                           " incomplete (status " + std::to_string(status) + ")");
+    }
+  }
+  ~Target() {
+    const GLuint textures[] = {color0, color1, depth};
+    glDeleteTextures(3, textures);
+    glDeleteFramebuffers(1, &fbo);
+  }
+
+  // Binds the target, sets the state every pass relies on, and clears it.
+  void clear(const glm::dvec3& background) const {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glViewport(0, 0, width, height);
+    set_pass_state();
+    glClearBufferfi(GL_DEPTH_STENCIL, 0, 0.f, 0);  // reversed Z: 0 is infinitely far; stencil level 0
+    if (distance_pass) {
+      const float far[4] = {NO_DISTANCE, 0, 0, 0};
+      const GLuint none[4] = {NO_OBJECT, 0, 0, 0};
+      glClearBufferfv(GL_COLOR, 0, far);
+      glClearBufferuiv(GL_COLOR, 1, none);
+    } else {
+      const float bg[4] = {float(background.x), float(background.y), float(background.z), 1.f};
+      const float none[4] = {NO_DISTANCE, -1.f, 0, 0};
+      glClearBufferfv(GL_COLOR, 0, bg);
+      glClearBufferfv(GL_COLOR, 1, none);
+    }
+  }
+
+  // Reads attachment `index` into `out` (`components` values per texel, GL row order).
+  void read(int index, GLenum format, GLenum type, void* out) const {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(index));
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, width, height, format, type, out);
+  }
+};
+
+// One view of the exact camera pass (gl_camera_exact.cpp): level 0 is the camera's own;
+// level L + 1 is what a planar mirror seen at level L shows. The scene is drawn through
+// `model` (the reflections about the mirrors passed, composed: world -> virtual world),
+// shaded at its own positions as seen from `eye` (the camera unfolded through the mirrors,
+// in world coordinates), keeping what lies on `plane`'s positive side (the last mirror's
+// front), without the mirror `skip` (its reflector + 1) it is seen through.
+struct GlScene::MirrorView {
+  int level = 0;
+  glm::dmat4 model{1.0};
+  glm::dvec3 eye{0.0};
+  glm::dvec4 plane{0.0, 0.0, 0.0, 1.0};  // keeps everything
+  uint32_t skip = 0;
+};
+
+// The exact camera pass's buffers beside the camera Target (same size, same depth-stencil
+// texture): the shadow count of one light (R32F, additive) and the mask of every volume
+// light's bit (RGBA32UI, OR-ed in).
+struct GlScene::ExactBuffers {
+  int width = 0, height = 0;
+  GLuint count = 0, mask = 0, count_fbo = 0, mask_fbo = 0;
+
+  ExactBuffers(const Target& t) : width(t.width), height(t.height) {
+    auto make = [&](GLenum format, GLuint* tex, GLuint* fbo) {
+      glGenTextures(1, tex);
+      glBindTexture(GL_TEXTURE_2D, *tex);
+      glTexStorage2D(GL_TEXTURE_2D, 1, format, width, height);
+      // One level, read by texelFetch: complete only with a filter that needs no mipmaps
+      // (an incomplete unsigned-integer texture reads as 0).
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      glGenFramebuffers(1, fbo);
+      glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
+      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, *tex, 0);
+      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, t.depth, 0);
+      const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+      if (status != GL_FRAMEBUFFER_COMPLETE) {
+        throw RuntimeFailure("shadow-volume framebuffer incomplete (status " + std::to_string(status) + ")");
+      }
+    };
+    make(GL_R32F, &count, &count_fbo);
+    make(GL_RGBA32UI, &mask, &mask_fbo);
+  }
+  ~ExactBuffers() {
+    const GLuint textures[] = {count, mask};
+    glDeleteTextures(2, textures);
+    const GLuint fbos[] = {count_fbo, mask_fbo};
+    glDeleteFramebuffers(2, fbos);
+  }
+};
+
+}  // namespace abcube
