@@ -20,7 +20,7 @@ namespace abcube {
 namespace {
 
 struct CrosscheckCommand {
-  std::string scene_path, stats_path, samples_image, gl = "auto";
+  std::string scene_path, stats_path, samples_image, shadow_image, gl = "auto";
   int cube_res = 0, device = -1, threads = 0;
 
   int run() const {
@@ -29,6 +29,7 @@ struct CrosscheckCommand {
     if (choice == GlChoice::none) throw InputError("--gl none: the cross-check compares GL with the CPU");
     check_output_path(stats_path, false);
     check_output_path(samples_image, true);
+    check_output_path(shadow_image, true);
     const Scene loaded = Scene::load(scene_path);
     SceneData scene = loaded.data();  // shares the triangles
     if (cube_res > 0) scene.render.cube_resolution = cube_res;
@@ -57,6 +58,17 @@ struct CrosscheckCommand {
                 "other object %zu\n",
                 r.samples, r.samples_same, r.sample_agreement, tol.sample_agreement_min, r.samples_gpu_only,
                 r.samples_cpu_only, r.samples_other_object);
+    if (r.shadow_lights > 0) {
+      auto line = [](const char* what, const ShadowAgreement& a) {
+        std::printf("  %-22s %.5f of %zu, away from edges %.5f of %zu (false shadow %zu, false light %zu)\n", what,
+                    a.share(), a.pairs, a.interior_share(), a.interior, a.false_shadow, a.false_light);
+      };
+      std::printf("shadows against the exact tracer (%dx%d, 32 samples a pixel, %d lights):\n", r.shadow_width,
+                  r.shadow_height, r.shadow_lights);
+      line("GPU shadow volumes", r.volumes);
+      line("GPU shadow maps", r.maps);
+      line("CPU shadow search", r.search);
+    }
     std::printf("time: GPU prepass %.1f ms, CPU cube A-buffer %.1f ms (%llu fragments)\n", r.gpu_ms, r.cpu_ms,
                 static_cast<unsigned long long>(r.fragments));
     std::printf("%s\n", r.pass ? "PASS" : ("FAIL: " + r.failures).c_str());
@@ -66,6 +78,7 @@ struct CrosscheckCommand {
       write_text_atomic(stats_path, j.dump(2) + "\n");
     }
     if (!samples_image.empty()) write_image(samples_image, r.sample_disagreement);
+    if (!shadow_image.empty() && r.shadow_lights > 0) write_image(shadow_image, r.shadow_disagreement);
     print_warnings(loaded, "abcube: ");
     return r.pass ? 0 : 1;
   }
@@ -86,6 +99,9 @@ CommandRun add_crosscheck_command(CLI::App& app) {
   cmd->add_option("--stats", c->stats_path, "figures and tolerances as JSON");
   cmd->add_option("--samples-image", c->samples_image,
                   "per pixel, the share of its 32 camera samples where GPU and CPU see different objects");
+  cmd->add_option("--shadow-image", c->shadow_image,
+                  "per pixel of the shadow camera, the share of (sample, light) pairs where the GPU's shadow volumes "
+                  "and the exact tracer differ");
   return [c] { return c->run(); };
 }
 

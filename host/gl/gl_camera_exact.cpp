@@ -318,26 +318,106 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
   glDepthFunc(GL_GREATER);
 }
 
+void GlScene::make_exact_programs() {
+  if (exact_program_) return;
+  const std::vector<const char*> scene_vert{"scene.vert"}, fill_vert{"fill.vert"};
+  exact_program_ = std::make_unique<GlProgram>(
+      scene_vert, std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "camera_exact.frag"});
+  probe_program_ = std::make_unique<GlProgram>(
+      scene_vert, std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "shadow_probe.frag"});
+  for (const GlProgram* p : {exact_program_.get(), probe_program_.get()}) {
+    p->use();
+    glUniform1i(p->uniform("u_volume_mask"), static_cast<GLint>(VOLUME_MASK_UNIT));
+  }
+  fill_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"fill.frag"});
+  fill_mask_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"fill_mask.frag"});
+  volume_program_ = std::make_unique<GlProgram>(scene_vert, std::vector<const char*>{"shadow_volume.frag"});
+  mask_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"volume_mask.frag"});
+  glGenBuffers(1, &recursed_);
+}
+
+GlScene::ShadowProbe GlScene::camera_shadow_probe(const Camera& camera) {
+  constexpr int PROBED = 16;
+  ShadowProbe out;
+  std::vector<GLint> probe(64, -1);
+  for (size_t i = 0; i < scene_.lights.size() && out.lights.size() < size_t{PROBED}; ++i) {
+    if (!scene_.lights[i].cast_shadows) continue;
+    if (i < probe.size()) probe[i] = static_cast<GLint>(out.lights.size());
+    out.lights.push_back(static_cast<int>(i));
+  }
+  const int64_t full_w = int64_t{camera.width} * MASK_COLUMNS, full_h = int64_t{camera.height} * MASK_ROWS;
+  const int64_t tile_max = std::min(CAMERA_TILE, max_size_);
+  const int tile_w = static_cast<int>(std::min(full_w, tile_max)), tile_h = static_cast<int>(std::min(full_h, tile_max));
+  Target& t = target(tile_w, tile_h, false);
+  make_exact_programs();
+  build_volumes();
+  if (!exact_buffers_ || exact_buffers_->width != tile_w || exact_buffers_->height != tile_h) {
+    exact_buffers_.reset();
+    exact_buffers_ = std::make_unique<ExactBuffers>(t);
+  }
+  const double aspect = static_cast<double>(camera.width) / camera.height;
+  const glm::mat4 clip = camera_clip_matrix(camera.position, camera.look_at, camera.up,
+                                            glm::radians(camera.fov_y_deg), aspect, near_);
+  const size_t grid = static_cast<size_t>(full_w * full_h);
+  out.volume.assign(grid, 0);
+  out.map.assign(grid, 0);
+  out.lit.assign(grid, 0);
+  std::vector<float> rgba(static_cast<size_t>(tile_w) * static_cast<size_t>(tile_h) * 4);
+  const GLenum colour[] = {GL_COLOR_ATTACHMENT0};
+  MirrorView view;
+  view.eye = camera.position;
+  for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
+    for (int64_t x0 = 0; x0 < full_w; x0 += tile_w) {
+      check_deadline();
+      const glm::mat4 tile_clip = tile_matrix(full_w, full_h, x0, y0, tile_w, tile_h) * clip;
+      t.clear(scene_.background);
+      const float none[4] = {0, 0, 0, 0};
+      glClearBufferfv(GL_COLOR, 0, none);
+      stencil_level(0);
+      glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+      draw_scene(*distance_program_, tile_clip, view);
+      glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+      if (!volume_lights_.empty()) count_volumes(tile_clip, view);
+      glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
+      glDrawBuffers(1, colour);
+      stencil_level(0);
+      glDepthFunc(GL_GEQUAL);
+      bind_lookups(*probe_program_, false);
+      upload_lights(view.eye);
+      probe_program_->use();
+      glUniform1iv(probe_program_->uniform("u_probe"), 64, probe.data());
+      glActiveTexture(GL_TEXTURE0 + VOLUME_MASK_UNIT);
+      glBindTexture(GL_TEXTURE_2D, exact_buffers_->mask);
+      glActiveTexture(GL_TEXTURE0);
+      draw_scene(*probe_program_, tile_clip, view);
+      glDepthFunc(GL_GREATER);
+      glFinish();
+      t.read(0, GL_RGBA, GL_FLOAT, rgba.data());
+      for (int64_t gy = 0; gy < tile_h && y0 + gy < full_h; ++gy) {
+        for (int64_t gx = 0; gx < tile_w && x0 + gx < full_w; ++gx) {
+          const size_t k = static_cast<size_t>(gy * tile_w + gx);
+          const size_t g = static_cast<size_t>((full_h - 1 - (y0 + gy)) * full_w + x0 + gx);
+          out.volume[g] = static_cast<uint16_t>(rgba[4 * k]);
+          out.map[g] = static_cast<uint16_t>(rgba[4 * k + 1]);
+          out.lit[g] = static_cast<uint16_t>(rgba[4 * k + 2]);
+        }
+      }
+    }
+  }
+  glDisable(GL_STENCIL_TEST);
+  glActiveTexture(GL_TEXTURE0 + VOLUME_MASK_UNIT);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  glActiveTexture(GL_TEXTURE0);
+  check_gl("shadow probe");
+  return out;
+}
+
 Image GlScene::camera_color_exact(const Camera& camera) {
   const int64_t full_w = int64_t{camera.width} * MASK_COLUMNS, full_h = int64_t{camera.height} * MASK_ROWS;
   const int64_t tile_max = std::min(CAMERA_TILE, max_size_);
   const int tile_w = static_cast<int>(std::min(full_w, tile_max)), tile_h = static_cast<int>(std::min(full_h, tile_max));
   Target& t = target(tile_w, tile_h, false);
-  if (!exact_program_) {
-    exact_program_ = std::make_unique<GlProgram>(
-        std::vector<const char*>{"scene.vert"},
-        std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "camera_exact.frag"});
-    exact_program_->use();
-    glUniform1i(exact_program_->uniform("u_volume_mask"), static_cast<GLint>(VOLUME_MASK_UNIT));
-    fill_program_ = std::make_unique<GlProgram>(std::vector<const char*>{"fill.vert"}, std::vector<const char*>{"fill.frag"});
-    fill_mask_program_ =
-        std::make_unique<GlProgram>(std::vector<const char*>{"fill.vert"}, std::vector<const char*>{"fill_mask.frag"});
-    volume_program_ = std::make_unique<GlProgram>(std::vector<const char*>{"scene.vert"},
-                                                  std::vector<const char*>{"shadow_volume.frag"});
-    mask_program_ =
-        std::make_unique<GlProgram>(std::vector<const char*>{"fill.vert"}, std::vector<const char*>{"volume_mask.frag"});
-    glGenBuffers(1, &recursed_);
-  }
+  make_exact_programs();
   if (exact_stats_.volumes) {
     if (!volumes_built_) build_volumes();
     if (!exact_buffers_ || exact_buffers_->width != tile_w || exact_buffers_->height != tile_h) {

@@ -141,6 +141,17 @@ class GlScene {
     fresnel_ = fresnel;
   }
 
+  // abcube crosscheck (issue 19 part 4): at the visible surface of each camera sample (the
+  // 4x8 grid, row 0 at the top, as camera_objects), for the first 16 shadow-casting lights
+  // (`lights`, probe bit k = lights[k]): the lights blocked by an opaque blocker according
+  // to the shadow volumes, according to the cube shadow maps (build_shadow_maps first), and
+  // the lights the surface faces.
+  struct ShadowProbe {
+    std::vector<int> lights;
+    std::vector<uint16_t> volume, map, lit;
+  };
+  ShadowProbe camera_shadow_probe(const Camera& camera);
+
   // The exact camera pass (ExactCameraOptions): later camera_color calls use it where it
   // applies; exact_camera_stats() says what the last one did.
   void set_exact_camera(const ExactCameraOptions& options) { exact_ = options; }
@@ -172,6 +183,7 @@ class GlScene {
   void fill_region(int level, const glm::vec4& colour);
   void build_volumes();
   std::string exact_mirrors_why_not() const;
+  void make_exact_programs();
   void bind_lookups(const GlProgram& program, bool with_environment);
   void bind_lookup_target(int n);
   void clear_lookup_target(int n, bool distance);
@@ -214,7 +226,8 @@ class GlScene {
   std::vector<int> volume_bit_;           // per light: its bit, or -1
   std::vector<GLuint> volume_vaos_, volume_vbos_;
   std::vector<GLsizei> volume_vertices_;
-  std::unique_ptr<GlProgram> exact_program_, fill_program_, fill_mask_program_, volume_program_, mask_program_;
+  std::unique_ptr<GlProgram> exact_program_, fill_program_, fill_mask_program_, volume_program_, mask_program_,
+      probe_program_;
   GLuint recursed_ = 0;  // per view: which mirrors had their view drawn (camera_exact.frag)
   std::unique_ptr<ExactBuffers> exact_buffers_;
 };

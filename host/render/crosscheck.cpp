@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "base/parallel.hpp"
 #include "base/statistics.hpp"
+#include "reference/raytrace.hpp"
+#include "search/search.hpp"
 #include "raster/abuffer.hpp"
 #include "raster/samples.hpp"
 #include "scene/camera.hpp"
@@ -138,6 +141,115 @@ void compare_camera(const SceneData& scene, int threads, GlScene& gl, Crosscheck
   if (r->samples > 0) r->sample_agreement = double(r->samples_same) / double(r->samples);
 }
 
+// What the exact tracer says at each sample of the shadow camera: the visible object, and per
+// probed light whether an opaque blocker stops it (S_l = 0) where the surface faces it.
+struct ExactShadows {
+  std::vector<uint32_t> object;  // NO_OBJECT where nothing
+  std::vector<uint16_t> blocked, lit;
+  std::vector<uint16_t> search_blocked;  // the CPU's shadow search at the same point
+};
+
+constexpr double GRAZING_COSINE = 1e-3;
+
+void compare_shadows(const SceneData& scene, int n, int threads, GlScene& gl, CrosscheckResult* r) {
+  Camera camera = scene.camera;
+  if (camera.width > SHADOW_CHECK_MAX_WIDTH) {
+    camera.height = std::max(1, static_cast<int>(std::lround(double(camera.height) * SHADOW_CHECK_MAX_WIDTH / camera.width)));
+    camera.width = SHADOW_CHECK_MAX_WIDTH;
+  }
+  r->shadow_width = camera.width;
+  r->shadow_height = camera.height;
+  gl.build_shadow_maps(n);
+  const GlScene::ShadowProbe probe = gl.camera_shadow_probe(camera);
+  const std::vector<uint32_t> gpu_ids = gl.camera_objects(camera);
+  r->shadow_lights = static_cast<int>(probe.lights.size());
+  if (probe.lights.empty()) return;
+
+  const RayTracer tracer(scene);
+  ABufferOptions options;
+  options.threads = threads;
+  options.near_distance = gl.near_distance();
+  const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, n, options);
+  const SearchContext context(scene, cube);
+  const RasterView view = camera_view(make_camera_frame(camera), gl.near_distance());
+  const int64_t gw = int64_t{camera.width} * MASK_COLUMNS, gh = int64_t{camera.height} * MASK_ROWS;
+  ExactShadows exact;
+  exact.object.assign(static_cast<size_t>(gw * gh), NO_OBJECT);
+  exact.blocked.assign(exact.object.size(), 0);
+  exact.lit.assign(exact.object.size(), 0);
+  exact.search_blocked.assign(exact.object.size(), 0);
+  parallel_for(static_cast<size_t>(gh), threads, [&](size_t gy, int) {
+    for (int64_t gx = 0; gx < gw; ++gx) {
+      const size_t g = gy * static_cast<size_t>(gw) + static_cast<size_t>(gx);
+      const int x = static_cast<int>(gx / MASK_COLUMNS), y = static_cast<int>(gy / MASK_ROWS);
+      const int k = sample_index(static_cast<int>(gx % MASK_COLUMNS), static_cast<int>(gy % MASK_ROWS));
+      const glm::dvec3 dir = view.direction(x + sample_dx(k), y + sample_dy(k));
+      Hit hit;
+      if (!tracer.intersect(camera.position, dir, &hit)) continue;
+      exact.object[g] = hit.object_id;
+      const glm::dvec3 v = glm::normalize(-dir);
+      const glm::dvec3 nrm = face_forward(hit.shading_normal, v);
+      for (size_t b = 0; b < probe.lights.size(); ++b) {
+        const PointLight& light = scene.lights[static_cast<size_t>(probe.lights[b])];
+        // Faces the light, by more than grazing: at N.L below GRAZING_COSINE the light adds
+        // less than that share of its full diffuse term, and whether it is blocked is
+        // decided by rounding (a light on a surface: the floor under it, seen by the GPU's
+        // float depths, by the tracer in double).
+        if (glm::dot(nrm, glm::normalize(light.position - hit.point)) <= GRAZING_COSINE) continue;
+        exact.lit[g] |= static_cast<uint16_t>(1u << b);
+        if (tracer.light_visibility(hit, light, nullptr) == glm::dvec3(0.0)) {
+          exact.blocked[g] |= static_cast<uint16_t>(1u << b);
+        }
+        if (shadow_search(context, hit.point, light.position).blocked) {
+          exact.search_blocked[g] |= static_cast<uint16_t>(1u << b);
+        }
+      }
+    }
+  });
+  r->shadow_disagreement = Image(camera.width, camera.height, 1);
+  std::vector<int> pairs_of_pixel(static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height), 0);
+  for (int64_t gy = 0; gy < gh; ++gy) {
+    for (int64_t gx = 0; gx < gw; ++gx) {
+      const size_t g = static_cast<size_t>(gy * gw + gx);
+      if (exact.object[g] == NO_OBJECT || gpu_ids[g] != exact.object[g]) continue;
+      for (size_t b = 0; b < probe.lights.size(); ++b) {
+        const uint16_t bit = static_cast<uint16_t>(1u << b);
+        if (!(exact.lit[g] & bit) || !(probe.lit[g] & bit)) continue;  // faces away: no light to block
+        const bool truth = exact.blocked[g] & bit;
+        bool interior = true;
+        for (int64_t dy = -1; dy <= 1 && interior; ++dy) {
+          for (int64_t dx = -1; dx <= 1 && interior; ++dx) {
+            const int64_t ny = gy + dy, nx = gx + dx;
+            if (ny < 0 || nx < 0 || ny >= gh || nx >= gw) continue;
+            const size_t h = static_cast<size_t>(ny * gw + nx);
+            interior = exact.object[h] == exact.object[g] && bool(exact.blocked[h] & bit) == truth;
+          }
+        }
+        const auto count = [&](ShadowAgreement& a, bool said) {
+          ++a.pairs;
+          a.agree += said == truth;
+          a.false_shadow += said && !truth;
+          a.false_light += !said && truth;
+          if (interior) {
+            ++a.interior;
+            a.interior_agree += said == truth;
+          }
+        };
+        count(r->volumes, probe.volume[g] & bit);
+        count(r->maps, probe.map[g] & bit);
+        count(r->search, exact.search_blocked[g] & bit);
+        const size_t pixel = static_cast<size_t>(gy / MASK_ROWS) * static_cast<size_t>(camera.width) +
+                             static_cast<size_t>(gx / MASK_COLUMNS);
+        ++pairs_of_pixel[pixel];
+        if (bool(probe.volume[g] & bit) != truth) r->shadow_disagreement.data[pixel] += 1.f;
+      }
+    }
+  }
+  for (size_t p = 0; p < pairs_of_pixel.size(); ++p) {
+    if (pairs_of_pixel[p] > 0) r->shadow_disagreement.data[p] /= float(pairs_of_pixel[p]);
+  }
+}
+
 }  // namespace
 
 CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const CrosscheckTolerances& tol) {
@@ -146,6 +258,7 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   gl.set_texture_level0(true);  // the CPU's point samples (README "Textures")
   compare_cube(scene, n, threads, gl, &r);
   compare_camera(scene, threads, gl, &r);
+  compare_shadows(scene, n, threads, gl, &r);
   const double mismatch =
       r.texels ? static_cast<double>(r.gpu_only + r.cpu_only) / static_cast<double>(r.texels) : 0.0;
   auto fail = [&r](bool bad, const std::string& what) {
@@ -158,8 +271,14 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   fail(r.interior_rmse > tol.interior_rmse, "camera interior RMSE");
   fail(r.interior_max_abs > tol.interior_max_abs, "camera interior max abs");
   fail(r.sample_agreement < tol.sample_agreement_min, "camera sample agreement");
+  fail(r.volumes.interior_share() < tol.volumes_agreement_min, "shadow volumes against the tracer");
   r.pass = r.failures.empty();
   return r;
+}
+
+nlohmann::json shadow_json(const ShadowAgreement& a) {
+  return {{"pairs", a.pairs}, {"agreement", a.share()}, {"false_shadow", a.false_shadow},
+          {"false_light", a.false_light}, {"interior_pairs", a.interior}, {"interior_agreement", a.interior_share()}};
 }
 
 nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolerances& tol) {
@@ -173,13 +292,17 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
                 {"fragments", r.fragments}}},
       {"camera", {{"pixels", r.pixels}, {"interior_pixels", r.interior_pixels}, {"interior_rmse", r.interior_rmse},
                   {"interior_max_abs", r.interior_max_abs}}},
+      {"shadows", {{"camera", {r.shadow_width, r.shadow_height}}, {"lights", r.shadow_lights},
+                   {"volumes", shadow_json(r.volumes)}, {"maps", shadow_json(r.maps)},
+                   {"cpu_search", shadow_json(r.search)}}},
       {"camera_samples", {{"samples", r.samples}, {"same_object", r.samples_same},
                           {"gpu_only", r.samples_gpu_only}, {"cpu_only", r.samples_cpu_only},
                           {"other_object", r.samples_other_object}, {"agreement", r.sample_agreement}}},
       {"tolerances", {{"distance_rel_median", tol.distance_median_rel}, {"distance_rel_p99", tol.distance_p99_rel},
                       {"same_object_min", tol.same_object_min}, {"coverage_mismatch_max", tol.coverage_mismatch_max},
                       {"interior_rmse", tol.interior_rmse}, {"interior_max_abs", tol.interior_max_abs},
-                      {"sample_agreement_min", tol.sample_agreement_min}}},
+                      {"sample_agreement_min", tol.sample_agreement_min},
+                      {"volumes_agreement_min", tol.volumes_agreement_min}}},
       {"pass", r.pass},
       {"failures", r.failures}};
 }

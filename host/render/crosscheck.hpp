@@ -30,6 +30,25 @@ struct CrosscheckTolerances {
   double interior_rmse = 5e-4;            // camera view, displayed values, interior pixels
   double interior_max_abs = 4.0 / 255.0;
   double sample_agreement_min = 0.9999;   // camera samples where GPU and CPU see the same object (or none)
+  // Shadows sample by sample (issue 19 part 4), away from shadow edges: the GPU's shadow
+  // volumes against the exact tracer.
+  double volumes_agreement_min = 0.999;
+};
+
+// The shadow comparison's camera: the scene's, at most this many pixels wide (aspect kept).
+constexpr int SHADOW_CHECK_MAX_WIDTH = 160;
+
+// One shadow technique against the exact tracer, over (sample, light) pairs where both the
+// GPU and the tracer see the same object and it faces the light (N.L above 1e-3: below it
+// the light adds less than a thousandth of its diffuse term, and whether a grazing segment
+// is blocked is decided by rounding: a light lying on a floor): agreement over all of
+// them, and over those away from shadow edges (the tracer's verdict and the object the
+// same at the 8 neighbouring samples of the 4x8 grid).
+struct ShadowAgreement {
+  size_t pairs = 0, agree = 0, interior = 0, interior_agree = 0;
+  size_t false_shadow = 0, false_light = 0;  // shadowed where the tracer lights, and the reverse
+  double share() const { return pairs ? double(agree) / double(pairs) : 1.0; }
+  double interior_share() const { return interior ? double(interior_agree) / double(interior) : 1.0; }
 };
 
 struct CrosscheckResult {
@@ -53,6 +72,13 @@ struct CrosscheckResult {
   double sample_agreement = 0;
   // Per pixel, how many of its 32 samples disagree (an image for `crosscheck --samples-image`).
   Image sample_disagreement;
+  // Shadows (issue 19 part 4): the GPU's shadow volumes and cube shadow maps, and the CPU's
+  // shadow search in the cube A-buffer, each against the exact tracer, sample by sample,
+  // on the first 16 shadow-casting lights; `shadow_disagreement`: per pixel, the share of
+  // its (sample, light) pairs where the volumes and the tracer differ.
+  int shadow_width = 0, shadow_height = 0, shadow_lights = 0;
+  ShadowAgreement volumes, maps, search;
+  Image shadow_disagreement;
   double gpu_ms = 0, cpu_ms = 0;  // prepass vs cube A-buffer build
   uint64_t fragments = 0;
   bool pass = false;

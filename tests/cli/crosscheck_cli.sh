@@ -43,9 +43,9 @@ fi
 /usr/bin/python3 "$REPO/tools/hard_scenes.py" --seed 5 --count 11 --out "$WORK/hard" --size 96x64 --cube-res 96 > /dev/null
 for scene in "$WORK"/hard/*.json; do
   "$ABCUBE" crosscheck "$scene" --stats "$WORK/hard.stats.json" > "$WORK/out" 2>&1
-  if python3 -c "import json,sys; s=json.load(open('$WORK/hard.stats.json'))['camera_samples']; sys.exit(0 if s['samples'] == 96 * 64 * 32 and s['agreement'] >= 0.9999 else 1)"; then
+  if python3 -c "import json,sys; d=json.load(open('$WORK/hard.stats.json')); s=d['camera_samples']; v=d['shadows']['volumes']; sys.exit(0 if s['samples'] == 96 * 64 * 32 and s['agreement'] >= 0.9999 and v['interior_agreement'] >= 0.999 else 1)"; then
     passed=$((passed + 1))
-    echo "ok   $(basename "$scene"): $(grep '^camera samples' "$WORK/out")"
+    echo "ok   $(basename "$scene"): $(grep '^camera samples' "$WORK/out"); volumes $(grep 'GPU shadow volumes' "$WORK/out")"
   else
     failed=$((failed + 1))
     echo "FAIL $(basename "$scene"):"
