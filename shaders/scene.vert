@@ -1,8 +1,9 @@
 // Every pass draws the scene's triangles with this stage. u_clip is cube_map.hpp's
-// face_clip_matrix or camera_clip_matrix (infinite reversed-Z); u_center is the eye.
-// u_model places virtual objects (the reflections of the planar mirrors a view has passed
-// through, gl_camera_exact.cpp; the identity otherwise), and gl_ClipDistance[0] keeps what
-// lies on u_clip_plane's positive side (the mirror's front) when GL_CLIP_DISTANCE0 is on.
+// face_clip_matrix or camera_clip_matrix (infinite reversed-Z), times the reflections of
+// the planar mirrors a virtual view has passed through (gl_camera_exact.cpp), one matrix
+// made on the CPU so that every program computes the same expression; u_center is the eye.
+// gl_ClipDistance[0] keeps what lies on u_clip_plane's positive side (the mirror's front)
+// when GL_CLIP_DISTANCE0 is on.
 // The shadow volumes (shadow_volume.frag) come through here too, with points at infinity
 // (w = 0): gl_Position is invariant, so a volume's near cap and the surface it caps get the
 // same depth at every sample.
@@ -15,7 +16,6 @@ layout(location = 5) in uint a_portal;    // planar reflector + 1 (planar_reflec
 layout(location = 6) in uint a_reversed;  // shadow volumes: the face's outward orientation is against its winding
 
 uniform mat4 u_clip;
-uniform mat4 u_model;
 uniform vec4 u_clip_plane;
 uniform vec3 u_center;
 // THE TIE RULE (cpu_core/scene/tie_rule.hpp): window depth near/w scaled by
@@ -32,9 +32,9 @@ flat out uint v_portal;
 flat out uint v_reversed;
 
 void main() {
-  gl_Position = u_clip * (u_model * a_position);
+  gl_Position = u_clip * a_position;
   gl_Position.z *= 1.0 + u_tie_step * float(a_object + 1u);
-  gl_ClipDistance[0] = dot(u_clip_plane, vec4(a_position.xyz, 1.0));
+  gl_ClipDistance[0] = dot(u_clip_plane, a_position);  // a point at infinity (w = 0): its direction's side
   v_relative = a_position.xyz - u_center;
   v_normal = a_normal;
   v_object = a_object;

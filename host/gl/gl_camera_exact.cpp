@@ -29,8 +29,11 @@
 // behind or at the visible surface (+1 back, -1 front) in the view's region, and the
 // light's bit set in the mask where the count is not 0. The colour pass (depth GEQUAL: the
 // same surfaces) reads the mask: S_l = 0 where the bit is set (common_shading.glsl). Virtual
-// views count the volumes through their own model matrix, unclipped: each prism stays
-// closed, so the count is the number of prisms holding the reflected point.
+// views count the volumes through their own model matrix, clipped at their mirror like the
+// surfaces (so that a near cap cut by the clip plane keeps its surface's depths): the ray
+// counted, beyond a point in front of the mirror, never comes back across the mirror's
+// plane, so the prisms' parts behind it are never crossed and the count is the number of
+// prisms holding the reflected point.
 #include <glad/gl.h>
 
 #include <algorithm>
@@ -185,10 +188,9 @@ void GlScene::count_volumes(const glm::mat4& clip, const MirrorView& view) {
     glEnable(GL_BLEND);
     glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ONE);
-    MirrorView unclipped = view;
-    unclipped.plane = glm::dvec4(0.0, 0.0, 0.0, 1.0);
-    unclipped.skip = 0;
-    set_view(*volume_program_, clip, unclipped);
+    // Clipped at the view's mirror as its surfaces are (a near cap and its surface cut alike
+    // keep the same depths); what is cut lies behind the mirror, where no counted ray goes.
+    set_view(*volume_program_, clip, view);
     glBindVertexArray(volume_vaos_[bit]);
     glDrawArrays(GL_TRIANGLES, 0, volume_vertices_[bit]);
     glDisable(GL_BLEND);

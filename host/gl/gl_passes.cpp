@@ -288,9 +288,8 @@ void GlScene::draw_reflector(const GlProgram& program, const glm::mat4& clip, co
 void GlScene::set_view(const GlProgram& program, const glm::mat4& clip, const MirrorView& view) {
   const glm::dvec3& center = view.eye;
   program.use();
-  glUniformMatrix4fv(program.uniform("u_clip"), 1, GL_FALSE, &clip[0][0]);
-  const glm::mat4 model(view.model);
-  glUniformMatrix4fv(program.uniform("u_model"), 1, GL_FALSE, &model[0][0]);
+  const glm::mat4 clip_model = view.level == 0 ? clip : glm::mat4(glm::dmat4(clip) * view.model);
+  glUniformMatrix4fv(program.uniform("u_clip"), 1, GL_FALSE, &clip_model[0][0]);
   glUniform4f(program.uniform("u_clip_plane"), float(view.plane.x), float(view.plane.y), float(view.plane.z),
               float(view.plane.w));
   glUniform1ui(program.uniform("u_skip_portal"), view.skip);

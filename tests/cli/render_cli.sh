@@ -119,7 +119,10 @@ check "--envmap-lookup up exits 2" [ $? -eq 2 ]
 "$ABCUBE" compare "$WORK/rt.png" "$WORK/rt.png" > "$WORK/cmp"
 check "identical images compare 0" [ $? -eq 0 ]
 check "identical images: PSNR inf" grep -q "PSNR        inf" "$WORK/cmp"
-"$ABCUBE" compare "$WORK/rt.png" "$WORK/gpu_egl.png" --diff "$WORK/heat.png" > "$WORK/cmp"
+# (The gpu method's exact camera pass now draws this scene as the tracer does: its old
+# techniques, the cube texture and shadow maps, give an image that differs.)
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/gpu_old.png" --method gpu --gpu-mirrors envmap --gpu-shadows maps 2> /dev/null
+"$ABCUBE" compare "$WORK/rt.png" "$WORK/gpu_old.png" --diff "$WORK/heat.png" > "$WORK/cmp"
 check "different images compare 1" [ $? -eq 1 ]
 check "heatmap written" [ -s "$WORK/heat.png" ]
 "$ABCUBE" compare "$WORK/rt.png" "$WORK/gpu_egl.png" --fail 1 > /dev/null
