@@ -2,15 +2,21 @@
 //   C = ka Ia Od + sum_l S_l I_l (kd Od max(0, N.L) + ks max(0, R.V)^n),  R = reflect(-L, N),
 // with N turned to face the viewer (two-sided lighting). p is relative to the eye.
 
-// Shadow volumes (gl_camera_exact.cpp): per camera sample, one bit per light (the light's
-// color.w, -1: none) saying whether an opaque blocker lies between the surface and the
-// light, counted exactly by depth-fail (shadow_volume.frag). Camera passes only.
+// Shadow volumes (gl_camera_exact.cpp): per camera sample and volume light (the light's
+// color.w, -1: none; light b is channel b % 4 of layer b / 4), the depth-fail count of its
+// volume's faces behind the surface (shadow_volume.frag): the number of opaque blockers'
+// prisms holding the surface point, 0 when none lies between it and the light. Camera
+// passes only.
 uniform bool u_volumes;
-uniform usampler2D u_volume_mask;
+uniform sampler2DArray u_volume_counts;
+
+bool volume_blocked(int b) {
+  return texelFetch(u_volume_counts, ivec3(ivec2(gl_FragCoord.xy), b / 4), 0)[b % 4] != 0.0;
+}
 
 // S_l (rule "shadows", as the CPU's shadow search and the exact tracer): 0 when an opaque
-// blocker lies between p and the light: from the shadow volumes' mask when the light has a
-// bit in it, else from its cube shadow map (p farther from the light than the nearest opaque
+// blocker lies between p and the light: from the shadow volumes' count when the light has
+// one, else from its cube shadow map (p farther from the light than the nearest opaque
 // surface the map stored in that direction, plus a bias of u_shadow_bias_texels texels, a
 // texel at distance d being about u_shadow_texel * d wide, grown at grazing light); then the
 // product of the transmittances of the translucent layers nearer to the light than p (less
@@ -21,9 +27,7 @@ vec3 light_visibility(int i, vec3 p, vec3 n) {
   bool volume = u_volumes && bit >= 0.0;
   if (!volume && (!u_shadows || layer < 0.0)) return vec3(1.0);
   if (volume) {
-    int b = int(bit);
-    uvec4 mask = texelFetch(u_volume_mask, ivec2(gl_FragCoord.xy), 0);
-    if ((mask[b / 32] & (1u << uint(b % 32))) != 0u) return vec3(0.0);
+    if (volume_blocked(int(bit))) return vec3(0.0);
     if (!u_shadows || layer < 0.0) return vec3(1.0);
   }
   vec3 d = p - lights[i].position.xyz;

@@ -1,6 +1,6 @@
 // abcube crosscheck (issue 19 part 4): at the visible surface of each camera sample, for the
 // first 16 shadow-casting lights (the light's probe index u_probe[i], -1: not probed), whether
-// the shadow volumes' mask and the cube shadow map each say an opaque blocker lies between
+// the shadow volumes' count and the cube shadow map each say an opaque blocker lies between
 // the surface and the light, and whether the surface faces the light (N.L > 0, N turned to
 // the eye): three 16-bit sets, as exact floats. common_shading.glsl's rules, taken apart.
 in vec3 v_relative;
@@ -14,7 +14,6 @@ void main() {
   vec3 p = v_relative;
   vec3 n = normalize(v_normal);
   if (dot(n, -p) < 0.0) n = -n;
-  uvec4 mask = texelFetch(u_volume_mask, ivec2(gl_FragCoord.xy), 0);
   uint volume = 0u, map = 0u, lit = 0u;
   for (int i = 0; i < min(u_light_count, 64); ++i) {
     int k = u_probe[i];
@@ -22,7 +21,7 @@ void main() {
     vec3 to_light = lights[i].position.xyz - p;
     if (dot(n, to_light) > 0.0) lit |= 1u << uint(k);
     int b = int(lights[i].color.w);
-    if (b >= 0 && (mask[b / 32] & (1u << uint(b % 32))) != 0u) volume |= 1u << uint(k);
+    if (b >= 0 && volume_blocked(b)) volume |= 1u << uint(k);
     float layer = lights[i].position.w;
     if (u_shadows && layer >= 0.0) {
       vec3 d = p - lights[i].position.xyz;

@@ -10,7 +10,7 @@ namespace abcube {
 namespace {
 constexpr EnumName<Method> METHOD_NAMES[] = {{Method::abuffer, "abuffer"}, {Method::zbuffer, "zbuffer"},
                                              {Method::envmap, "envmap"},   {Method::raytrace, "raytrace"},
-                                             {Method::gpu, "gpu"}};
+                                             {Method::gpu, "gpu"},         {Method::hybrid, "hybrid"}};
 }
 
 const char* method_name(Method m) { return enum_name(METHOD_NAMES, m); }

@@ -13,7 +13,7 @@ namespace abcube {
 
 class TextureSet;  // scene/texture.hpp
 
-enum class Method { abuffer, zbuffer, envmap, raytrace, gpu };
+enum class Method { abuffer, zbuffer, envmap, raytrace, gpu, hybrid };
 const char* method_name(Method m);
 // Parses a method name; returns false for an unknown one.
 bool parse_method(const std::string& s, Method* out);

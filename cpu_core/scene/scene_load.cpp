@@ -153,7 +153,7 @@ RenderSettings read_render(const Fields& f) {
     const std::string name = read_string(f.src(), *v, f.at("method"));
     if (!parse_method(name, &r.method)) {
       fail(f.src(), f.at("method"),
-           "must be one of abuffer, zbuffer, envmap, raytrace, gpu, got " + describe(*v));
+           "must be one of abuffer, zbuffer, envmap, raytrace, gpu, hybrid, got " + describe(*v));
     }
   }
   r.cube_resolution = f.integer("cube_resolution", r.cube_resolution, 1, MAX_CUBE_RESOLUTION);
@@ -348,12 +348,12 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   if (obj.triangle_count == 0) {
     // Loads and renders (nothing), but an empty export, a wrong file or a mistyped vertex
     // is the likely cause.
-    const bool from_file = type == "mesh" || type == "gltf";
+    const bool named_file = type == "mesh" || type == "gltf";
     const std::string what =
-        from_file ? (type == "gltf" ? "glTF " : "mesh ") + quote_path(read_string(st.src, f.need("file"), f.at("file")))
+        named_file ? (type == "gltf" ? "glTF " : "mesh ") + quote_path(read_string(st.src, f.need("file"), f.at("file")))
                   : type;
     st.scene.warnings.push_back(one_line(
-        st.src.name + ": " + (from_file ? f.at("file") : path) + ": warning: " + what + " has no triangles" +
+        st.src.name + ": " + (named_file ? f.at("file") : path) + ": warning: " + what + " has no triangles" +
         (faces > 0 ? " of nonzero area (" + std::to_string(faces) + " dropped)" : "")));
   }
   // A closed surface has an inside; make its geometric normals point out of it.

@@ -42,7 +42,7 @@ std::string budget_words(uint64_t budget_bytes, bool capped) {
 uint64_t estimate_render_bytes(const SceneData& scene) {
   const uint64_t pixels = static_cast<uint64_t>(scene.camera.width) * static_cast<uint64_t>(scene.camera.height);
   const uint64_t n = static_cast<uint64_t>(scene.render.cube_resolution);
-  const bool gpu = scene.render.method == Method::gpu;
+  const bool gpu = scene.render.method == Method::gpu || scene.render.method == Method::hybrid;
   uint64_t shadow_lights = 0;
   for (const PointLight& l : scene.lights) shadow_lights += l.cast_shadows ? 1 : 0;
   const uint64_t per_triangle = SCENE_TRIANGLE_BYTES + (gpu ? GL_TRIANGLE_BYTES : 0);

@@ -384,13 +384,14 @@ static std::pair<uint64_t, uint64_t> searches_and_failures(const MapShadingStats
 }
 
 Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
-                      MapShadingStats* stats, Image* fallback) {
+                      MapShadingStats* stats, Image* fallback, const std::vector<uint8_t>* only) {
   // Per pixel: secondary searches and failures (one resolve worker owns a row at a time).
   std::vector<std::pair<uint64_t, uint64_t>> pixel_searches;
   if (fallback) pixel_searches.assign(static_cast<size_t>(camera.width()) * static_cast<size_t>(camera.height()), {0, 0});
   ResolveOptions ro;
   ro.threads = threads;
   ro.exact_priority = shader.exact_priority();
+  ro.only = only;
   // Statistics per resolve worker, merged at the end: no lock while shading.
   std::vector<MapShadingStats> per_worker(static_cast<size_t>(resolve_workers(camera, ro)));
   // The fragment shaded at its covered quarters, adaptively (header, QUARTER_SPLIT_SRGB).

@@ -184,7 +184,8 @@ class MapShader {
 // channel): per pixel, the share of its fragments' secondary searches that found nothing
 // (a reflection or refraction-exit miss, a shadow walk on a zero-area surface or
 // aborted, a lens transfer refused), 0 where none was made.
+// `only` (optional): the pixels to render (ResolveOptions::only); the others stay black.
 Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
-                      MapShadingStats* stats, Image* fallback = nullptr);
+                      MapShadingStats* stats, Image* fallback = nullptr, const std::vector<uint8_t>* only = nullptr);
 
 }  // namespace abcube

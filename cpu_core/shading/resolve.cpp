@@ -166,6 +166,9 @@ Image resolve_image_per_worker(const ABuffer& camera, const TriangleSoup& triang
   parallel_for(static_cast<size_t>(camera.height()), threads, [&](size_t row, int worker) {
     const int y = static_cast<int>(row);
     for (int x = 0; x < camera.width(); ++x) {
+      if (options.only && !(*options.only)[static_cast<size_t>(y) * static_cast<size_t>(camera.width()) + static_cast<size_t>(x)]) {
+        continue;
+      }
       const auto shade_here = [&](const Fragment& f) { return shade(f, x, y, worker); };
       const SampleDepth depth{&camera.view, &triangles, x, y};
       const glm::dvec3 c = pack(camera.list(x, y), FULL_MASK, shade_here, triangles, background,

@@ -101,6 +101,9 @@ struct ResolveOptions {
   int threads = 0;  // 0 = std::thread::hardware_concurrency()
   // Intersecting fragments: EXACT PRIORITY MASKS (true) or the thesis' Vis_front estimate.
   bool exact_priority = true;
+  // When set (width x height, row 0 at the top): only the pixels whose entry is not 0 are
+  // resolved; the others stay black (the hybrid method: the pixels the GPU left to the CPU).
+  const std::vector<uint8_t>* only = nullptr;
 };
 
 // The antialiased image (row 0 at the top): pack_under_mask(list, FULL_MASK) per pixel.

@@ -5,18 +5,19 @@
 // the stencil buffer"). The stencil value of a sample is the mirror level of the view it
 // shows. A view of level L is drawn where the stencil is L. Then, for each planar reflector
 // of the scene (planar_reflectors.hpp) while L < max_depth:
-//   1. mark: the reflector's own triangles, where they are the visible surface (depth
-//      EQUAL: the same vertex stage, invariant), raise the stencil to L + 1 (an occlusion
-//      query skips a mirror that covers no sample);
+//   1. mark: the reflector's own triangles, where they are the visible surface of the
+//      view's depth pass (depth EQUAL: the same vertex stage, invariant), raise the stencil
+//      to L + 1 (an occlusion query skips a mirror that covers no sample; the mirror's
+//      projected bounds become the scissor of what follows);
 //   2. clear that region: depth to the far plane, colour to the background;
 //   3. draw the level L + 1 view there: the scene reflected about the mirror's plane
 //      (model = model_L * R, R the reflection), only what lies in front of the mirror
 //      (gl_ClipDistance on the mirror's plane, turned towards the eye), the mirror itself
 //      left out, each point shaded as seen from the eye reflected (R eye_L), recursively;
-//   4. composite: the reflector drawn again over its region with its local shading, blended
-//      C = C_local + kr * C_behind (glBlendFunc(ONE, CONSTANT_COLOR), constant kr: a planar
-//      reflector neither refracts nor is transparent, so its weights are its material's),
-//      its depth written back and the stencil lowered to L.
+//   4. the mirror's depth written back over its region, the stencil lowered to L.
+// Then the view's colour pass: each surface shaded, a mirror whose view was drawn blended
+// over it, C = C_local + kr * C_behind (dual-source blending; constant kr: a planar
+// reflector neither refracts nor is transparent, so its weights are its material's).
 // This is Whitted's mirror term at the camera's own samples: the virtual view behind a
 // mirror is what the reflected rays of those samples meet (their depth is the unfolded path
 // length; gl_ClipDistance drops what lies between the mirror and the reflected eye). A
@@ -26,9 +27,9 @@
 //
 // SHADOW VOLUMES (course notes 3.3; Everitt & Kilgard 2002, shadow_volume.hpp). Before a
 // view's colour: its depth alone, then per volume light the count of its volume's faces
-// behind or at the visible surface (+1 back, -1 front) in the view's region, and the
-// light's bit set in the mask where the count is not 0. The colour pass (depth GEQUAL: the
-// same surfaces) reads the mask: S_l = 0 where the bit is set (common_shading.glsl). Virtual
+// behind or at the visible surface (+1 back, -1 front), in the light's channel of a layered
+// float target (additive blending, four lights a layer). The colour pass (depth EQUAL: the
+// same surfaces) reads them: S_l = 0 where the count is not 0 (common_shading.glsl). Virtual
 // views count the volumes through their own model matrix, clipped at their mirror like the
 // surfaces (so that a near cap cut by the clip plane keeps its surface's depths): the ray
 // counted, beyond a point in front of the mirror, never comes back across the mirror's
@@ -49,6 +50,7 @@
 #include "raster/cube_map.hpp"
 #include "raster/samples.hpp"
 #include "scene/shadow_volume.hpp"
+#include "shading/shading.hpp"
 
 namespace abcube {
 
@@ -62,6 +64,28 @@ glm::dmat4 reflection_matrix(const glm::dvec3& n, double d) {
     r[3][c] = -2.0 * d * n[c];
   }
   return r;
+}
+
+// The pixels of the tile (width x height) that triangles `r` of the soup cover when drawn
+// through `clip_model`, within `parent` (x, y, width, height); the parent itself when one
+// of their corners is behind the eye. Empty (zero size) when they fall outside.
+glm::ivec4 projected_bounds(const TriangleSoup& soup, const std::vector<uint32_t>& triangles, const glm::dmat4& clip_model,
+                            const glm::ivec4& parent, int width, int height) {
+  double lo_x = 1e300, lo_y = 1e300, hi_x = -1e300, hi_y = -1e300;
+  for (const uint32_t t : triangles) {
+    for (size_t k = 0; k < 3; ++k) {
+      const glm::dvec4 c = clip_model * glm::dvec4(glm::dvec3(soup.positions[3 * static_cast<size_t>(t) + k]), 1.0);
+      if (!(c.w > 0.0)) return parent;
+      const double x = (c.x / c.w * 0.5 + 0.5) * width, y = (c.y / c.w * 0.5 + 0.5) * height;
+      lo_x = std::min(lo_x, x), lo_y = std::min(lo_y, y), hi_x = std::max(hi_x, x), hi_y = std::max(hi_y, y);
+    }
+  }
+  // One pixel of margin each way: the rasteriser's own rounding.
+  const double x0 = std::max(std::floor(lo_x) - 1.0, double(parent.x)), y0 = std::max(std::floor(lo_y) - 1.0, double(parent.y));
+  const double x1 = std::min(std::ceil(hi_x) + 1.0, double(parent.x + parent.z));
+  const double y1 = std::min(std::ceil(hi_y) + 1.0, double(parent.y + parent.w));
+  if (!(x1 > x0) || !(y1 > y0)) return glm::ivec4(0);
+  return glm::ivec4(int(x0), int(y0), int(x1 - x0), int(y1 - y0));
 }
 
 // The stencil test of a view of level L: draw where the stencil is L, change nothing.
@@ -82,13 +106,14 @@ std::string GlScene::exact_mirrors_why_not() const {
 
 bool GlScene::plan_exact_camera() {
   ExactCameraStats& s = exact_stats_;
-  s.mirrors = s.volumes = false;
+  s.mirrors = s.volumes = s.plain = false;
   s.mirrors_why = s.volumes_why = "";
   s.mirror_views = s.mirror_views_empty = s.mirror_views_over_budget = 0;
+  s.samples_approximate = s.pixels_exact = 0;
   s.deepest_level = 0;
   s.reflectors = reflectors_.reflectors.size();
   s.curved_reflective_triangles = reflectors_.curved_triangles;
-  if (!exact_.planar_mirrors && !exact_.shadow_volumes) return false;
+  if (!exact_.planar_mirrors && !exact_.shadow_volumes && !exact_.always) return false;
   std::string both;
   for (const uint32_t id : scene_.triangles->material_id) {
     if (scene_.materials[id].opacity < 1.0) both = "coverage transparency (the peeled camera pass)";
@@ -96,12 +121,17 @@ bool GlScene::plan_exact_camera() {
   GLint units = 0, dual = 0;
   glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &units);
   glGetIntegerv(GL_MAX_DUAL_SOURCE_DRAW_BUFFERS, &dual);
-  if (units <= static_cast<GLint>(VOLUME_MASK_UNIT) || dual < 1) {
+  if (units <= static_cast<GLint>(VOLUME_COUNT_UNIT) || dual < 1) {
     both = "this GL offers " + std::to_string(units) + " texture units and " + std::to_string(dual) +
            " dual-source draw buffers (17 and 1 needed)";
   }
   bool casts = false;
   for (const PointLight& l : scene_.lights) casts = casts || l.cast_shadows;
+  translucent_shadows_ = false;
+  for (const uint32_t id : scene_.triangles->material_id) {
+    const glm::dvec3 t = blocker_transmittance(scene_.materials[id]);
+    translucent_shadows_ = translucent_shadows_ || (casts && t != glm::dvec3(0.0) && t != glm::dvec3(1.0));
+  }
   if (exact_.planar_mirrors) {
     s.mirrors_why = both.empty() ? exact_mirrors_why_not() : both;
     s.mirrors = s.mirrors_why.empty();
@@ -110,7 +140,13 @@ bool GlScene::plan_exact_camera() {
     s.volumes_why = !both.empty() ? both : casts ? "" : "no light casts shadows";
     s.volumes = s.volumes_why.empty();
   }
-  return s.mirrors || s.volumes;
+  // What the pass leaves approximate in every lit sample: translucent casters (shadow maps'
+  // peels), shadows by maps, lights past the volumes' bits.
+  size_t casting = 0;
+  for (const PointLight& l : scene_.lights) casting += l.cast_shadows ? 1 : 0;
+  shadows_approximate_ = translucent_shadows_ || (casts && !s.volumes) || casting > size_t{MAX_VOLUME_LIGHTS};
+  s.plain = !s.mirrors && !s.volumes && exact_.always && both.empty();
+  return s.mirrors || s.volumes || s.plain;
 }
 
 void GlScene::build_volumes() {
@@ -159,60 +195,40 @@ void GlScene::fill_region(int level, const glm::vec4& colour) {
   glDepthFunc(GL_GREATER);
 }
 
-// The view's shadow mask: for each volume light, its depth-fail count in the view's region
-// (the view's depth is drawn), and its bit where that count is not 0.
+// The view's shadow-volume counts: per volume light, in its channel of its layer, the
+// depth-fail count of its volume's faces behind or at the view's surfaces (the view's depth
+// is drawn), over the view's scissor (the colour pass reads them in its stencil region only).
 void GlScene::count_volumes(const glm::mat4& clip, const MirrorView& view) {
   ExactBuffers& b = *exact_buffers_;
   const GLenum one[] = {GL_COLOR_ATTACHMENT0};
-  // The mask's region cleared.
-  glBindFramebuffer(GL_FRAMEBUFFER, b.mask_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, b.fbo);
   glDrawBuffers(1, one);
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   stencil_level(view.level);
-  glDisable(GL_DEPTH_TEST);
-  fill_mask_program_->use();
-  glBindVertexArray(vao_);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-  for (size_t bit = 0; bit < volume_lights_.size(); ++bit) {
-    // The count's region cleared, then the volume's faces behind or at the surface added.
-    glBindFramebuffer(GL_FRAMEBUFFER, b.count_fbo);
-    glDrawBuffers(1, one);
-    glDisable(GL_DEPTH_TEST);
-    fill_program_->use();
-    glUniform4f(fill_program_->uniform("u_fill"), 0.f, 0.f, 0.f, 0.f);
-    glBindVertexArray(vao_);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LEQUAL);  // reversed Z: at or behind the stored surface
-    glDepthMask(GL_FALSE);
+  glDepthFunc(GL_LEQUAL);  // reversed Z: at or behind the stored surface
+  glDepthMask(GL_FALSE);
+  glBlendEquation(GL_FUNC_ADD);
+  glBlendFunc(GL_ONE, GL_ONE);
+  for (int layer = 0; layer < b.layers; ++layer) {
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, b.counts, 0, layer);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    const float zero[4] = {0, 0, 0, 0};
+    glClearBufferfv(GL_COLOR, 0, zero);  // within the scissor
     glEnable(GL_BLEND);
-    glBlendEquation(GL_FUNC_ADD);
-    glBlendFunc(GL_ONE, GL_ONE);
-    // Clipped at the view's mirror as its surfaces are (a near cap and its surface cut alike
-    // keep the same depths); what is cut lies behind the mirror, where no counted ray goes.
-    set_view(*volume_program_, clip, view);
-    glBindVertexArray(volume_vaos_[bit]);
-    glDrawArrays(GL_TRIANGLES, 0, volume_vertices_[bit]);
+    for (size_t bit = 4 * static_cast<size_t>(layer); bit < std::min(volume_lights_.size(), 4 * static_cast<size_t>(layer) + 4); ++bit) {
+      const int channel = static_cast<int>(bit % 4);
+      glColorMask(channel == 0, channel == 1, channel == 2, channel == 3);
+      // Clipped at the view's mirror as its surfaces are (a near cap and its surface cut
+      // alike keep the same depths); what is cut lies behind the mirror, where no counted
+      // ray goes.
+      set_view(*volume_program_, clip, view);
+      glBindVertexArray(volume_vaos_[bit]);
+      glDrawArrays(GL_TRIANGLES, 0, volume_vertices_[bit]);
+    }
     glDisable(GL_BLEND);
-    glDepthMask(GL_TRUE);
-    glDepthFunc(GL_GREATER);
-    // Its bit where the count is not 0.
-    glBindFramebuffer(GL_FRAMEBUFFER, b.mask_fbo);
-    glDrawBuffers(1, one);
-    glDisable(GL_DEPTH_TEST);
-    glEnable(GL_COLOR_LOGIC_OP);
-    glLogicOp(GL_OR);
-    mask_program_->use();
-    glUniform1i(mask_program_->uniform("u_bit"), static_cast<GLint>(bit));
-    glUniform1i(mask_program_->uniform("u_count"), 0);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, b.count);
-    glBindVertexArray(vao_);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glBindTexture(GL_TEXTURE_2D, 0);
-    glDisable(GL_COLOR_LOGIC_OP);
   }
-  glEnable(GL_DEPTH_TEST);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_GREATER);
   glBindVertexArray(vao_);
 }
 
@@ -225,6 +241,8 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
     glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
     glDrawBuffers(1, colour);
     if (view.level > 0) glEnable(GL_CLIP_DISTANCE0); else glDisable(GL_CLIP_DISTANCE0);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(view.scissor.x, view.scissor.y, view.scissor.z, view.scissor.w);
   };
   // 1. The view's depth.
   bind_target();
@@ -233,51 +251,80 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
   glDepthFunc(GL_GREATER);
   draw_scene(*distance_program_, clip, view);
 
-  // 2. The views behind the mirrors it shows, each drawn into the mirror's region.
+  // 2. The views behind the mirrors it shows, each drawn into the mirror's region. First
+  // which mirrors are a visible surface anywhere in the view (one occlusion query each, read
+  // together: one wait for the GL), then each of those in turn.
   std::vector<uint32_t> recursed(reflectors_.reflectors.size() + 1, 0);
   if (exact_stats_.mirrors && view.level < exact_.max_depth) {
-    GLuint query = 0;
-    glGenQueries(1, &query);
+    struct Candidate {
+      size_t r;
+      double side;
+      glm::ivec4 bounds;
+      GLuint query = 0;
+    };
+    std::vector<Candidate> candidates;
     for (size_t r = 0; r < reflectors_.reflectors.size(); ++r) {
       const PlanarReflector& mirror = reflectors_.reflectors[r];
-      const uint32_t id = static_cast<uint32_t>(r + 1);
       const double side = mirror.side(view.eye);
-      if (id == view.skip || side == 0.0) continue;  // the mirror seen through; one seen edge-on covers nothing
-      // Mark where it is the visible surface: stencil L -> L + 1 (over the budget: only asked).
-      const bool budget = *views_left > 0;
-      glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-      glDepthMask(GL_FALSE);
-      glDepthFunc(GL_EQUAL);
-      glStencilFunc(GL_EQUAL, view.level, 0xff);
-      glStencilOp(GL_KEEP, GL_KEEP, budget ? GL_INCR : GL_KEEP);
-      glBeginQuery(GL_ANY_SAMPLES_PASSED, query);
-      draw_reflector(*distance_program_, clip, view, r);
+      if (static_cast<uint32_t>(r + 1) == view.skip || side == 0.0) continue;  // seen through; edge-on covers nothing
+      const glm::ivec4 bounds = projected_bounds(*scene_.triangles, mirror.triangles, glm::dmat4(clip) * view.model,
+                                                 view.scissor, t.width, t.height);
+      if (bounds.z <= 0 || bounds.w <= 0) {
+        ++exact_stats_.mirror_views_empty;
+        continue;
+      }
+      candidates.push_back({r, side, bounds});
+    }
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glDepthMask(GL_FALSE);
+    glDepthFunc(GL_EQUAL);
+    stencil_level(view.level);
+    for (Candidate& c : candidates) {
+      glGenQueries(1, &c.query);
+      glBeginQuery(GL_ANY_SAMPLES_PASSED, c.query);
+      draw_reflector(*distance_program_, clip, view, c.r);
       glEndQuery(GL_ANY_SAMPLES_PASSED);
-      glDepthMask(GL_TRUE);
-      glDepthFunc(GL_GREATER);
+    }
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_GREATER);
+    for (Candidate& c : candidates) {
       GLuint marked = 0;
-      glGetQueryObjectuiv(query, GL_QUERY_RESULT, &marked);
+      glGetQueryObjectuiv(c.query, GL_QUERY_RESULT, &marked);
+      glDeleteQueries(1, &c.query);
       if (!marked) {
         ++exact_stats_.mirror_views_empty;
         continue;
       }
-      if (!budget) {  // this mirror shows the environment map, as the envmap method would
+      if (*views_left <= 0) {  // this mirror shows the environment map, as the envmap method would
         ++exact_stats_.mirror_views_over_budget;
         continue;
       }
+      const PlanarReflector& mirror = reflectors_.reflectors[c.r];
+      const uint32_t id = static_cast<uint32_t>(c.r + 1);
       --*views_left;
       ++exact_stats_.mirror_views;
       recursed[id] = 1;
+      // Mark where it is the visible surface: stencil L -> L + 1.
+      glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+      glDepthMask(GL_FALSE);
+      glDepthFunc(GL_EQUAL);
+      glStencilFunc(GL_EQUAL, view.level, 0xff);
+      glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
+      draw_reflector(*distance_program_, clip, view, c.r);
+      glDepthMask(GL_TRUE);
+      glDepthFunc(GL_GREATER);
       // Its region cleared to the background at the far plane, then the view behind it.
       glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-      fill_region(view.level + 1, glm::vec4(glm::vec3(scene_.background), 1.f));
       MirrorView behind;
       behind.level = view.level + 1;
       const glm::dmat4 reflect = reflection_matrix(mirror.normal, mirror.offset);
       behind.model = view.model * reflect;
       behind.eye = glm::dvec3(reflect * glm::dvec4(view.eye, 1.0));
-      behind.plane = (side > 0 ? 1.0 : -1.0) * glm::dvec4(mirror.normal, mirror.offset);
+      behind.plane = (c.side > 0 ? 1.0 : -1.0) * glm::dvec4(mirror.normal, mirror.offset);
       behind.skip = id;
+      behind.scissor = c.bounds;
+      glScissor(c.bounds.x, c.bounds.y, c.bounds.z, c.bounds.w);
+      fill_region(view.level + 1, glm::vec4(glm::vec3(scene_.background), 0.f));
       render_view(clip, behind, views_left);
       // The mirror's depth back over its region, and the stencil back to L.
       bind_target();
@@ -285,22 +332,25 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
       glStencilFunc(GL_EQUAL, view.level + 1, 0xff);
       glStencilOp(GL_KEEP, GL_KEEP, GL_DECR);
       glDepthFunc(GL_ALWAYS);
-      draw_reflector(*distance_program_, clip, view, r);
+      draw_reflector(*distance_program_, clip, view, c.r);
       glDepthFunc(GL_GREATER);
       stencil_level(view.level);
     }
-    glDeleteQueries(1, &query);
   }
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 
-  // 3. The view's shadow mask, from its depth.
+  // 3. The view's shadow-volume counts, from its depth.
   const bool volumes = exact_stats_.volumes && !volume_lights_.empty();
   if (volumes) count_volumes(clip, view);
 
-  // 4. Its colour: the visible surfaces (depth GEQUAL), a mirror drawn behind blended over.
+  // 4. Its colour: the visible surfaces (depth EQUAL: the same vertex stage as the depth
+  // pass, invariant; the mirror the view is seen through, left out of that pass, fails it;
+  // no discard, so the fragments behind are dropped before they are shaded), a mirror drawn
+  // behind blended over.
   bind_target();
   stencil_level(view.level);
-  glDepthFunc(GL_GEQUAL);
+  glDepthFunc(GL_EQUAL);
+  glDepthMask(GL_FALSE);
   upload_lights(view.eye);
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, recursed_);
   glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(recursed.size() * sizeof(uint32_t)), recursed.data(),
@@ -308,15 +358,18 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, recursed_);
   exact_program_->use();
   glUniform1i(exact_program_->uniform("u_volumes"), volumes);
+  glUniform1i(exact_program_->uniform("u_bounces_left"), view.level < exact_.max_depth);
+  glUniform1i(exact_program_->uniform("u_translucent_shadows"), shadows_approximate_);
   glUniform1i(exact_program_->uniform("u_environment"), environment_ != 0 && view.level < exact_.max_depth);
-  glActiveTexture(GL_TEXTURE0 + VOLUME_MASK_UNIT);
-  glBindTexture(GL_TEXTURE_2D, volumes ? exact_buffers_->mask : 0);
+  glActiveTexture(GL_TEXTURE0 + VOLUME_COUNT_UNIT);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, volumes ? exact_buffers_->counts : 0);
   glActiveTexture(GL_TEXTURE0);
   glEnable(GL_BLEND);
   glBlendEquation(GL_FUNC_ADD);
   glBlendFunc(GL_ONE, GL_SRC1_COLOR);
   draw_scene(*exact_program_, clip, view);
   glDisable(GL_BLEND);
+  glDepthMask(GL_TRUE);
   glDepthFunc(GL_GREATER);
 }
 
@@ -329,12 +382,11 @@ void GlScene::make_exact_programs() {
       scene_vert, std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "shadow_probe.frag"});
   for (const GlProgram* p : {exact_program_.get(), probe_program_.get()}) {
     p->use();
-    glUniform1i(p->uniform("u_volume_mask"), static_cast<GLint>(VOLUME_MASK_UNIT));
+    glUniform1i(p->uniform("u_volume_counts"), static_cast<GLint>(VOLUME_COUNT_UNIT));
   }
   fill_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"fill.frag"});
-  fill_mask_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"fill_mask.frag"});
   volume_program_ = std::make_unique<GlProgram>(scene_vert, std::vector<const char*>{"shadow_volume.frag"});
-  mask_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"volume_mask.frag"});
+  resolve_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"resolve_samples.frag"});
   glGenBuffers(1, &recursed_);
 }
 
@@ -353,9 +405,10 @@ GlScene::ShadowProbe GlScene::camera_shadow_probe(const Camera& camera) {
   Target& t = target(tile_w, tile_h, false);
   make_exact_programs();
   build_volumes();
-  if (!exact_buffers_ || exact_buffers_->width != tile_w || exact_buffers_->height != tile_h) {
+  if (!exact_buffers_ || exact_buffers_->width != tile_w || exact_buffers_->height != tile_h ||
+      exact_buffers_->layers != (static_cast<int>(volume_lights_.size()) + 3) / 4) {
     exact_buffers_.reset();
-    exact_buffers_ = std::make_unique<ExactBuffers>(t);
+    exact_buffers_ = std::make_unique<ExactBuffers>(t, static_cast<int>(volume_lights_.size()));
   }
   const double aspect = static_cast<double>(camera.width) / camera.height;
   const glm::mat4 clip = camera_clip_matrix(camera.position, camera.look_at, camera.up,
@@ -388,8 +441,8 @@ GlScene::ShadowProbe GlScene::camera_shadow_probe(const Camera& camera) {
       upload_lights(view.eye);
       probe_program_->use();
       glUniform1iv(probe_program_->uniform("u_probe"), 64, probe.data());
-      glActiveTexture(GL_TEXTURE0 + VOLUME_MASK_UNIT);
-      glBindTexture(GL_TEXTURE_2D, exact_buffers_->mask);
+      glActiveTexture(GL_TEXTURE0 + VOLUME_COUNT_UNIT);
+      glBindTexture(GL_TEXTURE_2D_ARRAY, exact_buffers_->counts);
       glActiveTexture(GL_TEXTURE0);
       draw_scene(*probe_program_, tile_clip, view);
       glDepthFunc(GL_GREATER);
@@ -407,8 +460,8 @@ GlScene::ShadowProbe GlScene::camera_shadow_probe(const Camera& camera) {
     }
   }
   glDisable(GL_STENCIL_TEST);
-  glActiveTexture(GL_TEXTURE0 + VOLUME_MASK_UNIT);
-  glBindTexture(GL_TEXTURE_2D, 0);
+  glActiveTexture(GL_TEXTURE0 + VOLUME_COUNT_UNIT);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
   glActiveTexture(GL_TEXTURE0);
   check_gl("shadow probe");
   return out;
@@ -422,9 +475,10 @@ Image GlScene::camera_color_exact(const Camera& camera) {
   make_exact_programs();
   if (exact_stats_.volumes) {
     if (!volumes_built_) build_volumes();
-    if (!exact_buffers_ || exact_buffers_->width != tile_w || exact_buffers_->height != tile_h) {
+    if (!exact_buffers_ || exact_buffers_->width != tile_w || exact_buffers_->height != tile_h ||
+      exact_buffers_->layers != (static_cast<int>(volume_lights_.size()) + 3) / 4) {
       exact_buffers_.reset();
-      exact_buffers_ = std::make_unique<ExactBuffers>(t);
+      exact_buffers_ = std::make_unique<ExactBuffers>(t, static_cast<int>(volume_lights_.size()));
     }
   }
   bind_lookups(*exact_program_, true);
@@ -435,29 +489,65 @@ Image GlScene::camera_color_exact(const Camera& camera) {
                                             glm::radians(camera.fov_y_deg), aspect, near_);
   const size_t tile_samples = static_cast<size_t>(tile_w) * static_cast<size_t>(tile_h);
   std::vector<float> rgba(tile_samples * 4);
-  std::vector<double> sum(static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height) * 3, 0.0);
+  Image out(camera.width, camera.height, 3);
+  exact_pixels_.assign(static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height), 1);
   for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
     for (int64_t x0 = 0; x0 < full_w; x0 += tile_w) {
       check_deadline();
       Clock::time_point t0 = Clock::now();
       t.clear(scene_.background);
+      const float background[4] = {float(scene_.background.x), float(scene_.background.y), float(scene_.background.z), 0.f};
+      glClearBufferfv(GL_COLOR, 0, background);  // alpha: no approximated surface yet
       MirrorView camera_view;
       camera_view.eye = camera.position;
+      camera_view.scissor = glm::ivec4(0, 0, tile_w, tile_h);
       int views_left = exact_.max_views;
       render_view(tile_matrix(full_w, full_h, x0, y0, tile_w, tile_h) * clip, camera_view, &views_left);
       glDisable(GL_STENCIL_TEST);
       glDisable(GL_CLIP_DISTANCE0);
+      glDisable(GL_SCISSOR_TEST);
       glFinish();
       timings_.camera_ms += ms_since(t0);
       t0 = Clock::now();
-      t.read(0, GL_RGBA, GL_FLOAT, rgba.data());
-      // GL's row 0 is the bottom; the image's row 0 is the top. Box filter of the 32 samples.
-      for (int64_t gy = 0; gy < tile_h && y0 + gy < full_h; ++gy) {
-        const size_t row = static_cast<size_t>((full_h - 1 - (y0 + gy)) / MASK_ROWS);
-        for (int64_t gx = 0; gx < tile_w && x0 + gx < full_w; ++gx) {
-          const size_t k = static_cast<size_t>(gy) * static_cast<size_t>(tile_w) + static_cast<size_t>(gx);
-          double* dst = &sum[(row * static_cast<size_t>(camera.width) + static_cast<size_t>((x0 + gx) / MASK_COLUMNS)) * 3];
-          for (int c = 0; c < 3; ++c) dst[c] += rgba[4 * k + static_cast<size_t>(c)];
+      // The box filter of each pixel's 32 samples on the GPU, then the tile's pixels read
+      // back (GL's row 0 is the bottom; the image's row 0 is the top).
+      const int pw = tile_w / MASK_COLUMNS, ph = tile_h / MASK_ROWS;
+      if (resolve_w_ != pw || resolve_h_ != ph) {
+        glDeleteTextures(1, &resolve_texture_);
+        glGenTextures(1, &resolve_texture_);
+        glBindTexture(GL_TEXTURE_2D, resolve_texture_);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, pw, ph);
+        if (!resolve_fbo_) glGenFramebuffers(1, &resolve_fbo_);
+        glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo_);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, resolve_texture_, 0);
+        resolve_w_ = pw;
+        resolve_h_ = ph;
+      }
+      const GLenum first[] = {GL_COLOR_ATTACHMENT0};
+      glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo_);
+      glDrawBuffers(1, first);
+      glViewport(0, 0, pw, ph);
+      glDisable(GL_DEPTH_TEST);
+      resolve_program_->use();
+      glUniform1i(resolve_program_->uniform("u_samples"), 0);
+      glActiveTexture(GL_TEXTURE0);
+      glBindTexture(GL_TEXTURE_2D, t.color0);
+      glBindVertexArray(vao_);
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+      glBindTexture(GL_TEXTURE_2D, 0);
+      glEnable(GL_DEPTH_TEST);
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo_);
+      glReadBuffer(GL_COLOR_ATTACHMENT0);
+      glPixelStorei(GL_PACK_ALIGNMENT, 1);
+      glReadPixels(0, 0, pw, ph, GL_RGBA, GL_FLOAT, rgba.data());
+      for (int64_t py = 0; py < ph && y0 + MASK_ROWS * py < full_h; ++py) {
+        const size_t row = static_cast<size_t>((full_h - 1 - (y0 + MASK_ROWS * py)) / MASK_ROWS);
+        for (int64_t px = 0; px < pw && x0 + MASK_COLUMNS * px < full_w; ++px) {
+          const size_t k = static_cast<size_t>(py * pw + px);
+          const size_t pixel = row * static_cast<size_t>(camera.width) + static_cast<size_t>(x0 / MASK_COLUMNS + px);
+          for (int c = 0; c < 3; ++c) out.data[pixel * 3 + static_cast<size_t>(c)] = rgba[4 * k + static_cast<size_t>(c)];
+          exact_stats_.samples_approximate += static_cast<uint64_t>(rgba[4 * k + 3]);
+          if (rgba[4 * k + 3] != 0.f) exact_pixels_[pixel] = 0;
         }
       }
       timings_.readback_ms += ms_since(t0);
@@ -465,8 +555,8 @@ Image GlScene::camera_color_exact(const Camera& camera) {
   }
   // The state the other passes expect back (Mesa refuses a draw to two buffers while the
   // blend function names the second source, even with blending off).
-  glActiveTexture(GL_TEXTURE0 + VOLUME_MASK_UNIT);
-  glBindTexture(GL_TEXTURE_2D, 0);
+  glActiveTexture(GL_TEXTURE0 + VOLUME_COUNT_UNIT);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
   glActiveTexture(GL_TEXTURE0);
   glBlendFunc(GL_ONE, GL_ZERO);
   glLogicOp(GL_COPY);
@@ -474,8 +564,7 @@ Image GlScene::camera_color_exact(const Camera& camera) {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, 0);
   camera_layers_ = 1;
   camera_layers_capped_ = false;
-  Image out(camera.width, camera.height, 3);
-  for (size_t k = 0; k < sum.size(); ++k) out.data[k] = static_cast<float>(sum[k] / MASK_SAMPLES);
+  exact_stats_.pixels_exact = static_cast<uint64_t>(std::count(exact_pixels_.begin(), exact_pixels_.end(), 1));
   check_gl("exact camera pass");
   return out;
 }

@@ -144,7 +144,7 @@ GlScene::GlScene(const SceneData& scene) : scene_(scene) {
   // unit is an error at draw time, even when one is never read).
   phong_program_->use();
   glUniform1i(phong_program_->uniform("u_previous"), static_cast<GLint>(CAMERA_PREVIOUS_UNIT));
-  glUniform1i(phong_program_->uniform("u_volume_mask"), static_cast<GLint>(VOLUME_MASK_UNIT));
+  glUniform1i(phong_program_->uniform("u_volume_counts"), static_cast<GLint>(VOLUME_COUNT_UNIT));
   glFinish();
   check_gl("scene upload");
   timings_.upload_ms = ms_since(t0);

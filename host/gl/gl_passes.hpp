@@ -51,7 +51,7 @@ constexpr int MAX_TEXTURE_ARRAYS = 4;
 // blockers by shadow volumes counted depth-fail (course notes 3.3; Everitt & Kilgard 2002).
 // What it cannot (curved mirrors, refraction, coverage transparency, more than
 // MAX_VOLUME_LIGHTS lights) keeps the cube maps: the environment map and the shadow maps.
-constexpr int MAX_VOLUME_LIGHTS = 128;  // bits of the mask (RGBA32UI)
+constexpr int MAX_VOLUME_LIGHTS = 128;  // counts: four a layer of an RGBA32F array
 struct ExactCameraOptions {
   bool planar_mirrors = false;  // stencil portals for planar_reflectors.hpp's mirrors
   bool shadow_volumes = false;  // shadow volumes for the shadow-casting lights
@@ -59,9 +59,16 @@ struct ExactCameraOptions {
   // Mirror views drawn per camera tile, at most; a mirror seen past that falls back to the
   // environment map (and is counted).
   int max_views = 256;
+  // Use the exact pass even with no planar mirror and no volume light (the hybrid method
+  // reads its per-pixel flags).
+  bool always = false;
 };
+// What the last exact camera pass says of each pixel: 1 when none of its 32 samples met a
+// surface the GPU only approximates (camera_exact.frag's alpha), 0 otherwise (the hybrid
+// method redoes those on the CPU).
 struct ExactCameraStats {
   bool mirrors = false, volumes = false;  // what the last camera pass used
+  bool plain = false;                     // the exact pass ran without either (ExactCameraOptions::always)
   std::string mirrors_why, volumes_why;   // why not, when asked but not used
   size_t reflectors = 0;                  // planar reflectors in the scene
   uint64_t curved_reflective_triangles = 0;
@@ -69,6 +76,8 @@ struct ExactCameraStats {
   uint64_t mirror_views_empty = 0;        // mirrors drawn but covering no sample
   uint64_t mirror_views_over_budget = 0;  // mirrors shown through the environment map instead
   int deepest_level = 0;
+  uint64_t samples_approximate = 0;       // camera samples whose path meets an approximated surface
+  uint64_t pixels_exact = 0;              // pixels with none
   int volume_lights = 0;
   uint64_t volume_triangles = 0;          // over every volume light
   double volume_build_ms = 0;
@@ -157,6 +166,7 @@ class GlScene {
   void set_exact_camera(const ExactCameraOptions& options) { exact_ = options; }
   const ExactCameraStats& exact_camera_stats() const { return exact_stats_; }
   const PlanarReflectors& planar_reflectors() const { return reflectors_; }
+  const std::vector<uint8_t>& exact_pixels() const { return exact_pixels_; }
 
   // Textures sampled at level 0 with zero derivatives (bilinear), as the CPU's point
   // samples, instead of trilinear over the pass's footprint: `abcube crosscheck` compares
@@ -218,6 +228,9 @@ class GlScene {
   // buffer per volume light (its index in volume_lights_ is its bit); its programs and buffers.
   ExactCameraOptions exact_;
   ExactCameraStats exact_stats_;
+  std::vector<uint8_t> exact_pixels_;
+  bool translucent_shadows_ = false;  // a shadow-casting light and a translucent caster
+  bool shadows_approximate_ = false;  // that, or shadows from maps, or lights past the volume bits
   PlanarReflectors reflectors_;
   GLuint portal_vbo_ = 0, portal_ebo_ = 0;
   std::vector<std::pair<size_t, size_t>> portal_ranges_;  // first index, count
@@ -226,8 +239,9 @@ class GlScene {
   std::vector<int> volume_bit_;           // per light: its bit, or -1
   std::vector<GLuint> volume_vaos_, volume_vbos_;
   std::vector<GLsizei> volume_vertices_;
-  std::unique_ptr<GlProgram> exact_program_, fill_program_, fill_mask_program_, volume_program_, mask_program_,
-      probe_program_;
+  std::unique_ptr<GlProgram> exact_program_, fill_program_, volume_program_, probe_program_, resolve_program_;
+  GLuint resolve_fbo_ = 0, resolve_texture_ = 0;  // a tile's pixels (resolve_samples.frag)
+  int resolve_w_ = 0, resolve_h_ = 0;
   GLuint recursed_ = 0;  // per view: which mirrors had their view drawn (camera_exact.frag)
   std::unique_ptr<ExactBuffers> exact_buffers_;
 };

@@ -3,6 +3,7 @@
 #pragma once
 #include <glad/gl.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 
@@ -13,8 +14,12 @@
 
 namespace abcube {
 
-// The camera pass renders at most this many samples a side at once (tiles beyond).
-constexpr int CAMERA_TILE = 2048;
+// The camera pass renders at most this many samples a side at once (tiles beyond). 1024:
+// on llvmpipe the exact camera pass of the flat-mirror suite at 640 x 480 took 574-993 ms
+// a scene with tiles of 1024, 726-992 with 2048, 817-1308 with 4096, 484-897 with 512
+// (tools/flat_mirror_scenes.py --seed 2, one run each); a mirror's scissor is tighter, and
+// the tile's buffers stay in cache.
+constexpr int CAMERA_TILE = 1024;
 // Texture units: 1 the opaque shadow maps, 2 the environment, 3.. the translucent peels,
 // then the camera's previous layer.
 constexpr GLenum PEEL_UNIT = 3;
@@ -22,9 +27,9 @@ constexpr GLenum CAMERA_PREVIOUS_UNIT = PEEL_UNIT + MAX_SHADOW_PEELS;
 // Then the base-colour texture arrays (16 units in all: GL 4.5's minimum for a fragment shader).
 constexpr GLenum TEXTURE_UNIT = CAMERA_PREVIOUS_UNIT + 1;
 static_assert(TEXTURE_UNIT + MAX_TEXTURE_ARRAYS <= 16, "texture units");
-// The shadow volumes' mask in the camera pass: unit 16 (llvmpipe and NVIDIA offer 32; the
+// The shadow volumes' counts in the camera pass: unit 16 (llvmpipe and NVIDIA offer 32; the
 // exact pass checks GL_MAX_TEXTURE_IMAGE_UNITS).
-constexpr GLenum VOLUME_MASK_UNIT = 16;
+constexpr GLenum VOLUME_COUNT_UNIT = 16;
 
 // The state every pass relies on: infinite reversed-Z (cube_map.hpp: depth in [0, 1], 1 at
 // the near plane, GL_GREATER), no culling (the map holds every surface), no blending.
@@ -42,6 +47,7 @@ inline void set_pass_state() {
   glDisable(GL_STENCIL_TEST);
   glDisable(GL_CLIP_DISTANCE0);
   glDisable(GL_COLOR_LOGIC_OP);
+  glDisable(GL_SCISSOR_TEST);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 }
 
@@ -132,41 +138,37 @@ struct GlScene::MirrorView {
   glm::dvec3 eye{0.0};
   glm::dvec4 plane{0.0, 0.0, 0.0, 1.0};  // keeps everything
   uint32_t skip = 0;
+  // The tile's pixels the view can reach (x, y, width, height): the bounds of its mirror's
+  // projection within its parent's (a scissor: the stencil decides, this saves the work).
+  glm::ivec4 scissor{0, 0, 0, 0};
 };
 
 // The exact camera pass's buffers beside the camera Target (same size, same depth-stencil
-// texture): the shadow count of one light (R32F, additive) and the mask of every volume
-// light's bit (RGBA32UI, OR-ed in).
+// texture): the shadow-volume counts, four lights a layer of an RGBA32F array (one channel
+// each, additive), drawn through one framebuffer whose colour is the layer being counted.
 struct GlScene::ExactBuffers {
-  int width = 0, height = 0;
-  GLuint count = 0, mask = 0, count_fbo = 0, mask_fbo = 0;
+  int width = 0, height = 0, layers = 0;
+  GLuint counts = 0, fbo = 0;
 
-  ExactBuffers(const Target& t) : width(t.width), height(t.height) {
-    auto make = [&](GLenum format, GLuint* tex, GLuint* fbo) {
-      glGenTextures(1, tex);
-      glBindTexture(GL_TEXTURE_2D, *tex);
-      glTexStorage2D(GL_TEXTURE_2D, 1, format, width, height);
-      // One level, read by texelFetch: complete only with a filter that needs no mipmaps
-      // (an incomplete unsigned-integer texture reads as 0).
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-      glGenFramebuffers(1, fbo);
-      glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
-      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, *tex, 0);
-      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, t.depth, 0);
-      const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-      if (status != GL_FRAMEBUFFER_COMPLETE) {
-        throw RuntimeFailure("shadow-volume framebuffer incomplete (status " + std::to_string(status) + ")");
-      }
-    };
-    make(GL_R32F, &count, &count_fbo);
-    make(GL_RGBA32UI, &mask, &mask_fbo);
+  ExactBuffers(const Target& t, int lights) : width(t.width), height(t.height), layers((lights + 3) / 4) {
+    glGenTextures(1, &counts);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, counts);
+    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32F, width, height, std::max(layers, 1));
+    // One level, read by texelFetch: complete only with a filter that needs no mipmaps.
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, counts, 0, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, t.depth, 0);
+    const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+      throw RuntimeFailure("shadow-volume framebuffer incomplete (status " + std::to_string(status) + ")");
+    }
   }
   ~ExactBuffers() {
-    const GLuint textures[] = {count, mask};
-    glDeleteTextures(2, textures);
-    const GLuint fbos[] = {count_fbo, mask_fbo};
-    glDeleteFramebuffers(2, fbos);
+    glDeleteTextures(1, &counts);
+    glDeleteFramebuffers(1, &fbo);
   }
 };
 

@@ -308,7 +308,7 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
 }
 
 Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options, nlohmann::json* stats,
-                           bool exact_priority) {
+                           bool exact_priority, const std::vector<uint8_t>* only) {
   ABufferStats s;
   Clock::time_point t0 = Clock::now();
   const ABuffer camera = build_camera_abuffer(scene, options, &s);
@@ -316,6 +316,7 @@ Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options
   ResolveOptions ro;
   ro.threads = options.threads;
   ro.exact_priority = exact_priority;
+  ro.only = only;
   t0 = Clock::now();
   Image image = resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera), scene.background, ro);
   (*stats)["timings_ms"]["camera_abuffer"] = build_ms;

@@ -93,7 +93,8 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
 // The camera view through the CPU A-buffer with local Phong (no searches yet).
 // Options: threads, layer cap, memory budget (abuffer.hpp).
 // `exact_priority`: the resolve's rule for intersecting fragments (resolve.hpp).
+// `only` (optional): the pixels to render (ResolveOptions::only).
 Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options, nlohmann::json* stats,
-                           bool exact_priority = true);
+                           bool exact_priority = true, const std::vector<uint8_t>* only = nullptr);
 
 }  // namespace abcube

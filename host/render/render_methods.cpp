@@ -29,6 +29,33 @@ json gl_json(const GlContext* ctx) {
   return j;
 }
 
+// What the exact camera pass rendered (issue 19): per kind of surface, the path it took and
+// why. `curved`: what curved mirrors and refraction took; `maps`: shadow maps were built.
+json gpu_paths_json(const GlScene& gl, const RenderRequest& request, const std::string& curved, bool maps) {
+  const ExactCameraStats& ex = gl.exact_camera_stats();
+  return {
+      {"planar_mirrors", {{"technique", ex.mirrors ? "stencil" : curved},
+                          {"why", ex.mirrors ? "exact: virtual views through the stencil test, to max_depth"
+                                             : request.gpu.planar_mirrors ? ex.mirrors_why : "asked: --gpu-mirrors envmap"},
+                          {"reflectors", ex.reflectors}, {"views", ex.mirror_views}, {"views_empty", ex.mirror_views_empty},
+                          {"views_over_budget", ex.mirror_views_over_budget}, {"max_views_per_tile", request.gpu.max_views},
+                          {"deepest_level", ex.deepest_level}}},
+      {"curved_mirrors_and_refraction", {{"technique", curved},
+                                         {"curved_reflective_triangles", ex.curved_reflective_triangles},
+                                         {"why", curved == "environment_map"
+                                                     ? "approximate: Blinn-Newell lookups in the cube texture around the eye"
+                                                     : curved == "none" ? "none in the view's reach (or max_depth 0)"
+                                                                        : "the CPU's A-buffer searches, for the pixels they reach"}}},
+      {"shadows", {{"technique", ex.volumes ? "shadow_volumes" : maps ? "shadow_maps" : "none"},
+                   {"why", ex.volumes ? "exact: depth-fail counting of every opaque blocker's prism"
+                                      : request.gpu.shadow_volumes ? ex.volumes_why : "asked: --gpu-shadows maps"},
+                   {"volume_lights", ex.volumes ? ex.volume_lights : 0},
+                   {"volume_triangles", ex.volumes ? ex.volume_triangles : 0},
+                   {"translucent_casters", maps && gl.shadow_peels() > 0 ? "shadow maps' peeled layers" : "none"}}},
+      {"camera_samples_approximate", ex.samples_approximate},
+      {"pixels_exact", ex.pixels_exact}};
+}
+
 Image render_gpu(MethodContext& mc) {
   const SceneData& scene = mc.scene;
   json& stats = mc.stats;
@@ -79,27 +106,72 @@ Image render_gpu(MethodContext& mc) {
   stats["counts"]["camera_samples_per_pixel"] = MASK_SAMPLES;
   stats["counts"]["camera_layers"] = gl.camera_layers();  // > 1: coverage transparency peeled
   stats["counts"]["camera_layers_capped"] = gl.camera_layers_capped();
-  // What the camera pass rendered exactly (issue 19): per kind of surface, the path it took.
+  stats["gpu_paths"] = gpu_paths_json(gl, mc.request, needed ? "environment_map" : "none", maps > 0);
   const ExactCameraStats& ex = gl.exact_camera_stats();
-  stats["gpu_paths"] = {
-      {"planar_mirrors", {{"technique", ex.mirrors ? "stencil" : "environment_map"},
-                          {"why", ex.mirrors ? "exact: virtual views through the stencil test, to max_depth"
-                                             : mc.request.gpu.planar_mirrors ? ex.mirrors_why : "asked: --gpu-mirrors envmap"},
-                          {"reflectors", ex.reflectors}, {"views", ex.mirror_views}, {"views_empty", ex.mirror_views_empty},
-                          {"views_over_budget", ex.mirror_views_over_budget}, {"max_views_per_tile", mc.request.gpu.max_views},
-                          {"deepest_level", ex.deepest_level}}},
-      {"curved_mirrors_and_refraction", {{"technique", needed ? "environment_map" : "none"},
-                                         {"curved_reflective_triangles", ex.curved_reflective_triangles},
-                                         {"why", "approximate: Blinn-Newell lookups in the cube texture around the eye"}}},
-      {"shadows", {{"technique", ex.volumes ? "shadow_volumes" : maps > 0 ? "shadow_maps" : "none"},
-                   {"why", ex.volumes ? "exact: depth-fail counting of every opaque blocker's prism"
-                                      : mc.request.gpu.shadow_volumes ? ex.volumes_why : "asked: --gpu-shadows maps"},
-                   {"volume_lights", ex.volumes ? ex.volume_lights : 0},
-                   {"volume_triangles", ex.volumes ? ex.volume_triangles : 0},
-                   {"translucent_casters", maps > 0 && gl.shadow_peels() > 0 ? "shadow maps' peeled layers" : "none"}}}};
   if (ex.volumes) stats["timings_ms"]["shadow_volumes_build"] = ex.volume_build_ms;
   stats["plan"]["passes"] = passes;
   stats["plan"]["skipped"] = skipped;
+  return image;
+}
+
+// HYBRID (issue 19 part 5): each kind of surface by the path that is exact and cheaper.
+// The GPU renders the camera view by its exact camera pass (planar mirrors by the stencil
+// test, opaque shadows by volumes, textures point-sampled as the CPU does), building no
+// cube map at all; each sample counts the surfaces on its path the GPU would only
+// approximate (curved mirrors, refraction, light through translucent casters:
+// camera_exact.frag). The pixels with such a sample are rendered again, alone, by the
+// abuffer method on the CPU (its cube map searches, its shadow searches); the others keep
+// the GPU's colour. So hybrid is abuffer wherever the GPU is not exact, and exact elsewhere.
+Image render_hybrid(MethodContext& mc) {
+  const SceneData& scene = mc.scene;
+  json& stats = mc.stats;
+  GlScene& gl = *mc.gl_scene;
+  const GpuTimings& before = mc.gl_before;
+  gl.drop_environment();
+  ExactCameraOptions exact = mc.request.gpu;
+  exact.always = true;
+  gl.set_exact_camera(exact);
+  gl.set_texture_level0(true);
+  check_deadline();
+  Image image = gl.camera_color(scene.camera, CameraSamples::mask_4x8);
+  gl.set_texture_level0(false);
+  const ExactCameraStats& ex = gl.exact_camera_stats();
+  const bool exact_pass = ex.mirrors || ex.volumes || ex.plain;
+  std::vector<uint8_t> cpu(static_cast<size_t>(scene.camera.width) * static_cast<size_t>(scene.camera.height), 1);
+  if (exact_pass) {
+    const std::vector<uint8_t>& on_gpu = gl.exact_pixels();
+    for (size_t p = 0; p < cpu.size(); ++p) cpu[p] = on_gpu[p] ? 0 : 1;
+  }
+  const size_t cpu_pixels = static_cast<size_t>(std::count(cpu.begin(), cpu.end(), 1));
+  const GpuTimings& t = gl.timings();
+  stats["timings_ms"]["upload"] = t.upload_ms - before.upload_ms;
+  stats["timings_ms"]["camera_raster"] = t.camera_ms - before.camera_ms;
+  stats["timings_ms"]["readback"] = t.readback_ms - before.readback_ms;
+  stats["gpu_paths"] = gpu_paths_json(gl, mc.request, cpu_pixels > 0 ? "cpu_searches" : "none", false);
+  if (ex.volumes) stats["timings_ms"]["shadow_volumes_build"] = ex.volume_build_ms;
+  json hybrid = {{"pixels", cpu.size()}, {"pixels_gpu", cpu.size() - cpu_pixels}, {"pixels_cpu", cpu_pixels}};
+  if (!exact_pass) hybrid["why_all_cpu"] = ex.mirrors_why.empty() ? ex.volumes_why : ex.mirrors_why;
+  if (cpu_pixels > 0) {
+    // The abuffer method for those pixels alone (its stats under "cpu").
+    json cpu_stats;
+    MethodContext cpu_mc{scene, mc.cache, mc.request, cpu_stats, mc.progress, nullptr, {}, mc.fallback};
+    const Image part = render_map_method(cpu_mc, &cpu);
+    for (size_t p = 0; p < cpu.size(); ++p) {
+      if (!cpu[p]) continue;
+      for (int c = 0; c < 3; ++c) image.data[3 * p + static_cast<size_t>(c)] = part.data[3 * p + static_cast<size_t>(c)];
+    }
+    for (const auto& [k, v] : cpu_stats["timings_ms"].items()) stats["timings_ms"]["cpu." + k] = v;
+    for (const char* key : {"plan", "cube_abuffer", "abuffer", "searches"}) {
+      if (cpu_stats.contains(key)) hybrid["cpu"][key] = cpu_stats[key];
+    }
+  } else {
+    hybrid["cpu"] = "skipped: every pixel is exact on the GPU (no cube map built)";
+  }
+  stats["hybrid"] = hybrid;
+  stats["plan"]["passes"] = cpu_pixels > 0 ? json::array({"camera_raster (exact pass)", "cpu abuffer for the pixels left"})
+                                           : json::array({"camera_raster (exact pass)"});
+  stats["plan"]["mode"] = "needed";
+  stats["counts"]["camera_samples_per_pixel"] = MASK_SAMPLES;
   return image;
 }
 
@@ -117,7 +189,7 @@ Image render_reference(MethodContext& mc, const char* key) {
   return image;
 }
 
-Image render_map_method(MethodContext& mc) {
+Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   const SceneData& scene = mc.scene;
   const RenderRequest& r = mc.request;
   json& stats = mc.stats;
@@ -127,7 +199,7 @@ Image render_map_method(MethodContext& mc) {
   stats["plan"]["passes"] = passes;
   stats["plan"]["skipped"] = skipped;
   stats["plan"]["mode"] = r.plan_everything ? "everything" : "needed";
-  if (!plan.cube_map) return render_abuffer_local(scene, r.abuffer, &stats, r.map.exact_priority);
+  if (!plan.cube_map) return render_abuffer_local(scene, r.abuffer, &stats, r.map.exact_priority, only);
   Clock::time_point t0 = Clock::now();
   ABufferStats cs;
   const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, scene.render.cube_resolution, r.abuffer, &cs);
@@ -136,7 +208,7 @@ Image render_map_method(MethodContext& mc) {
   std::unique_ptr<RayTracer> reference;
   if (r.reference) reference = std::make_unique<RayTracer>(scene, mc.cache.bvh());
   MapShadingOptions options = r.map;
-  options.method = scene.render.method;
+  options.method = scene.render.method == Method::hybrid ? Method::abuffer : scene.render.method;  // hybrid: abuffer's searches
   options.walk_all_shadows = r.plan_everything;
   t0 = Clock::now();
   const MapShader shader(scene, cube, options, reference.get(), &mc.cache);
@@ -149,7 +221,7 @@ Image render_map_method(MethodContext& mc) {
   stats["timings_ms"]["camera_abuffer"] = ms_since(t0);
   t0 = Clock::now();
   MapShadingStats ms;
-  Image image = render_with_map(scene, camera, shader, r.threads, &ms, mc.fallback);
+  Image image = render_with_map(scene, camera, shader, r.threads, &ms, mc.fallback, only);
   stats["timings_ms"]["shade_and_resolve"] = ms_since(t0);
   stats["abuffer"] = abuffer_json(as, false);
   stats["searches"] = map_shading_json(ms);

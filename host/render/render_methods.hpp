@@ -46,8 +46,13 @@ struct MethodContext {
 // The Z-buffer raster on the GPU: camera view only, Phong, aliased.
 Image render_gpu(MethodContext& mc);
 // The cube-map methods (abuffer, zbuffer, envmap): the map is built only when something
-// needs it (a reflecting or refracting material, a shadow-casting light).
-Image render_map_method(MethodContext& mc);
+// needs it (a reflecting or refracting material, a shadow-casting light). `only`
+// (optional): the pixels to render, the others black.
+Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only = nullptr);
+// The hybrid method (README "The gpu method at its best"): the GPU's exact camera pass,
+// and the abuffer method on the CPU for the pixels whose samples meet a surface the GPU
+// only approximates.
+Image render_hybrid(MethodContext& mc);
 // The exact Whitted tracer; its stats go under `key` ("raytrace" or "reference").
 Image render_reference(MethodContext& mc, const char* key);
 // The image's error against the exact image (traced now, or --reference-image); PSNR.

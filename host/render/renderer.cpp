@@ -91,7 +91,7 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   *view = base;  // shares the triangles (SharedTriangles)
   RenderSettings& rs = view->render;
   if (!o.method.empty()) {
-    rs.method = parse_named(o.method, parse_method, "method", "method", "abuffer, zbuffer, envmap, raytrace, gpu");
+    rs.method = parse_named(o.method, parse_method, "method", "method", "abuffer, zbuffer, envmap, raytrace, gpu, hybrid");
   }
   if (o.error_target >= 0) {
     if (!(o.error_target <= 0.5)) throw InputError("error-target: must be in [0, 0.5], got " + std::to_string(o.error_target));
@@ -303,15 +303,17 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
                    wants_fallback ? &fallback : nullptr};
   Image image;
   switch (view.render.method) {
-    case Method::gpu: {
+    case Method::gpu:
+    case Method::hybrid: {
       const Clock::time_point t0 = Clock::now();
       const bool first_open = !impl_->gl_tried;
       GlContext* ctx = impl_->open_gl();
+      const std::string which = std::string("--method ") + method_name(view.render.method);
       if (!ctx) {
-        if (impl_->gl_choice == GlChoice::none) throw InputError("--method gpu needs OpenGL, but --gl none was given");
+        if (impl_->gl_choice == GlChoice::none) throw InputError(which + " needs OpenGL, but --gl none was given");
         std::string log = impl_->gl_log;
         for (char& c : log) c = c == '\n' ? ';' : c;
-        throw RuntimeFailure("--method gpu needs OpenGL and no GL path works here: " + log);
+        throw RuntimeFailure(which + " needs OpenGL and no GL path works here: " + log);
       }
       stats["gl"] = gl_json(ctx);
       stats["timings_ms"]["gl_init"] = first_open ? ms_since(t0) : 0.0;
@@ -319,7 +321,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
       bool uploaded = false;
       mc.gl_scene = &impl_->gl_scene_for(scene, &uploaded);
       if (!uploaded) mc.gl_before = mc.gl_scene->timings();  // else its upload is this render's
-      image = render_gpu(mc);
+      image = view.render.method == Method::gpu ? render_gpu(mc) : render_hybrid(mc);
       break;
     }
     case Method::abuffer:
@@ -366,9 +368,10 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
 void refuse_unused_options(const Scene& scene, const RenderOptions& o) {
   Method m = scene.data().render.method;
   if (!o.method.empty() && !parse_method(o.method, &m)) {
-    throw InputError("method: unknown method " + quote(o.method) + " (abuffer, zbuffer, envmap, raytrace, gpu)");
+    throw InputError("method: unknown method " + quote(o.method) + " (abuffer, zbuffer, envmap, raytrace, gpu, hybrid)");
   }
-  const bool map = m == Method::abuffer || m == Method::zbuffer || m == Method::envmap;
+  // hybrid takes the map methods' options (its CPU part is abuffer's) and the gpu method's.
+  const bool map = m == Method::abuffer || m == Method::zbuffer || m == Method::envmap || m == Method::hybrid;
   const RenderOptions defaults;
   const auto refuse = [&](const std::string& option, const char* why) {
     throw InputError(option + ": not used by --method " + method_name(m) + " (" + why + ")");
@@ -387,14 +390,14 @@ void refuse_unused_options(const Scene& scene, const RenderOptions& o) {
     if (o.resolve != defaults.resolve) refuse("resolve", "the CPU A-buffer's resolve: abuffer, zbuffer, envmap");
     if (o.max_layers != defaults.max_layers) refuse("max-layers", "the CPU A-buffer's lists: abuffer, zbuffer, envmap");
   }
-  if (o.refraction != defaults.refraction && m != Method::abuffer && m != Method::zbuffer) {
-    refuse("refraction", "the lens replaces an exit search: abuffer, zbuffer");
+  if (o.refraction != defaults.refraction && m != Method::abuffer && m != Method::zbuffer && m != Method::hybrid) {
+    refuse("refraction", "the lens replaces an exit search: abuffer, zbuffer, hybrid");
   }
   if (o.envmap_lookup != defaults.envmap_lookup && m != Method::envmap && m != Method::gpu) {
     refuse("envmap-lookup", "environment map lookups: envmap, gpu");
   }
-  if (m != Method::gpu) {
-    const char* gpu = "the GPU's camera pass: gpu";
+  if (m != Method::gpu && m != Method::hybrid) {
+    const char* gpu = "the GPU's camera pass: gpu, hybrid";
     if (o.gpu_mirrors != defaults.gpu_mirrors) refuse("gpu-mirrors", gpu);
     if (o.gpu_shadows != defaults.gpu_shadows) refuse("gpu-shadows", gpu);
     if (o.gpu_max_views != defaults.gpu_max_views) refuse("gpu-max-views", gpu);

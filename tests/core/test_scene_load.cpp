@@ -465,7 +465,7 @@ TEST(SceneLoadErrors, LightsAndRender) {
   EXPECT_ERROR(s.str(), "lights[0].color[1]: must be >= 0, got -1");
   s = SceneText();
   s.render = R"({"method": "photon"})";
-  EXPECT_ERROR(s.str(), "scene.json: render.method: must be one of abuffer, zbuffer, envmap, raytrace, gpu, got \"photon\"");
+  EXPECT_ERROR(s.str(), "scene.json: render.method: must be one of abuffer, zbuffer, envmap, raytrace, gpu, hybrid, got \"photon\"");
   s.render = R"({"cube_resolution": 0})";
   EXPECT_ERROR(s.str(), "render.cube_resolution: must be >= 1, got 0");
   s.render = R"({"cube_resolution": 20000})";

@@ -1,0 +1,21 @@
+// The box filter of the 4x8 samples of each pixel (raster/samples.hpp) on the GPU: the
+// camera tile's sample grid (u_samples, 8 columns and 4 rows a pixel) into one texel a
+// pixel, so that the exact camera pass reads back pixels, not samples. RGB: the mean of
+// the 32 samples (as the CPU resolve weighs its masks); alpha: how many of them met a
+// surface the GPU approximates (camera_exact.frag's alpha above 0; 0: the pixel is exact).
+uniform sampler2D u_samples;
+layout(location = 0) out vec4 o_pixel;
+
+void main() {
+  ivec2 base = ivec2(gl_FragCoord.xy) * ivec2(8, 4);
+  vec3 sum = vec3(0.0);
+  float approximate = 0.0;
+  for (int row = 0; row < 4; ++row) {
+    for (int col = 0; col < 8; ++col) {
+      vec4 s = texelFetch(u_samples, base + ivec2(col, row), 0);
+      sum += s.rgb;
+      approximate += s.a != 0.0 ? 1.0 : 0.0;
+    }
+  }
+  o_pixel = vec4(sum / 32.0, approximate);
+}
