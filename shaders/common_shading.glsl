@@ -28,6 +28,9 @@ vec3 light_visibility(int i, vec3 p, vec3 n) {
   if (!volume && (!u_shadows || layer < 0.0)) return vec3(1.0);
   if (volume) {
     if (volume_blocked(int(bit))) return vec3(0.0);
+    // No translucent blocker between: nothing to dim (its volume counted 0).
+    float translucent = lights[i].volumes.x;
+    if (translucent >= 0.0 && !volume_blocked(int(translucent))) return vec3(1.0);
     if (!u_shadows || layer < 0.0) return vec3(1.0);
   }
   vec3 d = p - lights[i].position.xyz;

@@ -32,7 +32,7 @@ glm::vec4 at_infinity(const glm::vec3& p, const glm::dvec3& light) {
 
 }  // namespace
 
-ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light) {
+ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light, Blockers kind) {
   const TriangleSoup& soup = *scene.triangles;
   ShadowVolume out;
   std::vector<DirectedEdge> edges;
@@ -40,8 +40,9 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
     out.vertices.push_back({p, object, reversed ? 1u : 0u});
   };
   for (uint32_t t = 0; t < soup.triangle_count(); ++t) {
-    const Material& m = scene.materials[soup.material_id[t]];
-    if (blocker_transmittance(m) != glm::dvec3(0.0)) continue;  // translucent: the shadow maps' peels
+    const glm::dvec3 through = blocker_transmittance(scene.materials[soup.material_id[t]]);
+    const bool opaque = through == glm::dvec3(0.0), clear = through == glm::dvec3(1.0);
+    if (kind == Blockers::opaque ? !opaque : (opaque || clear)) continue;
     if (plane_holds_light(soup, t, light)) continue;             // a light on this surface: no blocker
     const size_t v = 3 * static_cast<size_t>(t);
     const glm::vec3 p[3] = {soup.positions[v], soup.positions[v + 1], soup.positions[v + 2]};

@@ -42,7 +42,12 @@ struct ShadowVolume {
   uint64_t sides_cancelled = 0;   // side quads left out in cancelling pairs
 };
 
-// The volume of the light at `light` over the scene's blockers.
-ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light);
+// Which blockers a volume is made of: the opaque ones (blocker_transmittance 0: the
+// shadow), or the translucent ones (neither 0 nor 1: glass, veils; where their count is 0
+// no light is dimmed by them, elsewhere the product of their transmittances is needed).
+enum class Blockers { opaque, translucent };
+
+// The volume of the light at `light` over the scene's blockers of that kind.
+ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light, Blockers kind = Blockers::opaque);
 
 }  // namespace abcube

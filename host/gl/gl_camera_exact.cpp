@@ -127,11 +127,7 @@ bool GlScene::plan_exact_camera() {
   }
   bool casts = false;
   for (const PointLight& l : scene_.lights) casts = casts || l.cast_shadows;
-  translucent_shadows_ = false;
-  for (const uint32_t id : scene_.triangles->material_id) {
-    const glm::dvec3 t = blocker_transmittance(scene_.materials[id]);
-    translucent_shadows_ = translucent_shadows_ || (casts && t != glm::dvec3(0.0) && t != glm::dvec3(1.0));
-  }
+
   if (exact_.planar_mirrors) {
     s.mirrors_why = both.empty() ? exact_mirrors_why_not() : both;
     s.mirrors = s.mirrors_why.empty();
@@ -140,11 +136,9 @@ bool GlScene::plan_exact_camera() {
     s.volumes_why = !both.empty() ? both : casts ? "" : "no light casts shadows";
     s.volumes = s.volumes_why.empty();
   }
-  // What the pass leaves approximate in every lit sample: translucent casters (shadow maps'
-  // peels), shadows by maps, lights past the volumes' bits.
-  size_t casting = 0;
-  for (const PointLight& l : scene_.lights) casting += l.cast_shadows ? 1 : 0;
-  shadows_approximate_ = translucent_shadows_ || (casts && !s.volumes) || casting > size_t{MAX_VOLUME_LIGHTS};
+  // What the pass leaves approximate in every lit sample: shadows by maps (and lights past
+  // the volumes' counts: camera_color_exact, once the volumes are built).
+  shadows_approximate_ = casts && !s.volumes;
   s.plain = !s.mirrors && !s.volumes && exact_.always && both.empty();
   return s.mirrors || s.volumes || s.plain;
 }
@@ -154,11 +148,20 @@ void GlScene::build_volumes() {
   volumes_built_ = true;
   const Clock::time_point t0 = Clock::now();
   volume_bit_.assign(scene_.lights.size(), -1);
-  for (size_t i = 0; i < scene_.lights.size() && volume_lights_.size() < size_t{MAX_VOLUME_LIGHTS}; ++i) {
+  translucent_bit_.assign(scene_.lights.size(), -1);
+  bool translucent = false;
+  for (const uint32_t id : scene_.triangles->material_id) {
+    const glm::dvec3 t = blocker_transmittance(scene_.materials[id]);
+    translucent = translucent || (t != glm::dvec3(0.0) && t != glm::dvec3(1.0));
+  }
+  const size_t per_light = translucent ? 2 : 1;
+  for (size_t i = 0; i < scene_.lights.size() && volume_lights_.size() + per_light <= size_t{MAX_VOLUME_LIGHTS}; ++i) {
     if (!scene_.lights[i].cast_shadows) continue;
-    volume_bit_[i] = static_cast<int>(volume_lights_.size());
+   for (const Blockers kind : {Blockers::opaque, Blockers::translucent}) {
+    if (kind == Blockers::translucent && !translucent) continue;
+    (kind == Blockers::opaque ? volume_bit_ : translucent_bit_)[i] = static_cast<int>(volume_lights_.size());
     volume_lights_.push_back(static_cast<int>(i));
-    const ShadowVolume v = build_shadow_volume(scene_, scene_.lights[i].position);
+    const ShadowVolume v = build_shadow_volume(scene_, scene_.lights[i].position, kind);
     GLuint vao = 0, vbo = 0;
     glGenVertexArrays(1, &vao);
     glBindVertexArray(vao);
@@ -175,6 +178,7 @@ void GlScene::build_volumes() {
     volume_vbos_.push_back(vbo);
     volume_vertices_.push_back(static_cast<GLsizei>(v.vertices.size()));
     exact_stats_.volume_triangles += v.vertices.size() / 3;
+   }
   }
   glBindVertexArray(vao_);
   exact_stats_.volume_lights = static_cast<int>(volume_lights_.size());
@@ -359,7 +363,7 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
   exact_program_->use();
   glUniform1i(exact_program_->uniform("u_volumes"), volumes);
   glUniform1i(exact_program_->uniform("u_bounces_left"), view.level < exact_.max_depth);
-  glUniform1i(exact_program_->uniform("u_translucent_shadows"), shadows_approximate_);
+  glUniform1i(exact_program_->uniform("u_shadows_approximate"), shadows_approximate_);
   glUniform1i(exact_program_->uniform("u_environment"), environment_ != 0 && view.level < exact_.max_depth);
   glActiveTexture(GL_TEXTURE0 + VOLUME_COUNT_UNIT);
   glBindTexture(GL_TEXTURE_2D_ARRAY, volumes ? exact_buffers_->counts : 0);
@@ -475,6 +479,9 @@ Image GlScene::camera_color_exact(const Camera& camera) {
   make_exact_programs();
   if (exact_stats_.volumes) {
     if (!volumes_built_) build_volumes();
+    for (size_t i = 0; i < scene_.lights.size(); ++i) {
+      shadows_approximate_ = shadows_approximate_ || (scene_.lights[i].cast_shadows && volume_bit_[i] < 0);
+    }
     if (!exact_buffers_ || exact_buffers_->width != tile_w || exact_buffers_->height != tile_h ||
       exact_buffers_->layers != (static_cast<int>(volume_lights_.size()) + 3) / 4) {
       exact_buffers_.reset();

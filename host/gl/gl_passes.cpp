@@ -37,6 +37,7 @@ struct MaterialGpu {
 struct LightGpu {
   float position[4];
   float color[4];
+  float volumes[4];
 };
 
 }  // namespace
@@ -255,9 +256,12 @@ void GlScene::upload_lights(const glm::dvec3& center) {
     const PointLight& l = scene_.lights[i];
     const glm::dvec3 p = l.position - center;
     const float layer = i < shadow_layer_.size() ? float(shadow_layer_[i]) : -1.f;
-    const float bit = i < volume_bit_.size() ? float(volume_bit_[i]) : -1.f;  // set by the exact camera pass
+    // The shadow-volume counts of its opaque and translucent blockers (the exact camera pass).
+    const float bit = i < volume_bit_.size() ? float(volume_bit_[i]) : -1.f;
+    const float translucent = i < translucent_bit_.size() ? float(translucent_bit_[i]) : -1.f;
     lights.push_back({{float(p.x), float(p.y), float(p.z), layer},
-                      {float(l.color.r), float(l.color.g), float(l.color.b), bit}});
+                      {float(l.color.r), float(l.color.g), float(l.color.b), bit},
+                      {translucent, 0.f, 0.f, 0.f}});
   }
   if (lights.empty()) lights.push_back({});
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, lights_);

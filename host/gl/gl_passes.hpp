@@ -51,7 +51,7 @@ constexpr int MAX_TEXTURE_ARRAYS = 4;
 // blockers by shadow volumes counted depth-fail (course notes 3.3; Everitt & Kilgard 2002).
 // What it cannot (curved mirrors, refraction, coverage transparency, more than
 // MAX_VOLUME_LIGHTS lights) keeps the cube maps: the environment map and the shadow maps.
-constexpr int MAX_VOLUME_LIGHTS = 128;  // counts: four a layer of an RGBA32F array
+constexpr int MAX_VOLUME_LIGHTS = 128;  // counts (opaque, and translucent where any): four a layer of an RGBA32F array
 struct ExactCameraOptions {
   bool planar_mirrors = false;  // stencil portals for planar_reflectors.hpp's mirrors
   bool shadow_volumes = false;  // shadow volumes for the shadow-casting lights
@@ -229,14 +229,14 @@ class GlScene {
   ExactCameraOptions exact_;
   ExactCameraStats exact_stats_;
   std::vector<uint8_t> exact_pixels_;
-  bool translucent_shadows_ = false;  // a shadow-casting light and a translucent caster
-  bool shadows_approximate_ = false;  // that, or shadows from maps, or lights past the volume bits
+  bool shadows_approximate_ = false;  // shadows from maps (no volumes), or lights past the volume counts
   PlanarReflectors reflectors_;
   GLuint portal_vbo_ = 0, portal_ebo_ = 0;
   std::vector<std::pair<size_t, size_t>> portal_ranges_;  // first index, count
   bool volumes_built_ = false;
-  std::vector<int> volume_lights_;        // light index per bit
-  std::vector<int> volume_bit_;           // per light: its bit, or -1
+  std::vector<int> volume_lights_;        // light index per count (channel)
+  std::vector<int> volume_bit_;           // per light: its opaque blockers' count, or -1
+  std::vector<int> translucent_bit_;      // per light: its translucent blockers' count, or -1
   std::vector<GLuint> volume_vaos_, volume_vbos_;
   std::vector<GLsizei> volume_vertices_;
   std::unique_ptr<GlProgram> exact_program_, fill_program_, volume_program_, probe_program_, resolve_program_;

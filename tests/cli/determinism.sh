@@ -4,7 +4,7 @@
 # scene of each template for a fixed seed and for one seed new each run, printed; and the
 # race's seeded room of bench/race_scenes.py). One batch per thread count renders every
 # (scene, method) pair as float EXR at 64x48 with a 64-texel cube map; the files are then
-# compared byte for byte. gpu is in the set where a GL path works (its image does not depend
+# compared byte for byte. gpu and hybrid are in the set where a GL path works (gpu's image does not depend
 # on the CPU threads, but its shadow and environment set-up run beside CPU work).
 # Usage (ctest runs it so): bash determinism.sh /path/to/abcube /path/to/repo
 # ABCUBE_DETERMINISM_SEED=S repeats a run's generated seed.
@@ -19,7 +19,7 @@ echo "generated scenes: seeds 3 and $SEED (ABCUBE_DETERMINISM_SEED=$SEED repeats
 
 methods="abuffer zbuffer envmap raytrace"
 if "$ABCUBE" info 2>/dev/null | grep -q 'auto picks: [a-z]'; then
-  if ! "$ABCUBE" info 2>/dev/null | grep -q 'auto picks: none'; then methods="$methods gpu"; fi
+  if ! "$ABCUBE" info 2>/dev/null | grep -q 'auto picks: none'; then methods="$methods gpu hybrid"; fi
 fi
 echo "methods: $methods"
 
