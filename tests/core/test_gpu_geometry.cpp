@@ -1,0 +1,123 @@
+// The CPU side of the gpu method's exact camera pass (issue 19): which triangles are planar
+// mirrors (scene/planar_reflectors.hpp), and the shadow volumes' geometry
+// (scene/shadow_volume.hpp): closed and consistently oriented, made of the right blockers.
+#include <array>
+#include <cstring>
+#include <map>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "scene/planar_reflectors.hpp"
+#include "scene/scene_load.hpp"
+#include "scene/shadow_volume.hpp"
+
+namespace abcube {
+namespace {
+
+SceneData scene_of(const std::string& materials, const std::string& objects, const std::string& lights = "[]") {
+  const std::string text = R"({"version": 1, "camera": {"position": [0, 1, 6], "look_at": [0, 0, 0], "width": 8, "height": 8},
+    "lights": )" + lights + R"(, "materials": )" + materials + R"(, "objects": )" + objects + "}";
+  return load_scene_text(text, "scene.json", ".");
+}
+
+const char* MATERIALS = R"({"mirror": {"reflect": 0.9}, "glass": {"transmit": 0.9, "ior": 1.5, "reflect": 0.1},
+  "veil": {"reflect": 0.5, "opacity": 0.5}, "matte": {}})";
+
+TEST(PlanarReflectors, FlatMirrorsByObjectAndPlane) {
+  const SceneData s = scene_of(MATERIALS, R"([
+    {"type": "quad", "vertices": [[-1, 0, -1], [-1, 0, 1], [1, 0, 1], [1, 0, -1]], "material": "mirror"},
+    {"type": "box", "min": [2, 0, 0], "max": [3, 1, 1], "material": "mirror"},
+    {"type": "sphere", "center": [-3, 1, 0], "radius": 0.5, "segments": 8, "material": "mirror"},
+    {"type": "box", "min": [4, 0, 0], "max": [5, 1, 1], "material": "glass"},
+    {"type": "quad", "vertices": [[-1, 2, -1], [-1, 2, 1], [1, 2, 1], [1, 2, -1]], "material": "veil"},
+    {"type": "box", "min": [6, 0, 0], "max": [7, 1, 1], "material": "matte"}])");
+  const PlanarReflectors r = find_planar_reflectors(s);
+  // The quad (one plane, two triangles) and the box (six faces): 7. The sphere is smooth
+  // (curved), glass refracts, the veil is transparent, matte does not reflect.
+  ASSERT_EQ(r.reflectors.size(), 7u);
+  EXPECT_EQ(r.reflectors[0].triangles.size(), 2u);
+  EXPECT_NEAR(std::abs(r.reflectors[0].normal.y), 1.0, 1e-12);
+  EXPECT_NEAR(r.reflectors[0].side(glm::dvec3(0, 3, 0)) * r.reflectors[0].normal.y, 3.0, 1e-12);
+  for (size_t k = 1; k < 7; ++k) {
+    EXPECT_EQ(r.reflectors[k].triangles.size(), 2u) << k;
+    EXPECT_EQ(r.reflectors[k].object, 1u) << k;
+  }
+  EXPECT_EQ(r.curved_triangles, s.objects[2].triangle_count);
+  for (uint32_t t = 0; t < s.triangles->triangle_count(); ++t) {
+    const bool mirror = t < s.objects[2].first_triangle;
+    EXPECT_EQ(r.reflector_of_triangle[t] != 0, mirror) << t;
+    if (mirror) EXPECT_LE(r.reflectors[r.reflector_of_triangle[t] - 1].triangles.front(), t);
+  }
+}
+
+// Every directed edge of the volume, a vertex being its float bits (a point, or a
+// direction at infinity), oriented outward (a near cap turned when `reversed`): a closed
+// oriented surface has each edge as often as its reverse.
+bool closed_and_oriented(const ShadowVolume& v, std::string* why) {
+  using Key = std::array<uint32_t, 4>;
+  auto key = [](const glm::vec4& p) {
+    Key k;
+    std::memcpy(k.data(), &p.x, sizeof k);
+    return k;
+  };
+  std::map<std::pair<Key, Key>, long> edges;
+  for (size_t t = 0; t < v.vertices.size(); t += 3) {
+    std::array<glm::vec4, 3> p = {v.vertices[t].position, v.vertices[t + 1].position, v.vertices[t + 2].position};
+    if (v.vertices[t].reversed) std::swap(p[1], p[2]);
+    for (int e = 0; e < 3; ++e) ++edges[{key(p[e]), key(p[(e + 1) % 3])}];
+  }
+  for (const auto& [e, n] : edges) {
+    const auto back = edges.find({e.second, e.first});
+    if (back == edges.end() || back->second != n) {
+      *why = "an edge without its reverse";
+      return false;
+    }
+  }
+  return true;
+}
+
+TEST(ShadowVolume, AQuadIsTwoPrismsWithTheirCommonSideLeftOut) {
+  const SceneData s = scene_of(MATERIALS, R"([{"type": "quad", "vertices": [[-1, 0, -1], [-1, 0, 1], [1, 0, 1], [1, 0, -1]], "material": "matte"}])");
+  const ShadowVolume v = build_shadow_volume(s, glm::dvec3(0.2, 3, 0.1));
+  EXPECT_EQ(v.blockers, 2u);
+  EXPECT_EQ(v.sides, 4u);             // the quad's outline
+  EXPECT_EQ(v.sides_cancelled, 2u);   // the diagonal, once from each triangle
+  EXPECT_EQ(v.vertices.size(), 2u * 6 + 4u * 6);
+  std::string why;
+  EXPECT_TRUE(closed_and_oriented(v, &why)) << why;
+  // A light below the quad: the same count, seen from the other side.
+  const ShadowVolume below = build_shadow_volume(s, glm::dvec3(0.2, -3, 0.1));
+  EXPECT_EQ(below.blockers, 2u);
+  EXPECT_TRUE(closed_and_oriented(below, &why)) << why;
+}
+
+TEST(ShadowVolume, BlockersByKindAndLightsOnSurfacesLeftOut) {
+  const SceneData s = scene_of(MATERIALS, R"([
+    {"type": "box", "min": [-1, 0, -1], "max": [1, 1, 1], "material": "matte"},
+    {"type": "box", "min": [2, 0, -1], "max": [3, 1, 1], "material": "glass"},
+    {"type": "quad", "vertices": [[-5, 0, -5], [-5, 0, 5], [5, 0, 5], [5, 0, -5]], "material": "veil"}])");
+  std::string why;
+  const ShadowVolume opaque = build_shadow_volume(s, glm::dvec3(0.3, 4, 0.2));
+  EXPECT_EQ(opaque.blockers, 12u);  // the matte box alone
+  EXPECT_TRUE(closed_and_oriented(opaque, &why)) << why;
+  const ShadowVolume translucent = build_shadow_volume(s, glm::dvec3(0.3, 4, 0.2), Blockers::translucent);
+  EXPECT_EQ(translucent.blockers, 12u + 2u);  // the glass box and the veil
+  EXPECT_TRUE(closed_and_oriented(translucent, &why)) << why;
+  // A light on the floor's plane y = 0 (rule "shadows": plane_holds_light): the veil casts
+  // nothing, nor the glass box's bottom face (two triangles) in the same plane.
+  const ShadowVolume on = build_shadow_volume(s, glm::dvec3(0.3, 0, 4), Blockers::translucent);
+  EXPECT_EQ(on.blockers, 12u - 2u);
+}
+
+TEST(ShadowVolume, SmoothMeshesStayClosed) {
+  const SceneData s = scene_of(MATERIALS, R"([{"type": "sphere", "center": [0, 1, 0], "radius": 0.7, "segments": 24, "material": "matte"}])");
+  const ShadowVolume v = build_shadow_volume(s, glm::dvec3(1, 5, 2));
+  EXPECT_EQ(v.blockers, s.triangles->triangle_count());
+  EXPECT_GT(v.sides_cancelled, 0u);
+  std::string why;
+  EXPECT_TRUE(closed_and_oriented(v, &why)) << why;
+}
+
+}  // namespace
+}  // namespace abcube
