@@ -140,7 +140,7 @@ EXR `abcube render` writes for the same inputs. With `aovs` (a list of "distance
 JSON as a dict, or None).
 
 Arguments left None take the scene's own value: method (abuffer | zbuffer | envmap |
-raytrace | gpu), cube_res (texels per cube face edge), max_depth (bounces), camera (a dict
+raytrace | gpu | hybrid), cube_res (texels per cube face edge), max_depth (bounces), camera (a dict
 with any of position, look_at, up, fov_y, width, height; only the keys given change),
 error_target, fresnel. timeout: seconds, RenderTimeout (a RuntimeError) past it.
 reference: also trace the exact image, error figures in the stats. The other keywords are

@@ -4,10 +4,11 @@
 // the 32 samples (as the CPU resolve weighs its masks); alpha: how many of them met a
 // surface the GPU approximates (camera_exact.frag's alpha above 0; 0: the pixel is exact).
 uniform sampler2D u_samples;
+uniform ivec2 u_margin;  // the tile's margin (gl_passes_internal.hpp SampleTiles), not kept
 layout(location = 0) out vec4 o_pixel;
 
 void main() {
-  ivec2 base = ivec2(gl_FragCoord.xy) * ivec2(8, 4);
+  ivec2 base = u_margin + ivec2(gl_FragCoord.xy) * ivec2(8, 4);
   vec3 sum = vec3(0.0);
   float approximate = 0.0;
   for (int row = 0; row < 4; ++row) {

@@ -1,9 +1,11 @@
-// Every pass draws the scene's triangles with this stage. u_clip is cube_map.hpp's
-// face_clip_matrix or camera_clip_matrix (infinite reversed-Z), times the reflections of
-// the planar mirrors a virtual view has passed through (gl_camera_exact.cpp), one matrix
-// made on the CPU so that every program computes the same expression; u_center is the eye.
-// gl_ClipDistance[0] keeps what lies on u_clip_plane's positive side (the mirror's front)
-// when GL_CLIP_DISTANCE0 is on.
+// Every pass draws the scene's triangles with this stage. The vertex is taken relative to
+// the eye u_center in double (a scene kilometres wide with millimetre detail keeps its
+// detail in the float that follows), then u_clip maps it: cube_map.hpp's face_clip_matrix or
+// camera_clip_matrix with the eye at the origin (infinite reversed-Z), times the linear part
+// of the reflections of the planar mirrors a virtual view has passed through
+// (gl_camera_exact.cpp), one matrix made on the CPU so that every program computes the same
+// expression. gl_ClipDistance[0] keeps what lies on u_clip_plane's positive side (the
+// mirror's front, relative to the eye) when GL_CLIP_DISTANCE0 is on.
 // The shadow volumes (shadow_volume.frag) come through here too, with points at infinity
 // (w = 0): gl_Position is invariant, so a volume's near cap and the surface it caps get the
 // same depth at every sample.
@@ -17,7 +19,7 @@ layout(location = 6) in uint a_reversed;  // shadow volumes: the face's outward 
 
 uniform mat4 u_clip;
 uniform vec4 u_clip_plane;
-uniform vec3 u_center;
+uniform dvec3 u_center;
 // THE TIE RULE (cpu_core/scene/tie_rule.hpp): window depth near/w scaled by
 // 1 + u_tie_step (object + 1), so at equal depth the later object passes GL_GREATER.
 uniform float u_tie_step;
@@ -32,10 +34,12 @@ flat out uint v_portal;
 flat out uint v_reversed;
 
 void main() {
-  gl_Position = u_clip * a_position;
+  // A point at infinity (w = 0, the shadow volumes') is a direction: nothing to subtract.
+  vec4 relative = a_position.w == 0.0 ? a_position : vec4(vec3(dvec3(a_position.xyz) - u_center), 1.0);
+  gl_Position = u_clip * relative;
   gl_Position.z *= 1.0 + u_tie_step * float(a_object + 1u);
-  gl_ClipDistance[0] = dot(u_clip_plane, a_position);  // a point at infinity (w = 0): its direction's side
-  v_relative = a_position.xyz - u_center;
+  gl_ClipDistance[0] = dot(u_clip_plane, relative);  // at infinity: its direction's side
+  v_relative = relative.xyz;
   v_normal = a_normal;
   v_object = a_object;
   v_material = a_material;

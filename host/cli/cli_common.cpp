@@ -14,7 +14,7 @@ namespace abcube {
 
 void RenderFlags::add_to(CLI::App* cmd) {
   cmd->add_option("--method", options.method,
-                  "abuffer | zbuffer | envmap | raytrace | gpu (default: the scene's render.method)");
+                  "abuffer | zbuffer | envmap | raytrace | gpu | hybrid (default: the scene's render.method)");
   cmd->add_option("--cube-res", options.cube_resolution,
                   "cube map face edge N, texels (default: the scene's render.cube_resolution)")
       ->check(CLI::Range(1, 16384));

@@ -67,14 +67,14 @@ glm::dmat4 reflection_matrix(const glm::dvec3& n, double d) {
 }
 
 // The pixels of the tile (width x height) that triangles `r` of the soup cover when drawn
-// through `clip_model`, within `parent` (x, y, width, height); the parent itself when one
+// through `clip_model` relative to `eye` (scene.vert), within `parent` (x, y, width, height); the parent itself when one
 // of their corners is behind the eye. Empty (zero size) when they fall outside.
 glm::ivec4 projected_bounds(const TriangleSoup& soup, const std::vector<uint32_t>& triangles, const glm::dmat4& clip_model,
-                            const glm::ivec4& parent, int width, int height) {
+                            const glm::dvec3& eye, const glm::ivec4& parent, int width, int height) {
   double lo_x = 1e300, lo_y = 1e300, hi_x = -1e300, hi_y = -1e300;
   for (const uint32_t t : triangles) {
     for (size_t k = 0; k < 3; ++k) {
-      const glm::dvec4 c = clip_model * glm::dvec4(glm::dvec3(soup.positions[3 * static_cast<size_t>(t) + k]), 1.0);
+      const glm::dvec4 c = clip_model * glm::dvec4(glm::dvec3(soup.positions[3 * static_cast<size_t>(t) + k]) - eye, 1.0);
       if (!(c.w > 0.0)) return parent;
       const double x = (c.x / c.w * 0.5 + 0.5) * width, y = (c.y / c.w * 0.5 + 0.5) * height;
       lo_x = std::min(lo_x, x), lo_y = std::min(lo_y, y), hi_x = std::max(hi_x, x), hi_y = std::max(hi_y, y);
@@ -271,7 +271,9 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
       const PlanarReflector& mirror = reflectors_.reflectors[r];
       const double side = mirror.side(view.eye);
       if (static_cast<uint32_t>(r + 1) == view.skip || side == 0.0) continue;  // seen through; edge-on covers nothing
-      const glm::ivec4 bounds = projected_bounds(*scene_.triangles, mirror.triangles, glm::dmat4(clip) * view.model,
+      glm::dmat4 linear = view.model;
+      linear[3] = glm::dvec4(0.0, 0.0, 0.0, 1.0);
+      const glm::ivec4 bounds = projected_bounds(*scene_.triangles, mirror.triangles, glm::dmat4(clip) * linear, view.eye,
                                                  view.scissor, t.width, t.height);
       if (bounds.z <= 0 || bounds.w <= 0) {
         ++exact_stats_.mirror_views_empty;
@@ -404,31 +406,29 @@ GlScene::ShadowProbe GlScene::camera_shadow_probe(const Camera& camera) {
     out.lights.push_back(static_cast<int>(i));
   }
   const int64_t full_w = int64_t{camera.width} * MASK_COLUMNS, full_h = int64_t{camera.height} * MASK_ROWS;
-  const int64_t tile_max = std::min(CAMERA_TILE, max_size_);
-  const int tile_w = static_cast<int>(std::min(full_w, tile_max)), tile_h = static_cast<int>(std::min(full_h, tile_max));
-  Target& t = target(tile_w, tile_h, false);
+  const SampleTiles tiles(full_w, full_h, max_size_);
+  const int tile_w = tiles.tile_w, tile_h = tiles.tile_h;
+  Target& t = target(tiles.target_w(), tiles.target_h(), false);
   make_exact_programs();
   build_volumes();
-  if (!exact_buffers_ || exact_buffers_->width != tile_w || exact_buffers_->height != tile_h ||
+  if (!exact_buffers_ || exact_buffers_->width != t.width || exact_buffers_->height != t.height ||
       exact_buffers_->layers != (static_cast<int>(volume_lights_.size()) + 3) / 4) {
     exact_buffers_.reset();
     exact_buffers_ = std::make_unique<ExactBuffers>(t, static_cast<int>(volume_lights_.size()));
   }
-  const double aspect = static_cast<double>(camera.width) / camera.height;
-  const glm::mat4 clip = camera_clip_matrix(camera.position, camera.look_at, camera.up,
-                                            glm::radians(camera.fov_y_deg), aspect, near_);
+  const glm::mat4 clip = relative_camera_clip(camera, near_);
   const size_t grid = static_cast<size_t>(full_w * full_h);
   out.volume.assign(grid, 0);
   out.map.assign(grid, 0);
   out.lit.assign(grid, 0);
-  std::vector<float> rgba(static_cast<size_t>(tile_w) * static_cast<size_t>(tile_h) * 4);
+  std::vector<float> rgba(static_cast<size_t>(t.width) * static_cast<size_t>(t.height) * 4);
   const GLenum colour[] = {GL_COLOR_ATTACHMENT0};
   MirrorView view;
   view.eye = camera.position;
   for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
     for (int64_t x0 = 0; x0 < full_w; x0 += tile_w) {
       check_deadline();
-      const glm::mat4 tile_clip = tile_matrix(full_w, full_h, x0, y0, tile_w, tile_h) * clip;
+      const glm::mat4 tile_clip = tiles.matrix(x0, y0) * clip;
       t.clear(scene_.background);
       const float none[4] = {0, 0, 0, 0};
       glClearBufferfv(GL_COLOR, 0, none);
@@ -454,7 +454,7 @@ GlScene::ShadowProbe GlScene::camera_shadow_probe(const Camera& camera) {
       t.read(0, GL_RGBA, GL_FLOAT, rgba.data());
       for (int64_t gy = 0; gy < tile_h && y0 + gy < full_h; ++gy) {
         for (int64_t gx = 0; gx < tile_w && x0 + gx < full_w; ++gx) {
-          const size_t k = static_cast<size_t>(gy * tile_w + gx);
+          const size_t k = tiles.index(gx, gy);
           const size_t g = static_cast<size_t>((full_h - 1 - (y0 + gy)) * full_w + x0 + gx);
           out.volume[g] = static_cast<uint16_t>(rgba[4 * k]);
           out.map[g] = static_cast<uint16_t>(rgba[4 * k + 1]);
@@ -473,16 +473,16 @@ GlScene::ShadowProbe GlScene::camera_shadow_probe(const Camera& camera) {
 
 Image GlScene::camera_color_exact(const Camera& camera) {
   const int64_t full_w = int64_t{camera.width} * MASK_COLUMNS, full_h = int64_t{camera.height} * MASK_ROWS;
-  const int64_t tile_max = std::min(CAMERA_TILE, max_size_);
-  const int tile_w = static_cast<int>(std::min(full_w, tile_max)), tile_h = static_cast<int>(std::min(full_h, tile_max));
-  Target& t = target(tile_w, tile_h, false);
+  const SampleTiles tiles(full_w, full_h, max_size_);
+  const int tile_w = tiles.tile_w, tile_h = tiles.tile_h;
+  Target& t = target(tiles.target_w(), tiles.target_h(), false);
   make_exact_programs();
   if (exact_stats_.volumes) {
     if (!volumes_built_) build_volumes();
     for (size_t i = 0; i < scene_.lights.size(); ++i) {
       shadows_approximate_ = shadows_approximate_ || (scene_.lights[i].cast_shadows && volume_bit_[i] < 0);
     }
-    if (!exact_buffers_ || exact_buffers_->width != tile_w || exact_buffers_->height != tile_h ||
+    if (!exact_buffers_ || exact_buffers_->width != t.width || exact_buffers_->height != t.height ||
       exact_buffers_->layers != (static_cast<int>(volume_lights_.size()) + 3) / 4) {
       exact_buffers_.reset();
       exact_buffers_ = std::make_unique<ExactBuffers>(t, static_cast<int>(volume_lights_.size()));
@@ -491,11 +491,8 @@ Image GlScene::camera_color_exact(const Camera& camera) {
   bind_lookups(*exact_program_, true);
   exact_program_->use();
   glUniform1i(exact_program_->uniform("u_portals_exact"), 1);
-  const double aspect = static_cast<double>(camera.width) / camera.height;
-  const glm::mat4 clip = camera_clip_matrix(camera.position, camera.look_at, camera.up,
-                                            glm::radians(camera.fov_y_deg), aspect, near_);
-  const size_t tile_samples = static_cast<size_t>(tile_w) * static_cast<size_t>(tile_h);
-  std::vector<float> rgba(tile_samples * 4);
+  const glm::mat4 clip = relative_camera_clip(camera, near_);
+  std::vector<float> rgba(static_cast<size_t>(tile_w / MASK_COLUMNS) * static_cast<size_t>(tile_h / MASK_ROWS) * 4);
   Image out(camera.width, camera.height, 3);
   exact_pixels_.assign(static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height), 1);
   for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
@@ -507,9 +504,9 @@ Image GlScene::camera_color_exact(const Camera& camera) {
       glClearBufferfv(GL_COLOR, 0, background);  // alpha: no approximated surface yet
       MirrorView camera_view;
       camera_view.eye = camera.position;
-      camera_view.scissor = glm::ivec4(0, 0, tile_w, tile_h);
+      camera_view.scissor = glm::ivec4(0, 0, t.width, t.height);
       int views_left = exact_.max_views;
-      render_view(tile_matrix(full_w, full_h, x0, y0, tile_w, tile_h) * clip, camera_view, &views_left);
+      render_view(tiles.matrix(x0, y0) * clip, camera_view, &views_left);
       glDisable(GL_STENCIL_TEST);
       glDisable(GL_CLIP_DISTANCE0);
       glDisable(GL_SCISSOR_TEST);
@@ -537,6 +534,7 @@ Image GlScene::camera_color_exact(const Camera& camera) {
       glDisable(GL_DEPTH_TEST);
       resolve_program_->use();
       glUniform1i(resolve_program_->uniform("u_samples"), 0);
+      glUniform2i(resolve_program_->uniform("u_margin"), SampleTiles::MARGIN_X, SampleTiles::MARGIN_Y);
       glActiveTexture(GL_TEXTURE0);
       glBindTexture(GL_TEXTURE_2D, t.color0);
       glBindVertexArray(vao_);

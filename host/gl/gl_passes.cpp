@@ -292,12 +292,19 @@ void GlScene::draw_reflector(const GlProgram& program, const glm::mat4& clip, co
 void GlScene::set_view(const GlProgram& program, const glm::mat4& clip, const MirrorView& view) {
   const glm::dvec3& center = view.eye;
   program.use();
-  const glm::mat4 clip_model = view.level == 0 ? clip : glm::mat4(glm::dmat4(clip) * view.model);
+  // `clip` has the eye at the origin (scene.vert subtracts it); a virtual view's reflections
+  // then act on the relative vertex by their linear part alone (M (p) - E = R (p - eye), the
+  // view's eye being the camera's unfolded through them).
+  glm::dmat4 linear = view.model;
+  linear[3] = glm::dvec4(0.0, 0.0, 0.0, 1.0);
+  const glm::mat4 clip_model = view.level == 0 ? clip : glm::mat4(glm::dmat4(clip) * linear);
   glUniformMatrix4fv(program.uniform("u_clip"), 1, GL_FALSE, &clip_model[0][0]);
+  // The clip plane relative to the eye: n . (rel + eye) + d.
+  const double offset = view.plane.w + glm::dot(glm::dvec3(view.plane), view.eye);
   glUniform4f(program.uniform("u_clip_plane"), float(view.plane.x), float(view.plane.y), float(view.plane.z),
-              float(view.plane.w));
+              view.level == 0 ? 1.f : float(offset));
   glUniform1ui(program.uniform("u_skip_portal"), view.skip);
-  glUniform3f(program.uniform("u_center"), float(center.x), float(center.y), float(center.z));
+  glUniform3d(program.uniform("u_center"), center.x, center.y, center.z);
   // tie_rule.hpp; not in the shadow passes, whose casters all count and whose translucent
   // peels order equal depths by triangle (shadow_caster.frag), GL_GREATER's draw order.
   const bool ties = &program != shadow_program_.get();
@@ -414,7 +421,7 @@ void GlScene::draw_shadow_casters(GLuint maps) {
       glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, maps, 0, 6 * shadow_layer_[i] + face);
       glDrawBuffers(1, buffers);
       clear_lookup_target(n_of_lookup_, true);
-      draw(*shadow_program_, face_clip_matrix(face, light, near_), light);
+      draw(*shadow_program_, face_clip_matrix(face, glm::dvec3(0.0), near_), light);
     }
   }
 }
@@ -494,7 +501,7 @@ void GlScene::build_environment(const glm::dvec3& center, int n) {
                            GL_TEXTURE_CUBE_MAP_POSITIVE_X + static_cast<GLenum>(face), environment_, 0);
     glDrawBuffers(1, buffers);
     clear_lookup_target(n, false);
-    draw(*phong_program_, face_clip_matrix(face, center, near_), center);
+    draw(*phong_program_, face_clip_matrix(face, glm::dvec3(0.0), near_), center);
   }
   glFinish();
   check_gl("environment map");
@@ -534,7 +541,7 @@ void GlScene::cube_distance(const glm::dvec3& center, int n, CubeImage* distance
     check_deadline();
     Clock::time_point t0 = Clock::now();
     t.clear(scene_.background);
-    draw(*distance_program_, face_clip_matrix(face, center, near_), center);
+    draw(*distance_program_, face_clip_matrix(face, glm::dvec3(0.0), near_), center);
     glFinish();
     timings_.cube_distance_ms += ms_since(t0);
     t0 = Clock::now();
@@ -553,24 +560,22 @@ void GlScene::cube_distance(const glm::dvec3& center, int n, CubeImage* distance
 
 std::vector<uint32_t> GlScene::camera_objects(const Camera& camera) {
   const int64_t full_w = int64_t{camera.width} * MASK_COLUMNS, full_h = int64_t{camera.height} * MASK_ROWS;
-  const int64_t tile_max = std::min(CAMERA_TILE, max_size_);
-  const int tile_w = static_cast<int>(std::min(full_w, tile_max)), tile_h = static_cast<int>(std::min(full_h, tile_max));
-  Target& t = target(tile_w, tile_h, true);
-  const double aspect = static_cast<double>(camera.width) / camera.height;
-  const glm::mat4 clip = camera_clip_matrix(camera.position, camera.look_at, camera.up,
-                                            glm::radians(camera.fov_y_deg), aspect, near_);
-  std::vector<uint32_t> out(static_cast<size_t>(full_w * full_h), NO_OBJECT), tile_ids(size_t(tile_w) * size_t(tile_h));
+  const SampleTiles tiles(full_w, full_h, max_size_);
+  const int tile_w = tiles.tile_w, tile_h = tiles.tile_h;
+  Target& t = target(tiles.target_w(), tiles.target_h(), true);
+  const glm::mat4 clip = relative_camera_clip(camera, near_);
+  std::vector<uint32_t> out(static_cast<size_t>(full_w * full_h), NO_OBJECT),
+      tile_ids(size_t(tiles.target_w()) * size_t(tiles.target_h()));
   for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
     for (int64_t x0 = 0; x0 < full_w; x0 += tile_w) {
       check_deadline();
       t.clear(scene_.background);
-      draw(*distance_program_, tile_matrix(full_w, full_h, x0, y0, tile_w, tile_h) * clip, camera.position);
+      draw(*distance_program_, tiles.matrix(x0, y0) * clip, camera.position);
       t.read(1, GL_RED_INTEGER, GL_UNSIGNED_INT, tile_ids.data());
       // GL's row 0 is the bottom; the grid's row 0 is the top.
       for (int64_t gy = 0; gy < tile_h && y0 + gy < full_h; ++gy) {
         for (int64_t gx = 0; gx < tile_w && x0 + gx < full_w; ++gx) {
-          out[static_cast<size_t>((full_h - 1 - (y0 + gy)) * full_w + x0 + gx)] =
-              tile_ids[static_cast<size_t>(gy * tile_w + gx)];
+          out[static_cast<size_t>((full_h - 1 - (y0 + gy)) * full_w + x0 + gx)] = tile_ids[tiles.index(gx, gy)];
         }
       }
     }
@@ -589,7 +594,7 @@ CubeImage GlScene::cube_color(const glm::dvec3& center, int n) {
     check_deadline();
     Clock::time_point t0 = Clock::now();
     t.clear(scene_.background);
-    draw(*phong_program_, face_clip_matrix(face, center, near_), center);
+    draw(*phong_program_, face_clip_matrix(face, glm::dvec3(0.0), near_), center);
     glFinish();
     timings_.cube_color_ms += ms_since(t0);
     t0 = Clock::now();
@@ -609,19 +614,17 @@ Image GlScene::camera_color(const Camera& camera, CameraSamples samples) {
   if (mask && plan_exact_camera()) return camera_color_exact(camera);
   const int64_t sx = mask ? MASK_COLUMNS : 1, sy = mask ? MASK_ROWS : 1;
   const int64_t full_w = camera.width * sx, full_h = camera.height * sy;
-  const int64_t tile_max = std::min(CAMERA_TILE, max_size_);
-  const int tile_w = static_cast<int>(std::min(full_w, tile_max)), tile_h = static_cast<int>(std::min(full_h, tile_max));
-  Target& t = target(tile_w, tile_h, false);
+  const SampleTiles tiles(full_w, full_h, max_size_);
+  const int tile_w = tiles.tile_w, tile_h = tiles.tile_h;
+  Target& t = target(tiles.target_w(), tiles.target_h(), false);
   upload_lights(camera.position);
   bind_lookups(*phong_program_, true);
-  const double aspect = static_cast<double>(camera.width) / camera.height;
-  const glm::mat4 clip = camera_clip_matrix(camera.position, camera.look_at, camera.up,
-                                            glm::radians(camera.fov_y_deg), aspect, near_);
+  const glm::mat4 clip = relative_camera_clip(camera, near_);
   // Coverage transparency (rule "opacity"): the view is peeled front to back, each layer
   // blended under the ones before it, C += T op c, T *= 1 - op, the background last.
   bool transparent = false;
   for (const uint32_t id : scene_.triangles->material_id) transparent = transparent || scene_.materials[id].opacity < 1.0;
-  const size_t tile_samples = static_cast<size_t>(tile_w) * static_cast<size_t>(tile_h);
+  const size_t tile_samples = static_cast<size_t>(tiles.target_w()) * static_cast<size_t>(tiles.target_h());
   std::vector<float> rgba(tile_samples * 4);
   std::vector<double> colour(tile_samples * 3), through(tile_samples);
   std::vector<double> sum(static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height) * 3, 0.0);
@@ -629,7 +632,7 @@ Image GlScene::camera_color(const Camera& camera, CameraSamples samples) {
   if (transparent) {
     glGenTextures(1, &previous);
     glBindTexture(GL_TEXTURE_2D, previous);
-    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RG32F, tile_w, tile_h);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RG32F, tiles.target_w(), tiles.target_h());
     glGenQueries(1, &query);
     phong_program_->use();
     glUniform1i(phong_program_->uniform("u_previous"), static_cast<GLint>(CAMERA_PREVIOUS_UNIT));
@@ -641,7 +644,7 @@ Image GlScene::camera_color(const Camera& camera, CameraSamples samples) {
   for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
     for (int64_t x0 = 0; x0 < full_w; x0 += tile_w) {
       check_deadline();
-      const glm::mat4 tile = tile_matrix(full_w, full_h, x0, y0, tile_w, tile_h);
+      const glm::mat4 tile = tiles.matrix(x0, y0);
       std::fill(colour.begin(), colour.end(), 0.0);
       std::fill(through.begin(), through.end(), 1.0);
       for (int layer = 0; layer < (transparent ? MAX_CAMERA_LAYERS : 1); ++layer) {
@@ -649,7 +652,8 @@ Image GlScene::camera_color(const Camera& camera, CameraSamples samples) {
         phong_program_->use();
         glUniform1i(phong_program_->uniform("u_peel"), layer);
         if (layer > 0) {
-          glCopyImageSubData(t.color1, GL_TEXTURE_2D, 0, 0, 0, 0, previous, GL_TEXTURE_2D, 0, 0, 0, 0, tile_w, tile_h, 1);
+          glCopyImageSubData(t.color1, GL_TEXTURE_2D, 0, 0, 0, 0, previous, GL_TEXTURE_2D, 0, 0, 0, 0, tiles.target_w(),
+                             tiles.target_h(), 1);
           glActiveTexture(GL_TEXTURE0 + CAMERA_PREVIOUS_UNIT);
           glBindTexture(GL_TEXTURE_2D, previous);
           glActiveTexture(GL_TEXTURE0);
@@ -684,7 +688,7 @@ Image GlScene::camera_color(const Camera& camera, CameraSamples samples) {
       for (int64_t gy = 0; gy < tile_h && y0 + gy < full_h; ++gy) {
         const size_t row = static_cast<size_t>((full_h - 1 - (y0 + gy)) / sy);
         for (int64_t gx = 0; gx < tile_w && x0 + gx < full_w; ++gx) {
-          const size_t k = static_cast<size_t>(gy) * static_cast<size_t>(tile_w) + static_cast<size_t>(gx);
+          const size_t k = tiles.index(gx, gy);
           double* dst = &sum[(row * static_cast<size_t>(camera.width) + static_cast<size_t>((x0 + gx) / sx)) * 3];
           for (int c = 0; c < 3; ++c) dst[c] += colour[3 * k + static_cast<size_t>(c)] + through[k] * bg[c];
         }

@@ -11,6 +11,7 @@
 
 #include "base/error.hpp"
 #include "gl/gl_passes.hpp"
+#include "raster/cube_map.hpp"
 
 namespace abcube {
 
@@ -54,6 +55,38 @@ inline void set_pass_state() {
 // The clip coordinates of the full sample grid (full_w x full_h, GL window coordinates, y
 // up) scaled and shifted so that the tile at (x0, y0), tile_w x tile_h, fills the viewport
 // (one tile: identity).
+// The camera's sample grid (full_w x full_h, GL window coordinates, y up) cut into tiles of
+// at most CAMERA_TILE a side, each rendered with a margin of MARGIN_X columns and MARGIN_Y
+// rows around it that is not kept: a triangle far larger than the view (a kilometre of
+// ground) is cut by the clipper at the viewport's edges, and the cut lands a fraction of a
+// sample off, so the outer samples of a tile without margin miss it. The margins keep the
+// pixel grid (8 and 4 samples a pixel).
+struct SampleTiles {
+  static constexpr int MARGIN_X = 8, MARGIN_Y = 4;
+  int64_t full_w = 0, full_h = 0;
+  int tile_w = 0, tile_h = 0;  // the kept part
+  SampleTiles(int64_t w, int64_t h, int max_size) : full_w(w), full_h(h) {
+    const int64_t limit = std::min<int64_t>(CAMERA_TILE, max_size - 2 * MARGIN_X);
+    tile_w = static_cast<int>(std::min(full_w, limit));
+    tile_h = static_cast<int>(std::min(full_h, limit));
+  }
+  int target_w() const { return tile_w + 2 * MARGIN_X; }
+  int target_h() const { return tile_h + 2 * MARGIN_Y; }
+  // The tile at (x0, y0) of the grid, margins included, filling the viewport.
+  glm::mat4 matrix(int64_t x0, int64_t y0) const;
+  // The index in a target-sized readback of sample (gx, gy) of the tile's kept part.
+  size_t index(int64_t gx, int64_t gy) const {
+    return static_cast<size_t>((gy + MARGIN_Y) * target_w() + gx + MARGIN_X);
+  }
+};
+
+// The camera's clip matrix with the eye at the origin (scene.vert subtracts the eye).
+inline glm::mat4 relative_camera_clip(const Camera& camera, double near_distance) {
+  const double aspect = static_cast<double>(camera.width) / camera.height;
+  return camera_clip_matrix(glm::dvec3(0.0), camera.look_at - camera.position, camera.up, glm::radians(camera.fov_y_deg),
+                            aspect, near_distance);
+}
+
 inline glm::mat4 tile_matrix(int64_t full_w, int64_t full_h, int64_t x0, int64_t y0, int tile_w, int tile_h) {
   glm::mat4 tile(1.f);
   tile[0][0] = float(double(full_w) / tile_w);
@@ -61,6 +94,10 @@ inline glm::mat4 tile_matrix(int64_t full_w, int64_t full_h, int64_t x0, int64_t
   tile[1][1] = float(double(full_h) / tile_h);
   tile[3][1] = float(-double(full_h) / tile_h * (double(2 * y0 + tile_h) / double(full_h) - 1.0));
   return tile;
+}
+
+inline glm::mat4 SampleTiles::matrix(int64_t x0, int64_t y0) const {
+  return tile_matrix(full_w, full_h, x0 - MARGIN_X, y0 - MARGIN_Y, target_w(), target_h());
 }
 
 // One framebuffer: distance (R32F) + object id (R32UI), or colour (RGBA32F); depth 32F with
