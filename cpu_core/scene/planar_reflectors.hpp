@@ -8,7 +8,10 @@
 // the mirror ray of the exact tracer (shading.hpp, about the shading normal) is the one of
 // its plane. The flat reflective triangles of one object, one material and one plane make
 // one reflector. Reflective triangles with smooth normals (a sphere) are curved: they keep
-// the cube-map methods, and are counted.
+// the cube-map methods, and are counted. So are the flat facets of an object with more than
+// MAX_PLANES_PER_OBJECT planes (a faceted metal part: thousands of mirrors a few pixels
+// wide, each a view of its own) and, past MAX_REFLECTORS in the scene, the smallest ones by
+// area: each reflector costs the stencil pass a view per level it is seen at.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -29,16 +32,18 @@ struct PlanarReflector {
 };
 
 struct PlanarReflectors {
-  std::vector<PlanarReflector> reflectors;
+  std::vector<PlanarReflector> reflectors;  // in the order of their objects
   // Per triangle of the soup: 0, or the index of its reflector plus 1.
   std::vector<uint32_t> reflector_of_triangle;
-  uint64_t curved_triangles = 0;  // reflective (kr > 0, kt = 0, opacity 1) but not flat
+  uint64_t curved_triangles = 0;  // reflective (kr > 0, kt = 0, opacity 1) but not flat, or left out (above)
 };
 
 // Flatness: every shading normal within this of +-(the geometric normal) (1 - cos); plane
 // equality: normals as close, and offsets within PLANE_RELATIVE of the largest coordinate.
 constexpr double FLAT_COSINE_TOLERANCE = 1e-6;
 constexpr double PLANE_RELATIVE = 1e-6;
+constexpr size_t MAX_PLANES_PER_OBJECT = 8;  // a box has 6
+constexpr size_t MAX_REFLECTORS = 64;
 
 PlanarReflectors find_planar_reflectors(const SceneData& scene);
 

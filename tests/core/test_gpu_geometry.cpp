@@ -2,6 +2,8 @@
 // mirrors (scene/planar_reflectors.hpp), and the shadow volumes' geometry
 // (scene/shadow_volume.hpp): closed and consistently oriented, made of the right blockers.
 #include <array>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <string>
@@ -48,6 +50,60 @@ TEST(PlanarReflectors, FlatMirrorsByObjectAndPlane) {
     const bool mirror = t < s.objects[2].first_triangle;
     EXPECT_EQ(r.reflector_of_triangle[t] != 0, mirror) << t;
     if (mirror) EXPECT_LE(r.reflectors[r.reflector_of_triangle[t] - 1].triangles.front(), t);
+  }
+}
+
+// A faceted object (more planes than MAX_PLANES_PER_OBJECT) and, past MAX_REFLECTORS,
+// the smallest reflectors are left to the cube maps and counted as curved; the ids of the
+// ones kept stay dense.
+TEST(PlanarReflectors, FacetedObjectsAndTheSmallestPastTheCapAreCurved) {
+  std::string objects = "[";
+  // MAX_REFLECTORS + 6 triangles, one object each, parallel planes y = k, area growing with k.
+  const size_t many = MAX_REFLECTORS + 6;
+  for (size_t k = 0; k < many; ++k) {
+    const double e = 0.1 + 0.01 * static_cast<double>(k), y = static_cast<double>(k);
+    objects += (k ? "," : "") + std::string(R"({"type": "triangle", "material": "mirror", "vertices": [[0, )") + std::to_string(y) +
+               ", 0], [0, " + std::to_string(y) + ", " + std::to_string(e) + "], [" + std::to_string(e) + ", " + std::to_string(y) + ", 0]]}";
+  }
+  objects += "]";
+  const SceneData s = scene_of(MATERIALS, objects);
+  const PlanarReflectors r = find_planar_reflectors(s);
+  ASSERT_EQ(r.reflectors.size(), MAX_REFLECTORS);
+  EXPECT_EQ(r.curved_triangles, many - MAX_REFLECTORS);
+  for (size_t k = 0; k < many; ++k) {
+    const uint32_t id = r.reflector_of_triangle[s.objects[k].first_triangle];
+    if (k < many - MAX_REFLECTORS) {
+      EXPECT_EQ(id, 0u) << "the smallest are left out: " << k;
+    } else {
+      ASSERT_NE(id, 0u) << k;
+      EXPECT_EQ(r.reflectors[id - 1].object, k);
+    }
+  }
+
+  // A fan of MAX_PLANES_PER_OBJECT + 1 flat facets in one object (a faceted cone: one
+  // mesh, flat normals) is curved as a whole; with MAX_PLANES_PER_OBJECT facets it is not.
+  for (const size_t facets : {MAX_PLANES_PER_OBJECT, MAX_PLANES_PER_OBJECT + 1}) {
+    const std::string dir = ::testing::TempDir();
+    const std::string obj = dir + "/fan" + std::to_string(facets) + ".obj";
+    FILE* f = std::fopen(obj.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fprintf(f, "v 0 1 0\n");
+    for (size_t k = 0; k < facets; ++k) {
+      const double a = 6.283185307179586 * static_cast<double>(k) / static_cast<double>(facets);
+      std::fprintf(f, "v %.17g 0 %.17g\n", std::cos(a), std::sin(a));
+    }
+    for (size_t k = 0; k < facets; ++k) std::fprintf(f, "f 1 %zu %zu\n", 2 + (k + 1) % facets, 2 + k);
+    std::fclose(f);
+    const std::string text = std::string(R"({"version": 1, "camera": {"position": [0, 1, 6], "look_at": [0, 0, 0], "width": 8, "height": 8},
+      "lights": [], "materials": )") + MATERIALS + R"(, "objects": [{"type": "mesh", "file": ")" + obj + R"(", "material": "mirror"}]})";
+    const PlanarReflectors c = find_planar_reflectors(load_scene_text(text, "scene.json", dir));
+    if (facets <= MAX_PLANES_PER_OBJECT) {
+      EXPECT_EQ(c.reflectors.size(), facets);
+      EXPECT_EQ(c.curved_triangles, 0u);
+    } else {
+      EXPECT_EQ(c.reflectors.size(), 0u);
+      EXPECT_EQ(c.curved_triangles, facets);
+    }
   }
 }
 
