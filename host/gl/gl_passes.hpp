@@ -165,6 +165,9 @@ class GlScene {
   // applies; exact_camera_stats() says what the last one did.
   void set_exact_camera(const ExactCameraOptions& options) { exact_ = options; }
   const ExactCameraStats& exact_camera_stats() const { return exact_stats_; }
+  // Whether the next mask_4x8 camera pass would be the exact one (the options set, the
+  // scene, this GL); exact_camera_stats() then says why not.
+  bool exact_camera_possible() { return plan_exact_camera(); }
   const PlanarReflectors& planar_reflectors() const { return reflectors_; }
   const std::vector<uint8_t>& exact_pixels() const { return exact_pixels_; }
 

@@ -131,12 +131,17 @@ Image render_hybrid(MethodContext& mc) {
   ExactCameraOptions exact = mc.request.gpu;
   exact.always = true;
   gl.set_exact_camera(exact);
-  gl.set_texture_level0(true);
   check_deadline();
-  Image image = gl.camera_color(scene.camera, CameraSamples::mask_4x8);
-  gl.set_texture_level0(false);
+  // Where the exact pass cannot run (coverage transparency, a GL without dual-source
+  // blending) every pixel is the CPU's: the GPU's camera pass is not drawn at all.
+  const bool exact_pass = gl.exact_camera_possible();
+  Image image;
+  if (exact_pass) {
+    gl.set_texture_level0(true);
+    image = gl.camera_color(scene.camera, CameraSamples::mask_4x8);
+    gl.set_texture_level0(false);
+  }
   const ExactCameraStats& ex = gl.exact_camera_stats();
-  const bool exact_pass = ex.mirrors || ex.volumes || ex.plain;
   std::vector<uint8_t> cpu(static_cast<size_t>(scene.camera.width) * static_cast<size_t>(scene.camera.height), 1);
   if (exact_pass) {
     const std::vector<uint8_t>& on_gpu = gl.exact_pixels();
@@ -145,8 +150,10 @@ Image render_hybrid(MethodContext& mc) {
   const size_t cpu_pixels = static_cast<size_t>(std::count(cpu.begin(), cpu.end(), 1));
   const GpuTimings& t = gl.timings();
   stats["timings_ms"]["upload"] = t.upload_ms - before.upload_ms;
-  stats["timings_ms"]["camera_raster"] = t.camera_ms - before.camera_ms;
-  stats["timings_ms"]["readback"] = t.readback_ms - before.readback_ms;
+  if (exact_pass) {
+    stats["timings_ms"]["camera_raster"] = t.camera_ms - before.camera_ms;
+    stats["timings_ms"]["readback"] = t.readback_ms - before.readback_ms;
+  }
   stats["gpu_paths"] = gpu_paths_json(gl, mc.request, cpu_pixels > 0 ? "cpu_searches" : "none", false);
   if (ex.volumes) stats["timings_ms"]["shadow_volumes_build"] = ex.volume_build_ms;
   json hybrid = {{"pixels", cpu.size()}, {"pixels_gpu", cpu.size() - cpu_pixels}, {"pixels_cpu", cpu_pixels}};
@@ -155,8 +162,9 @@ Image render_hybrid(MethodContext& mc) {
     // The abuffer method for those pixels alone (its stats under "cpu").
     json cpu_stats;
     MethodContext cpu_mc{scene, mc.cache, mc.request, cpu_stats, mc.progress, nullptr, {}, mc.fallback};
-    const Image part = render_map_method(cpu_mc, &cpu);
-    for (size_t p = 0; p < cpu.size(); ++p) {
+    const Image part = render_map_method(cpu_mc, exact_pass ? &cpu : nullptr);
+    if (!exact_pass) image = part;
+    for (size_t p = 0; exact_pass && p < cpu.size(); ++p) {
       if (!cpu[p]) continue;
       for (int c = 0; c < 3; ++c) image.data[3 * p + static_cast<size_t>(c)] = part.data[3 * p + static_cast<size_t>(c)];
     }
@@ -168,8 +176,9 @@ Image render_hybrid(MethodContext& mc) {
     hybrid["cpu"] = "skipped: every pixel is exact on the GPU (no cube map built)";
   }
   stats["hybrid"] = hybrid;
-  stats["plan"]["passes"] = cpu_pixels > 0 ? json::array({"camera_raster (exact pass)", "cpu abuffer for the pixels left"})
-                                           : json::array({"camera_raster (exact pass)"});
+  stats["plan"]["passes"] = !exact_pass      ? json::array({"cpu abuffer for every pixel"})
+                           : cpu_pixels > 0 ? json::array({"camera_raster (exact pass)", "cpu abuffer for the pixels left"})
+                                            : json::array({"camera_raster (exact pass)"});
   stats["plan"]["mode"] = "needed";
   stats["counts"]["camera_samples_per_pixel"] = MASK_SAMPLES;
   return image;

@@ -80,5 +80,16 @@ for name in cornell default hidden_point shadows textured; do
   check "$name: hybrid no less accurate than abuffer ($hy against $ab)" \
     awk -v h="$hy" -v a="$ab" 'BEGIN { exit !(h == "inf" || (a != "inf" && h >= a)) }'
 done
+# Coverage transparency (default.json's veil) rules the exact pass out: hybrid is abuffer,
+# byte for byte, and draws no GPU camera pass at all.
+"$ABCUBE" render "$REPO/scenes/default.json" -o "$WORK/default_hybrid_stats.exr" --method hybrid --cube-res 128 \
+  --stats "$WORK/default_hybrid.json" 2> "$WORK/err"
+check "default: hybrid equals abuffer" cmp -s <("$ABCUBE" compare --exact "$WORK/default_hybrid_stats.exr" "$WORK/repo_default_abuffer.exr") <(echo IDENTICAL)
+check "default: hybrid draws no camera pass" /usr/bin/python3 -c "
+import json, sys
+s = json.load(open(sys.argv[1]))
+sys.exit(not ('camera_raster' not in s['timings_ms'] and s['plan']['passes'] == ['cpu abuffer for every pixel']
+              and s['hybrid']['pixels_cpu'] == s['hybrid']['pixels'] and 'coverage' in s['hybrid']['why_all_cpu']))" \
+  "$WORK/default_hybrid.json"
 echo "flat_mirrors: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
