@@ -22,21 +22,10 @@
 #include "scene/scene_load.hpp"
 #include "shading/scene_cache.hpp"
 
-#ifndef ABCUBE_VERSION
-#define ABCUBE_VERSION "0.0.0"
-#endif
-#ifndef ABCUBE_GIT_COMMIT
-#define ABCUBE_GIT_COMMIT ""
-#endif
 
 namespace abcube {
 
 using nlohmann::json;
-
-std::string version_string() {
-  const std::string commit = ABCUBE_GIT_COMMIT;
-  return std::string("abcube ") + ABCUBE_VERSION + (commit.empty() ? "" : " (git " + commit + ")");
-}
 
 namespace {
 
