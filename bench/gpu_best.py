@@ -117,7 +117,7 @@ def main(argv=None):
         w.writeheader()
         w.writerows(rows)
     L = ["# The gpu method at its best, and hybrid", "",
-         "Written by `bench/gpu_best.py` %s UTC; abcube %s; %s, cube N = %d, `--runs %d`, 2 threads (the default)."
+         "Written by `bench/gpu_best.py` %s UTC; %s; %s, cube N = %d, `--runs %d`, 2 threads (the default)."
          % (time.strftime("%Y-%m-%d %H:%M", time.gmtime()), run([a.abcube, "--version"]).strip(), a.size, a.cube_res,
             a.runs),
          "Load average (1 min) %.2f at start, %.2f at end; %.0f s in all." % (load, os.getloadavg()[0], time.time() - t_start),
