@@ -1,5 +1,6 @@
 // abcube.Renderer and abcube.RenderResult: one render call with keyword overrides, the GIL
 // released while the library renders (include/abcube/renderer.hpp).
+#include <csignal>
 #include <string>
 #include <utility>
 #include <vector>
@@ -81,6 +82,52 @@ void reject_unknown_keywords(const py::kwargs& unknown) {
                    "plan_everything, reference_image, resolve, side_structure)");
 }
 
+// Ctrl-C during a render gives KeyboardInterrupt, as everywhere else in Python. While the
+// GIL is released, Python's own SIGINT handler only marks the signal for the main thread's
+// next bytecode, which would come after the render. So a render called from the main
+// thread, while SIGINT has Python's default handler, puts a C handler in its place for its
+// duration: it asks the render to stop at its next check (request_stop: async-signal-safe,
+// process-wide until this render returns: a render of another thread that checks meanwhile
+// stops with RuntimeError "interrupted (SIGINT)"), and KeyboardInterrupt is raised once the
+// render has returned. Constructed and destroyed with the GIL held.
+class SigintStopsRender {
+ public:
+  SigintStopsRender() {
+    const py::module_ threading = py::module_::import("threading"), signal = py::module_::import("signal");
+    active_ = threading.attr("current_thread")().is(threading.attr("main_thread")()) &&
+              signal.attr("getsignal")(signal.attr("SIGINT")).is(signal.attr("default_int_handler"));
+    if (!active_) return;
+    seen_ = 0;
+    struct sigaction action {};
+    action.sa_handler = on_sigint;
+    sigemptyset(&action.sa_mask);
+    active_ = sigaction(SIGINT, &action, &previous_) == 0;
+  }
+  SigintStopsRender(const SigintStopsRender&) = delete;
+  SigintStopsRender& operator=(const SigintStopsRender&) = delete;
+  // Python's handler back; true when a SIGINT came while ours was in place (the stop it
+  // asked for is then withdrawn, so that the next render runs).
+  bool restore() {
+    if (!active_) return false;
+    sigaction(SIGINT, &previous_, nullptr);
+    active_ = false;
+    if (seen_ == 0) return false;
+    clear_stop_request();
+    return true;
+  }
+  ~SigintStopsRender() { restore(); }
+
+ private:
+  static void on_sigint(int signal_number) {
+    seen_ = 1;
+    request_stop(signal_number);
+  }
+  static volatile std::sig_atomic_t seen_;
+  bool active_ = false;
+  struct sigaction previous_ {};
+};
+volatile std::sig_atomic_t SigintStopsRender::seen_ = 0;
+
 // Renders with the GIL released: arguments converted before, results after.
 py::object render(Renderer& renderer, const py::handle& scene_object, const RenderArgs& args) {
   if (!py::isinstance<Scene>(scene_object)) {
@@ -91,9 +138,18 @@ py::object render(Renderer& renderer, const py::handle& scene_object, const Rend
   const RenderOptions options = options_from_args(args);
   const bool want_result = !args.aovs.is_none() || options.stats;
   RenderResult result;
-  {
+  SigintStopsRender sigint;
+  try {
     py::gil_scoped_release release;
     result = renderer.render(scene, options);
+  } catch (const Interrupted&) {
+    if (!sigint.restore()) throw;
+    PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
+  }
+  if (sigint.restore()) {  // Ctrl-C after the render's last check: the result is dropped, as Python would
+    PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
   }
   if (!want_result) return image_to_array(std::move(result.image));
 
@@ -153,7 +209,9 @@ CLI's --map-only: searches see only the map, no side structure for the triangles
 hold).
 
 A bad argument or scene raises SceneError (a ValueError) naming it; other failures
-RuntimeError. The GIL is released while the render runs (see Renderer).)doc";
+RuntimeError. The GIL is released while the render runs (see Renderer). Ctrl-C (SIGINT,
+with Python's default handler) stops a render called from the main thread at its next
+check and raises KeyboardInterrupt.)doc";
 
 }  // namespace
 

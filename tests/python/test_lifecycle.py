@@ -82,3 +82,46 @@ def test_many_scene_loads_bounded_memory():
             rss = resident_kib()
     gc.collect()
     assert resident_kib() - rss < 4 * 1024
+
+
+CTRL_C_SCRIPT = r'''
+import os, signal, sys, threading
+import abcube
+# A camera inside a mirror box around a glass sphere that both reflects and refracts: the
+# tracer's ray tree doubles at every glass hit. At max_depth 10 a pixel takes about 2 ms on
+# one thread here, so a 64 x 32768 image would take over an hour: the
+# render cannot end within the test's time unless it is stopped (checked between rows).
+scene = abcube.scene_from_dict({
+    "version": 1,
+    "camera": {"position": [0, 0, -1.5], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 60,
+               "width": 64, "height": 32768},
+    "lights": [{"type": "point", "position": [0, 1.5, -1.5], "color": [1, 1, 1]}],
+    "materials": {"mirror": {"color": [0.2, 0.2, 0.2], "reflect": 0.8},
+                  "glass": {"color": [1, 1, 1], "diffuse": 0, "reflect": 0.3, "transmit": 0.7,
+                            "ior": 1.5}},
+    "objects": [{"type": "box", "min": [-2, -2, -2], "max": [2, 2, 2], "material": "mirror"},
+                {"type": "sphere", "center": [0, 0, 0], "radius": 0.8, "segments": 16,
+                 "material": "glass"}],
+    "render": {"method": "raytrace", "max_depth": 10}})
+r = abcube.Renderer(gl="none", threads=1)
+threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+image = None
+try:
+    image = r.render(scene)
+except KeyboardInterrupt:
+    print("KeyboardInterrupt")
+print("completed" if image is not None else "stopped")
+print(r.render(scene, max_depth=1, camera={"width": 8, "height": 6}).shape)
+'''
+
+
+def test_ctrl_c_stops_a_render():
+    # SIGINT while a render runs in the main thread (the GIL released): the render stops at
+    # its next check and raises KeyboardInterrupt, and the next render runs. In a child
+    # process: a KeyboardInterrupt that escaped would end pytest's session.
+    import subprocess
+    import sys
+    done = subprocess.run([sys.executable, "-c", CTRL_C_SCRIPT], capture_output=True, text=True,
+                          timeout=120)  # a watchdog: the render alone would take an hour
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split("\n")[:3] == ["KeyboardInterrupt", "stopped", "(6, 8, 3)"], done.stdout
