@@ -288,8 +288,9 @@ namespace {
 
 // One row of the image: every pixel the mean of its camera samples (box filter).
 void render_row(const RayTracer& tracer, const CameraFrame& frame, int spp, int y, Image* image,
-                RayCounts* counts) {
+                RayCounts* counts, const std::vector<uint8_t>* only) {
   for (int x = 0; x < frame.width; ++x) {
+    if (only && !(*only)[static_cast<size_t>(y) * static_cast<size_t>(frame.width) + static_cast<size_t>(x)]) continue;
     glm::dvec3 sum(0.0);
     for (int k = 0; k < spp; ++k) {
       const double sx = spp == 1 ? 0.5 : sample_dx(k);
@@ -309,6 +310,9 @@ Image render_raytrace(const SceneData& scene, const RaytraceOptions& options, Ra
                      std::to_string(options.samples_per_pixel));
   }
   if (options.threads < 0) throw InputError("raytrace: threads must be >= 0, got " + std::to_string(options.threads));
+  ABCUBE_CHECK(!options.only || options.only->size() == static_cast<size_t>(scene.camera.width) *
+                                                         static_cast<size_t>(scene.camera.height),
+               "the pixel mask does not match the image");
   const RayTracer tracer(scene, options.bvh);
   const CameraFrame frame = make_camera_frame(scene.camera);
   Image image(frame.width, frame.height, 3);
@@ -320,7 +324,7 @@ Image render_raytrace(const SceneData& scene, const RaytraceOptions& options, Ra
   double reported = 0;  // written by worker 0 only, which is the calling thread
   parallel_for(static_cast<size_t>(frame.height), threads, [&](size_t row, int worker) {
     render_row(tracer, frame, options.samples_per_pixel, static_cast<int>(row), &image,
-               &counts[static_cast<size_t>(worker)]);
+               &counts[static_cast<size_t>(worker)], options.only);
     const int done = ++rows_done;
     if (worker == 0 && options.progress) options.progress(reported = static_cast<double>(done) / frame.height);
   });

@@ -89,6 +89,9 @@ struct RaytraceOptions {
   std::function<void(double)> progress;
   // The scene's BVH when already built (SceneCache); null: built for this render.
   std::shared_ptr<const Bvh> bvh;
+  // Width x height, row-major: only the pixels marked non-zero are traced, the others
+  // left black (the hybrid method's pixels of edge_ties.hpp); null: every pixel.
+  const std::vector<uint8_t>* only = nullptr;
 };
 
 struct RaytraceStats {

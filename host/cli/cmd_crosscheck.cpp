@@ -55,9 +55,9 @@ struct CrosscheckCommand {
                 r.interior_pixels, r.pixels, r.interior_rmse, tol.interior_rmse, r.interior_max_abs,
                 tol.interior_max_abs);
     std::printf("camera samples: %zu, same object %zu (agreement %.6f >= %.4f), GPU only %zu, CPU only %zu, "
-                "other object %zu\n",
+                "other object %zu; differing within 1/128 of a sample of an edge (edge_ties.hpp, apart) %zu\n",
                 r.samples, r.samples_same, r.sample_agreement, tol.sample_agreement_min, r.samples_gpu_only,
-                r.samples_cpu_only, r.samples_other_object);
+                r.samples_cpu_only, r.samples_other_object, r.samples_edge_ties);
     if (r.shadow_lights > 0) {
       auto line = [](const char* what, const ShadowAgreement& a) {
         std::printf("  %-22s %.5f of %zu, away from edges %.5f of %zu (false shadow %zu, false light %zu)\n", what,

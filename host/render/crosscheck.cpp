@@ -8,6 +8,7 @@
 #include "reference/raytrace.hpp"
 #include "search/search.hpp"
 #include "raster/abuffer.hpp"
+#include "raster/edge_ties.hpp"
 #include "raster/samples.hpp"
 #include "scene/camera.hpp"
 #include "raster/cube_map.hpp"
@@ -93,11 +94,14 @@ void compare_camera(const SceneData& scene, int threads, GlScene& gl, Crosscheck
   ResolveOptions ro;
   ro.threads = threads;
   const Image cpu = resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera), scene.background, ro);
+  // Interior: one surface over all 32 samples, none of them at an edge tie (edge_ties.hpp).
+  const std::vector<uint8_t> tie_pixels = edge_tie_pixels(scene);
   double sum_sq = 0;
   for (int y = 0; y < camera.height(); ++y) {
     for (int x = 0; x < camera.width(); ++x) {
       ++r->pixels;
       if (!interior_pixel(scene, camera.list(x, y))) continue;
+      if (tie_pixels[static_cast<size_t>(y) * static_cast<size_t>(camera.width()) + static_cast<size_t>(x)]) continue;
       ++r->interior_pixels;
       const glm::vec3 a = gpu.rgb(x, y), b = cpu.rgb(x, y);
       for (int c = 0; c < 3; ++c) {
@@ -111,7 +115,10 @@ void compare_camera(const SceneData& scene, int threads, GlScene& gl, Crosscheck
 
   // Visibility, sample by sample: the GPU's object ids at the 4x8 sample grid against the
   // A-buffer's nearest surface per sample.
+  // A sample within 1/128 of a sample of an edge is counted apart when the two differ: GL's
+  // snapped vertices may put it on either side (edge_ties.hpp).
   const std::vector<uint32_t> gpu_ids = gl.camera_objects(scene.camera);
+  const std::vector<uint8_t> ties = edge_tie_samples(scene);
   const TriangleSoup& soup = *scene.triangles;
   const int64_t grid_w = int64_t{camera.width()} * MASK_COLUMNS;
   r->sample_disagreement = Image(camera.width(), camera.height(), 1);
@@ -129,6 +136,10 @@ void compare_camera(const SceneData& scene, int threads, GlScene& gl, Crosscheck
           ++r->samples_same;
           continue;
         }
+        if (ties[static_cast<size_t>(gy * grid_w + gx)]) {
+          ++r->samples_edge_ties;
+          continue;
+        }
         ++differ;
         if (c == NO_OBJECT) ++r->samples_gpu_only;
         else if (g == NO_OBJECT) ++r->samples_cpu_only;
@@ -138,7 +149,9 @@ void compare_camera(const SceneData& scene, int threads, GlScene& gl, Crosscheck
           float(differ) / float(MASK_SAMPLES);
     }
   }
-  if (r->samples > 0) r->sample_agreement = double(r->samples_same) / double(r->samples);
+  if (r->samples > r->samples_edge_ties) {
+    r->sample_agreement = double(r->samples_same) / double(r->samples - r->samples_edge_ties);
+  }
 }
 
 // What the exact tracer says at each sample of the shadow camera: the visible object, and per
@@ -297,7 +310,8 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
                    {"cpu_search", shadow_json(r.search)}}},
       {"camera_samples", {{"samples", r.samples}, {"same_object", r.samples_same},
                           {"gpu_only", r.samples_gpu_only}, {"cpu_only", r.samples_cpu_only},
-                          {"other_object", r.samples_other_object}, {"agreement", r.sample_agreement}}},
+                          {"other_object", r.samples_other_object}, {"edge_ties_differing", r.samples_edge_ties},
+                          {"agreement", r.sample_agreement}}},
       {"tolerances", {{"distance_rel_median", tol.distance_median_rel}, {"distance_rel_p99", tol.distance_p99_rel},
                       {"same_object_min", tol.same_object_min}, {"coverage_mismatch_max", tol.coverage_mismatch_max},
                       {"interior_rmse", tol.interior_rmse}, {"interior_max_abs", tol.interior_max_abs},

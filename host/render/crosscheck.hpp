@@ -69,6 +69,7 @@ struct CrosscheckResult {
   // every pixel, the object the GPU's Z-buffer sees against the one the CPU A-buffer's masks
   // and exact priority masks say is nearest (resolve.hpp visible_triangles).
   size_t samples = 0, samples_same = 0, samples_gpu_only = 0, samples_cpu_only = 0, samples_other_object = 0;
+  size_t samples_edge_ties = 0;  // differing, within EDGE_TIE_EPS of an edge: not in sample_agreement
   double sample_agreement = 0;
   // Per pixel, how many of its 32 samples disagree (an image for `crosscheck --samples-image`).
   Image sample_disagreement;

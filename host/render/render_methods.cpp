@@ -9,6 +9,7 @@
 #include "base/parallel.hpp"
 #include "base/timer.hpp"
 #include "io/metrics.hpp"
+#include "raster/edge_ties.hpp"
 #include "raster/samples.hpp"
 #include "reference/raytrace.hpp"
 #include "render/crosscheck.hpp"
@@ -143,9 +144,34 @@ Image render_hybrid(MethodContext& mc) {
   }
   const ExactCameraStats& ex = gl.exact_camera_stats();
   std::vector<uint8_t> cpu(static_cast<size_t>(scene.camera.width) * static_cast<size_t>(scene.camera.height), 1);
+  // The pixels the GPU would have kept but where its snapped vertices may have decided a
+  // sample unlike the exact rules (edge_ties.hpp: exact only up to its sub-pixel grid):
+  // their surfaces are all exact ones, so the exact tracer renders them.
+  std::vector<uint8_t> traced;
+  size_t traced_pixels = 0;
   if (exact_pass) {
     const std::vector<uint8_t>& on_gpu = gl.exact_pixels();
     for (size_t p = 0; p < cpu.size(); ++p) cpu[p] = on_gpu[p] ? 0 : 1;
+    const Clock::time_point t0 = Clock::now();
+    traced = edge_tie_pixels(scene);
+    for (size_t p = 0; p < cpu.size(); ++p) {
+      traced[p] = traced[p] && on_gpu[p] ? 1 : 0;
+      traced_pixels += traced[p];
+    }
+    stats["timings_ms"]["edge_ties"] = ms_since(t0);
+  }
+  if (traced_pixels > 0) {
+    RaytraceOptions options;
+    options.threads = mc.request.threads;
+    options.bvh = mc.cache.bvh();
+    options.only = &traced;
+    const Clock::time_point t0 = Clock::now();
+    const Image part = render_raytrace(scene, options, nullptr);
+    stats["timings_ms"]["edge_ties_traced"] = ms_since(t0);
+    for (size_t p = 0; p < traced.size(); ++p) {
+      if (!traced[p]) continue;
+      for (int c = 0; c < 3; ++c) image.data[3 * p + static_cast<size_t>(c)] = part.data[3 * p + static_cast<size_t>(c)];
+    }
   }
   const size_t cpu_pixels = static_cast<size_t>(std::count(cpu.begin(), cpu.end(), 1));
   const GpuTimings& t = gl.timings();
@@ -156,7 +182,10 @@ Image render_hybrid(MethodContext& mc) {
   }
   stats["gpu_paths"] = gpu_paths_json(gl, mc.request, cpu_pixels > 0 ? "cpu_searches" : "none", false);
   if (ex.volumes) stats["timings_ms"]["shadow_volumes_build"] = ex.volume_build_ms;
-  json hybrid = {{"pixels", cpu.size()}, {"pixels_gpu", cpu.size() - cpu_pixels}, {"pixels_cpu", cpu_pixels}};
+  json hybrid = {{"pixels", cpu.size()},
+                 {"pixels_gpu", cpu.size() - cpu_pixels - traced_pixels},
+                 {"pixels_cpu", cpu_pixels},
+                 {"pixels_traced_edge_ties", traced_pixels}};
   if (!exact_pass) hybrid["why_all_cpu"] = ex.mirrors_why.empty() ? ex.volumes_why : ex.mirrors_why;
   if (cpu_pixels > 0) {
     // The abuffer method for those pixels alone (its stats under "cpu").
@@ -176,9 +205,12 @@ Image render_hybrid(MethodContext& mc) {
     hybrid["cpu"] = "skipped: every pixel is exact on the GPU (no cube map built)";
   }
   stats["hybrid"] = hybrid;
-  stats["plan"]["passes"] = !exact_pass      ? json::array({"cpu abuffer for every pixel"})
-                           : cpu_pixels > 0 ? json::array({"camera_raster (exact pass)", "cpu abuffer for the pixels left"})
-                                            : json::array({"camera_raster (exact pass)"});
+  json passes = json::array();
+  if (!exact_pass) passes.push_back("cpu abuffer for every pixel");
+  if (exact_pass) passes.push_back("camera_raster (exact pass)");
+  if (traced_pixels > 0) passes.push_back("exact tracer for the pixels with a sample at an edge (edge ties)");
+  if (exact_pass && cpu_pixels > 0) passes.push_back("cpu abuffer for the pixels left");
+  stats["plan"]["passes"] = passes;
   stats["plan"]["mode"] = "needed";
   stats["counts"]["camera_samples_per_pixel"] = MASK_SAMPLES;
   return image;

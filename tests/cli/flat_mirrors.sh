@@ -40,6 +40,14 @@ batch_all() {
 }
 batch_all "$WORK/scenes" "" raytrace abuffer gpu hybrid
 psnr() { "$ABCUBE" compare "$1" "$2" | awk '/^PSNR/ {print $2}'; }
+# at_least A B [SLACK]: PSNR A >= B - SLACK, both capped at 100 dB (RMSE 1e-5): above that
+# the two differ by float rounding alone (the GPU shades in float, the CPU in double; a
+# scene abuffer renders exactly, inf, came out of the GPU at 152.65 dB).
+at_least() {
+  awk -v x="$1" -v y="$2" -v slack="${3:-0}" \
+    'function cap(v) { return (v == "inf" || v + 0 > 100) ? 100 : v + 0 }
+     BEGIN { exit !(x != "" && y != "" && cap(x) >= cap(y) - slack) }'
+}
 for scene in "$WORK"/scenes/*.json; do
   stem=$(basename "$scene" .json)
   gpu=$(psnr "$WORK/gpu/$stem.exr" "$WORK/raytrace/$stem.exr")
@@ -47,22 +55,35 @@ for scene in "$WORK"/scenes/*.json; do
   echo "$stem: gpu $gpu dB, abuffer $ab dB"
   check "$stem: gpu reaches 35 dB ($gpu)" awk -v g="$gpu" 'BEGIN { exit !(g == "inf" || g >= 35) }'
   check "$stem: gpu within 1 dB of abuffer or better ($gpu against $ab)" \
-    awk -v g="$gpu" -v a="$ab" 'BEGIN { exit !(g == "inf" || (a != "inf" && g >= a - 1)) }'
+    at_least "$gpu" "$ab" 1
   hy=$(psnr "$WORK/hybrid/$stem.exr" "$WORK/raytrace/$stem.exr")
   check "$stem: hybrid no less accurate than abuffer ($hy against $ab)" \
-    awk -v h="$hy" -v a="$ab" 'BEGIN { exit !(h == "inf" || (a != "inf" && h >= a)) }'
+    at_least "$hy" "$ab"
 done
-# One scene of each hard-case template (seed 5: km-wide ground, a camera inside a room,
-# nested glass, ...): hybrid no less accurate than abuffer there either.
-/usr/bin/python3 "$REPO/tools/hard_scenes.py" --seed 5 --count 11 --out "$WORK/hard" --size 128x96 --cube-res 128 > /dev/null
+# One scene of each hard-case template (km-wide ground, a camera inside a room, nested
+# glass, ...) for seed 5, for seed 103 (seams_103_10: a mirror's top edge 0.0008 of a sample
+# above a sample row's centres, which GL's snapped vertices put on the other side: a line of
+# wrong pixels, 51.0 against abuffer's 54.1 dB, before edge_ties.hpp) and for this run's new
+# seed: hybrid no less accurate than abuffer there either.
+for seed in 5 103 "$SEED"; do
+  /usr/bin/python3 "$REPO/tools/hard_scenes.py" --seed "$seed" --count 11 --out "$WORK/hard" --size 128x96 \
+    --cube-res 128 > /dev/null || { echo "FAIL: tools/hard_scenes.py --seed $seed"; exit 1; }
+done
 batch_all "$WORK/hard" hard_ raytrace abuffer hybrid
+"$ABCUBE" render "$WORK/hard/seams_103_10.json" -o "$WORK/seams_103_10.exr" --method hybrid --stats "$WORK/seams.json" \
+  2> "$WORK/err"
+check "seams_103_10: the pixels at the mirror's edge are traced" /usr/bin/python3 -c "
+import json, sys
+s = json.load(open(sys.argv[1]))['hybrid']
+sys.exit(not (s['pixels_traced_edge_ties'] >= 21 and s['pixels_gpu'] + s['pixels_cpu'] + s['pixels_traced_edge_ties'] == s['pixels']))" \
+  "$WORK/seams.json"
 for scene in "$WORK"/hard/*.json; do
   stem=$(basename "$scene" .json)
   ab=$(psnr "$WORK/hard_abuffer/$stem.exr" "$WORK/hard_raytrace/$stem.exr")
   hy=$(psnr "$WORK/hard_hybrid/$stem.exr" "$WORK/hard_raytrace/$stem.exr")
   echo "$stem: hybrid $hy dB, abuffer $ab dB"
   check "$stem: hybrid no less accurate than abuffer ($hy against $ab)" \
-    awk -v h="$hy" -v a="$ab" 'BEGIN { exit !(h == "inf" || (a != "inf" && h >= a)) }'
+    at_least "$hy" "$ab"
 done
 # The repository's scenes (glass, a curved mirror, coverage transparency: pixels for the CPU).
 for name in cornell default hidden_point shadows textured; do
@@ -78,7 +99,7 @@ for name in cornell default hidden_point shadows textured; do
   hy=$(psnr "$WORK/repo_${name}_hybrid.exr" "$WORK/repo_${name}_raytrace.exr")
   echo "$name: hybrid $hy dB, abuffer $ab dB"
   check "$name: hybrid no less accurate than abuffer ($hy against $ab)" \
-    awk -v h="$hy" -v a="$ab" 'BEGIN { exit !(h == "inf" || (a != "inf" && h >= a)) }'
+    at_least "$hy" "$ab"
 done
 # Coverage transparency (default.json's veil) rules the exact pass out: hybrid is abuffer,
 # byte for byte, and draws no GPU camera pass at all.
