@@ -71,7 +71,12 @@ Material convert_mtl(LoadState& st, const std::string& path, const std::string& 
   if (!in.diffuse_texname.empty()) {
     const size_t line = mtl_line(mtl_file, in.name, "map_Kd");
     const std::string at = quote_path(mtl_file) + (line > 0 ? ":" + std::to_string(line) : "") + ": map_Kd ";
-    m.texture = texture_file(st, path, at, in.diffuse_texname, std::filesystem::path(mtl_file).parent_path().string());
+    // MTL files written on Windows separate folders by '\' (assimp-testmodels' spider.mtl:
+    // ".\wal67ar_small.jpg"): read as '/' here. (A file name holding a
+    // '\' of its own cannot be named from an MTL file then.)
+    std::string texture = in.diffuse_texname;
+    std::replace(texture.begin(), texture.end(), '\\', '/');
+    m.texture = texture_file(st, path, at, texture, std::filesystem::path(mtl_file).parent_path().string());
   }
   return m;
 }
