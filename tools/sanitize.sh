@@ -24,7 +24,7 @@ configure() {  # FOLDER SANITIZERS
 # ctest in build-asan with the arguments given; then, if every failure was LeakSanitizer's
 # own tracer crashing at the process's exit after the test itself had passed ("Tracer
 # caught signal 11 ... LeakSanitizer has encountered a fatal error": its StopTheWorld
-# thread, seen once in a CI run, on egl.GpuLookupsGl.EnvironmentReflectionMatchesExactForFarWalls
+# thread, seen once in a run of .ci/run, on egl.GpuLookupsGl.EnvironmentReflectionMatchesExactForFarWalls
 # with llvmpipe's threads exiting), those tests once more. Any other failure, or a report
 # of ASan, UBSan or a leak, stands.
 asan_ctest() {

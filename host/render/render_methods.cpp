@@ -115,6 +115,18 @@ Image render_gpu(MethodContext& mc) {
   return image;
 }
 
+namespace {
+
+// The pixels of `from` that `mask` marks, into `to` (the same size, RGB).
+void copy_pixels(const Image& from, const std::vector<uint8_t>& mask, Image* to) {
+  for (size_t p = 0; p < mask.size(); ++p) {
+    if (!mask[p]) continue;
+    for (size_t c = 0; c < 3; ++c) to->data[3 * p + c] = from.data[3 * p + c];
+  }
+}
+
+}  // namespace
+
 // HYBRID (issue 19 part 5): each kind of surface by the path that is exact and cheaper.
 // The GPU renders the camera view by its exact camera pass (planar mirrors by the stencil
 // test, opaque shadows by volumes, textures point-sampled as the CPU does), building no
@@ -168,10 +180,7 @@ Image render_hybrid(MethodContext& mc) {
     const Clock::time_point t0 = Clock::now();
     const Image part = render_raytrace(scene, options, nullptr);
     stats["timings_ms"]["edge_ties_traced"] = ms_since(t0);
-    for (size_t p = 0; p < traced.size(); ++p) {
-      if (!traced[p]) continue;
-      for (int c = 0; c < 3; ++c) image.data[3 * p + static_cast<size_t>(c)] = part.data[3 * p + static_cast<size_t>(c)];
-    }
+    copy_pixels(part, traced, &image);
   }
   const size_t cpu_pixels = static_cast<size_t>(std::count(cpu.begin(), cpu.end(), 1));
   const GpuTimings& t = gl.timings();
@@ -193,10 +202,7 @@ Image render_hybrid(MethodContext& mc) {
     MethodContext cpu_mc{scene, mc.cache, mc.request, cpu_stats, mc.progress, nullptr, {}, mc.fallback};
     const Image part = render_map_method(cpu_mc, exact_pass ? &cpu : nullptr);
     if (!exact_pass) image = part;
-    for (size_t p = 0; exact_pass && p < cpu.size(); ++p) {
-      if (!cpu[p]) continue;
-      for (int c = 0; c < 3; ++c) image.data[3 * p + static_cast<size_t>(c)] = part.data[3 * p + static_cast<size_t>(c)];
-    }
+    if (exact_pass) copy_pixels(part, cpu, &image);
     for (const auto& [k, v] : cpu_stats["timings_ms"].items()) stats["timings_ms"]["cpu." + k] = v;
     for (const char* key : {"plan", "cube_abuffer", "abuffer", "searches"}) {
       if (cpu_stats.contains(key)) hybrid["cpu"][key] = cpu_stats[key];
