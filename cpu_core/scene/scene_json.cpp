@@ -129,14 +129,27 @@ std::string parser_message(const std::string& what) {
     const size_t colon = m.find(": ");
     if (colon != std::string::npos) m = m.substr(colon + 2);
   }
-  // The token nlohmann quotes ("...; last read: 'TOKEN'[; expected ...]", "number overflow
-  // parsing 'TOKEN'") can be a whole string or number of megabytes: cut short.
+  // The token nlohmann quotes ("...; last read: 'TOKEN'[; expected NAME]", "number overflow
+  // parsing 'TOKEN'") can be a whole string or number of megabytes: cut short. The token
+  // may hold anything, "'; expected " too (a fuzzed input did), so its end is found from
+  // the message's end: the closing quote, or before "; expected " and one of the names
+  // nlohmann gives a token type (lexer::token_type_name).
+  static const char* const names[] = {"<uninitialized>", "true literal", "false literal", "null literal",
+                                      "string literal", "number literal", "'['", "'{'", "']'", "'}'", "':'", "','",
+                                      "<parse error>", "end of input", "'[', '{', or a literal", "unknown token"};
+  auto ends_with = [&](const std::string& tail) {
+    return m.size() >= tail.size() && m.compare(m.size() - tail.size(), tail.size(), tail) == 0;
+  };
   for (const char* opener : {"; last read: '", "number overflow parsing '"}) {
     const size_t at = m.find(opener);
     if (at == std::string::npos) continue;
     const size_t from = at + std::strlen(opener);
-    size_t to = m.rfind("'; expected ");
-    if (to == std::string::npos || to < from) to = !m.empty() && m.back() == '\'' ? m.size() - 1 : std::string::npos;
+    size_t to = std::string::npos;
+    for (const char* name : names) {
+      const std::string tail = std::string("'; expected ") + name;
+      if (ends_with(tail)) to = m.size() - tail.size();
+    }
+    if (to == std::string::npos && ends_with("'")) to = m.size() - 1;
     if (to == std::string::npos || to < from) continue;
     m = m.substr(0, from) + printable(std::string_view(m).substr(from, to - from)) + m.substr(to);
   }
