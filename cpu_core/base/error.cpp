@@ -1,5 +1,6 @@
 #include "base/error.hpp"
 
+#include <cstdint>
 #include <cstdio>
 #include <utility>
 
@@ -76,12 +77,20 @@ size_t append_escaped(std::string& out, std::string_view text, size_t i, bool qu
   return n;
 }
 
-// The first `max_chars` characters of `text` escaped, and how many bytes of it they took.
-std::pair<std::string, size_t> escape_prefix(std::string_view text, size_t max_chars, bool quoted) {
+// The first `max_chars` characters of `text` escaped, in at most `max_bytes` bytes (a cut
+// never splits a character or an escape), and how many bytes of `text` they took.
+std::pair<std::string, size_t> escape_prefix(std::string_view text, size_t max_chars, bool quoted,
+                                             size_t max_bytes = SIZE_MAX) {
   std::string out;
   size_t shown = 0;
   for (size_t chars = 0; shown < text.size() && chars < max_chars; ++chars) {
-    shown += append_escaped(out, text, shown, quoted);
+    const size_t before = out.size();
+    const size_t took = append_escaped(out, text, shown, quoted);
+    if (out.size() > max_bytes) {
+      out.resize(before);
+      break;
+    }
+    shown += took;
   }
   return {out, shown};
 }
@@ -96,8 +105,8 @@ std::string printable(std::string_view text, size_t max_chars) {
   return shown < text.size() ? body + length_note(text) : body;
 }
 
-std::string quote(std::string_view text, size_t max_chars) {
-  const auto [body, shown] = escape_prefix(text, max_chars, true);
+std::string quote(std::string_view text, size_t max_chars, size_t max_bytes) {
+  const auto [body, shown] = escape_prefix(text, max_chars, true, max_bytes);
   return "\"" + body + "\"" + (shown < text.size() ? length_note(text) : "");
 }
 

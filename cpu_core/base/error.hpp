@@ -2,6 +2,7 @@
 // text from the input is put into a message (quote, printable, one_line).
 #pragma once
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -27,12 +28,14 @@ std::string printable(std::string_view text, size_t max_chars = QUOTE_MAX_CHARS)
 
 // How every message quotes input: printable(text) between double quotes, quotes and
 // backslashes escaped as \" and \\, e.g. "my \"glass\"", "\e]0;title\x07", "aaaa"... (200000 bytes).
-std::string quote(std::string_view text, size_t max_chars = QUOTE_MAX_CHARS);
+// `max_bytes` also caps the bytes between the quotes (an escaped byte takes four: \xNN).
+std::string quote(std::string_view text, size_t max_chars = QUOTE_MAX_CHARS, size_t max_bytes = SIZE_MAX);
 
-// Paths are quoted whole up to this many characters (real paths are shorter; a "file"
-// field of megabytes is still cut).
-constexpr size_t QUOTE_PATH_MAX_CHARS = 1024;
-inline std::string quote_path(std::string_view path) { return quote(path, QUOTE_PATH_MAX_CHARS); }
+// Paths are quoted whole up to this many bytes as shown, escapes included (real paths are
+// shorter; a "file" field of megabytes, or a name of control bytes, is still cut), so that
+// a message naming two or three paths stays under 4 KiB.
+constexpr size_t QUOTE_PATH_MAX_BYTES = 1024;
+inline std::string quote_path(std::string_view path) { return quote(path, QUOTE_PATH_MAX_BYTES, QUOTE_PATH_MAX_BYTES); }
 
 // A message made one line and safe for a terminal: each line break becomes `line_break`,
 // a tab a blank, every other control byte is escaped as by printable (nothing is cut), and

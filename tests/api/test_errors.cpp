@@ -179,6 +179,19 @@ TEST(ErrorsQuote, LongTextIsCutWithItsLength) {
   EXPECT_EQ(quote(accents), "\"" + expected + "\"... (200 bytes)");
 }
 
+// A path is cut by the bytes it shows, escapes included: a name of 1,100 control bytes
+// (fuzz_obj's mtllib, once 4,247 bytes of message) shows 256 escapes of 4 bytes, no more.
+TEST(ErrorsQuote, PathIsCutByTheBytesItShows) {
+  const std::string plain(QUOTE_PATH_MAX_BYTES, 'p');
+  EXPECT_EQ(quote_path(plain), "\"" + plain + "\"");  // not cut
+  const std::string controls(1100, '\x01');
+  std::string expected;
+  for (size_t i = 0; i < QUOTE_PATH_MAX_BYTES / 4; ++i) expected += "\\x01";
+  EXPECT_EQ(quote_path(controls), "\"" + expected + "\"... (1100 bytes)");
+  // A cut never splits an escape: 1,023 bytes of room take 255 escapes.
+  EXPECT_EQ(quote(controls, SIZE_MAX, 1023), "\"" + expected.substr(4) + "\"... (1100 bytes)");
+}
+
 TEST(ErrorsQuote, OneLineJoinsLinesAndEscapesTheRest) {
   EXPECT_EQ(one_line("a\nb\r\nc\td  \n"), "a b c d");
   EXPECT_EQ(one_line("shader log:\nline 1\nline 2\n", "; "), "shader log:; line 1; line 2");
