@@ -8,6 +8,7 @@
 
 #include "raster/cube_map.hpp"
 #include "base/error.hpp"
+#include "reference/triangle_test.hpp"
 #include "scene/tie_rule.hpp"
 #include "base/memory.hpp"
 #include "base/timer.hpp"
@@ -405,13 +406,30 @@ void nearest_layer_face(const CubeABuffer& cube, const TriangleSoup& triangles, 
       double best = HUGE_VAL;
       uint32_t best_id = std::numeric_limits<uint32_t>::max(), best_triangle = 0;
       CoverageMask best_mask = 0;
+      const RayQuery centre_ray(cube.centre, d);
+      auto covers_centre = [&](uint32_t triangle) {
+        TriangleHit hit;
+        return intersect_triangle(centre_ray, triangles, triangle, HUGE_VAL, &hit);
+      };
       for (const Fragment& f : b.list(x, y)) {
         if ((f.mask & CENTRE_SAMPLES) == 0) continue;
         const glm::dvec3 r = point_on_triangle_plane(b.view, triangles, f.triangle(), x + 0.5, y + 0.5) - cube.centre;
         const double dist = glm::length(r);
-        // THE TIE RULE (scene/tie_rule.hpp): at the same distance the later object wins.
-        if (glm::dot(r, d) > 0.0 &&
-            (best == HUGE_VAL || seen_before(triangles, d, {f.triangle(), dist}, {best_triangle, best}))) {
+        if (!(glm::dot(r, d) > 0.0)) continue;
+        bool nearer = best == HUGE_VAL;
+        if (!nearer && f.triangle() != best_triangle &&
+            same_distance(triangles, d, {f.triangle(), dist}, {best_triangle, best})) {
+          // Two surfaces at the same distance over the centre samples: coplanar triangles
+          // meeting at an edge that passes between those samples, or coincident ones. The
+          // one whose triangle holds the texel centre itself is what a prepass sampling
+          // the centre sees (the exact ray test); where both or neither do, THE TIE RULE
+          // (scene/tie_rule.hpp): the later object.
+          const bool f_covers = covers_centre(f.triangle()), best_covers = covers_centre(best_triangle);
+          nearer = f_covers != best_covers ? f_covers : ranks_above(triangles, f.triangle(), best_triangle);
+        } else if (!nearer) {
+          nearer = seen_before(triangles, d, {f.triangle(), dist}, {best_triangle, best});
+        }
+        if (nearer) {
           best = dist;
           best_id = triangles.object_id[f.triangle()];
           best_triangle = f.triangle();

@@ -165,7 +165,9 @@ const Fragment* centre_fragment(const ABuffer& buffer, int x, int y);
 // distance from the centre along the texel-centre direction to the plane of the nearest
 // (smallest such distance) fragment covering a centre sample, and its object id. Texels
 // without one hold +infinity and UINT32_MAX. Also the Z-buffered map's layer (Patow 1995).
-// Surfaces at the same distance: THE TIE RULE (scene/tie_rule.hpp) picks, and `tied` marks
+// Surfaces at the same distance: the one whose triangle holds the texel centre itself
+// (coplanar triangles meeting at an edge between the centre samples), else THE TIE RULE
+// (scene/tie_rule.hpp) picks, and `tied` marks
 // the texel (1) when another object's fragment over one of the same centre samples was at
 // that distance (coincident surfaces; two surfaces meeting at an edge cover disjoint samples).
 struct NearestLayer {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 
+#include "raster/raster.hpp"
 #include "raster/samples.hpp"
 #include "scene/camera.hpp"
 
@@ -43,38 +44,44 @@ struct EdgeTies {
 
 }  // namespace
 
-void visit_edge_ties(const SceneData& scene, double eps, const std::function<void(int64_t, int64_t)>& visit) {
-  const Camera& camera = scene.camera;
-  const CameraFrame f = make_camera_frame(camera);
+void visit_edge_ties(const RasterView& view, int columns, int rows, const TriangleSoup& soup, double eps,
+                     const std::function<void(int64_t, int64_t)>& visit) {
   EdgeTies ties;
-  ties.grid_w = int64_t{camera.width} * MASK_COLUMNS;
-  ties.grid_h = int64_t{camera.height} * MASK_ROWS;
+  ties.grid_w = int64_t{view.width} * columns;
+  ties.grid_h = int64_t{view.height} * rows;
   ties.eps = eps;
   ties.visit = &visit;
-  const double sx = 0.5 * double(ties.grid_w) / (f.tan_half_fov_y * f.aspect), sy = 0.5 * double(ties.grid_h) / f.tan_half_fov_y;
-  // Camera space (right, up, forward) of a vertex; then the sample grid (y down).
-  auto to_samples = [&](const glm::dvec3& c) {
-    return glm::dvec2(0.5 * double(ties.grid_w) + sx * c.x / c.z, 0.5 * double(ties.grid_h) - sy * c.y / c.z);
+  // A point r = P - centre with depth w = row_w . r > 0 on the sample grid.
+  auto to_samples = [&](const glm::dvec3& r) {
+    const double w = glm::dot(view.row_w, r);
+    return glm::dvec2(columns * glm::dot(view.row_x, r) / w, rows * glm::dot(view.row_y, r) / w);
   };
-  const std::vector<glm::vec3>& positions = scene.triangles->positions;
-  std::vector<glm::dvec3> c(3);
+  const std::vector<glm::vec3>& positions = soup.positions;
+  std::vector<glm::dvec3> r(3);
+  std::vector<double> w(3);
   double reach = 0;
-  for (const glm::vec3& p : positions) reach = std::max(reach, glm::length(glm::dvec3(p) - f.eye));
+  for (const glm::vec3& p : positions) reach = std::max(reach, glm::length(glm::dvec3(p) - view.centre));
   const double near = 1e-6 * std::max(reach, 1e-300);
   for (size_t t = 0; 3 * t + 2 < positions.size(); ++t) {
     for (size_t k = 0; k < 3; ++k) {
-      const glm::dvec3 r = glm::dvec3(positions[3 * t + k]) - f.eye;
-      c[k] = glm::dvec3(glm::dot(r, f.right), glm::dot(r, f.up), glm::dot(r, f.forward));
+      r[k] = glm::dvec3(positions[3 * t + k]) - view.centre;
+      w[k] = glm::dot(view.row_w, r[k]);
     }
     for (size_t k = 0; k < 3; ++k) {
-      glm::dvec3 a = c[k], b = c[(k + 1) % 3];
-      if (a.z < near && b.z < near) continue;
+      glm::dvec3 a = r[k], b = r[(k + 1) % 3];
+      const double wa = w[k], wb = w[(k + 1) % 3];
+      if (wa < near && wb < near) continue;
       // The part in front of the eye: cut where depth = near (the line is unchanged).
-      if (a.z < near) a = a + (b - a) * ((near - a.z) / (b.z - a.z));
-      if (b.z < near) b = b + (a - b) * ((near - b.z) / (a.z - b.z));
+      if (wa < near) a = a + (b - a) * ((near - wa) / (wb - wa));
+      if (wb < near) b = b + (a - b) * ((near - wb) / (wa - wb));
       ties.edge(to_samples(a), to_samples(b));
     }
   }
+}
+
+void visit_edge_ties(const SceneData& scene, double eps, const std::function<void(int64_t, int64_t)>& visit) {
+  visit_edge_ties(camera_view(make_camera_frame(scene.camera), 1e-4), MASK_COLUMNS, MASK_ROWS, *scene.triangles, eps,
+                  visit);
 }
 
 std::vector<uint8_t> edge_tie_pixels(const SceneData& scene, double eps) {

@@ -21,6 +21,7 @@
 #include <functional>
 #include <vector>
 
+#include "raster/raster.hpp"
 #include "scene/scene_data.hpp"
 
 namespace abcube {
@@ -34,6 +35,10 @@ constexpr double EDGE_TIE_EPS = 1.0 / 128.0;
 // per edge that comes that close).
 void visit_edge_ties(const SceneData& scene, double eps, const std::function<void(int64_t, int64_t)>& visit);
 std::vector<uint8_t> edge_tie_pixels(const SceneData& scene, double eps = EDGE_TIE_EPS);
+// The same for any view (raster.hpp: a camera image, a cube face) with `columns` x `rows`
+// samples a pixel (1 x 1: a GL pass sampling each pixel's centre, as the cube prepass).
+void visit_edge_ties(const RasterView& view, int columns, int rows, const TriangleSoup& soup, double eps,
+                     const std::function<void(int64_t, int64_t)>& visit);
 // The same per sample: (width * 8) x (height * 4), row-major, row 0 at the top (crosscheck).
 std::vector<uint8_t> edge_tie_samples(const SceneData& scene, double eps = EDGE_TIE_EPS);
 

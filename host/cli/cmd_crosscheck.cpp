@@ -43,8 +43,9 @@ struct CrosscheckCommand {
 
     std::printf("crosscheck %s, cube %d, %s\n", scene_path.c_str(), scene.render.cube_resolution,
                 describe_gl(ctx.get()).c_str());
-    std::printf("cube texels: %zu, covered on both %zu, GPU only %zu, CPU only %zu\n", r.texels, r.both_covered,
-                r.gpu_only, r.cpu_only);
+    std::printf("cube texels: %zu, covered on both %zu, GPU only %zu, CPU only %zu; differing within 1/128 of a "
+                "texel of an edge (edge_ties.hpp, apart) %zu\n",
+                r.texels, r.both_covered, r.gpu_only, r.cpu_only, r.texels_edge_ties);
     std::printf("distance |gpu-cpu|/cpu: median %.2e (<= %.0e), p99 %.2e (<= %.0e), max %.2e\n",
                 r.distance_median_rel, tol.distance_median_rel, r.distance_p99_rel, tol.distance_p99_rel,
                 r.distance_max_rel);

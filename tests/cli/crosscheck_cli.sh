@@ -26,9 +26,11 @@ for scene in default hidden_point cornell shadows textured; do
 done
 # Visibility sample by sample (issue 19 part 1): the stats count every camera sample, the
 # disagreement image has a value per pixel, and one scene of every hard-case template (seed 5)
-# has its sample agreement within crosscheck.hpp's tolerance. (The older figures, the
-# interior pixels' colour and the cube's same-object share, do not hold on every template:
-# README "GPU against CPU" says which and why; they are checked on the scenes above.)
+# passes every tolerance of crosscheck.hpp (exit 0), its sample agreement and shadow volumes
+# checked again from the stats. (Before interior pixels had to be one triangle over the
+# whole pixel and its centre, and the nearest layer picked the triangle holding the texel
+# centre between coplanar neighbours, the interior colour and the cube's same-object share
+# failed on some templates: README "GPU against CPU".)
 scene=default
 "$ABCUBE" crosscheck "$REPO/scenes/$scene.json" --cube-res 96 --samples-image "$WORK/samples.exr" \
   --stats "$WORK/samples.json" > /dev/null 2>&1
@@ -42,10 +44,26 @@ else
 fi
 /usr/bin/python3 "$REPO/tools/hard_scenes.py" --seed 5 --count 11 --out "$WORK/hard" --size 96x64 --cube-res 96 > /dev/null
 for scene in "$WORK"/hard/*.json; do
-  "$ABCUBE" crosscheck "$scene" --stats "$WORK/hard.stats.json" > "$WORK/out" 2>&1
-  if python3 -c "import json,sys; d=json.load(open('$WORK/hard.stats.json')); s=d['camera_samples']; v=d['shadows']['volumes']; sys.exit(0 if s['samples'] == 96 * 64 * 32 and s['agreement'] >= 0.9999 and v['interior_agreement'] >= 0.999 else 1)"; then
+  if "$ABCUBE" crosscheck "$scene" --stats "$WORK/hard.stats.json" > "$WORK/out" 2>&1 &&
+     python3 -c "import json,sys; d=json.load(open('$WORK/hard.stats.json')); s=d['camera_samples']; v=d['shadows']['volumes']; sys.exit(0 if s['samples'] == 96 * 64 * 32 and s['agreement'] >= 0.9999 and v['interior_agreement'] >= 0.999 else 1)"; then
     passed=$((passed + 1))
     echo "ok   $(basename "$scene"): $(grep '^camera samples' "$WORK/out"); volumes $(grep 'GPU shadow volumes' "$WORK/out")"
+  else
+    failed=$((failed + 1))
+    echo "FAIL $(basename "$scene"):"
+    cat "$WORK/out"
+  fi
+done
+# Generated scenes on which crosscheck once failed a valid render (tests/cli/crosscheck_regressions,
+# tools/hard_scenes.py --seed 77, 128 x 96, N = 128): thin_features_77_16, interior max abs
+# 0.60 (a wire between the 32 samples over the pixel centre the GPU image samples);
+# nested_glass_77_29, same object 0.99257 (coplanar stripes meeting between the centre
+# samples and the texel centre); seams_highlight (a seams scene without its box), interior
+# max abs 0.0169 > 4/255 (a merged fragment's averaged normal in a sphere's highlight).
+for scene in "$REPO"/tests/cli/crosscheck_regressions/*.json; do
+  if "$ABCUBE" crosscheck "$scene" > "$WORK/out" 2>&1; then
+    passed=$((passed + 1))
+    echo "ok   $(basename "$scene"): $(grep -E '^camera interior' "$WORK/out")"
   else
     failed=$((failed + 1))
     echo "FAIL $(basename "$scene"):"

@@ -347,6 +347,41 @@ TEST(ABuffer, NearestLayerIsThePrepassAtTexelCentres) {
   EXPECT_EQ(centre_fragment(cube.faces[NEG_Z], 0, 0), nullptr);
 }
 
+// Two coplanar quads of two objects meeting at an edge that passes between the texel
+// centre (u = 0.5) and the centre samples' second column (u = 0.5625), at u = 0.53 of the
+// texels of one column: both objects cover centre samples at the same distance. The
+// prepass samples the centre, which the first object holds; THE TIE RULE alone gave the
+// texel to the later object (the seeded "nested_glass" stripes: 88 texels of one row).
+TEST(ABuffer, NearestLayerBetweenCoplanarNeighboursIsTheOneHoldingTheCentre) {
+  SceneData s = facing_camera();
+  const uint32_t m = add_material(s, Material{});
+  const int n = 16, column = 9;
+  const RasterView view = cube_face_view(POS_Z, dvec3(0.0), n, 1e-4);
+  auto on_plane = [&](double x, double y) {
+    const dvec3 d = view.direction(x, y);
+    return d * (2.0 / d.z);
+  };
+  const double x_edge = on_plane(column + 0.53, 8.0).x;
+  const bool u_grows_with_x = on_plane(column + 1.0, 8.0).x > on_plane(column, 8.0).x;
+  const double lo = u_grows_with_x ? -5.0 : x_edge, hi = u_grows_with_x ? x_edge : 5.0;  // holds u < 0.53
+  add_quad(s, {lo, -5, 2}, {hi, -5, 2}, {hi, 5, 2}, {lo, 5, 2}, m);
+  const double lo2 = u_grows_with_x ? x_edge : -5.0, hi2 = u_grows_with_x ? 5.0 : x_edge;
+  add_quad(s, {lo2, -5, 2}, {hi2, -5, 2}, {hi2, 5, 2}, {lo2, 5, 2}, m);
+  const CubeABuffer cube = build_cube_abuffer(s, dvec3(0.0), n, test_options(true));
+  const NearestLayer nl = nearest_layer(cube, *s.triangles);
+  for (int y = 0; y < n; ++y) {
+    const size_t t = static_cast<size_t>(y * n);
+    // Both objects' fragments are over centre samples of the column's texels.
+    int objects_over_centre = 0;
+    for (const Fragment& f : cube.faces[POS_Z].list(column, y)) objects_over_centre += (f.mask & CENTRE_SAMPLES) != 0;
+    EXPECT_EQ(objects_over_centre, 2) << "texel " << column << ", " << y;
+    EXPECT_EQ(nl.object.faces[POS_Z][t + column], 0u) << "texel " << column << ", " << y;
+    EXPECT_EQ(nl.tied.faces[POS_Z][t + column], 0u);  // disjoint samples: not coincident
+    EXPECT_EQ(nl.object.faces[POS_Z][t + column - 1], 0u);
+    EXPECT_EQ(nl.object.faces[POS_Z][t + column + 1], 1u);
+  }
+}
+
 // The whole convention against the exact tracer: along each texel-centre direction of the
 // repository scene, the first hit's distance and object are what nearest_layer holds, and
 // the hit triangle's fragment, when it has one, brackets the hit distance. Texels where an
