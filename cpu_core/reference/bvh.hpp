@@ -92,6 +92,9 @@ class Bvh {
   size_t triangle_count() const { return all_ ? soup_->triangle_count() : triangles_.size(); }
   // Its k-th triangle's index in the soup.
   uint32_t triangle(uint32_t k) const { return all_ ? k : triangles_[k]; }
+  // The soup's triangles it was built over (the second constructor), ascending as given;
+  // empty for the whole soup.
+  const std::vector<uint32_t>& subset() const { return triangles_; }
   const TriangleSoup& soup() const { return *soup_; }
   // The largest absolute vertex coordinate, M.
   double magnitude() const { return magnitude_; }

@@ -390,29 +390,33 @@ std::vector<uint32_t> edge_partners(const TriangleSoup& soup, size_t first, size
   ABCUBE_CHECK(3 * (first + count) <= soup.positions.size() && 3 * count < NO_PARTNER - 1, "triangle range");
   const glm::vec3* p = soup.positions.data() + 3 * first;
   const uint32_t* object = soup.object_id.data() + first;
-  // Vertex ids: the first corner with the same object and position.
-  std::vector<uint32_t> vertex = first_equal(
-      3 * count,
-      [&](uint32_t c) {
-        const VertexKey k = vertex_key(p[c]);
-        return mix64((uint64_t{k.bits[0]} << 32 | k.bits[1]) ^ mix64(uint64_t{k.bits[2]} << 32 | object[c / 3]));
-      },
-      [&](uint32_t a, uint32_t b) { return object[a / 3] == object[b / 3] && vertex_key(p[a]) == vertex_key(p[b]); },
-      [](uint32_t) { return false; });
-  // Edge ids: the first half-edge with the same two vertices, in either order.
-  const auto ends = [&](uint32_t h) {
-    const uint64_t a = vertex[h], b = vertex[h - h % 3 + (h % 3 + 1) % 3];
-    return std::min(a, b) << 32 | std::max(a, b);
+  // Edge ids: the first half-edge of the same object whose two end positions are the same
+  // (bit for bit, -0 = +0), in either order. Compared by position, not through per-corner
+  // vertex ids: no second array of 4 bytes a corner beside the answer (peak memory).
+  const auto next = [](uint32_t c) { return c - c % 3 + (c % 3 + 1) % 3; };
+  const auto vertex_hash = [&](uint32_t c) {
+    const VertexKey k = vertex_key(p[c]);
+    return mix64((uint64_t{k.bits[0]} << 32 | k.bits[1]) ^ mix64(uint64_t{k.bits[2]} << 32 | object[c / 3]));
   };
-  const std::vector<uint32_t> edge = first_equal(
-      3 * count, [&](uint32_t h) { return mix64(ends(h)); }, [&](uint32_t a, uint32_t b) { return ends(a) == ends(b); },
-      [&](uint32_t h) { return vertex[h] == vertex[h - h % 3 + (h % 3 + 1) % 3]; });
-  vertex = {};
-  // Pair each half-edge with the first of its edge; a third one unpairs the edge.
+  const auto same_vertex = [&](uint32_t a, uint32_t b) { return vertex_key(p[a]) == vertex_key(p[b]); };
+  std::vector<uint32_t> partner = first_equal(
+      3 * count,
+      [&](uint32_t h) {
+        const uint64_t a = vertex_hash(h), b = vertex_hash(next(h));
+        return mix64(std::min(a, b) ^ mix64(std::max(a, b)));
+      },
+      [&](uint32_t a, uint32_t b) {
+        if (object[a / 3] != object[b / 3]) return false;
+        return (same_vertex(a, b) && same_vertex(next(a), next(b))) || (same_vertex(a, next(b)) && same_vertex(next(a), b));
+      },
+      [&](uint32_t h) { return same_vertex(h, next(h)); });
+  // Pair each half-edge with the first of its edge; a third one unpairs the edge. In place:
+  // entry h holds h's edge id until h is reached, its partner after (every write goes to
+  // an entry at or before h, already reached).
   constexpr uint32_t SHARED = NO_PARTNER - 1;  // an edge of three or more half-edges
-  std::vector<uint32_t> partner(3 * count, NO_PARTNER);
   for (uint32_t h = 0; h < partner.size(); ++h) {
-    const uint32_t f = edge[h];
+    const uint32_t f = partner[h];
+    partner[h] = NO_PARTNER;
     if (f == NO_PARTNER || f == h) continue;
     if (partner[f] == NO_PARTNER) {
       partner[f] = h;

@@ -13,8 +13,10 @@ namespace abcube {
 
 SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube,
                              std::shared_ptr<const MeshNeighbours> neighbours)
-    : scene_(&scene), cube_(&cube), media_(scene), positions_(scene.triangles->positions.data()),
-      neighbours_(std::move(neighbours)) {
+    : SearchContext(scene, cube, NeighboursSource([given = std::move(neighbours)] { return given; })) {}
+
+SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube, const NeighboursSource& neighbours)
+    : scene_(&scene), cube_(&cube), media_(scene), positions_(scene.triangles->positions.data()) {
   const TriangleSoup& soup = *scene.triangles;
   const uint32_t count = static_cast<uint32_t>(soup.triangle_count());
   // The raster's own rule decides which triangles the map cannot hold (raster.hpp).
@@ -23,7 +25,6 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube,
   for (uint32_t k = 0; k < count; ++k) {
     if (setup_triangle(view, soup, k, &setup) == SetupResult::edge_on) zero_area_.push_back(k);
   }
-  if (!neighbours_) neighbours_ = std::make_shared<const MeshNeighbours>(build_mesh_neighbours(soup));
   // Where each face holds fragments, row by row (empty_ahead), BLOCK BOUNDS, and which
   // triangles have a fragment (THE SIDE STRUCTURE).
   std::vector<uint8_t> seen(count, 0);
@@ -75,7 +76,9 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube,
     }
   }
   build_pyramid();
-  build_side_structure(seen);
+  build_side_structure(std::move(seen));
+  if (neighbours) neighbours_ = neighbours();
+  if (!neighbours_) neighbours_ = std::make_shared<const MeshNeighbours>(build_mesh_neighbours(soup));
 }
 
 // THE Z PYRAMID (search.hpp): each level from the 2 x 2 nodes of the one below, halving
@@ -121,23 +124,23 @@ size_t SearchContext::block_bounds_bytes() const {
 
 // THE SIDE STRUCTURE (search.hpp): the zero-area triangles and those without a fragment,
 // non-degenerate (a plane), in a BVH of their own.
-void SearchContext::build_side_structure(const std::vector<uint8_t>& seen) {
+void SearchContext::build_side_structure(std::vector<uint8_t> seen) {
+  std::vector<uint32_t> side;
   for (uint32_t k = 0; k < seen.size(); ++k) {
     const bool zero_area = std::binary_search(zero_area_.begin(), zero_area_.end(), k);
-    if ((zero_area || !seen[k]) && plane(k).normal != glm::dvec3(0.0)) side_.push_back(k);
+    if ((zero_area || !seen[k]) && plane(k).normal != glm::dvec3(0.0)) side.push_back(k);
   }
-  if (side_.empty()) return;
-  side_bvh_ = std::make_shared<const Bvh>(*scene_->triangles, side_);
+  seen = std::vector<uint8_t>();  // freed before the tree is built
+  if (side.empty()) return;
+  side.shrink_to_fit();
+  side_bvh_ = std::make_shared<const Bvh>(*scene_->triangles, std::move(side));
 }
 
 // Vertices are the same when their object and float position are (bit for bit, -0 = +0);
 // an edge links the two triangles that have it, in either direction (tessellate.hpp).
 MeshNeighbours build_mesh_neighbours(const TriangleSoup& soup) {
-  std::vector<uint32_t> partner = edge_partners(soup, 0, soup.triangle_count());
-  MeshNeighbours neighbours(soup.triangle_count());
-  for (size_t h = 0; h < partner.size(); ++h) {
-    neighbours[h / 3][h % 3] = partner[h] == NO_PARTNER ? SearchContext::NO_NEIGHBOUR : partner[h] / 3;
-  }
+  MeshNeighbours neighbours{edge_partners(soup, 0, soup.triangle_count())};
+  for (uint32_t& q : neighbours.across) q = q == NO_PARTNER ? SearchContext::NO_NEIGHBOUR : q / 3;
   return neighbours;
 }
 

@@ -69,7 +69,9 @@ MapShader::MapShader(const SceneData& scene, const CubeABuffer& cube, const MapS
                      const RayTracer* reference, const SceneCache* cache)
     : scene_(scene), cube_(cube), options_(options), reference_(reference) {
   options_.search.layers = options.method == Method::zbuffer ? SearchLayers::nearest : SearchLayers::all;
-  ctx_ = std::make_unique<SearchContext>(scene, cube, cache ? cache->neighbours() : nullptr);
+  ctx_ = std::make_unique<SearchContext>(scene, cube, [cache]() -> std::shared_ptr<const MeshNeighbours> {
+    return cache ? cache->neighbours() : nullptr;  // asked for once the side structure is built
+  });
   lens_of_object_.assign(scene.objects.size(), -1);
   if (options_.refraction != RefractionMode::search) {
     lenses_ = cache ? *cache->lenses() : fit_lenses(scene);
