@@ -1,10 +1,12 @@
 // The memory a render of a scene needs, estimated before it starts (scene_load.hpp).
+#include <algorithm>
 #include <string>
 
 #include "base/error.hpp"
 #include "base/memory.hpp"
 #include "scene/scene_json.hpp"
 #include "scene/scene_load.hpp"
+#include "scene/shadow_volume.hpp"
 
 namespace abcube {
 
@@ -18,8 +20,19 @@ constexpr uint64_t MIB = uint64_t{1} << 20;
 // pyramid of the searches (or the gpu method's cube textures). A triangle:
 // SCENE_TRIANGLE_BYTES, and the gpu method adds the GL vertex buffer (3 vertices of 32
 // bytes, gl_passes.cpp) and what llvmpipe holds while it draws them (about 90 more,
-// measured from /proc/self/statm around the first draw; gpu measured 380 a triangle at 1M
-// triangles, marginal 230). A shadow-casting light under gpu: a cube map of N x N floats.
+// measured from /proc/self/statm around the first draw; gpu with --gpu-shadows maps
+// measured a marginal 239 a triangle, 2026-11-25). A shadow-casting light under gpu: a
+// cube map of N x N floats.
+// Shadow volumes (gpu and hybrid, gl_camera_exact.cpp): each volume light's near and far
+// caps are 6 vertices a triangle in a GL buffer, one light's vertices are built on the CPU
+// while the buffers before it are held, and the side pairing holds 16 bytes a corner: at
+// 1M triangles under two lights bench/memory.py measured 823 bytes a triangle above the
+// baseline in all, where this gives 836 (sides beyond a mesh's silhouettes are not counted:
+// a soup of disjoint triangles has more). --gpu-shadows maps needs none of it; the
+// estimate, made before the method's options are read, counts it for every gpu render.
+constexpr uint64_t VOLUME_TRIANGLE_BYTES = 6 * sizeof(ShadowVolumeVertex);
+constexpr uint64_t VOLUME_PAIRING_TRIANGLE_BYTES = 3 * 16;
+constexpr uint64_t MAX_VOLUME_LIGHTS = 128;  // gl_passes.hpp: lights past it use maps
 constexpr uint64_t PIXEL_BYTES = 3 * sizeof(float) + 64;
 constexpr uint64_t TEXEL_BYTES = 64;
 constexpr uint64_t GL_TRIANGLE_BYTES = 3 * 32 + 90;
@@ -45,7 +58,9 @@ uint64_t estimate_render_bytes(const SceneData& scene) {
   const bool gpu = scene.render.method == Method::gpu || scene.render.method == Method::hybrid;
   uint64_t shadow_lights = 0;
   for (const PointLight& l : scene.lights) shadow_lights += l.cast_shadows ? 1 : 0;
-  const uint64_t per_triangle = SCENE_TRIANGLE_BYTES + (gpu ? GL_TRIANGLE_BYTES : 0);
+  const uint64_t volume_lights = std::min(shadow_lights, MAX_VOLUME_LIGHTS);
+  const uint64_t volumes = volume_lights > 0 ? (volume_lights + 1) * VOLUME_TRIANGLE_BYTES + VOLUME_PAIRING_TRIANGLE_BYTES : 0;
+  const uint64_t per_triangle = SCENE_TRIANGLE_BYTES + (gpu ? GL_TRIANGLE_BYTES + volumes : 0);
   return pixels * PIXEL_BYTES + 6 * n * n * TEXEL_BYTES + scene.triangles->triangle_count() * per_triangle +
          (gpu ? shadow_lights * n * n * GL_SHADOW_TEXEL_BYTES : 0);
 }

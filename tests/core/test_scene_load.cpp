@@ -911,13 +911,18 @@ TEST(SceneLoadMemory, EstimateAndBudget) {
   // and what llvmpipe holds while drawing (about 90).
   SceneData gpu = s;
   gpu.render.method = Method::gpu;
-  // and a cube shadow map of N x N floats per shadow-casting light (the scene has one).
+  // and a cube shadow map of N x N floats per shadow-casting light (the scene has one),
+  // and its shadow volume: near and far caps, 6 vertices of 24 bytes a triangle, held
+  // for each volume light and built for one more, and the side pairing's 48.
   ASSERT_EQ(gpu.lights.size(), 1u);
-  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90) + 6u * 100 * 100 * 4);
+  const uint64_t volume = 6 * 24;
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90 + 2 * volume + 48) + 6u * 100 * 100 * 4);
   gpu.lights.push_back(gpu.lights.front());
-  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90) + 2 * 6u * 100 * 100 * 4);
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90 + 3 * volume + 48) + 2 * 6u * 100 * 100 * 4);
   gpu.lights.back().cast_shadows = false;
-  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90) + 6u * 100 * 100 * 4);
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90 + 2 * volume + 48) + 6u * 100 * 100 * 4);
+  gpu.lights.front().cast_shadows = false;  // no shadows: no volumes, no maps
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90));
   // A huge cube map is refused by its estimate, not by an allocation failure.
   text.render = R"({"cube_resolution": 16384})";
   EXPECT_GT(estimate_render_bytes(load_text(text.str())), uint64_t{6} * 16384 * 16384 * 32);
