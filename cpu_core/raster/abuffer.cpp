@@ -410,10 +410,9 @@ void nearest_layer_face(const CubeABuffer& cube, const TriangleSoup& triangles, 
       double best = HUGE_VAL;
       uint32_t best_id = std::numeric_limits<uint32_t>::max(), best_triangle = 0;
       CoverageMask best_mask = 0;
-      const RayQuery centre_ray(cube.centre, d);
-      auto covers_centre = [&](uint32_t triangle) {
+      auto covers_centre = [&](uint32_t triangle) {  // only at a tie: not on the common path
         TriangleHit hit;
-        return intersect_triangle(centre_ray, triangles, triangle, HUGE_VAL, &hit);
+        return intersect_triangle(RayQuery(cube.centre, d), triangles, triangle, HUGE_VAL, &hit);
       };
       for (const Fragment& f : b.list(x, y)) {
         if ((f.mask & CENTRE_SAMPLES) == 0) continue;

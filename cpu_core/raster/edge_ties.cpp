@@ -80,8 +80,9 @@ void visit_edge_ties(const RasterView& view, int columns, int rows, const Triang
 }
 
 void visit_edge_ties(const SceneData& scene, double eps, const std::function<void(int64_t, int64_t)>& visit) {
-  visit_edge_ties(camera_view(make_camera_frame(scene.camera), 1e-4), MASK_COLUMNS, MASK_ROWS, *scene.triangles, eps,
-                  visit);
+  const double unused_near = 1e-4;  // the walk cuts edges at its own near depth
+  visit_edge_ties(camera_view(make_camera_frame(scene.camera), unused_near), MASK_COLUMNS, MASK_ROWS, *scene.triangles,
+                  eps, visit);
 }
 
 std::vector<uint8_t> edge_tie_pixels(const SceneData& scene, double eps) {

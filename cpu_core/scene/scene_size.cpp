@@ -32,7 +32,6 @@ constexpr uint64_t MIB = uint64_t{1} << 20;
 // estimate, made before the method's options are read, counts it for every gpu render.
 constexpr uint64_t VOLUME_TRIANGLE_BYTES = 6 * sizeof(ShadowVolumeVertex);
 constexpr uint64_t VOLUME_PAIRING_TRIANGLE_BYTES = 3 * 16;
-constexpr uint64_t MAX_VOLUME_LIGHTS = 128;  // gl_passes.hpp: lights past it use maps
 constexpr uint64_t PIXEL_BYTES = 3 * sizeof(float) + 64;
 constexpr uint64_t TEXEL_BYTES = 64;
 constexpr uint64_t GL_TRIANGLE_BYTES = 3 * 32 + 90;
@@ -58,7 +57,7 @@ uint64_t estimate_render_bytes(const SceneData& scene) {
   const bool gpu = scene.render.method == Method::gpu || scene.render.method == Method::hybrid;
   uint64_t shadow_lights = 0;
   for (const PointLight& l : scene.lights) shadow_lights += l.cast_shadows ? 1 : 0;
-  const uint64_t volume_lights = std::min(shadow_lights, MAX_VOLUME_LIGHTS);
+  const uint64_t volume_lights = std::min(shadow_lights, uint64_t{MAX_VOLUME_LIGHTS});
   const uint64_t volumes = volume_lights > 0 ? (volume_lights + 1) * VOLUME_TRIANGLE_BYTES + VOLUME_PAIRING_TRIANGLE_BYTES : 0;
   const uint64_t per_triangle = SCENE_TRIANGLE_BYTES + (gpu ? GL_TRIANGLE_BYTES + volumes : 0);
   return pixels * PIXEL_BYTES + 6 * n * n * TEXEL_BYTES + scene.triangles->triangle_count() * per_triangle +

@@ -47,6 +47,11 @@ struct ShadowVolume {
 // no light is dimmed by them, elsewhere the product of their transmittances is needed).
 enum class Blockers { opaque, translucent };
 
+// Volumes a render counts at most (opaque, and translucent where any, per light): four a
+// layer of an RGBA32F array (gl_camera_exact.cpp); lights past them keep their cube shadow
+// maps. The memory estimate (scene_size.cpp) counts no more.
+constexpr int MAX_VOLUME_LIGHTS = 128;
+
 // The volume of the light at `light` over the scene's blockers of that kind.
 ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light, Blockers kind = Blockers::opaque);
 

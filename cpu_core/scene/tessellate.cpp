@@ -386,6 +386,13 @@ size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t obj
   return dropped;
 }
 
+namespace {
+
+// The corner after corner c of its triangle (corners 3t, 3t + 1, 3t + 2).
+uint32_t next_corner(uint32_t c) { return c - c % 3 + (c % 3 + 1) % 3; }
+
+}  // namespace
+
 std::vector<uint32_t> edge_partners(const TriangleSoup& soup, size_t first, size_t count) {
   ABCUBE_CHECK(3 * (first + count) <= soup.positions.size() && 3 * count < NO_PARTNER - 1, "triangle range");
   const glm::vec3* p = soup.positions.data() + 3 * first;
@@ -393,7 +400,6 @@ std::vector<uint32_t> edge_partners(const TriangleSoup& soup, size_t first, size
   // Edge ids: the first half-edge of the same object whose two end positions are the same
   // (bit for bit, -0 = +0), in either order. Compared by position, not through per-corner
   // vertex ids: no second array of 4 bytes a corner beside the answer (peak memory).
-  const auto next = [](uint32_t c) { return c - c % 3 + (c % 3 + 1) % 3; };
   const auto vertex_hash = [&](uint32_t c) {
     const VertexKey k = vertex_key(p[c]);
     return mix64((uint64_t{k.bits[0]} << 32 | k.bits[1]) ^ mix64(uint64_t{k.bits[2]} << 32 | object[c / 3]));
@@ -402,14 +408,15 @@ std::vector<uint32_t> edge_partners(const TriangleSoup& soup, size_t first, size
   std::vector<uint32_t> partner = first_equal(
       3 * count,
       [&](uint32_t h) {
-        const uint64_t a = vertex_hash(h), b = vertex_hash(next(h));
+        const uint64_t a = vertex_hash(h), b = vertex_hash(next_corner(h));
         return mix64(std::min(a, b) ^ mix64(std::max(a, b)));
       },
       [&](uint32_t a, uint32_t b) {
         if (object[a / 3] != object[b / 3]) return false;
-        return (same_vertex(a, b) && same_vertex(next(a), next(b))) || (same_vertex(a, next(b)) && same_vertex(next(a), b));
+        const uint32_t a2 = next_corner(a), b2 = next_corner(b);
+        return (same_vertex(a, b) && same_vertex(a2, b2)) || (same_vertex(a, b2) && same_vertex(a2, b));
       },
-      [&](uint32_t h) { return same_vertex(h, next(h)); });
+      [&](uint32_t h) { return same_vertex(h, next_corner(h)); });
   // Pair each half-edge with the first of its edge; a third one unpairs the edge. In place:
   // entry h holds h's edge id until h is reached, its partner after (every write goes to
   // an entry at or before h, already reached).
@@ -434,11 +441,10 @@ bool is_closed_surface(const TriangleSoup& soup, size_t first, size_t count) {
   if (count == 0) return false;
   const std::vector<uint32_t> partner = edge_partners(soup, first, count);
   const glm::vec3* p = soup.positions.data() + 3 * first;
-  const auto next = [](uint32_t c) { return c - c % 3 + (c % 3 + 1) % 3; };
   for (uint32_t h = 0; h < partner.size(); ++h) {
     // Every edge shared by exactly two half-edges running in opposite directions.
     const uint32_t q = partner[h];
-    if (q == NO_PARTNER || !(vertex_key(p[h]) == vertex_key(p[next(q)]))) return false;
+    if (q == NO_PARTNER || !(vertex_key(p[h]) == vertex_key(p[next_corner(q)]))) return false;
   }
   return true;
 }

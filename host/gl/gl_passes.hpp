@@ -10,6 +10,7 @@
 #include "io/image.hpp"
 #include "scene/planar_reflectors.hpp"
 #include "scene/scene_data.hpp"
+#include "scene/shadow_volume.hpp"
 #include "shading/map_shading.hpp"
 
 namespace abcube {
@@ -51,7 +52,6 @@ constexpr int MAX_TEXTURE_ARRAYS = 4;
 // blockers by shadow volumes counted depth-fail (course notes 3.3; Everitt & Kilgard 2002).
 // What it cannot (curved mirrors, refraction, coverage transparency, more than
 // MAX_VOLUME_LIGHTS lights) keeps the cube maps: the environment map and the shadow maps.
-constexpr int MAX_VOLUME_LIGHTS = 128;  // counts (opaque, and translucent where any): four a layer of an RGBA32F array
 struct ExactCameraOptions {
   bool planar_mirrors = false;  // stencil portals for planar_reflectors.hpp's mirrors
   bool shadow_volumes = false;  // shadow volumes for the shadow-casting lights
