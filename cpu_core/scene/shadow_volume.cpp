@@ -51,6 +51,11 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
     if (!(facing != 0.0) || !std::isfinite(facing)) continue;  // degenerate, or edge-on to the light
     const bool reversed = facing < 0.0;  // oriented cap: (a, c, b)
     const uint32_t object = soup.object_id[t];
+    // A closed object's triangles facing away from the light add nothing: a segment from a
+    // point to the light that meets the object enters it, seen from the light, through a
+    // triangle facing the light, whose prism holds the point (its winding faces out:
+    // scene_load.cpp). Their prisms only doubled the count inside those, and the fill.
+    if (reversed && scene.objects[object].closed) continue;
     ++out.blockers;
     // Near cap, the triangle's own vertices in their own order; far cap, reversed.
     for (int k = 0; k < 3; ++k) push(glm::vec4(p[k], 1.f), object, reversed);
