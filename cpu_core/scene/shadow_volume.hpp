@@ -4,9 +4,7 @@
 // the light, exactly where shadow maps compare depths at a texel's resolution.
 //
 // Every blocker triangle (opaque: blocker_transmittance 0; its plane not through the light,
-// plane_holds_light; of a closed object, only those facing the light: the first surface a
-// ray from the light meets on a closed object is one of them) bounds the prism of points
-// behind it as seen from the light: its near
+// plane_holds_light) bounds the prism of points behind it as seen from the light: its near
 // cap (the triangle), its far cap (its corners pushed to infinity along the light's rays:
 // homogeneous w = 0), and one side per edge (the edge and its two rays to infinity). Each
 // prism is closed and oriented outward (near cap towards the light), so along any ray the

@@ -154,37 +154,38 @@ TEST(ShadowVolume, BlockersByKindAndLightsOnSurfacesLeftOut) {
     {"type": "box", "min": [2, 0, -1], "max": [3, 1, 1], "material": "glass"},
     {"type": "quad", "vertices": [[-5, 0, -5], [-5, 0, 5], [5, 0, 5], [5, 0, -5]], "material": "veil"}])");
   std::string why;
-  // The light above the matte box (x and z within it): of a closed box only the faces
-  // towards the light cast (its top), two triangles.
   const ShadowVolume opaque = build_shadow_volume(s, glm::dvec3(0.3, 4, 0.2));
-  EXPECT_EQ(opaque.blockers, 2u);  // the matte box alone
+  EXPECT_EQ(opaque.blockers, 12u);  // the matte box alone
   EXPECT_TRUE(closed_and_oriented(opaque, &why)) << why;
   const ShadowVolume translucent = build_shadow_volume(s, glm::dvec3(0.3, 4, 0.2), Blockers::translucent);
-  EXPECT_EQ(translucent.blockers, 4u + 2u);  // the glass box's top and -x face, and the open veil's two triangles
+  EXPECT_EQ(translucent.blockers, 12u + 2u);  // the glass box and the veil
   EXPECT_TRUE(closed_and_oriented(translucent, &why)) << why;
   // A light on the floor's plane y = 0 (rule "shadows": plane_holds_light): the veil casts
-  // nothing, nor the glass box's bottom face in the same plane; its -x and +z faces face
-  // the light.
+  // nothing, nor the glass box's bottom face (two triangles) in the same plane.
   const ShadowVolume on = build_shadow_volume(s, glm::dvec3(0.3, 0, 4), Blockers::translucent);
-  EXPECT_EQ(on.blockers, 4u);
-  EXPECT_TRUE(closed_and_oriented(on, &why)) << why;
+  EXPECT_EQ(on.blockers, 12u - 2u);
+}
+
+// A closed box casts from all its faces, those facing away from the light too: with the
+// light inside it, or on one of its faces (which casts nothing), no light-facing face lies
+// between the light and a point behind the box. (Leaving them out was tried: the light on
+// a mirror of tests/cli/flat_mirrors.sh lost its shadows, 18.5 dB.)
+TEST(ShadowVolume, AClosedBoxCastsFromEveryFace) {
+  const SceneData s = scene_of(MATERIALS, R"([{"type": "box", "min": [-1, 0, -1], "max": [1, 1, 1], "material": "matte"}])");
+  ASSERT_TRUE(s.objects[0].closed);
+  std::string why;
+  const ShadowVolume inside = build_shadow_volume(s, glm::dvec3(0.1, 0.5, 0.2));
+  EXPECT_EQ(inside.blockers, 12u);
+  EXPECT_TRUE(closed_and_oriented(inside, &why)) << why;
+  const ShadowVolume on_top = build_shadow_volume(s, glm::dvec3(0.1, 1.0, 0.2));
+  EXPECT_EQ(on_top.blockers, 10u);  // every face but the top, whose plane holds the light
+  EXPECT_TRUE(closed_and_oriented(on_top, &why)) << why;
 }
 
 TEST(ShadowVolume, SmoothMeshesStayClosed) {
   const SceneData s = scene_of(MATERIALS, R"([{"type": "sphere", "center": [0, 1, 0], "radius": 0.7, "segments": 24, "material": "matte"}])");
-  const glm::dvec3 light(1, 5, 2);
-  const ShadowVolume v = build_shadow_volume(s, light);
-  // A closed sphere: its triangles facing the light, and the sides of its silhouette.
-  size_t facing = 0;
-  const TriangleSoup& soup = *s.triangles;
-  for (size_t t = 0; t < soup.triangle_count(); ++t) {
-    const glm::dvec3 a(soup.positions[3 * t]), b(soup.positions[3 * t + 1]), c(soup.positions[3 * t + 2]);
-    facing += glm::dot(glm::cross(b - a, c - a), light - a) > 0.0;
-  }
-  ASSERT_TRUE(s.objects[0].closed);
-  EXPECT_EQ(v.blockers, facing);
-  EXPECT_GT(facing, soup.triangle_count() / 3);
-  EXPECT_LT(facing, 2 * soup.triangle_count() / 3);
+  const ShadowVolume v = build_shadow_volume(s, glm::dvec3(1, 5, 2));
+  EXPECT_EQ(v.blockers, s.triangles->triangle_count());
   EXPECT_GT(v.sides_cancelled, 0u);
   std::string why;
   EXPECT_TRUE(closed_and_oriented(v, &why)) << why;
