@@ -49,8 +49,8 @@ uniform sampler2DArray u_textures[MAX_TEXTURE_ARRAYS];
 // True: level 0 only (zero derivatives), the CPU's point sample (abcube crosscheck).
 uniform bool u_texture_level0;
 
-vec3 diffuse_color(MaterialGpu m, vec2 uv) {
-  vec2 dx = dFdx(uv), dy = dFdy(uv);
+// dx, dy: the change of uv from one sample to the next along x and y (the footprint).
+vec3 diffuse_color_footprint(MaterialGpu m, vec2 uv, vec2 dx, vec2 dy) {
   if (u_texture_level0) dx = dy = vec2(0.0);
   float code = m.transmission.w;
   if (code < 0.0) return m.color_ambient.rgb;
@@ -63,3 +63,5 @@ vec3 diffuse_color(MaterialGpu m, vec2 uv) {
   else t = textureGrad(u_textures[3], coordinate, dx, dy).rgb;
   return m.color_ambient.rgb * t;
 }
+
+vec3 diffuse_color(MaterialGpu m, vec2 uv) { return diffuse_color_footprint(m, uv, dFdx(uv), dFdy(uv)); }

@@ -3,15 +3,21 @@
 // with N turned to face the viewer (two-sided lighting). p is relative to the eye.
 
 // Shadow volumes (gl_camera_exact.cpp): per camera sample and volume light (the light's
-// color.w, -1: none; light b is channel b % 4 of layer b / 4), the depth-fail count of its
+// color.w, -1: none; count b is layer b), the depth-fail count of its
 // volume's faces behind the surface (shadow_volume.frag): the number of opaque blockers'
 // prisms holding the surface point, 0 when none lies between it and the light. Camera
 // passes only.
 uniform bool u_volumes;
 uniform sampler2DArray u_volume_counts;
 
+// A pass that shades a group of samples at once (camera_groups.frag) gives their common
+// answer instead: bit b of volume_set (volume_from_set true).
+bool volume_from_set = false;
+uvec4 volume_set = uvec4(0u);
+
 bool volume_blocked(int b) {
-  return texelFetch(u_volume_counts, ivec3(ivec2(gl_FragCoord.xy), b / 4), 0)[b % 4] != 0.0;
+  if (volume_from_set) return ((volume_set[b / 32] >> uint(b % 32)) & 1u) != 0u;
+  return texelFetch(u_volume_counts, ivec3(ivec2(gl_FragCoord.xy), b), 0).r != 0.0;
 }
 
 // S_l (rule "shadows", as the CPU's shadow search and the exact tracer): 0 when an opaque

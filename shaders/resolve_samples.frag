@@ -3,8 +3,13 @@
 // pixel, so that the exact camera pass reads back pixels, not samples. RGB: the mean of
 // the 32 samples (as the CPU resolve weighs its masks); alpha: how many of them met a
 // surface the GPU approximates (camera_exact.frag's alpha above 0; 0: the pixel is exact).
+// With per-pixel shading (u_pixels, camera_groups.frag), a pixel whose weight's alpha is not
+// -1 was shaded whole: C = color + weight * mean, and its samples are approximate where
+// its colour is, or where what they show behind it is (weight.a 1).
 uniform sampler2D u_samples;
 uniform ivec2 u_margin;  // the tile's margin (gl_passes_internal.hpp SampleTiles), not kept
+uniform bool u_pixels;
+uniform sampler2D u_pixel_color, u_pixel_weight;  // per pixel of the target, margins included
 layout(location = 0) out vec4 o_pixel;
 
 void main() {
@@ -19,4 +24,10 @@ void main() {
     }
   }
   o_pixel = vec4(sum / 32.0, approximate);
+  if (!u_pixels) return;
+  ivec2 pixel = base / ivec2(8, 4);
+  vec4 weight = texelFetch(u_pixel_weight, pixel, 0);
+  if (weight.a < 0.0) return;
+  vec4 color = texelFetch(u_pixel_color, pixel, 0);
+  o_pixel = vec4(color.rgb + weight.rgb * o_pixel.rgb, color.a != 0.0 ? 32.0 : weight.a != 0.0 ? approximate : 0.0);
 }

@@ -23,6 +23,10 @@ uniform dvec3 u_center;
 // THE TIE RULE (cpu_core/scene/tie_rule.hpp): window depth near/w scaled by
 // 1 + u_tie_step (object + 1), so at equal depth the later object passes GL_GREATER.
 uniform float u_tie_step;
+// The planar reflector (+ 1) a virtual view is seen through (gl_camera_exact.cpp): its
+// triangles are left out, every vertex put at the clip origin (w = 0), where no triangle is
+// drawn. 0: none.
+uniform uint u_skip_portal;
 
 invariant gl_Position;
 out vec3 v_relative;  // position relative to the eye, interpolated perspective-correctly
@@ -38,6 +42,7 @@ void main() {
   vec4 relative = a_position.w == 0.0 ? a_position : vec4(vec3(dvec3(a_position.xyz) - u_center), 1.0);
   gl_Position = u_clip * relative;
   gl_Position.z *= 1.0 + u_tie_step * float(a_object + 1u);
+  if (u_skip_portal != 0u && a_portal == u_skip_portal) gl_Position = vec4(0.0);
   gl_ClipDistance[0] = dot(u_clip_plane, relative);  // at infinity: its direction's side
   v_relative = relative.xyz;
   v_normal = a_normal;

@@ -54,6 +54,9 @@ void RenderFlags::add_to(CLI::App* cmd) {
   cmd->add_option("--gpu-max-views", options.gpu_max_views,
                   "gpu: mirror views drawn per camera tile, at most (a mirror past it shows the cube texture)")
       ->capture_default_str()->check(CLI::Range(0, 1 << 20));
+  cmd->add_option("--gpu-shading", options.gpu_shading,
+                  "gpu: shade once a pixel and surface, its samples grouped by triangle and shadow | once a sample")
+      ->capture_default_str();
   cmd->add_flag("--fresnel", [this](int64_t) { options.fresnel = true; }, "Schlick weights for kr and kt");
   cmd->add_option("--max-layers", options.max_layers, "A-buffer layers kept per list, 0 = all")
       ->capture_default_str()->check(CLI::Range(0, 1 << 20));

@@ -27,8 +27,8 @@
 //
 // SHADOW VOLUMES (course notes 3.3; Everitt & Kilgard 2002, shadow_volume.hpp). Before a
 // view's colour: its depth alone, then per volume light the count of its volume's faces
-// behind or at the visible surface (+1 back, -1 front), in the light's channel of a layered
-// float target (additive blending, four lights a layer). The colour pass (depth EQUAL: the
+// behind or at the visible surface (+1 back, -1 front), in the light's layer of a layered
+// float target (additive blending). The colour pass (depth EQUAL: the
 // same surfaces) reads them: S_l = 0 where the count is not 0 (common_shading.glsl). Virtual
 // views count the volumes through their own model matrix, clipped at their mirror like the
 // surfaces (so that a near cap cut by the clip plane keeps its surface's depths): the ray
@@ -55,7 +55,6 @@
 namespace abcube {
 
 namespace {
-
 // The reflection about the plane dot(n, x) + d = 0 (n unit), as a 4x4 matrix.
 glm::dmat4 reflection_matrix(const glm::dvec3& n, double d) {
   glm::dmat4 r(1.0);
@@ -143,6 +142,20 @@ bool GlScene::plan_exact_camera() {
   return s.mirrors || s.volumes || s.plain;
 }
 
+std::string GlScene::shade_pixels_why_not() const {
+  if (volume_lights_.size() > 32) {
+    return std::to_string(volume_lights_.size()) + " volume counts (a sample's key holds 32)";
+  }
+  GLint64 block = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
+  const uint64_t bytes = static_cast<uint64_t>(vertex_count_) * VERTEX_BYTES;
+  if (bytes > static_cast<uint64_t>(block)) {
+    return "the vertex buffer's " + std::to_string(bytes) + " bytes exceed GL_MAX_SHADER_STORAGE_BLOCK_SIZE " +
+           std::to_string(block);
+  }
+  return "";
+}
+
 void GlScene::build_volumes() {
   if (volumes_built_) return;
   volumes_built_ = true;
@@ -199,7 +212,7 @@ void GlScene::fill_region(int level, const glm::vec4& colour) {
   glDepthFunc(GL_GREATER);
 }
 
-// The view's shadow-volume counts: per volume light, in its channel of its layer, the
+// The view's shadow-volume counts: per volume light, in its layer, the
 // depth-fail count of its volume's faces behind or at the view's surfaces (the view's depth
 // is drawn), over the view's scissor (the colour pass reads them in its stencil region only).
 void GlScene::count_volumes(const glm::mat4& clip, const MirrorView& view) {
@@ -214,23 +227,16 @@ void GlScene::count_volumes(const glm::mat4& clip, const MirrorView& view) {
   glBlendFunc(GL_ONE, GL_ONE);
   for (int layer = 0; layer < b.layers; ++layer) {
     glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, b.counts, 0, layer);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     const float zero[4] = {0, 0, 0, 0};
     glClearBufferfv(GL_COLOR, 0, zero);  // within the scissor
     glEnable(GL_BLEND);
-    for (size_t bit = 4 * static_cast<size_t>(layer); bit < std::min(volume_lights_.size(), 4 * static_cast<size_t>(layer) + 4); ++bit) {
-      const int channel = static_cast<int>(bit % 4);
-      glColorMask(channel == 0, channel == 1, channel == 2, channel == 3);
-      // Clipped at the view's mirror as its surfaces are (a near cap and its surface cut
-      // alike keep the same depths); what is cut lies behind the mirror, where no counted
-      // ray goes.
-      set_view(*volume_program_, clip, view);
-      glBindVertexArray(volume_vaos_[bit]);
-      glDrawArrays(GL_TRIANGLES, 0, volume_vertices_[bit]);
-    }
+    // Clipped at the view's mirror as its surfaces are (a near cap and its surface cut alike
+    // keep the same depths); what is cut lies behind the mirror, where no counted ray goes.
+    set_view(*volume_program_, clip, view);
+    glBindVertexArray(volume_vaos_[static_cast<size_t>(layer)]);
+    glDrawArrays(GL_TRIANGLES, 0, volume_vertices_[static_cast<size_t>(layer)]);
     glDisable(GL_BLEND);
   }
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDepthMask(GL_TRUE);
   glDepthFunc(GL_GREATER);
   glBindVertexArray(vao_);
@@ -253,7 +259,7 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
   stencil_level(view.level);
   glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
   glDepthFunc(GL_GREATER);
-  draw_scene(*distance_program_, clip, view);
+  draw_scene(*depth_program_, clip, view);
 
   // 2. The views behind the mirrors it shows, each drawn into the mirror's region. First
   // which mirrors are a visible surface anywhere in the view (one occlusion query each, read
@@ -288,7 +294,7 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
     for (Candidate& c : candidates) {
       glGenQueries(1, &c.query);
       glBeginQuery(GL_ANY_SAMPLES_PASSED, c.query);
-      draw_reflector(*distance_program_, clip, view, c.r);
+      draw_reflector(*depth_program_, clip, view, c.r);
       glEndQuery(GL_ANY_SAMPLES_PASSED);
     }
     glDepthMask(GL_TRUE);
@@ -316,7 +322,7 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
       glDepthFunc(GL_EQUAL);
       glStencilFunc(GL_EQUAL, view.level, 0xff);
       glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
-      draw_reflector(*distance_program_, clip, view, c.r);
+      draw_reflector(*depth_program_, clip, view, c.r);
       glDepthMask(GL_TRUE);
       glDepthFunc(GL_GREATER);
       // Its region cleared to the background at the far plane, then the view behind it.
@@ -338,7 +344,7 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
       glStencilFunc(GL_EQUAL, view.level + 1, 0xff);
       glStencilOp(GL_KEEP, GL_KEEP, GL_DECR);
       glDepthFunc(GL_ALWAYS);
-      draw_reflector(*distance_program_, clip, view, c.r);
+      draw_reflector(*depth_program_, clip, view, c.r);
       glDepthFunc(GL_GREATER);
       stencil_level(view.level);
     }
@@ -370,6 +376,10 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
   glActiveTexture(GL_TEXTURE0 + VOLUME_COUNT_UNIT);
   glBindTexture(GL_TEXTURE_2D_ARRAY, volumes ? exact_buffers_->counts : 0);
   glActiveTexture(GL_TEXTURE0);
+  if (shade_pixels()) {
+    shade_groups(clip, view, volumes);
+    return;
+  }
   glEnable(GL_BLEND);
   glBlendEquation(GL_FUNC_ADD);
   glBlendFunc(GL_ONE, GL_SRC1_COLOR);
@@ -379,17 +389,98 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
   glDepthFunc(GL_GREATER);
 }
 
+// The view's colour shaded once a pixel and surface (ExactCameraOptions::Shading::pixels):
+// its visible triangle at each sample of its stencil region (camera_ids.frag), then one
+// fragment a pixel of its scissor groups the samples and shades each group
+// (camera_groups.frag), blending over the target's texels itself. Called from render_view's
+// step 4, with the target bound, its state set and the lights uploaded; leaves the depth
+// and stencil tests on and the target's viewport, as that step does.
+void GlScene::shade_groups(const glm::mat4& clip, const MirrorView& view, bool volumes) {
+  Target& t = *target_;
+  if (!visibility_ || visibility_->width != t.width || visibility_->height != t.height) {
+    visibility_.reset();
+    visibility_ = std::make_unique<VisibilityBuffers>(t);
+  }
+  VisibilityBuffers& v = *visibility_;
+  // The view's scissor grown to whole pixels: the second pass reads every sample of a pixel,
+  // so the keys of those outside the view's scissor are cleared too (the stencil keeps the
+  // view's own samples within it).
+  const int x0 = view.scissor.x / MASK_COLUMNS, y0 = view.scissor.y / MASK_ROWS;
+  const int x1 = (view.scissor.x + view.scissor.z + MASK_COLUMNS - 1) / MASK_COLUMNS;
+  const int y1 = (view.scissor.y + view.scissor.w + MASK_ROWS - 1) / MASK_ROWS;
+  // 1. Which triangle each sample of the view shows, and its volume lights' set.
+  glBindFramebuffer(GL_FRAMEBUFFER, v.fbo);
+  glScissor(x0 * MASK_COLUMNS, y0 * MASK_ROWS, (x1 - x0) * MASK_COLUMNS, (y1 - y0) * MASK_ROWS);
+  const GLenum first[] = {GL_COLOR_ATTACHMENT0};
+  glDrawBuffers(1, first);
+  const GLuint none[4] = {0, 0, 0, 0};
+  glClearBufferuiv(GL_COLOR, 0, none);
+  stencil_level(view.level);
+  glDepthFunc(GL_EQUAL);
+  glDepthMask(GL_FALSE);
+  set_view(*ids_program_, clip, view);
+  glUniform1i(ids_program_->uniform("u_volume_layers"), volumes ? exact_buffers_->layers : 0);
+  draw_scene(*ids_program_, clip, view);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_GREATER);
+
+  // 2. One fragment a pixel of the scissor.
+  glBindFramebuffer(GL_FRAMEBUFFER, v.pixels_fbo);
+  glViewport(0, 0, t.width / MASK_COLUMNS, t.height / MASK_ROWS);
+  glScissor(x0, y0, x1 - x0, y1 - y0);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_STENCIL_TEST);
+  glDisable(GL_CLIP_DISTANCE0);
+  const GlProgram& p = *groups_program_;
+  set_view(p, clip, view);
+  glm::dmat4 linear = view.model;
+  linear[3] = glm::dvec4(0.0, 0.0, 0.0, 1.0);
+  const glm::mat4 unproject(glm::inverse(glm::dmat4(clip) * linear));
+  glUniformMatrix4fv(p.uniform("u_unproject"), 1, GL_FALSE, &unproject[0][0]);
+  glUniform2f(p.uniform("u_grid"), float(t.width), float(t.height));
+  glUniform1i(p.uniform("u_volumes"), volumes);
+  glUniform1i(p.uniform("u_bounces_left"), view.level < exact_.max_depth);
+  glUniform1i(p.uniform("u_shadows_approximate"), shadows_approximate_);
+  glUniform1i(p.uniform("u_environment"), environment_ != 0 && view.level < exact_.max_depth);
+  glUniform1i(p.uniform("u_uvs"), uv_vbo_ != 0);
+  glUniform1i(p.uniform("u_portals"), portal_vbo_ != 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, vbo_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, uv_vbo_ != 0 ? uv_vbo_ : vbo_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, portal_vbo_ != 0 ? portal_vbo_ : vbo_);
+  glUniform1i(p.uniform("u_pixels"), view.level == 0);
+  glBindImageTexture(0, t.color0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  glBindImageTexture(1, v.pixel_color, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(2, v.pixel_weight, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, v.ids);
+  glBindVertexArray(vao_);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  // Its image stores seen by what follows: blending, the parent view's passes, the resolve.
+  glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  for (GLuint unit = 0; unit < 3; ++unit) glBindImageTexture(unit, 0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  glViewport(0, 0, t.width, t.height);
+  glEnable(GL_DEPTH_TEST);
+  glEnable(GL_STENCIL_TEST);
+}
+
 void GlScene::make_exact_programs() {
   if (exact_program_) return;
   const std::vector<const char*> scene_vert{"scene.vert"}, fill_vert{"fill.vert"};
   exact_program_ = std::make_unique<GlProgram>(
-      scene_vert, std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "camera_exact.frag"});
+      scene_vert, std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "camera_surface.glsl", "camera_exact.frag"});
+  groups_program_ = std::make_unique<GlProgram>(
+      fill_vert, std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "camera_surface.glsl", "camera_groups.frag"});
+  ids_program_ = std::make_unique<GlProgram>(scene_vert, std::vector<const char*>{"camera_ids.frag"});
+  depth_program_ = std::make_unique<GlProgram>(scene_vert, std::vector<const char*>{"camera_depth.frag"});
   probe_program_ = std::make_unique<GlProgram>(
       scene_vert, std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "shadow_probe.frag"});
-  for (const GlProgram* p : {exact_program_.get(), probe_program_.get()}) {
+  for (const GlProgram* p : {exact_program_.get(), probe_program_.get(), groups_program_.get(), ids_program_.get()}) {
     p->use();
     glUniform1i(p->uniform("u_volume_counts"), static_cast<GLint>(VOLUME_COUNT_UNIT));
   }
+  groups_program_->use();
+  glUniform1i(groups_program_->uniform("u_keys"), 0);
   fill_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"fill.frag"});
   volume_program_ = std::make_unique<GlProgram>(scene_vert, std::vector<const char*>{"shadow_volume.frag"});
   resolve_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"resolve_samples.frag"});
@@ -412,7 +503,7 @@ GlScene::ShadowProbe GlScene::camera_shadow_probe(const Camera& camera) {
   make_exact_programs();
   build_volumes();
   if (!exact_buffers_ || exact_buffers_->width != t.width || exact_buffers_->height != t.height ||
-      exact_buffers_->layers != (static_cast<int>(volume_lights_.size()) + 3) / 4) {
+      exact_buffers_->layers != static_cast<int>(volume_lights_.size())) {
     exact_buffers_.reset();
     exact_buffers_ = std::make_unique<ExactBuffers>(t, static_cast<int>(volume_lights_.size()));
   }
@@ -434,7 +525,7 @@ GlScene::ShadowProbe GlScene::camera_shadow_probe(const Camera& camera) {
       glClearBufferfv(GL_COLOR, 0, none);
       stencil_level(0);
       glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-      draw_scene(*distance_program_, tile_clip, view);
+      draw_scene(*depth_program_, tile_clip, view);
       glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
       if (!volume_lights_.empty()) count_volumes(tile_clip, view);
       glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
@@ -483,14 +574,21 @@ Image GlScene::camera_color_exact(const Camera& camera) {
       shadows_approximate_ = shadows_approximate_ || (scene_.lights[i].cast_shadows && volume_bit_[i] < 0);
     }
     if (!exact_buffers_ || exact_buffers_->width != t.width || exact_buffers_->height != t.height ||
-      exact_buffers_->layers != (static_cast<int>(volume_lights_.size()) + 3) / 4) {
+      exact_buffers_->layers != static_cast<int>(volume_lights_.size())) {
       exact_buffers_.reset();
       exact_buffers_ = std::make_unique<ExactBuffers>(t, static_cast<int>(volume_lights_.size()));
     }
   }
-  bind_lookups(*exact_program_, true);
-  exact_program_->use();
-  glUniform1i(exact_program_->uniform("u_portals_exact"), 1);
+  exact_stats_.shading_pixels = false;
+  exact_stats_.shading_why = "asked: --gpu-shading samples";
+  if (exact_.shading == ExactCameraOptions::Shading::pixels) {
+    exact_stats_.shading_why = shade_pixels_why_not();
+    exact_stats_.shading_pixels = exact_stats_.shading_why.empty();
+  }
+  for (const GlProgram* p : {groups_program_.get(), exact_program_.get()}) {
+    bind_lookups(*p, true);
+    glUniform1i(p->uniform("u_portals_exact"), 1);
+  }
   const glm::mat4 clip = relative_camera_clip(camera, near_);
   std::vector<float> rgba(static_cast<size_t>(tile_w / MASK_COLUMNS) * static_cast<size_t>(tile_h / MASK_ROWS) * 4);
   Image out(camera.width, camera.height, 3);
@@ -535,11 +633,25 @@ Image GlScene::camera_color_exact(const Camera& camera) {
       resolve_program_->use();
       glUniform1i(resolve_program_->uniform("u_samples"), 0);
       glUniform2i(resolve_program_->uniform("u_margin"), SampleTiles::MARGIN_X, SampleTiles::MARGIN_Y);
+      // Per-pixel shading: the camera view's pixels shaded whole (camera_groups.frag).
+      const bool pixels = shade_pixels() && visibility_;
+      glUniform1i(resolve_program_->uniform("u_pixels"), pixels);
+      glUniform1i(resolve_program_->uniform("u_pixel_color"), 1);
+      glUniform1i(resolve_program_->uniform("u_pixel_weight"), 2);
+      glActiveTexture(GL_TEXTURE1);
+      glBindTexture(GL_TEXTURE_2D, pixels ? visibility_->pixel_color : 0);
+      glActiveTexture(GL_TEXTURE2);
+      glBindTexture(GL_TEXTURE_2D, pixels ? visibility_->pixel_weight : 0);
       glActiveTexture(GL_TEXTURE0);
       glBindTexture(GL_TEXTURE_2D, t.color0);
       glBindVertexArray(vao_);
       glDrawArrays(GL_TRIANGLES, 0, 3);
       glBindTexture(GL_TEXTURE_2D, 0);
+      for (const GLenum unit : {GL_TEXTURE1, GL_TEXTURE2}) {
+        glActiveTexture(unit);
+        glBindTexture(GL_TEXTURE_2D, 0);
+      }
+      glActiveTexture(GL_TEXTURE0);
       glEnable(GL_DEPTH_TEST);
       glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo_);
       glReadBuffer(GL_COLOR_ATTACHMENT0);

@@ -27,6 +27,7 @@ struct Vertex {
   uint32_t object;
   uint32_t material;
 };
+static_assert(sizeof(Vertex) == VERTEX_BYTES, "camera_groups.frag reads the vertices as 8 words");
 
 struct MaterialGpu {
   float color_ambient[4];
@@ -219,6 +220,7 @@ std::vector<float> GlScene::upload_textures() {
 GlScene::~GlScene() {
   target_.reset();
   exact_buffers_.reset();
+  visibility_.reset();
   glDeleteBuffers(1, &portal_vbo_);
   glDeleteBuffers(1, &portal_ebo_);
   glDeleteBuffers(1, &recursed_);

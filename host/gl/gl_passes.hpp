@@ -62,6 +62,10 @@ struct ExactCameraOptions {
   // Use the exact pass even with no planar mirror and no volume light (the hybrid method
   // reads its per-pixel flags).
   bool always = false;
+  // How the colour of a view is shaded (gl_camera_exact.cpp): once a pixel and surface (the
+  // samples grouped by triangle and shadow-volume set, camera_groups.frag), or once a sample
+  // (camera_exact.frag).
+  enum class Shading { pixels, samples } shading = Shading::pixels;
 };
 // What the last exact camera pass says of each pixel: 1 when none of its 32 samples met a
 // surface the GPU only approximates (camera_exact.frag's alpha), 0 otherwise (the hybrid
@@ -80,6 +84,8 @@ struct ExactCameraStats {
   uint64_t pixels_exact = 0;              // pixels with none
   int volume_lights = 0;
   uint64_t volume_triangles = 0;          // over every volume light
+  bool shading_pixels = false;            // the colour shaded once a pixel and surface (else once a sample)
+  std::string shading_why;                // why per sample, when pixels were asked
   double volume_build_ms = 0;
 };
 
@@ -237,12 +243,21 @@ class GlScene {
   GLuint portal_vbo_ = 0, portal_ebo_ = 0;
   std::vector<std::pair<size_t, size_t>> portal_ranges_;  // first index, count
   bool volumes_built_ = false;
-  std::vector<int> volume_lights_;        // light index per count (channel)
+  std::vector<int> volume_lights_;        // light index per count (its layer)
   std::vector<int> volume_bit_;           // per light: its opaque blockers' count, or -1
   std::vector<int> translucent_bit_;      // per light: its translucent blockers' count, or -1
   std::vector<GLuint> volume_vaos_, volume_vbos_;
   std::vector<GLsizei> volume_vertices_;
   std::unique_ptr<GlProgram> exact_program_, fill_program_, volume_program_, probe_program_, resolve_program_;
+  std::unique_ptr<GlProgram> ids_program_, groups_program_, depth_program_;  // per-group shading (camera_ids, camera_groups)
+  struct VisibilityBuffers;
+  std::unique_ptr<VisibilityBuffers> visibility_;
+  void shade_groups(const glm::mat4& clip, const MirrorView& view, bool volumes);
+  // Shading::pixels, unless its keys cannot hold every volume light's bit (camera_ids.frag:
+  // 32) or the vertex buffer is larger than a shader storage block may be (the reason, "" when
+  // it can).
+  std::string shade_pixels_why_not() const;
+  bool shade_pixels() const { return exact_stats_.shading_pixels; }
   GLuint resolve_fbo_ = 0, resolve_texture_ = 0;  // a tile's pixels (resolve_samples.frag)
   int resolve_w_ = 0, resolve_h_ = 0;
   GLuint recursed_ = 0;  // per view: which mirrors had their view drawn (camera_exact.frag)

@@ -12,6 +12,7 @@
 #include "base/error.hpp"
 #include "gl/gl_passes.hpp"
 #include "raster/cube_map.hpp"
+#include "raster/samples.hpp"
 
 namespace abcube {
 
@@ -21,6 +22,9 @@ namespace abcube {
 // (tools/flat_mirror_scenes.py --seed 2, one run each); a mirror's scissor is tighter, and
 // the tile's buffers stay in cache.
 constexpr int CAMERA_TILE = 1024;
+// The scene's GL vertex (gl_passes.cpp Vertex, camera_groups.frag VertexGpu): position,
+// normal, object, material.
+constexpr size_t VERTEX_BYTES = 32;
 // Texture units: 1 the opaque shadow maps, 2 the environment, 3.. the translucent peels,
 // then the camera's previous layer.
 constexpr GLenum PEEL_UNIT = 3;
@@ -181,16 +185,17 @@ struct GlScene::MirrorView {
 };
 
 // The exact camera pass's buffers beside the camera Target (same size, same depth-stencil
-// texture): the shadow-volume counts, four lights a layer of an RGBA32F array (one channel
-// each, additive), drawn through one framebuffer whose colour is the layer being counted.
+// texture): the shadow-volume counts, a layer of an R32F array per volume light (additive),
+// drawn through one framebuffer whose colour is the layer being counted. (Four lights a
+// layer of RGBA32F made the count pass of a one-light scene 4 times the bytes to blend.)
 struct GlScene::ExactBuffers {
   int width = 0, height = 0, layers = 0;
   GLuint counts = 0, fbo = 0;
 
-  ExactBuffers(const Target& t, int lights) : width(t.width), height(t.height), layers((lights + 3) / 4) {
+  ExactBuffers(const Target& t, int lights) : width(t.width), height(t.height), layers(lights) {
     glGenTextures(1, &counts);
     glBindTexture(GL_TEXTURE_2D_ARRAY, counts);
-    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_RGBA32F, width, height, std::max(layers, 1));
+    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_R32F, width, height, std::max(layers, 1));
     // One level, read by texelFetch: complete only with a filter that needs no mipmaps.
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
@@ -206,6 +211,54 @@ struct GlScene::ExactBuffers {
   ~ExactBuffers() {
     glDeleteTextures(1, &counts);
     glDeleteFramebuffers(1, &fbo);
+  }
+};
+
+// The per-group shading's buffers beside the camera Target (gl_camera_exact.cpp): the
+// key of each sample of a view (camera_ids.frag, RG32UI, drawn with the target's depth-stencil), and
+// a framebuffer with no attachment, one pixel of it per 8 x 4 samples of the target; the
+// colour and weight of the camera view's pixels shaded whole (RGBA32F, one texel a pixel).
+struct GlScene::VisibilityBuffers {
+  int width = 0, height = 0;
+  GLuint ids = 0, fbo = 0, pixels_fbo = 0, pixel_color = 0, pixel_weight = 0;
+
+  explicit VisibilityBuffers(const Target& t) : width(t.width), height(t.height) {
+    const auto make = [](GLenum format, int w, int h) {
+      GLuint tex = 0;
+      glGenTextures(1, &tex);
+      glBindTexture(GL_TEXTURE_2D, tex);
+      glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      return tex;
+    };
+    ids = make(GL_RG32UI, width, height);
+    pixel_color = make(GL_RGBA32F, width / MASK_COLUMNS, height / MASK_ROWS);
+    pixel_weight = make(GL_RGBA32F, width / MASK_COLUMNS, height / MASK_ROWS);
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, ids, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, t.depth, 0);
+    check("visibility");
+    glGenFramebuffers(1, &pixels_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, pixels_fbo);
+    glFramebufferParameteri(GL_FRAMEBUFFER, GL_FRAMEBUFFER_DEFAULT_WIDTH, width / MASK_COLUMNS);
+    glFramebufferParameteri(GL_FRAMEBUFFER, GL_FRAMEBUFFER_DEFAULT_HEIGHT, height / MASK_ROWS);
+    check("per-pixel shading");
+  }
+  ~VisibilityBuffers() {
+    const GLuint textures[] = {ids, pixel_color, pixel_weight};
+    glDeleteTextures(3, textures);
+    const GLuint fbos[] = {fbo, pixels_fbo};
+    glDeleteFramebuffers(2, fbos);
+  }
+
+ private:
+  static void check(const char* what) {
+    const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+      throw RuntimeFailure(std::string(what) + " framebuffer incomplete (status " + std::to_string(status) + ")");
+    }
   }
 };
 

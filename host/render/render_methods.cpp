@@ -53,6 +53,9 @@ json gpu_paths_json(const GlScene& gl, const RenderRequest& request, const std::
                    {"volume_lights", ex.volumes ? ex.volume_lights : 0},
                    {"volume_triangles", ex.volumes ? ex.volume_triangles : 0},
                    {"translucent_casters", maps && gl.shadow_peels() > 0 ? "shadow maps' peeled layers" : "none"}}},
+      {"shading", {{"technique", ex.shading_pixels ? "pixels" : "samples"},
+                   {"why", ex.shading_pixels ? "once a pixel and surface: its samples grouped by triangle and shadow-volume set"
+                                             : ex.shading_why}}},
       {"camera_samples_approximate", ex.samples_approximate},
       {"pixels_exact", ex.pixels_exact}};
 }

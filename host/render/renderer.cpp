@@ -134,10 +134,14 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   if (o.gpu_shadows != "volumes" && o.gpu_shadows != "maps") {
     throw InputError("gpu-shadows: unknown technique " + quote(o.gpu_shadows) + " (volumes, maps)");
   }
+  if (o.gpu_shading != "pixels" && o.gpu_shading != "samples") {
+    throw InputError("gpu-shading: unknown mode " + quote(o.gpu_shading) + " (pixels, samples)");
+  }
   if (o.gpu_max_views < 0) throw InputError("gpu-max-views: must be >= 0, got " + std::to_string(o.gpu_max_views));
   r.gpu.planar_mirrors = o.gpu_mirrors == "stencil";
   r.gpu.shadow_volumes = o.gpu_shadows == "volumes";
   r.gpu.max_views = o.gpu_max_views;
+  r.gpu.shading = o.gpu_shading == "pixels" ? ExactCameraOptions::Shading::pixels : ExactCameraOptions::Shading::samples;
   r.gpu.max_depth = view->render.max_depth;
   r.abuffer.max_layers = o.max_layers;
   if (o.max_memory_mib > (uint64_t{1} << 30)) throw InputError("max-memory: must be at most 2^30 MiB");
@@ -390,6 +394,7 @@ void refuse_unused_options(const Scene& scene, const RenderOptions& o) {
     if (o.gpu_mirrors != defaults.gpu_mirrors) refuse("gpu-mirrors", gpu);
     if (o.gpu_shadows != defaults.gpu_shadows) refuse("gpu-shadows", gpu);
     if (o.gpu_max_views != defaults.gpu_max_views) refuse("gpu-max-views", gpu);
+    if (o.gpu_shading != defaults.gpu_shading) refuse("gpu-shading", gpu);
   }
 }
 

@@ -12,16 +12,11 @@ ABCUBE=$1
 REPO=$2
 CLI_TEST=flat_mirrors
 . "$(dirname "$0")/lib/check.sh"
+. "$(dirname "$0")/lib/generated.sh"
 SEED=${ABCUBE_FLAT_SEED:-$RANDOM}
 echo "seeds: 1 and $SEED (ABCUBE_FLAT_SEED=$SEED repeats this run)"
-if ! "$ABCUBE" info 2>/dev/null | grep -q 'auto picks: [eo]'; then
-  echo "SKIPPED: no GL path here (the gpu method needs one)"
-  exit 0
-fi
-for seed in 1 "$SEED"; do
-  /usr/bin/python3 "$REPO/tools/flat_mirror_scenes.py" --seed "$seed" --count 5 --out "$WORK/scenes" \
-    --size 128x96 --cube-res 128 > /dev/null || { echo "FAIL: tools/flat_mirror_scenes.py --seed $seed"; exit 1; }
-done
+require_gl
+for seed in 1 "$SEED"; do generate flat_mirror_scenes "$seed" 5 "$WORK/scenes"; done
 # batch_all DIR PREFIX METHOD...: every scene of DIR rendered by each method in one batch,
 # into $WORK/PREFIX$method/.
 batch_all() {
@@ -72,10 +67,7 @@ done
 # above a sample row's centres, which GL's snapped vertices put on the other side: a line of
 # wrong pixels, 51.0 against abuffer's 54.1 dB, before edge_ties.hpp) and for this run's new
 # seed: hybrid no less accurate than abuffer there either.
-for seed in 5 103 "$SEED"; do
-  /usr/bin/python3 "$REPO/tools/hard_scenes.py" --seed "$seed" --count 11 --out "$WORK/hard" --size 128x96 \
-    --cube-res 128 > /dev/null || { echo "FAIL: tools/hard_scenes.py --seed $seed"; exit 1; }
-done
+for seed in 5 103 "$SEED"; do generate hard_scenes "$seed" 11 "$WORK/hard"; done
 batch_all "$WORK/hard" hard_ raytrace abuffer hybrid
 "$ABCUBE" render "$WORK/hard/seams_103_10.json" -o "$WORK/seams_103_10.exr" --method hybrid --stats "$WORK/seams.json" \
   2> "$WORK/err"
