@@ -9,7 +9,8 @@ Scenes: tools/flat_mirror_scenes.py (every template for each seed: mirrors all f
 scene of each tools/hard_scenes.py template (first seed), the repository's scenes/*.json,
 scenes/models/engine_room.json. Methods: raytrace (the reference), abuffer at the scene's
 N, gpu (exact camera pass: stencil mirrors, shadow volumes), gpu_maps (the old techniques:
---gpu-mirrors envmap --gpu-shadows maps), hybrid. Each render is a whole `abcube render`
+--gpu-mirrors envmap --gpu-shadows maps), hybrid (its camera pass shaded once a pixel and
+surface), hybrid_samples (--gpu-shading samples: once a sample). Each render is a whole `abcube render`
 process, the methods interleaved, `--runs` times; the time is the program's own total
 (stats timings_ms.total: load, GL start, passes; not the process start), median [min,
 max]; the error is PSNR against raytrace on displayed values. Writes NAME.csv and NAME.md
@@ -28,7 +29,7 @@ import time
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 METHODS = [("abuffer", ["--method", "abuffer"]), ("gpu", ["--method", "gpu"]),
            ("gpu_maps", ["--method", "gpu", "--gpu-mirrors", "envmap", "--gpu-shadows", "maps"]),
-           ("hybrid", ["--method", "hybrid"])]
+           ("hybrid", ["--method", "hybrid"]), ("hybrid_samples", ["--method", "hybrid", "--gpu-shading", "samples"])]
 
 
 def run(cmd):
@@ -123,15 +124,31 @@ def main(argv=None):
          "Load average (1 min) %.2f at start, %.2f at end; %.0f s in all." % (load, os.getloadavg()[0], time.time() - t_start),
          "", "Times: the program's own total (load, GL start, passes, not the process start), median of the runs "
          "[min, max], ms. Errors: PSNR against raytrace (displayed values), dB. `gpu_maps`: the old techniques "
-         "(`--gpu-mirrors envmap --gpu-shadows maps`). `cpu`: the share of pixels hybrid sent to the CPU.", "",
-         "| set | scene | raytrace ms | abuffer dB | ms | gpu dB | ms | gpu_maps dB | ms | hybrid dB | ms | cpu |",
-         "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+         "(`--gpu-mirrors envmap --gpu-shadows maps`). `hybrid_samples`: hybrid with `--gpu-shading samples` "
+         "(the GPU's colour shaded once a sample, as before per-pixel shading). `cpu`: the share of pixels hybrid "
+         "sent to the CPU.", ""]
+    flat = [r for r in rows if r["set"] == "flat mirrors"]
+    if flat:
+        faster = sum(r["hybrid_ms"] < r["abuffer_ms"] for r in flat)
+        apart = sum(r["hybrid_ms_max"] < r["abuffer_ms_min"] for r in flat)
+        slower_apart = sum(r["hybrid_ms_min"] > r["abuffer_ms_max"] for r in flat)
+        worse = sum(r["hybrid_db"] < r["abuffer_db"] for r in rows)
+        ratios = sorted(r["hybrid_ms"] / r["abuffer_ms"] for r in flat)
+        L += ["Flat mirrors, hybrid against abuffer: median faster on %d of %d scenes (every run faster on %d, every "
+              "run slower on %d); hybrid's time over abuffer's %.2f-%.2f (median %.2f). hybrid less accurate than "
+              "abuffer on %d of %d scenes in all." % (faster, len(flat), apart, slower_apart, ratios[0], ratios[-1],
+                                                     statistics.median(ratios), worse, len(rows)), ""]
+    L += ["| set | scene | raytrace ms | abuffer dB | ms | gpu dB | ms | gpu_maps dB | ms | hybrid dB | ms | cpu "
+          "| hybrid_samples dB | ms |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        L.append("| %s | %s | %d | %.2f | %d [%d, %d] | %.2f | %d [%d, %d] | %.2f | %d | %.2f | %d [%d, %d] | %.0f%% |" % (
+        L.append("| %s | %s | %d | %.2f | %d [%d, %d] | %.2f | %d [%d, %d] | %.2f | %d | %.2f | %d [%d, %d] | %.0f%% "
+                 "| %.2f | %d [%d, %d] |" % (
             r["set"], r["scene"], r["raytrace_ms"], r["abuffer_db"], r["abuffer_ms"], r["abuffer_ms_min"],
             r["abuffer_ms_max"], r["gpu_db"], r["gpu_ms"], r["gpu_ms_min"], r["gpu_ms_max"], r["gpu_maps_db"],
             r["gpu_maps_ms"], r["hybrid_db"], r["hybrid_ms"], r["hybrid_ms_min"], r["hybrid_ms_max"],
-            100 * r["hybrid_cpu_share"]))
+            100 * r["hybrid_cpu_share"], r["hybrid_samples_db"], r["hybrid_samples_ms"], r["hybrid_samples_ms_min"],
+            r["hybrid_samples_ms_max"]))
     with open(os.path.join(a.out, a.name + ".md"), "w") as f:
         f.write("\n".join(L) + "\n")
     print("wrote %s.{csv,md}" % os.path.join(a.out, a.name), file=sys.stderr)

@@ -80,10 +80,18 @@ void shade(uvec2 key, uint members, bool pixel) {
   uint material = c0.material;
   vec3 od = materials[material].color_ambient.rgb;
   if (u_uvs && materials[material].transmission.w >= 0.0) {
-    // The footprint of one sample, as dFdx and dFdy give it in the per-sample pass.
+    // The texture at each sample of the group, with the footprint of one sample (as dFdx
+    // and dFdy give it in the per-sample pass), averaged: the shading is linear in Od, so
+    // the group's colour is the mean of its samples' colours in that term.
     vec3 bx = barycentrics(at + vec2(1.0, 0.0), r0, r1, r2), by = barycentrics(at + vec2(0.0, 1.0), r0, r1, r2);
     mat3x2 uv = mat3x2(uvs[v0], uvs[v0 + 1u], uvs[v0 + 2u]);
-    od = diffuse_color_footprint(materials[material], uv * b, uv * (bx - b), uv * (by - b));
+    vec2 dx = uv * (bx - b), dy = uv * (by - b);
+    od = vec3(0.0);
+    for (uint m = members; m != 0u; m &= m - 1u) {
+      vec2 s = vec2(sample_at(findLSB(m))) + 0.5;
+      od += diffuse_color_footprint(materials[material], uv * barycentrics(s, r0, r1, r2), dx, dy);
+    }
+    od /= float(bitCount(members));
   }
   volume_from_set = true;
   volume_set = uvec4(key.y, 0u, 0u, 0u);

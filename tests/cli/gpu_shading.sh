@@ -48,6 +48,19 @@ for scene in "$WORK"/scenes/*.json; do
     awk -v p="$p" -v s="$s" 'BEGIN { exit !(p != "" && s != "" && (p == "inf" || p + 0 >= 60 || p + 0 >= s - 0.5)) }'
   check "$stem: pixels and samples agree to 40 dB ($a)" awk -v a="$a" 'BEGIN { exit !(a == "inf" || a + 0 >= 40) }'
 done
+# A textured scene under hybrid (textures point-sampled at each sample, as the CPU does): a
+# pixel's texels are its samples' mean, not one texel at their centre (that gave 50.5 dB
+# against the samples' 60.3).
+for args in "raytrace" "hybrid" "hybrid --gpu-shading samples"; do
+  # shellcheck disable=SC2086
+  "$ABCUBE" render "$REPO/scenes/textured.json" -o "$WORK/textured_$(echo "$args" | tr -d ' -').exr" --method $args \
+    2> /dev/null
+done
+s=$(psnr "$WORK/textured_hybridgpushadingsamples.exr" "$WORK/textured_raytrace.exr")
+p=$(psnr "$WORK/textured_hybrid.exr" "$WORK/textured_raytrace.exr")
+echo "textured (hybrid): samples $s dB, pixels $p dB"
+check "textured: hybrid by pixels as near the tracer as by samples ($p against $s)" \
+  awk -v p="$p" -v s="$s" 'BEGIN { exit !(p != "" && s != "" && p + 0 >= s - 0.5) }'
 # technique NAME STATS WANT [WHY]: the stats' gpu_paths.shading.
 technique() {
   check "$1: shading $3" /usr/bin/python3 -c "
