@@ -22,7 +22,8 @@ struct PyRenderResult {
 struct RenderArgs {
   py::object method, cube_res, max_depth, camera, aovs, stats, timeout, reference, threads,
       search, refine, theta_max_deg, refraction, envmap_lookup, error_target, fresnel,
-      max_layers, max_memory_mib, max_pixels, plan_everything, reference_image, resolve, side_structure;
+      max_layers, max_memory_mib, max_pixels, plan_everything, reference_image, resolve, side_structure,
+      gpu_mirrors, gpu_shadows, gpu_max_views, gpu_shading;
 };
 
 // Copies the keyword arguments given into RenderOptions; the others keep the struct's
@@ -68,6 +69,10 @@ RenderOptions options_from_args(const RenderArgs& a) {
   if (!a.max_pixels.is_none()) o.max_pixels = unsigned_arg(a.max_pixels, "max_pixels");
   o.plan_everything = bool_arg(a.plan_everything, "plan_everything");
   if (!a.reference_image.is_none()) o.reference_image = path_arg(a.reference_image, "reference_image");
+  if (!a.gpu_mirrors.is_none()) o.gpu_mirrors = string_arg(a.gpu_mirrors, "gpu_mirrors");
+  if (!a.gpu_shadows.is_none()) o.gpu_shadows = string_arg(a.gpu_shadows, "gpu_shadows");
+  if (!a.gpu_max_views.is_none()) o.gpu_max_views = int_arg(a.gpu_max_views, "gpu_max_views");
+  if (!a.gpu_shading.is_none()) o.gpu_shading = string_arg(a.gpu_shading, "gpu_shading");
   return o;
 }
 
@@ -79,7 +84,8 @@ void reject_unknown_keywords(const py::kwargs& unknown) {
                    "' (method, cube_res, max_depth, camera, aovs, stats, timeout, reference, "
                    "threads, search, refine, theta_max_deg, refraction, envmap_lookup, "
                    "error_target, fresnel, max_layers, max_memory_mib, max_pixels, "
-                   "plan_everything, reference_image, resolve, side_structure)");
+                   "plan_everything, reference_image, resolve, side_structure, gpu_mirrors, "
+                   "gpu_shadows, gpu_max_views, gpu_shading)");
 }
 
 // Ctrl-C during a render gives KeyboardInterrupt, as everywhere else in Python. While the
@@ -206,7 +212,9 @@ bisector | position), max_layers, max_memory_mib, max_pixels, plan_everything,
 reference_image, resolve (exact | thesis: intersecting fragments by per-sample priority
 masks or by the thesis' Vis_front estimate), side_structure (default True; False is the
 CLI's --map-only: searches see only the map, no side structure for the triangles it cannot
-hold).
+hold); and for gpu and hybrid: gpu_mirrors (stencil | envmap), gpu_shadows (volumes | maps),
+gpu_max_views, gpu_shading (pixels | samples: the camera pass's colour shaded once a pixel
+and surface or once a sample).
 
 A bad argument or scene raises SceneError (a ValueError) naming it; other failures
 RuntimeError. The GIL is released while the render runs (see Renderer). Ctrl-C (SIGINT,
@@ -245,14 +253,17 @@ void bind_renderer(py::module_& m) {
              const py::object& max_layers, const py::object& max_memory_mib,
              const py::object& max_pixels, const py::object& plan_everything,
              const py::object& reference_image, const py::object& resolve,
-             const py::object& side_structure, const py::kwargs& unknown) {
+             const py::object& side_structure, const py::object& gpu_mirrors,
+             const py::object& gpu_shadows, const py::object& gpu_max_views,
+             const py::object& gpu_shading, const py::kwargs& unknown) {
             reject_unknown_keywords(unknown);
             return render(self, scene,
                           RenderArgs{method, cube_res, max_depth, camera, aovs, stats, timeout,
                                      reference, threads, search, refine, theta_max_deg,
                                      refraction, envmap_lookup, error_target, fresnel,
                                      max_layers, max_memory_mib, max_pixels, plan_everything,
-                                     reference_image, resolve, side_structure});
+                                     reference_image, resolve, side_structure, gpu_mirrors,
+                                     gpu_shadows, gpu_max_views, gpu_shading});
           },
           py::arg("scene"), py::kw_only(), py::arg("method") = py::none(),
           py::arg("cube_res") = py::none(), py::arg("max_depth") = py::none(),
@@ -266,6 +277,8 @@ void bind_renderer(py::module_& m) {
           py::arg("max_memory_mib") = py::none(), py::arg("max_pixels") = py::none(),
           py::arg("plan_everything") = false, py::arg("reference_image") = py::none(),
           py::arg("resolve") = py::none(), py::arg("side_structure") = py::none(),
+          py::arg("gpu_mirrors") = py::none(), py::arg("gpu_shadows") = py::none(),
+          py::arg("gpu_max_views") = py::none(), py::arg("gpu_shading") = py::none(),
           RENDER_DOC)
       .def_property_readonly("gl_path", &Renderer::gl_path,
                              "The GL path opened (\"\" before the first GL render; \"none\" "

@@ -14,6 +14,15 @@ layout(location = 0) out vec4 o_pixel;
 
 void main() {
   ivec2 base = u_margin + ivec2(gl_FragCoord.xy) * ivec2(8, 4);
+  vec4 weight = vec4(-1.0), color = vec4(0.0);
+  if (u_pixels) {
+    weight = texelFetch(u_pixel_weight, base / ivec2(8, 4), 0);
+    color = texelFetch(u_pixel_color, base / ivec2(8, 4), 0);
+    if (weight == vec4(0.0)) {  // shaded whole, nothing behind: no sample to read
+      o_pixel = vec4(color.rgb, color.a != 0.0 ? 32.0 : 0.0);
+      return;
+    }
+  }
   vec3 sum = vec3(0.0);
   float approximate = 0.0;
   for (int row = 0; row < 4; ++row) {
@@ -24,10 +33,6 @@ void main() {
     }
   }
   o_pixel = vec4(sum / 32.0, approximate);
-  if (!u_pixels) return;
-  ivec2 pixel = base / ivec2(8, 4);
-  vec4 weight = texelFetch(u_pixel_weight, pixel, 0);
-  if (weight.a < 0.0) return;
-  vec4 color = texelFetch(u_pixel_color, pixel, 0);
+  if (weight.a < 0.0) return;  // per sample (or no per-pixel shading)
   o_pixel = vec4(color.rgb + weight.rgb * o_pixel.rgb, color.a != 0.0 ? 32.0 : weight.a != 0.0 ? approximate : 0.0);
 }

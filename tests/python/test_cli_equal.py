@@ -15,6 +15,10 @@ CASES = [
     ("zbuffer", [], {}, "none"),
     ("envmap", ["--envmap-lookup", "bisector"], {"envmap_lookup": "bisector"}, "none"),
     ("gpu", [], {}, "egl"),
+    ("gpu", ["--gpu-shading", "samples"], {"gpu_shading": "samples"}, "egl"),
+    ("gpu", ["--gpu-mirrors", "envmap", "--gpu-shadows", "maps", "--gpu-max-views", "4"],
+     {"gpu_mirrors": "envmap", "gpu_shadows": "maps", "gpu_max_views": 4}, "egl"),
+    ("hybrid", [], {}, "egl"),
 ]
 
 
