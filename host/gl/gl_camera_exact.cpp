@@ -55,6 +55,7 @@
 namespace abcube {
 
 namespace {
+
 // The reflection about the plane dot(n, x) + d = 0 (n unit), as a 4x4 matrix.
 glm::dmat4 reflection_matrix(const glm::dvec3& n, double d) {
   glm::dmat4 r(1.0);
@@ -418,7 +419,7 @@ void GlScene::shade_groups(const glm::mat4& clip, const MirrorView& view, bool v
   stencil_level(view.level);
   glDepthFunc(GL_EQUAL);
   glDepthMask(GL_FALSE);
-  set_view(*ids_program_, clip, view);
+  ids_program_->use();
   glUniform1i(ids_program_->uniform("u_volume_layers"), volumes ? exact_buffers_->layers : 0);
   draw_scene(*ids_program_, clip, view);
   glDepthMask(GL_TRUE);
