@@ -70,8 +70,11 @@ def main(argv=None):
     py = "/usr/bin/python3"
     scenes = []  # (set, path)
     seeds = [int(s) for s in a.seeds.split(",") if s]
+    sys.path.insert(0, os.path.join(REPO, "tools"))
+    import flat_mirror_scenes  # noqa: E402 (every template once a seed)
     for seed in seeds:
-        out = run([py, os.path.join(REPO, "tools", "flat_mirror_scenes.py"), "--seed", str(seed), "--count", "5",
+        out = run([py, os.path.join(REPO, "tools", "flat_mirror_scenes.py"), "--seed", str(seed), "--count",
+                   str(len(flat_mirror_scenes.TEMPLATES)),
                    "--out", os.path.join(work, "flat"), "--size", a.size, "--cube-res", str(a.cube_res)])
         scenes += [("flat mirrors", p) for p in out.split()]
     if not a.no_repo:

@@ -3,11 +3,13 @@
 renders exactly (planar mirrors by the stencil test, shadows by volumes) and the cube-map
 methods approximate.
 
-Five templates, after the cases where the old gpu method scored 12 to 30 dB against the
+Six templates, after the cases where the old gpu method scored 12 to 30 dB against the
 exact tracer: a mirror whose plane holds the camera, seen in a second mirror; a floor
 mirror showing a quad that an occluder hides from the camera; thin boxes in front of
 mirror boxes (mirrors facing mirrors: rays bounce to max_depth); a wide flat water surface
-seen at a grazing angle; a point light lying on a mirror. No material refracts, no mirror
+seen at a grazing angle; a point light lying on a mirror box; a point light on, or 1e-6
+above or below, an open mirror quad (its shadow volume reaches infinity in nearly the
+quad's plane, across every camera tile). No material refracts, no mirror
 is curved, nothing is coverage-transparent (those keep the cube maps: README "The gpu
 method at its best").
 
@@ -131,12 +133,29 @@ def t_light_on_mirror(rng):
     return scene(rng, camera_looking(eye, [0, 0.4, 0], rng.uniform(45, 60)), lights, mats, objs)
 
 
+def t_light_on_open_mirror(rng):
+    """A point light on (or 1e-6 above or below) an open mirror quad: its shadow volume's
+    sides lie nearly in the quad's plane and reach infinity across the whole view."""
+    mats = {"floor": diffuse(rng), "table": mirror_material(rng)}
+    objs = [floor(6, "floor")]
+    top = rng.uniform(0.5, 0.9)
+    w, d = rng.uniform(0.5, 1.0), rng.uniform(0.3, 0.7)
+    objs.append(quad([0, top, 0], [0, 0, d], [w, 0, 0], "table"))  # u x v = +y: faces up
+    objs += scatter_props(rng, mats, 4, 0.1, 0.3, ring=(1.2, 2.5))
+    lift = rng.choice([0.0, 1e-6, -1e-6])
+    lights = [point_light([rng.uniform(-0.4, 0.4) * w, top + lift, rng.uniform(-0.4, 0.4) * d], rng.uniform(0.6, 1.0)),
+              point_light([rng.uniform(-2, 2), 3.0, 2.5], 0.4)]
+    eye = add([0, 0.4, 0], mul(spherical(rng.uniform(-40, 40), rng.uniform(20, 45)), rng.uniform(3, 4)))
+    return scene(rng, camera_looking(eye, [0, 0.4, 0], rng.uniform(45, 60)), lights, mats, objs)
+
+
 TEMPLATES = {
     "mirror_through_camera": t_mirror_through_camera,
     "floor_mirror_hidden": t_floor_mirror_hidden,
     "box_mirrors": t_box_mirrors,
     "grazing_water": t_grazing_water,
     "light_on_mirror": t_light_on_mirror,
+    "light_on_open_mirror": t_light_on_open_mirror,
 }
 
 

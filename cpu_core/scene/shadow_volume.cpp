@@ -119,4 +119,97 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
   return out;
 }
 
+void split_at_infinity(const std::vector<ShadowVolumeVertex>& triangles, std::vector<ShadowVolumeVertex>* finite,
+                       std::vector<ShadowVolumeVertex>* infinite) {
+  for (size_t i = 0; i + 2 < triangles.size(); i += 3) {
+    const bool at_infinity = triangles[i].position.w == 0.f || triangles[i + 1].position.w == 0.f ||
+                             triangles[i + 2].position.w == 0.f;
+    std::vector<ShadowVolumeVertex>& to = at_infinity ? *infinite : *finite;
+    to.insert(to.end(), triangles.begin() + static_cast<std::ptrdiff_t>(i),
+              triangles.begin() + static_cast<std::ptrdiff_t>(i + 3));
+  }
+}
+
+namespace {
+
+// A corner of a polygon being clipped: homogeneous, relative to the eye (w = 0: a direction).
+using Corner = glm::dvec4;
+
+bool before(const Corner& a, const Corner& b) {
+  for (int k = 0; k < 4; ++k) {
+    if (a[k] != b[k]) return a[k] < b[k];
+  }
+  return false;
+}
+
+// The point of segment a-b on the plane (values da, db of opposite signs), computed from the
+// segment's endpoints in one order whichever way it is traversed.
+Corner cut(const Corner& a, double da, const Corner& b, double db) {
+  if (before(b, a)) return cut(b, db, a, da);
+  const double t = da / (da - db);
+  return a + t * (b - a);
+}
+
+// Sutherland-Hodgman against one plane (kept: dot(plane, corner) >= 0), `in` to `out`.
+void clip_polygon(const std::vector<Corner>& in, const glm::dvec4& plane, std::vector<Corner>* out) {
+  out->clear();
+  const size_t n = in.size();
+  for (size_t i = 0; i < n; ++i) {
+    const Corner& a = in[i];
+    const Corner& b = in[(i + 1) % n];
+    const double da = glm::dot(plane, a), db = glm::dot(plane, b);
+    if (da >= 0.0) out->push_back(a);
+    if ((da >= 0.0) != (db >= 0.0)) out->push_back(cut(a, da, b, db));
+  }
+}
+
+}  // namespace
+
+size_t clip_faces_at_infinity(const std::vector<ShadowVolumeVertex>& infinite, const glm::dmat4& clip_from_relative,
+                              const glm::dvec3& eye, double tie_step, const glm::dvec4* plane,
+                              std::vector<ShadowVolumeVertex>* out) {
+  const glm::dmat4 t = glm::transpose(clip_from_relative);
+  size_t written = 0;
+  std::vector<Corner> a, b;
+  std::vector<glm::vec4> window;
+  for (size_t i = 0; i + 2 < infinite.size(); i += 3) {
+    const uint32_t object = infinite[i].object, reversed = infinite[i].reversed;
+    const double scale = 1.0 + tie_step * (double(object) + 1.0);
+    // The planes, as functionals of the relative corner: w - x, w + x, w - y, w + y, w - s z.
+    const glm::dvec4 planes[6] = {t * glm::dvec4(-1, 0, 0, 1), t * glm::dvec4(1, 0, 0, 1),
+                                  t * glm::dvec4(0, -1, 0, 1), t * glm::dvec4(0, 1, 0, 1),
+                                  t * glm::dvec4(0, 0, -scale, 1), plane ? *plane : glm::dvec4(0, 0, 0, 1)};
+    const int count = plane ? 6 : 5;
+    a.clear();
+    for (size_t k = 0; k < 3; ++k) {
+      const glm::vec4& p = infinite[i + k].position;
+      a.push_back(p.w == 0.f ? Corner(glm::dvec3(p), 0.0) : Corner(glm::dvec3(p) - eye, 1.0));
+    }
+    bool outside = false;  // every corner beyond one plane: nothing of it is seen
+    for (int q = 0; q < count && !outside; ++q) {
+      outside = glm::dot(planes[q], a[0]) < 0.0 && glm::dot(planes[q], a[1]) < 0.0 && glm::dot(planes[q], a[2]) < 0.0;
+    }
+    if (outside) continue;
+    for (int q = 0; q < count && a.size() >= 3; ++q) {
+      clip_polygon(a, planes[q], &b);
+      a.swap(b);
+    }
+    if (a.size() < 3) continue;
+    // Window-space points: w > 0 on every corner kept (w >= |x|, and w = x = y = 0 only at
+    // a degenerate corner, skipped).
+    window.clear();
+    for (const Corner& c : a) {
+      const glm::dvec4 h = clip_from_relative * c;
+      if (!(h.w > 0.0)) break;
+      window.emplace_back(float(h.x / h.w), float(h.y / h.w), float(scale * h.z / h.w), 1.f);
+    }
+    if (window.size() != a.size()) continue;
+    for (size_t k = 1; k + 1 < window.size(); ++k) {
+      for (const glm::vec4& v : {window[0], window[k], window[k + 1]}) out->push_back({v, object, reversed});
+      ++written;
+    }
+  }
+  return written;
+}
+
 }  // namespace abcube

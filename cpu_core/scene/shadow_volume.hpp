@@ -55,4 +55,34 @@ constexpr int MAX_VOLUME_LIGHTS = 128;
 // The volume of the light at `light` over the scene's blockers of that kind.
 ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light, Blockers kind = Blockers::opaque);
 
+// THE FACES AT INFINITY, CLIPPED ON THE CPU. A side (two corners at infinity) or a far cap
+// (three) of a light almost in its caster's plane reaches infinity in directions nearly
+// perpendicular to the view, or behind the eye: clip coordinates with w near 0 or below,
+// which the GL's clipper (in float) cuts at the viewport's edges with vertices off by far
+// more than a sample. The far cap that should cover the whole image then missed wedges at
+// its edges, and the shadow there with it (a light 1e-6 above an open quad: 37.2 dB against
+// the tracer where abuffer reached 58.3; tests/cli/flat_mirrors.sh). So these faces are
+// clipped here, in double, to the view's clip volume: -w <= x, y <= w, the near plane
+// (z <= w, the window depth of reversed Z at most 1) and, in a mirror's virtual view, the
+// mirror's plane; then given to the GL as window-space points (x/w, y/w, z/w, 1), which it
+// need not clip again. An edge two faces share is cut from its endpoints in one canonical
+// order, so both get the same new vertices: no crack, no overlap (Sutherland-Hodgman keeps
+// each edge's part as a run of the polygon's boundary).
+
+// The volume's triangles split: those with every corner finite (the near caps, drawn by the
+// GL with the scene's own transform so that each keeps its surface's depth), and those with a
+// corner at infinity (sides, far caps: clip_faces_at_infinity).
+void split_at_infinity(const std::vector<ShadowVolumeVertex>& triangles, std::vector<ShadowVolumeVertex>* finite,
+                       std::vector<ShadowVolumeVertex>* infinite);
+
+// The triangles `infinite` (corners: points w = 1 in world coordinates, directions w = 0)
+// seen through `clip_from_relative` (the view's clip matrix applied to a point relative to
+// `eye`, or to a direction), clipped as above, triangulated as fans into `out` with
+// positions in clip coordinates of w = 1. `tie_step`: THE TIE RULE's depth scale (z times
+// 1 + tie_step (object + 1), scene.vert). `plane` (n, d), when given: keep n . (p - eye) + d w
+// >= 0 (a virtual view's mirror, relative to its eye). Returns the triangles written.
+size_t clip_faces_at_infinity(const std::vector<ShadowVolumeVertex>& infinite, const glm::dmat4& clip_from_relative,
+                              const glm::dvec3& eye, double tie_step, const glm::dvec4* plane,
+                              std::vector<ShadowVolumeVertex>* out);
+
 }  // namespace abcube

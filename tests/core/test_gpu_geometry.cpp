@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "raster/cube_map.hpp"
 #include "scene/planar_reflectors.hpp"
 #include "scene/scene_load.hpp"
 #include "scene/shadow_volume.hpp"
@@ -180,6 +181,92 @@ TEST(ShadowVolume, AClosedBoxCastsFromEveryFace) {
   const ShadowVolume on_top = build_shadow_volume(s, glm::dvec3(0.1, 1.0, 0.2));
   EXPECT_EQ(on_top.blockers, 10u);  // every face but the top, whose plane holds the light
   EXPECT_TRUE(closed_and_oriented(on_top, &why)) << why;
+}
+
+// The faces at infinity clipped in double (shadow_volume.hpp): a light 1e-6 above an open
+// quad (tools/flat_mirror_scenes.py light_on_open_mirror_3_0, where the GL's own clipping
+// lost wedges of shadow at the image's edge), seen from above. Two of the far caps' corners
+// lie behind the eye and their sides reach infinity nearly in the quad's plane. At every
+// point of a grid over the view (every point of the image, its corners and edges included),
+// the depth-fail count of the clipped faces plus the near caps, against the floor seen
+// there (or a plane above the light), is 1 where it is in the quad's shadow and 0 elsewhere,
+// as a segment test decides; points within 1e-9 of an edge or of the shadow's boundary are
+// left out.
+TEST(ShadowVolume, FacesAtInfinityClippedCountTheShadowEverywhere) {
+  const SceneData s = scene_of(MATERIALS, R"([{"type": "quad", "vertices": [[-0.964029168, 0.57461057, -0.328310396],
+    [-0.964029168, 0.57461057, 0.328310396], [0.964029168, 0.57461057, 0.328310396],
+    [0.964029168, 0.57461057, -0.328310396]], "material": "matte"}])");
+  const glm::dvec3 light(-0.067170248, 0.57461157, -0.040167352);
+  const glm::dvec3 eye(-1.14215524, 2.12445066, 2.85335192), look_at(0, 0.4, 0);
+  const ShadowVolume v = build_shadow_volume(s, light);
+  std::vector<ShadowVolumeVertex> finite, infinite, clipped;
+  split_at_infinity(v.vertices, &finite, &infinite);
+  EXPECT_EQ(finite.size(), 6u);              // the two near caps
+  EXPECT_EQ(infinite.size(), 3u * (2 + 8));  // two far caps, four sides of two triangles
+  const glm::dmat4 m(camera_clip_matrix(glm::dvec3(0.0), look_at - eye, glm::dvec3(0, 1, 0), glm::radians(49.419),
+                                        640.0 / 480.0, 1e-4));
+  const size_t triangles = clip_faces_at_infinity(infinite, m, eye, 0.0, nullptr, &clipped);
+  ASSERT_EQ(clipped.size(), 3 * triangles);
+  // Every face, in window space (x, y in [-1, 1], depth): the clipped ones as given, the
+  // near caps through the same matrix.
+  std::vector<std::array<glm::dvec3, 3>> faces;
+  for (size_t i = 0; i < clipped.size(); i += 3) {
+    faces.push_back({glm::dvec3(clipped[i].position), glm::dvec3(clipped[i + 1].position), glm::dvec3(clipped[i + 2].position)});
+  }
+  for (size_t i = 0; i < finite.size(); i += 3) {
+    std::array<glm::dvec3, 3> f;
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec4 h = m * glm::dvec4(glm::dvec3(finite[i + k].position) - eye, 1.0);
+      f[k] = glm::dvec3(h) / h.w;
+    }
+    faces.push_back(f);
+  }
+  const glm::dmat4 unproject = glm::inverse(m);
+  const auto edge = [](const glm::dvec3& a, const glm::dvec3& b, double x, double y) {
+    return (b.x - a.x) * (y - a.y) - (b.y - a.y) * (x - a.x);
+  };
+  int shadowed = 0, lit = 0, skipped = 0;
+  constexpr int NX = 160, NY = 120;
+  for (const double height : {0.0, 1.0}) {  // the floor (in the quad's wide shadow), a plane above the light (lit)
+  for (int j = 0; j < NY; ++j) {
+    for (int i = 0; i < NX; ++i) {
+      const double x = -1.0 + 2.0 * (i + 0.5) / NX, y = -1.0 + 2.0 * (j + 0.5) / NY;
+      // The plane y = height on this point's ray, and its window depth.
+      const glm::dvec4 far = unproject * glm::dvec4(x, y, 0.5, 1.0);
+      const glm::dvec3 dir = glm::normalize(glm::dvec3(far) / far.w);
+      if (!(dir.y < 0.0)) continue;
+      const glm::dvec3 p = eye + dir * ((height - eye.y) / dir.y);
+      const glm::dvec4 hp = m * glm::dvec4(p - eye, 1.0);
+      const double depth = hp.z / hp.w;
+      // Shadowed: the segment from p to the light meets the quad (its plane between them).
+      const double t = (0.57461057 - p.y) / (light.y - p.y);
+      const glm::dvec3 q = p + t * (light - p);
+      const bool in_shadow = t > 0.0 && t < 1.0 && std::abs(q.x) < 0.964029168 && std::abs(q.z) < 0.328310396;
+      bool near_edge = std::abs(std::abs(q.x) - 0.964029168) < 1e-9 || std::abs(std::abs(q.z) - 0.328310396) < 1e-9;
+      int count = 0;
+      for (const auto& f : faces) {
+        const double e0 = edge(f[0], f[1], x, y), e1 = edge(f[1], f[2], x, y), e2 = edge(f[2], f[0], x, y);
+        const double area = edge(f[0], f[1], f[2].x, f[2].y);
+        if (area == 0.0) continue;
+        const double scale = std::abs(area);
+        if (std::min({std::abs(e0), std::abs(e1), std::abs(e2)}) < 1e-9 * scale) near_edge = true;
+        const bool inside = area > 0 ? (e0 > 0 && e1 > 0 && e2 > 0) : (e0 < 0 && e1 < 0 && e2 < 0);
+        if (!inside) continue;
+        const double z = (e1 * f[0].z + e2 * f[1].z + e0 * f[2].z) / area;
+        if (z <= depth) count += area > 0 ? -1 : 1;  // depth-fail: at or behind; front (CCW) -1
+      }
+      if (near_edge) {
+        ++skipped;
+        continue;
+      }
+      EXPECT_EQ(count, in_shadow ? 1 : 0) << "at (" << x << ", " << y << ") on y = " << height;
+      ++(in_shadow ? shadowed : lit);
+    }
+  }
+  }
+  EXPECT_GT(shadowed, 10000);  // the floor
+  EXPECT_GT(lit, 10000);       // the plane above
+  EXPECT_LT(skipped, 20);
 }
 
 TEST(ShadowVolume, SmoothMeshesStayClosed) {
