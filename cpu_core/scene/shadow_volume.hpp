@@ -13,7 +13,10 @@
 // the surface point, whichever side of the volumes the eye is on. Open surfaces (a quad)
 // need nothing special: their triangles are prisms like any other. Two sides on one edge
 // with opposite directions (two neighbours oriented alike, the inside of a mesh) are the
-// same quad traversed both ways: they cancel on every ray and are left out.
+// same quad traversed both ways: they cancel on every ray and are left out. A closed
+// object strictly outside which the light lies (lights_outside_closed) casts from its
+// triangles facing the light alone: every segment to the light that meets it enters it
+// through one of those.
 //
 // The near caps keep their triangle's vertex order (a flag says when their orientation is
 // reversed): the GL draws them with the same vertices, in the same order, as the surface
@@ -40,7 +43,14 @@ struct ShadowVolume {
   uint64_t blockers = 0;          // triangles that cast (prisms)
   uint64_t sides = 0;             // side quads kept
   uint64_t sides_cancelled = 0;   // side quads left out in cancelling pairs
+  uint64_t facing_away_left_out = 0;  // closed objects' triangles facing away from a light outside them
 };
+
+// Whether the light is strictly outside each closed object (per object; false for an open
+// one): no triangle of it has its plane through the light (plane_holds_light), and its
+// winding number about the light (the solid angles its outward triangles subtend, over 4 pi:
+// 0 outside, 1 inside, 1/2 on its surface; van Oosterom & Strackee 1983) is below 1/2.
+std::vector<uint8_t> lights_outside_closed(const SceneData& scene, const glm::dvec3& light);
 
 // Which blockers a volume is made of: the opaque ones (blocker_transmittance 0: the
 // shadow), or the translucent ones (neither 0 nor 1: glass, veils; where their count is 0
