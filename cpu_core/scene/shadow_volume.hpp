@@ -69,10 +69,10 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
 // (three) of a light almost in its caster's plane reaches infinity in directions nearly
 // perpendicular to the view, or behind the eye: clip coordinates with w near 0 or below,
 // which the GL's clipper (in float) cuts at the viewport's edges with vertices off by far
-// more than a sample. The far cap that should cover the whole image then missed wedges at
-// its edges, and the shadow there with it (a light 1e-6 above an open quad: 37.2 dB against
-// the tracer where abuffer reached 58.3; tests/cli/flat_mirrors.sh). So these faces are
-// clipped here, in double, to the view's clip volume: -w <= x, y <= w, the near plane
+// more than a sample. The far cap that should cover the whole camera tile then missed wedges
+// at its edges, and the shadow there with it (a light 1e-6 above an open quad: 37.2 dB
+// against the tracer where abuffer reached 58.3; tests/cli/flat_mirrors.sh). So these faces
+// are clipped here, in double, to the view's (the tile's) clip volume: -w <= x, y <= w, the near plane
 // (z <= w, the window depth of reversed Z at most 1) and, in a mirror's virtual view, the
 // mirror's plane; then given to the GL as window-space points (x/w, y/w, z/w, 1), which it
 // need not clip again. An edge two faces share is cut from its endpoints in one canonical

@@ -259,78 +259,30 @@ void GlScene::count_volumes(const glm::mat4& clip, const MirrorView& view) {
   glBindVertexArray(vao_);
 }
 
-void GlScene::clear_clipped_cache() {
-  for (const ClippedFaces& c : clipped_cache_) {
-    glDeleteBuffers(1, &c.vbo);
-    glDeleteVertexArrays(1, &c.vao);
-  }
-  clipped_cache_.clear();
-  clipped_cached_vertices_ = 0;
-}
-
-// A volume's faces at infinity, clipped on the CPU (shadow_volume.hpp) for this view, or
-// taken from the cache when another tile clipped them already, and drawn as window-space
-// points: the identity for scene.vert's transform, no tie scale (applied), no mirror plane
-// (clipped at). At most 4M vertices (96 MB) are kept; past that, clipped each tile.
+// A volume's faces at infinity, clipped on the CPU (shadow_volume.hpp) to this view and tile
+// and drawn as window-space points: the identity for scene.vert's transform, no tie scale
+// (applied), no mirror plane (clipped at).
 void GlScene::draw_faces_at_infinity(int layer, const glm::mat4& clip, const MirrorView& view) {
-  constexpr size_t CACHED_VERTICES = size_t{4} << 20;
+  // The view's transform as set_view gives the GL (in double) and its mirror's plane
+  // relative to its eye.
   glm::dmat4 linear = view.model;
   linear[3] = glm::dvec4(0.0, 0.0, 0.0, 1.0);
   const glm::dvec4 plane(glm::dvec3(view.plane), view.plane.w + glm::dot(glm::dvec3(view.plane), view.eye));
-  const ClippedFaces* hit = nullptr;
-  for (const ClippedFaces& c : clipped_cache_) {
-    if (whole_viewport_ && c.layer == layer && c.level == view.level && c.model == view.model && c.eye == view.eye &&
-        (view.level == 0 || c.plane == plane)) {
-      hit = &c;
-      break;
-    }
-  }
-  GLuint vao = clipped_vao_;
-  GLsizei count = 0;
-  if (hit) {
-    vao = hit->vao;
-    count = hit->count;
-  } else {
-    // The view's transform as set_view gives the GL (in double, the whole grid's when the
-    // tiles share one viewport) and its mirror's plane relative to its eye.
-    const glm::dmat4 clip_from_relative = (whole_viewport_ ? whole_clip_ : gl_from_tile_ * glm::dmat4(clip)) * linear;
-    const double tie_step = double(float(gl_tie_step(scene_.objects.size())));  // as set_view gives it
-    clipped_volume_.clear();
-    clip_faces_at_infinity(volume_infinite_[static_cast<size_t>(layer)], clip_from_relative, view.eye, tie_step,
-                           view.level > 0 ? &plane : nullptr, &clipped_volume_);
-    count = static_cast<GLsizei>(clipped_volume_.size());
-    GLuint vbo = clipped_vbo_;
-    if (whole_viewport_ && clipped_cached_vertices_ + clipped_volume_.size() <= CACHED_VERTICES) {
-      ClippedFaces c;
-      c.layer = layer;
-      c.level = view.level;
-      c.model = view.model;
-      c.eye = view.eye;
-      c.plane = plane;
-      c.count = count;
-      glGenVertexArrays(1, &c.vao);
-      glBindVertexArray(c.vao);
-      glGenBuffers(1, &c.vbo);
-      glBindBuffer(GL_ARRAY_BUFFER, c.vbo);
-      volume_attributes();
-      clipped_cache_.push_back(c);
-      clipped_cached_vertices_ += clipped_volume_.size();
-      vao = c.vao;
-      vbo = c.vbo;
-    }
-    glBindVertexArray(vao);
-    glBindBuffer(GL_ARRAY_BUFFER, vbo);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(clipped_volume_.size() * sizeof(ShadowVolumeVertex)),
-                 clipped_volume_.data(), vbo == clipped_vbo_ ? GL_STREAM_DRAW : GL_STATIC_DRAW);
-  }
-  if (count == 0) return;
+  const double tie_step = double(float(gl_tie_step(scene_.objects.size())));  // as set_view gives it
+  clipped_volume_.clear();
+  clip_faces_at_infinity(volume_infinite_[static_cast<size_t>(layer)], glm::dmat4(clip) * linear, view.eye, tie_step,
+                         view.level > 0 ? &plane : nullptr, &clipped_volume_);
+  if (clipped_volume_.empty()) return;
   const glm::mat4 identity(1.f);
   glUniformMatrix4fv(volume_program_->uniform("u_clip"), 1, GL_FALSE, &identity[0][0]);
   glUniform3d(volume_program_->uniform("u_center"), 0.0, 0.0, 0.0);
   glUniform1f(volume_program_->uniform("u_tie_step"), 0.f);
   glUniform4f(volume_program_->uniform("u_clip_plane"), 0.f, 0.f, 0.f, 1.f);
-  glBindVertexArray(vao);
-  glDrawArrays(GL_TRIANGLES, 0, count);
+  glBindVertexArray(clipped_vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, clipped_vbo_);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(clipped_volume_.size() * sizeof(ShadowVolumeVertex)),
+               clipped_volume_.data(), GL_STREAM_DRAW);
+  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(clipped_volume_.size()));
 }
 
 void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* views_left) {
@@ -550,29 +502,9 @@ void GlScene::shade_groups(const glm::mat4& clip, const MirrorView& view, bool v
   // Its image stores seen by what follows: blending, the parent view's passes, the resolve.
   glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   for (GLuint unit = 0; unit < 3; ++unit) glBindImageTexture(unit, 0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-  glViewport(tile_viewport_.x, tile_viewport_.y, tile_viewport_.z, tile_viewport_.w);
+  glViewport(0, 0, t.width, t.height);
   glEnable(GL_DEPTH_TEST);
   glEnable(GL_STENCIL_TEST);
-}
-
-void GlScene::begin_tile(const SampleTiles& tiles, int64_t x0, int64_t y0, const glm::mat4& camera_clip) {
-  whole_viewport_ = whole_viewport(tiles, max_viewport_, viewport_bounds_);
-  if (whole_viewport_) {
-    whole_clip_ = whole_matrix(tiles) * glm::dmat4(camera_clip);  // the same for every tile
-    gl_from_tile_ = whole_from_tile(tiles, x0, y0);
-    tile_viewport_ = whole_viewport_of(tiles, x0, y0);
-  } else {
-    gl_from_tile_ = glm::dmat4(1.0);
-    tile_viewport_ = glm::ivec4(0, 0, tiles.target_w(), tiles.target_h());
-  }
-  glViewport(tile_viewport_.x, tile_viewport_.y, tile_viewport_.z, tile_viewport_.w);
-}
-
-void GlScene::end_tiles() {
-  gl_from_tile_ = glm::dmat4(1.0);
-  whole_viewport_ = false;
-  clear_clipped_cache();
-  if (target_) glViewport(0, 0, target_->width, target_->height);
 }
 
 void GlScene::make_exact_programs() {
@@ -627,16 +559,11 @@ GlScene::ShadowProbe GlScene::camera_shadow_probe(const Camera& camera) {
   const GLenum colour[] = {GL_COLOR_ATTACHMENT0};
   MirrorView view;
   view.eye = camera.position;
-  struct TilesEnd {
-    GlScene* scene;
-    ~TilesEnd() { scene->end_tiles(); }
-  } tiles_end{this};
   for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
     for (int64_t x0 = 0; x0 < full_w; x0 += tile_w) {
       check_deadline();
       const glm::mat4 tile_clip = tiles.matrix(x0, y0) * clip;
       t.clear(scene_.background);
-      begin_tile(tiles, x0, y0, clip);
       const float none[4] = {0, 0, 0, 0};
       glClearBufferfv(GL_COLOR, 0, none);
       stencil_level(0);
@@ -709,16 +636,11 @@ Image GlScene::camera_color_exact(const Camera& camera) {
   std::vector<float> rgba(static_cast<size_t>(tile_w / MASK_COLUMNS) * static_cast<size_t>(tile_h / MASK_ROWS) * 4);
   Image out(camera.width, camera.height, 3);
   exact_pixels_.assign(static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height), 1);
-  struct TilesEnd {
-    GlScene* scene;
-    ~TilesEnd() { scene->end_tiles(); }
-  } tiles_end{this};
   for (int64_t y0 = 0; y0 < full_h; y0 += tile_h) {
     for (int64_t x0 = 0; x0 < full_w; x0 += tile_w) {
       check_deadline();
       Clock::time_point t0 = Clock::now();
       t.clear(scene_.background);
-      begin_tile(tiles, x0, y0, clip);
       const float background[4] = {float(scene_.background.x), float(scene_.background.y), float(scene_.background.z), 0.f};
       glClearBufferfv(GL_COLOR, 0, background);  // alpha: no approximated surface yet
       MirrorView camera_view;

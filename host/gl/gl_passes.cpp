@@ -46,8 +46,6 @@ struct LightGpu {
 GlScene::GlScene(const SceneData& scene) : scene_(scene) {
   const Clock::time_point t0 = Clock::now();
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size_);
-  glGetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport_);
-  glGetIntegerv(GL_VIEWPORT_BOUNDS_RANGE, viewport_bounds_);
   const double radius = max_distance_from(scene, scene.camera.position);
   near_ = default_near_distance(radius);
 
@@ -228,7 +226,6 @@ GlScene::~GlScene() {
   glDeleteBuffers(1, &recursed_);
   glDeleteBuffers(static_cast<GLsizei>(volume_vbos_.size()), volume_vbos_.data());
   glDeleteVertexArrays(static_cast<GLsizei>(volume_vaos_.size()), volume_vaos_.data());
-  clear_clipped_cache();
   glDeleteBuffers(1, &clipped_vbo_);
   glDeleteVertexArrays(1, &clipped_vao_);
   glDeleteTextures(static_cast<GLsizei>(texture_arrays_.size()), texture_arrays_.data());
@@ -304,9 +301,7 @@ void GlScene::set_view(const GlProgram& program, const glm::mat4& clip, const Mi
   // view's eye being the camera's unfolded through them).
   glm::dmat4 linear = view.model;
   linear[3] = glm::dvec4(0.0, 0.0, 0.0, 1.0);
-  const glm::mat4 clip_model = view.level == 0 && gl_from_tile_ == glm::dmat4(1.0)
-                                   ? clip
-                                   : glm::mat4(gl_from_tile_ * glm::dmat4(clip) * linear);
+  const glm::mat4 clip_model = view.level == 0 ? clip : glm::mat4(glm::dmat4(clip) * linear);
   glUniformMatrix4fv(program.uniform("u_clip"), 1, GL_FALSE, &clip_model[0][0]);
   // The clip plane relative to the eye: n . (rel + eye) + d.
   const double offset = view.plane.w + glm::dot(glm::dvec3(view.plane), view.eye);

@@ -102,8 +102,6 @@ int gl_shadow_light_limit();
 
 // The scene uploaded to the current GL context. Needs a current GL 4.5 context for its
 // whole life (gl_context.hpp).
-struct SampleTiles;  // gl_passes_internal.hpp
-
 class GlScene {
  public:
   explicit GlScene(const SceneData& scene);
@@ -225,16 +223,6 @@ class GlScene {
   GLsizei vertex_count_ = 0;
   double near_ = 1e-4;
   int max_size_ = 0;
-  int max_viewport_[2] = {0, 0}, viewport_bounds_[2] = {0, 0};
-  // The exact camera pass's current tile (SampleTiles::whole_viewport): the GL viewport its
-  // draws use, and the map from the tile's clip coordinates to the whole grid's that
-  // set_view applies (identity outside a tile, or when the grid exceeds the viewport limits).
-  glm::dmat4 gl_from_tile_{1.0};
-  glm::ivec4 tile_viewport_{0};
-  bool whole_viewport_ = false;  // and then the whole grid's clip matrix, in double:
-  glm::dmat4 whole_clip_{1.0};
-  void begin_tile(const SampleTiles& tiles, int64_t x0, int64_t y0, const glm::mat4& camera_clip);
-  void end_tiles();
   void draw_shadow_casters(GLuint maps);
   void peel_translucent_casters(int n, int layers);
   int n_of_lookup_ = 0;
@@ -261,23 +249,10 @@ class GlScene {
   std::vector<GLuint> volume_vaos_, volume_vbos_;
   std::vector<GLsizei> volume_vertices_;  // the finite triangles (near caps) of each
   // Each volume's triangles with a corner at infinity (shadow_volume.hpp), clipped per view
-  // on the CPU into clipped_volume_ and drawn from clipped_vbo_.
+  // and tile on the CPU into clipped_volume_ and drawn from clipped_vbo_.
   std::vector<std::vector<ShadowVolumeVertex>> volume_infinite_;
   std::vector<ShadowVolumeVertex> clipped_volume_;
   GLuint clipped_vao_ = 0, clipped_vbo_ = 0;
-  // Those clipped faces kept per view and volume while a camera's tiles are drawn in one
-  // viewport (the same clip coordinates for every tile): clipped once, not once a tile.
-  struct ClippedFaces {
-    int layer = 0, level = 0;
-    glm::dmat4 model{1.0};
-    glm::dvec3 eye{0.0};
-    glm::dvec4 plane{0.0};
-    GLuint vao = 0, vbo = 0;
-    GLsizei count = 0;
-  };
-  std::vector<ClippedFaces> clipped_cache_;
-  size_t clipped_cached_vertices_ = 0;
-  void clear_clipped_cache();
   void draw_faces_at_infinity(int layer, const glm::mat4& clip, const MirrorView& view);
   std::unique_ptr<GlProgram> exact_program_, fill_program_, volume_program_, probe_program_, resolve_program_;
   std::unique_ptr<GlProgram> ids_program_, groups_program_, depth_program_;  // per-group shading (camera_ids, camera_groups)

@@ -91,52 +91,17 @@ inline glm::mat4 relative_camera_clip(const Camera& camera, double near_distance
                             aspect, near_distance);
 }
 
-inline glm::dmat4 tile_matrix_d(int64_t full_w, int64_t full_h, int64_t x0, int64_t y0, int64_t tile_w,
-                                int64_t tile_h) {
-  glm::dmat4 tile(1.0);
-  tile[0][0] = double(full_w) / double(tile_w);
-  tile[3][0] = -double(full_w) / double(tile_w) * (double(2 * x0 + tile_w) / double(full_w) - 1.0);
-  tile[1][1] = double(full_h) / double(tile_h);
-  tile[3][1] = -double(full_h) / double(tile_h) * (double(2 * y0 + tile_h) / double(full_h) - 1.0);
-  return tile;
-}
-
 inline glm::mat4 tile_matrix(int64_t full_w, int64_t full_h, int64_t x0, int64_t y0, int tile_w, int tile_h) {
-  return glm::mat4(tile_matrix_d(full_w, full_h, x0, y0, tile_w, tile_h));
+  glm::mat4 tile(1.f);
+  tile[0][0] = float(double(full_w) / tile_w);
+  tile[3][0] = float(-double(full_w) / tile_w * (double(2 * x0 + tile_w) / double(full_w) - 1.0));
+  tile[1][1] = float(double(full_h) / tile_h);
+  tile[3][1] = float(-double(full_h) / tile_h * (double(2 * y0 + tile_h) / double(full_h) - 1.0));
+  return tile;
 }
 
 inline glm::mat4 SampleTiles::matrix(int64_t x0, int64_t y0) const {
   return tile_matrix(full_w, full_h, x0 - MARGIN_X, y0 - MARGIN_Y, target_w(), target_h());
-}
-
-// THE WHOLE GRID IN ONE VIEWPORT. The exact camera pass draws each tile with the clip
-// coordinates of the whole grid (margins around it included) and a GL viewport offset so
-// that the tile lands in the target: GL then clips every tile's triangles where it clips
-// the whole image's, never at a tile's edge. Clipped at the tiles' edges, a shadow volume's
-// faces reaching infinity lost their counts in wedges along the seams (a light 1e-6 above
-// an open quad: 32.8 dB against the tracer, 90.2 in one tile; tests/cli/flat_mirrors.sh).
-// Where the grid exceeds GL_MAX_VIEWPORT_DIMS or GL_VIEWPORT_BOUNDS_RANGE the tile's own
-// clip coordinates remain (whole_viewport false).
-inline bool whole_viewport(const SampleTiles& t, const int max_dims[2], const int bounds[2]) {
-  const int64_t w = t.full_w + 2 * SampleTiles::MARGIN_X, h = t.full_h + 2 * SampleTiles::MARGIN_Y;
-  return w <= max_dims[0] && h <= max_dims[1] && -t.full_w >= bounds[0] && -t.full_h >= bounds[0] &&
-         w <= bounds[1] && h <= bounds[1];
-}
-// The map from the tile at (x0, y0)'s clip coordinates to the whole grid's (margins
-// included), and the viewport that puts that tile in the target.
-inline glm::dmat4 whole_matrix(const SampleTiles& t) {  // the whole grid's, margins included
-  return tile_matrix_d(t.full_w, t.full_h, -SampleTiles::MARGIN_X, -SampleTiles::MARGIN_Y,
-                       t.full_w + 2 * SampleTiles::MARGIN_X, t.full_h + 2 * SampleTiles::MARGIN_Y);
-}
-inline glm::dmat4 whole_from_tile(const SampleTiles& t, int64_t x0, int64_t y0) {
-  const glm::dmat4 whole = whole_matrix(t);
-  const glm::dmat4 tile =
-      tile_matrix_d(t.full_w, t.full_h, x0 - SampleTiles::MARGIN_X, y0 - SampleTiles::MARGIN_Y, t.target_w(), t.target_h());
-  return whole * glm::inverse(tile);
-}
-inline glm::ivec4 whole_viewport_of(const SampleTiles& t, int64_t x0, int64_t y0) {
-  return glm::ivec4(static_cast<int>(-x0), static_cast<int>(-y0), static_cast<int>(t.full_w + 2 * SampleTiles::MARGIN_X),
-                    static_cast<int>(t.full_h + 2 * SampleTiles::MARGIN_Y));
 }
 
 // One framebuffer: distance (R32F) + object id (R32UI), or colour (RGBA32F); depth 32F with

@@ -87,9 +87,8 @@ done
 # 128x96, showed nothing). light_on_open_mirror: the light on, or 1e-6 above or below, an
 # open mirror quad, whose volume's sides and far caps reach infinity nearly in its plane and
 # behind the eye. Clipped by the GL at each tile's edges they lost their counts in wedges
-# along the seams; in one viewport for the whole image (gl_passes_internal.hpp's
-# whole_viewport), still at the image's right edge: seed 3 gave hybrid 37.17 dB against
-# abuffer's 58.34, 88.93 once those faces are clipped in double (shadow_volume.hpp).
+# along the seams: seed 3 gave hybrid 37.17 dB against abuffer's 58.34, 88.93 once those
+# faces are clipped in double on the CPU (shadow_volume.hpp).
 for seed in 3 "$SEED"; do
   /usr/bin/python3 "$REPO/tools/flat_mirror_scenes.py" --seed "$seed" --count 1 --out "$WORK/tiles" --size 640x480 \
     --cube-res 128 --templates light_on_open_mirror > /dev/null ||
