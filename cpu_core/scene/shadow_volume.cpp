@@ -158,15 +158,23 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
   return out;
 }
 
-void split_at_infinity(const std::vector<ShadowVolumeVertex>& triangles, std::vector<ShadowVolumeVertex>* finite,
-                       std::vector<ShadowVolumeVertex>* infinite) {
-  for (size_t i = 0; i + 2 < triangles.size(); i += 3) {
-    const bool at_infinity = triangles[i].position.w == 0.f || triangles[i + 1].position.w == 0.f ||
-                             triangles[i + 2].position.w == 0.f;
-    std::vector<ShadowVolumeVertex>& to = at_infinity ? *infinite : *finite;
-    to.insert(to.end(), triangles.begin() + static_cast<std::ptrdiff_t>(i),
-              triangles.begin() + static_cast<std::ptrdiff_t>(i + 3));
+void split_at_infinity(std::vector<ShadowVolumeVertex>* triangles, std::vector<ShadowVolumeVertex>* infinite) {
+  std::vector<ShadowVolumeVertex>& v = *triangles;
+  const auto at_infinity = [&](size_t i) {
+    return v[i].position.w == 0.f || v[i + 1].position.w == 0.f || v[i + 2].position.w == 0.f;
+  };
+  size_t count = 0;
+  for (size_t i = 0; i + 2 < v.size(); i += 3) count += at_infinity(i) ? 3 : 0;
+  infinite->reserve(infinite->size() + count);
+  size_t kept = 0;
+  for (size_t i = 0; i + 2 < v.size(); i += 3) {
+    if (at_infinity(i)) {
+      infinite->insert(infinite->end(), v.begin() + static_cast<std::ptrdiff_t>(i), v.begin() + static_cast<std::ptrdiff_t>(i + 3));
+    } else {
+      for (size_t k = 0; k < 3; ++k) v[kept++] = v[i + k];
+    }
   }
+  v.resize(kept);
 }
 
 namespace {

@@ -79,11 +79,12 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
 // order, so both get the same new vertices: no crack, no overlap (Sutherland-Hodgman keeps
 // each edge's part as a run of the polygon's boundary).
 
-// The volume's triangles split: those with every corner finite (the near caps, drawn by the
-// GL with the scene's own transform so that each keeps its surface's depth), and those with a
-// corner at infinity (sides, far caps: clip_faces_at_infinity).
-void split_at_infinity(const std::vector<ShadowVolumeVertex>& triangles, std::vector<ShadowVolumeVertex>* finite,
-                       std::vector<ShadowVolumeVertex>* infinite);
+// The volume's triangles split, in place: `triangles` keeps those with every corner finite
+// (the near caps, drawn by the GL with the scene's own transform so that each keeps its
+// surface's depth), in their order; those with a corner at infinity (sides, far caps:
+// clip_faces_at_infinity) move to `infinite`. No third copy: the peak is the volume plus
+// its faces at infinity.
+void split_at_infinity(std::vector<ShadowVolumeVertex>* triangles, std::vector<ShadowVolumeVertex>* infinite);
 
 // The triangles `infinite` (corners: points w = 1 in world coordinates, directions w = 0)
 // seen through `clip_from_relative` (the view's clip matrix applied to a point relative to

@@ -186,10 +186,11 @@ void GlScene::build_volumes() {
     if (kind == Blockers::translucent && !translucent) continue;
     (kind == Blockers::opaque ? volume_bit_ : translucent_bit_)[i] = static_cast<int>(volume_lights_.size());
     volume_lights_.push_back(static_cast<int>(i));
-    const ShadowVolume v = build_shadow_volume(scene_, scene_.lights[i].position, kind);
-    std::vector<ShadowVolumeVertex> finite;
+    ShadowVolume v = build_shadow_volume(scene_, scene_.lights[i].position, kind);
+    const size_t volume_triangles = v.vertices.size() / 3;
     volume_infinite_.emplace_back();
-    split_at_infinity(v.vertices, &finite, &volume_infinite_.back());
+    split_at_infinity(&v.vertices, &volume_infinite_.back());
+    const std::vector<ShadowVolumeVertex>& finite = v.vertices;
     GLuint vao = 0, vbo = 0;
     glGenVertexArrays(1, &vao);
     glBindVertexArray(vao);
@@ -201,7 +202,7 @@ void GlScene::build_volumes() {
     volume_vaos_.push_back(vao);
     volume_vbos_.push_back(vbo);
     volume_vertices_.push_back(static_cast<GLsizei>(finite.size()));
-    exact_stats_.volume_triangles += v.vertices.size() / 3;
+    exact_stats_.volume_triangles += volume_triangles;
    }
   }
   glGenVertexArrays(1, &clipped_vao_);

@@ -247,8 +247,8 @@ TEST(ShadowVolume, FacesAtInfinityClippedCountTheShadowEverywhere) {
   const glm::dvec3 light(-0.067170248, 0.57461157, -0.040167352);
   const glm::dvec3 eye(-1.14215524, 2.12445066, 2.85335192), look_at(0, 0.4, 0);
   const ShadowVolume v = build_shadow_volume(s, light);
-  std::vector<ShadowVolumeVertex> finite, infinite, clipped;
-  split_at_infinity(v.vertices, &finite, &infinite);
+  std::vector<ShadowVolumeVertex> finite = v.vertices, infinite, clipped;
+  split_at_infinity(&finite, &infinite);
   EXPECT_EQ(finite.size(), 6u);              // the two near caps
   EXPECT_EQ(infinite.size(), 3u * (2 + 8));  // two far caps, four sides of two triangles
   const glm::dmat4 m(camera_clip_matrix(glm::dvec3(0.0), look_at - eye, glm::dvec3(0, 1, 0), glm::radians(49.419),
