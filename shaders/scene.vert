@@ -6,9 +6,10 @@
 // (gl_camera_exact.cpp), one matrix made on the CPU so that every program computes the same
 // expression. gl_ClipDistance[0] keeps what lies on u_clip_plane's positive side (the
 // mirror's front, relative to the eye) when GL_CLIP_DISTANCE0 is on.
-// The shadow volumes (shadow_volume.frag) come through here too, with points at infinity
-// (w = 0): gl_Position is invariant, so a volume's near cap and the surface it caps get the
-// same depth at every sample.
+// The shadow volumes (shadow_volume.frag) come through here too: their near caps are the
+// scene's own triangles with a code each (volume_caps.glsl, prepended for that program
+// alone), and gl_Position is invariant, so a cap and the surface it caps get the same depth
+// at every sample; their faces at infinity come clipped on the CPU, as window-space points.
 layout(location = 0) in vec4 a_position;  // the scene's buffer gives xyz: w = 1
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in uint a_object;
@@ -43,6 +44,14 @@ void main() {
   gl_Position = u_clip * relative;
   gl_Position.z *= 1.0 + u_tie_step * float(a_object + 1u);
   if (u_skip_portal != 0u && a_portal == u_skip_portal) gl_Position = vec4(0.0);
+  uint reversed = a_reversed;
+#ifdef VOLUME_CAPS
+  if (u_caps) {
+    const uint code = volume_cap_code(gl_VertexID);
+    if (code == 0u) gl_Position = vec4(0.0);
+    reversed = code == 2u ? 1u : 0u;
+  }
+#endif
   gl_ClipDistance[0] = dot(u_clip_plane, relative);  // at infinity: its direction's side
   v_relative = relative.xyz;
   v_normal = a_normal;
@@ -50,5 +59,5 @@ void main() {
   v_material = a_material;
   v_uv = a_uv;
   v_portal = a_portal;
-  v_reversed = a_reversed;
+  v_reversed = reversed;
 }

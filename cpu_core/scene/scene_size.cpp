@@ -23,15 +23,17 @@ constexpr uint64_t MIB = uint64_t{1} << 20;
 // measured from /proc/self/statm around the first draw; gpu with --gpu-shadows maps
 // measured a marginal 239 a triangle, 2026-11-25). A shadow-casting light under gpu: a
 // cube map of N x N floats.
-// Shadow volumes (gpu and hybrid, gl_camera_exact.cpp): each volume light's near and far
-// caps are 6 vertices a triangle in a GL buffer, one light's vertices are built on the CPU
-// while the buffers before it are held, and the side pairing holds 16 bytes a corner: at
-// 1M triangles under two lights bench/memory.py measured 823 bytes a triangle above the
-// baseline in all, where this gives 836 (sides beyond a mesh's silhouettes are not counted:
-// a soup of disjoint triangles has more). --gpu-shadows maps needs none of it; the
+// Shadow volumes (gpu and hybrid, gl_camera_exact.cpp, shadow_volume.hpp): a light has at
+// most two (its opaque and its translucent blockers), each a code a triangle on the CPU and
+// in a GL buffer, and its runs of casting triangles (8 bytes a run, a run a triangle at
+// worst); the side pairing, while a volume is built, a bucket's byte a corner and at most
+// PAIRING_BUCKET_EDGES edges of 32 bytes at once. Sides beyond a mesh's silhouettes are not
+// counted (a soup of disjoint triangles has more). --gpu-shadows maps needs none of it; the
 // estimate, made before the method's options are read, counts it for every gpu render.
-constexpr uint64_t VOLUME_TRIANGLE_BYTES = 6 * sizeof(ShadowVolumeVertex);
-constexpr uint64_t VOLUME_PAIRING_TRIANGLE_BYTES = 3 * 16;
+// (The volumes held 6 vertices of 24 bytes a triangle before, 144 a light.)
+constexpr uint64_t VOLUME_TRIANGLE_BYTES = 2 * (2 + 8);
+constexpr uint64_t VOLUME_PAIRING_TRIANGLE_BYTES = 3;
+constexpr uint64_t VOLUME_PAIRING_EDGES_BYTES = PAIRING_BUCKET_EDGES * PAIRING_EDGE_BYTES;
 constexpr uint64_t PIXEL_BYTES = 3 * sizeof(float) + 64;
 constexpr uint64_t TEXEL_BYTES = 64;
 constexpr uint64_t GL_TRIANGLE_BYTES = 3 * 32 + 90;
@@ -58,10 +60,12 @@ uint64_t estimate_render_bytes(const SceneData& scene) {
   uint64_t shadow_lights = 0;
   for (const PointLight& l : scene.lights) shadow_lights += l.cast_shadows ? 1 : 0;
   const uint64_t volume_lights = std::min(shadow_lights, uint64_t{MAX_VOLUME_LIGHTS});
-  const uint64_t volumes = volume_lights > 0 ? (volume_lights + 1) * VOLUME_TRIANGLE_BYTES + VOLUME_PAIRING_TRIANGLE_BYTES : 0;
+  const uint64_t triangles = scene.triangles->triangle_count();
+  const uint64_t volumes = volume_lights > 0 ? volume_lights * VOLUME_TRIANGLE_BYTES + VOLUME_PAIRING_TRIANGLE_BYTES : 0;
+  const uint64_t pairing = volume_lights > 0 ? std::min(VOLUME_PAIRING_EDGES_BYTES, 3 * PAIRING_EDGE_BYTES * triangles) : 0;
   const uint64_t per_triangle = SCENE_TRIANGLE_BYTES + (gpu ? GL_TRIANGLE_BYTES + volumes : 0);
-  return pixels * PIXEL_BYTES + 6 * n * n * TEXEL_BYTES + scene.triangles->triangle_count() * per_triangle +
-         (gpu ? shadow_lights * n * n * GL_SHADOW_TEXEL_BYTES : 0);
+  return pixels * PIXEL_BYTES + 6 * n * n * TEXEL_BYTES + triangles * per_triangle +
+         (gpu ? shadow_lights * n * n * GL_SHADOW_TEXEL_BYTES + pairing : 0);
 }
 
 void check_render_size(const SceneData& scene, uint64_t budget_bytes, bool capped) {

@@ -19,7 +19,7 @@ std::array<uint32_t, 3> bits(const glm::vec3& p) {
 
 // An edge of an oriented near cap, keyed by its endpoints' float bits (the soup's vertices
 // of neighbours are the same floats), lo < hi; `forward`: traversed lo -> hi. 32 bytes, the
-// key read from lo and hi when sorting (3 a blocker, the build's largest array).
+// key read from lo and hi when sorting (PAIRING_EDGE_BYTES).
 struct DirectedEdge {
   glm::vec3 lo, hi;
   uint32_t object;
@@ -28,12 +28,33 @@ struct DirectedEdge {
     const std::array<uint32_t, 3> l = bits(lo), h = bits(hi);
     return {l[0], l[1], l[2], h[0], h[1], h[2]};
   }
+  uint64_t hash() const {  // of the key, mixed (splitmix64's finaliser per word)
+    uint64_t h = 0x9e3779b97f4a7c15ull;
+    for (const uint32_t x : key()) {
+      h ^= x;
+      h *= 0xff51afd7ed558ccdull;
+      h ^= h >> 33;
+    }
+    return h;
+  }
 };
+
 
 glm::vec4 at_infinity(const glm::vec3& p, const glm::dvec3& light) {
   const glm::dvec3 d = glm::dvec3(p) - light;
   return glm::vec4(glm::vec3(d), 0.f);
 }
+
+// The far cap of blocker t (code CAP or CAP_REVERSED): its corners pushed to infinity, in
+// the order that orients it outward, away from the light (the oriented cap (a, c, b)
+// reversed).
+std::array<glm::vec4, 3> far_cap(const TriangleSoup& soup, uint32_t t, uint8_t code, const glm::dvec3& light) {
+  const glm::vec3* p = &soup.positions[3 * static_cast<size_t>(t)];
+  const bool reversed = code == CAP_REVERSED;
+  return {at_infinity(p[0], light), at_infinity(p[reversed ? 1 : 2], light), at_infinity(p[reversed ? 2 : 1], light)};
+}
+
+static_assert(sizeof(DirectedEdge) == PAIRING_EDGE_BYTES, "the memory estimate counts the pairing's edges");
 
 }  // namespace
 
@@ -95,86 +116,91 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
     return true;
   };
   ShadowVolume out;
-  // The oriented caps' edges u -> w, sorted: per edge, the directions that do not cancel
-  // in pairs are its sides. Counted before any vertex is made, so that the vertices are
-  // allocated once at their size (peak memory: no growth by doubling).
-  std::vector<DirectedEdge> edges;
-  edges.reserve(3 * soup.triangle_count());  // at most (pages never written stay free)
+  out.light = light;
+  out.caps.assign(soup.triangle_count(), NO_CAP);
   for (uint32_t t = 0; t < soup.triangle_count(); ++t) {
     bool reversed = false;
     if (!casts(t, &reversed)) continue;
+    out.caps[t] = reversed ? CAP_REVERSED : CAP;
     ++out.blockers;
-    const glm::vec3* p = &soup.positions[3 * static_cast<size_t>(t)];
-    const int cap[3] = {0, reversed ? 2 : 1, reversed ? 1 : 2};
-    for (int k = 0; k < 3; ++k) {
-      const glm::vec3& u = p[cap[k]];
-      const glm::vec3& w = p[cap[(k + 1) % 3]];
-      const bool forward = bits(u) < bits(w);
-      edges.push_back({forward ? u : w, forward ? w : u, soup.object_id[t], forward});
-    }
   }
   out.facing_away_left_out = left_out;
-  std::sort(edges.begin(), edges.end(), [](const DirectedEdge& x, const DirectedEdge& y) { return x.key() < y.key(); });
-  struct Side {
-    size_t edge;  // its first entry in `edges`
-    long net;     // forward minus backward directions
+  // The oriented caps' edges u -> w, sorted: per edge, the directions that do not cancel in
+  // pairs are its sides. In buckets by a hash of the edge's endpoints, a bucket sorted at a
+  // time, so that about PAIRING_BUCKET_EDGES edges are held at once whatever the scene's
+  // size (all of them at once were 96 bytes a triangle, the gpu method's peak).
+  const auto for_each_edge = [&](const auto& f) {
+    uint64_t i = 0;
+    for (uint32_t t = 0; t < soup.triangle_count(); ++t) {
+      if (out.caps[t] == NO_CAP) continue;
+      const bool reversed = out.caps[t] == CAP_REVERSED;
+      const glm::vec3* p = &soup.positions[3 * static_cast<size_t>(t)];
+      const int cap[3] = {0, reversed ? 2 : 1, reversed ? 1 : 2};
+      for (int k = 0; k < 3; ++k) {
+        const glm::vec3& u = p[cap[k]];
+        const glm::vec3& w = p[cap[(k + 1) % 3]];
+        const bool forward = bits(u) < bits(w);
+        f(i++, DirectedEdge{forward ? u : w, forward ? w : u, soup.object_id[t], forward});
+      }
+    }
   };
-  std::vector<Side> sides;
-  for (size_t i = 0; i < edges.size();) {
-    size_t j = i;
-    long net = 0;
-    const std::array<uint32_t, 6> key = edges[i].key();
-    for (; j < edges.size() && edges[j].key() == key; ++j) net += edges[j].forward ? 1 : -1;
-    const long count = net < 0 ? -net : net;
-    out.sides_cancelled += (j - i) - static_cast<size_t>(count);
-    if (count > 0) sides.push_back({i, net});
-    out.sides += static_cast<uint64_t>(count);
-    i = j;
+  const uint64_t edge_count = 3 * out.blockers;
+  const uint32_t buckets = static_cast<uint32_t>(
+      std::clamp<uint64_t>((edge_count + PAIRING_BUCKET_EDGES - 1) / PAIRING_BUCKET_EDGES, 1, 255));
+  std::vector<uint8_t> bucket_of;  // per edge, when there are buckets
+  std::vector<uint64_t> bucket_size(buckets, 0);
+  if (buckets > 1) {
+    bucket_of.resize(edge_count);
+    for_each_edge([&](uint64_t i, const DirectedEdge& e) {
+      bucket_of[i] = static_cast<uint8_t>(e.hash() % buckets);
+      ++bucket_size[bucket_of[i]];
+    });
+  } else {
+    bucket_size[0] = edge_count;
   }
-  out.vertices.reserve(6 * (out.blockers + out.sides));
-  auto push = [&out](const glm::vec4& p, uint32_t object, bool reversed) {
-    out.vertices.push_back({p, object, reversed ? 1u : 0u});
-  };
-  for (uint32_t t = 0; t < soup.triangle_count(); ++t) {
-    bool reversed = false;
-    if (!casts(t, &reversed)) continue;
-    const glm::vec3* p = &soup.positions[3 * static_cast<size_t>(t)];
-    const uint32_t object = soup.object_id[t];
-    // Near cap, the triangle's own vertices in their own order; far cap, reversed.
-    for (int k = 0; k < 3; ++k) push(glm::vec4(p[k], 1.f), object, reversed);
-    const int order[3] = {0, reversed ? 1 : 2, reversed ? 2 : 1};  // the oriented cap (a, c, b) reversed
-    for (int k = 0; k < 3; ++k) push(at_infinity(p[order[k]], light), object, false);
-  }
-  for (const Side& side : sides) {
-    const DirectedEdge& e = edges[side.edge];
-    const glm::vec3 u = side.net > 0 ? e.lo : e.hi;
-    const glm::vec3 w = side.net > 0 ? e.hi : e.lo;
-    for (long n = 0; n < (side.net < 0 ? -side.net : side.net); ++n) {
-      // The side of edge u -> w, outward: (u, u_inf, w_inf) and (u, w_inf, w).
-      const glm::vec4 u1(u, 1.f), w1(w, 1.f), ui = at_infinity(u, light), wi = at_infinity(w, light);
-      for (const glm::vec4& q : {u1, ui, wi, u1, wi, w1}) push(q, e.object, false);
+  std::vector<DirectedEdge> edges;
+  edges.reserve(*std::max_element(bucket_size.begin(), bucket_size.end()));
+  for (uint32_t bucket = 0; bucket < buckets; ++bucket) {
+    edges.clear();
+    for_each_edge([&](uint64_t i, const DirectedEdge& e) {
+      if (buckets == 1 || bucket_of[i] == bucket) edges.push_back(e);
+    });
+    std::sort(edges.begin(), edges.end(), [](const DirectedEdge& x, const DirectedEdge& y) { return x.key() < y.key(); });
+    for (size_t i = 0; i < edges.size();) {
+      size_t j = i;
+      long net = 0;
+      const std::array<uint32_t, 6> key = edges[i].key();
+      for (; j < edges.size() && edges[j].key() == key; ++j) net += edges[j].forward ? 1 : -1;
+      const long count = net < 0 ? -net : net;
+      out.sides_cancelled += (j - i) - static_cast<size_t>(count);
+      out.sides += static_cast<uint64_t>(count);
+      const DirectedEdge& e = edges[i];
+      const glm::vec3 u = net > 0 ? e.lo : e.hi;
+      const glm::vec3 w = net > 0 ? e.hi : e.lo;
+      for (long n = 0; n < count; ++n) {
+        // The side of edge u -> w, outward: (u, u_inf, w_inf) and (u, w_inf, w).
+        const glm::vec4 u1(u, 1.f), w1(w, 1.f), ui = at_infinity(u, light), wi = at_infinity(w, light);
+        for (const glm::vec4& q : {u1, ui, wi, u1, wi, w1}) out.side_vertices.push_back({q, e.object, 0u});
+      }
+      i = j;
     }
   }
   return out;
 }
 
-void split_at_infinity(std::vector<ShadowVolumeVertex>* triangles, std::vector<ShadowVolumeVertex>* infinite) {
-  std::vector<ShadowVolumeVertex>& v = *triangles;
-  const auto at_infinity = [&](size_t i) {
-    return v[i].position.w == 0.f || v[i + 1].position.w == 0.f || v[i + 2].position.w == 0.f;
-  };
-  size_t count = 0;
-  for (size_t i = 0; i + 2 < v.size(); i += 3) count += at_infinity(i) ? 3 : 0;
-  infinite->reserve(infinite->size() + count);
-  size_t kept = 0;
-  for (size_t i = 0; i + 2 < v.size(); i += 3) {
-    if (at_infinity(i)) {
-      infinite->insert(infinite->end(), v.begin() + static_cast<std::ptrdiff_t>(i), v.begin() + static_cast<std::ptrdiff_t>(i + 3));
-    } else {
-      for (size_t k = 0; k < 3; ++k) v[kept++] = v[i + k];
-    }
+std::vector<ShadowVolumeVertex> volume_triangles(const ShadowVolume& volume, const TriangleSoup& soup) {
+  std::vector<ShadowVolumeVertex> out;
+  out.reserve(6 * volume.blockers + volume.side_vertices.size());
+  for (uint32_t t = 0; t < soup.triangle_count(); ++t) {
+    if (volume.caps[t] == NO_CAP) continue;
+    const glm::vec3* p = &soup.positions[3 * static_cast<size_t>(t)];
+    const uint32_t reversed = volume.caps[t] == CAP_REVERSED ? 1u : 0u;
+    for (int k = 0; k < 3; ++k) out.push_back({glm::vec4(p[k], 1.f), soup.object_id[t], reversed});
+    const std::array<glm::vec4, 3> far = far_cap(soup, t, volume.caps[t], volume.light);
+    for (const glm::vec4& q : far) out.push_back({q, soup.object_id[t], 0u});
   }
-  v.resize(kept);
+  out.insert(out.end(), volume.side_vertices.begin(), volume.side_vertices.end());
+  return out;
 }
 
 namespace {
@@ -212,15 +238,14 @@ void clip_polygon(const std::vector<Corner>& in, const glm::dvec4& plane, std::v
 
 }  // namespace
 
-size_t clip_faces_at_infinity(const std::vector<ShadowVolumeVertex>& infinite, const glm::dmat4& clip_from_relative,
+size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& soup, const glm::dmat4& clip_from_relative,
                               const glm::dvec3& eye, double tie_step, const glm::dvec4* plane,
                               std::vector<ShadowVolumeVertex>* out) {
   const glm::dmat4 t = glm::transpose(clip_from_relative);
   size_t written = 0;
   std::vector<Corner> a, b;
   std::vector<glm::vec4> window;
-  for (size_t i = 0; i + 2 < infinite.size(); i += 3) {
-    const uint32_t object = infinite[i].object, reversed = infinite[i].reversed;
+  const auto clip_face = [&](const std::array<glm::vec4, 3>& corners, uint32_t object, uint32_t reversed) {
     const double scale = 1.0 + tie_step * (double(object) + 1.0);
     // The planes, as functionals of the relative corner: w - x, w + x, w - y, w + y, w - s z.
     const glm::dvec4 planes[6] = {t * glm::dvec4(-1, 0, 0, 1), t * glm::dvec4(1, 0, 0, 1),
@@ -228,33 +253,36 @@ size_t clip_faces_at_infinity(const std::vector<ShadowVolumeVertex>& infinite, c
                                   t * glm::dvec4(0, 0, -scale, 1), plane ? *plane : glm::dvec4(0, 0, 0, 1)};
     const int count = plane ? 6 : 5;
     a.clear();
-    for (size_t k = 0; k < 3; ++k) {
-      const glm::vec4& p = infinite[i + k].position;
+    for (const glm::vec4& p : corners) {
       a.push_back(p.w == 0.f ? Corner(glm::dvec3(p), 0.0) : Corner(glm::dvec3(p) - eye, 1.0));
     }
-    bool outside = false;  // every corner beyond one plane: nothing of it is seen
-    for (int q = 0; q < count && !outside; ++q) {
-      outside = glm::dot(planes[q], a[0]) < 0.0 && glm::dot(planes[q], a[1]) < 0.0 && glm::dot(planes[q], a[2]) < 0.0;
+    for (int q = 0; q < count; ++q) {  // every corner beyond one plane: nothing of it is seen
+      if (glm::dot(planes[q], a[0]) < 0.0 && glm::dot(planes[q], a[1]) < 0.0 && glm::dot(planes[q], a[2]) < 0.0) return;
     }
-    if (outside) continue;
     for (int q = 0; q < count && a.size() >= 3; ++q) {
       clip_polygon(a, planes[q], &b);
       a.swap(b);
     }
-    if (a.size() < 3) continue;
+    if (a.size() < 3) return;
     // Window-space points: w > 0 on every corner kept (w >= |x|, and w = x = y = 0 only at
     // a degenerate corner, skipped).
     window.clear();
     for (const Corner& c : a) {
       const glm::dvec4 h = clip_from_relative * c;
-      if (!(h.w > 0.0)) break;
+      if (!(h.w > 0.0)) return;
       window.emplace_back(float(h.x / h.w), float(h.y / h.w), float(scale * h.z / h.w), 1.f);
     }
-    if (window.size() != a.size()) continue;
     for (size_t k = 1; k + 1 < window.size(); ++k) {
       for (const glm::vec4& v : {window[0], window[k], window[k + 1]}) out->push_back({v, object, reversed});
       ++written;
     }
+  };
+  for (uint32_t f = 0; f < soup.triangle_count(); ++f) {
+    if (volume.caps[f] != NO_CAP) clip_face(far_cap(soup, f, volume.caps[f], volume.light), soup.object_id[f], 0u);
+  }
+  const std::vector<ShadowVolumeVertex>& sides = volume.side_vertices;
+  for (size_t i = 0; i + 2 < sides.size(); i += 3) {
+    clip_face({sides[i].position, sides[i + 1].position, sides[i + 2].position}, sides[i].object, sides[i].reversed);
   }
   return written;
 }

@@ -38,13 +38,32 @@ struct ShadowVolumeVertex {
   uint32_t reversed;   // 1: the face's outward orientation is opposite to its winding
 };
 
+// A volume is kept as little as the GL and the clipping need (issue 14 part 6: it held 6
+// vertices of 24 bytes a blocker, 144 bytes a triangle a light, copies of what the scene
+// already has). Its near caps are the scene's own triangles, drawn from the scene's vertex
+// buffer with a code each (scene.vert, VOLUME_CAPS); its far caps are made from the soup
+// when they are clipped; only its sides, along the edges that do not cancel, are stored.
+enum CapCode : uint8_t {
+  NO_CAP = 0,        // the triangle casts nothing in this volume
+  CAP = 1,           // it casts; its prism is oriented as it is wound
+  CAP_REVERSED = 2,  // it casts; its prism's outward orientation is opposite to its winding
+};
+
 struct ShadowVolume {
-  std::vector<ShadowVolumeVertex> vertices;  // triangles, three vertices each
+  glm::dvec3 light{0.0};
+  std::vector<uint8_t> caps;                     // CapCode per soup triangle
+  std::vector<ShadowVolumeVertex> side_vertices; // the sides: triangles, three vertices each
   uint64_t blockers = 0;          // triangles that cast (prisms)
   uint64_t sides = 0;             // side quads kept
   uint64_t sides_cancelled = 0;   // side quads left out in cancelling pairs
   uint64_t facing_away_left_out = 0;  // closed objects' triangles facing away from a light outside them
+  uint64_t triangle_count() const { return 2 * blockers + 2 * sides; }
 };
+
+// Every face of the volume as triangles, in the order the GL counts them: per blocker its
+// near cap (w = 1, the triangle's own vertices in their own order) then its far cap (w = 0),
+// then the sides. For tests and tools; the render never makes this array.
+std::vector<ShadowVolumeVertex> volume_triangles(const ShadowVolume& volume, const TriangleSoup& soup);
 
 // Whether the light is strictly outside each closed object (per object; false for an open
 // one): no triangle of it has its plane through the light (plane_holds_light), and its
@@ -61,6 +80,11 @@ enum class Blockers { opaque, translucent };
 // each of an R32F array (gl_camera_exact.cpp); lights past them keep their cube shadow
 // maps. The memory estimate (scene_size.cpp) counts no more.
 constexpr int MAX_VOLUME_LIGHTS = 128;
+
+// The side pairing of build_shadow_volume sorts the caps' edges (PAIRING_EDGE_BYTES each) in
+// buckets by a hash, about PAIRING_BUCKET_EDGES at once, with a bucket's byte per edge.
+constexpr uint64_t PAIRING_BUCKET_EDGES = uint64_t{1} << 20;
+constexpr uint64_t PAIRING_EDGE_BYTES = 32;
 
 // The volume of the light at `light` over the scene's blockers of that kind.
 ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light, Blockers kind = Blockers::opaque);
@@ -79,20 +103,13 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
 // order, so both get the same new vertices: no crack, no overlap (Sutherland-Hodgman keeps
 // each edge's part as a run of the polygon's boundary).
 
-// The volume's triangles split, in place: `triangles` keeps those with every corner finite
-// (the near caps, drawn by the GL with the scene's own transform so that each keeps its
-// surface's depth), in their order; those with a corner at infinity (sides, far caps:
-// clip_faces_at_infinity) move to `infinite`. No third copy: the peak is the volume plus
-// its faces at infinity.
-void split_at_infinity(std::vector<ShadowVolumeVertex>* triangles, std::vector<ShadowVolumeVertex>* infinite);
-
-// The triangles `infinite` (corners: points w = 1 in world coordinates, directions w = 0)
-// seen through `clip_from_relative` (the view's clip matrix applied to a point relative to
+// The volume's faces with a corner at infinity (its far caps, made from `soup`, then its
+// sides; corners: points w = 1 in world coordinates, directions w = 0) seen through `clip_from_relative` (the view's clip matrix applied to a point relative to
 // `eye`, or to a direction), clipped as above, triangulated as fans into `out` with
 // positions in clip coordinates of w = 1. `tie_step`: THE TIE RULE's depth scale (z times
 // 1 + tie_step (object + 1), scene.vert). `plane` (n, d), when given: keep n . (p - eye) + d w
 // >= 0 (a virtual view's mirror, relative to its eye). Returns the triangles written.
-size_t clip_faces_at_infinity(const std::vector<ShadowVolumeVertex>& infinite, const glm::dmat4& clip_from_relative,
+size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& soup, const glm::dmat4& clip_from_relative,
                               const glm::dvec3& eye, double tie_step, const glm::dvec4* plane,
                               std::vector<ShadowVolumeVertex>* out);
 

@@ -43,6 +43,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "base/error.hpp"
+#include "base/memory.hpp"
 #include "base/parallel.hpp"
 #include "base/timer.hpp"
 #include "gl/gl_passes.hpp"
@@ -133,7 +134,7 @@ bool GlScene::plan_exact_camera() {
     s.mirrors = s.mirrors_why.empty();
   }
   if (exact_.shadow_volumes) {
-    s.volumes_why = !both.empty() ? both : casts ? "" : "no light casts shadows";
+    s.volumes_why = !both.empty() ? both : casts ? volume_caps_why_not() : "no light casts shadows";
     s.volumes = s.volumes_why.empty();
   }
   // What the pass leaves approximate in every lit sample: shadows by maps (and lights past
@@ -141,6 +142,21 @@ bool GlScene::plan_exact_camera() {
   shadows_approximate_ = casts && !s.volumes;
   s.plain = !s.mirrors && !s.volumes && exact_.always && both.empty();
   return s.mirrors || s.volumes || s.plain;
+}
+
+// The near caps' codes are read from a storage buffer by the vertex stage (volume_caps.glsl).
+std::string GlScene::volume_caps_why_not() const {
+  GLint blocks = 0;
+  GLint64 block = 0;
+  glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &blocks);
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
+  if (blocks < 1) return "this GL offers no storage buffer to a vertex shader (the volumes' caps need one)";
+  const uint64_t bytes = scene_.triangles->triangle_count();
+  if (bytes > static_cast<uint64_t>(block)) {
+    return "the volumes' caps' " + std::to_string(bytes) + " bytes exceed GL_MAX_SHADER_STORAGE_BLOCK_SIZE " +
+           std::to_string(block);
+  }
+  return "";
 }
 
 std::string GlScene::shade_pixels_why_not() const {
@@ -171,6 +187,7 @@ void volume_attributes() {
 void GlScene::build_volumes() {
   if (volumes_built_) return;
   volumes_built_ = true;
+  release_free_memory();  // what the GL freed after the shadow maps, before the volumes are built
   const Clock::time_point t0 = Clock::now();
   volume_bit_.assign(scene_.lights.size(), -1);
   translucent_bit_.assign(scene_.lights.size(), -1);
@@ -186,22 +203,33 @@ void GlScene::build_volumes() {
     if (kind == Blockers::translucent && !translucent) continue;
     (kind == Blockers::opaque ? volume_bit_ : translucent_bit_)[i] = static_cast<int>(volume_lights_.size());
     volume_lights_.push_back(static_cast<int>(i));
-    ShadowVolume v = build_shadow_volume(scene_, scene_.lights[i].position, kind);
-    const size_t volume_triangles = v.vertices.size() / 3;
-    volume_infinite_.emplace_back();
-    split_at_infinity(&v.vertices, &volume_infinite_.back());
-    const std::vector<ShadowVolumeVertex>& finite = v.vertices;
-    GLuint vao = 0, vbo = 0;
-    glGenVertexArrays(1, &vao);
-    glBindVertexArray(vao);
-    glGenBuffers(1, &vbo);
-    glBindBuffer(GL_ARRAY_BUFFER, vbo);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(finite.size() * sizeof(ShadowVolumeVertex)),
-                 finite.data(), GL_STATIC_DRAW);
-    volume_attributes();
-    volume_vaos_.push_back(vao);
-    volume_vbos_.push_back(vbo);
-    volume_vertices_.push_back(static_cast<GLsizei>(finite.size()));
+    volumes_.push_back(build_shadow_volume(scene_, scene_.lights[i].position, kind));
+    const ShadowVolume& v = volumes_.back();
+    const size_t volume_triangles = v.triangle_count();
+    // The caps' codes, four to a word of the storage buffer (byte k of word i is triangle
+    // 4 i + k: a little-endian host, as every GL host this runs on).
+    GLuint caps = 0;
+    glGenBuffers(1, &caps);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, caps);
+    const size_t bytes = (v.caps.size() + 3) / 4 * 4;
+    glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(std::max<size_t>(bytes, 4)), nullptr, GL_STATIC_DRAW);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, static_cast<GLsizeiptr>(v.caps.size()), v.caps.data());
+    volume_caps_.push_back(caps);
+    // The runs of consecutive casting triangles, drawn alone (a light's translucent volume
+    // has a few glass blockers among every triangle of the scene).
+    CapRuns runs;
+    for (size_t t = 0; t < v.caps.size();) {
+      if (v.caps[t] == NO_CAP) {
+        ++t;
+        continue;
+      }
+      size_t end = t;
+      while (end < v.caps.size() && v.caps[end] != NO_CAP) ++end;
+      runs.first.push_back(static_cast<GLint>(3 * t));
+      runs.count.push_back(static_cast<GLsizei>(3 * (end - t)));
+      t = end;
+    }
+    cap_runs_.push_back(std::move(runs));
     exact_stats_.volume_triangles += volume_triangles;
    }
   }
@@ -249,9 +277,16 @@ void GlScene::count_volumes(const glm::mat4& clip, const MirrorView& view) {
     glEnable(GL_BLEND);
     // Clipped at the view's mirror as its surfaces are (a near cap and its surface cut alike
     // keep the same depths); what is cut lies behind the mirror, where no counted ray goes.
+    // The near caps: the scene's own vertex buffer, its runs of casting triangles, each
+    // triangle with its cap's code (every portal's cap is drawn).
     set_view(*volume_program_, clip, view);
-    glBindVertexArray(volume_vaos_[static_cast<size_t>(layer)]);
-    glDrawArrays(GL_TRIANGLES, 0, volume_vertices_[static_cast<size_t>(layer)]);
+    glUniform1ui(volume_program_->uniform("u_skip_portal"), 0u);
+    glUniform1i(volume_program_->uniform("u_caps"), 1);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, VOLUME_CAPS_BINDING, volume_caps_[static_cast<size_t>(layer)]);
+    glBindVertexArray(vao_);
+    const CapRuns& runs = cap_runs_[static_cast<size_t>(layer)];
+    glMultiDrawArrays(GL_TRIANGLES, runs.first.data(), runs.count.data(), static_cast<GLsizei>(runs.first.size()));
+    glUniform1i(volume_program_->uniform("u_caps"), 0);
     draw_faces_at_infinity(layer, clip, view);
     glDisable(GL_BLEND);
   }
@@ -271,7 +306,7 @@ void GlScene::draw_faces_at_infinity(int layer, const glm::mat4& clip, const Mir
   const glm::dvec4 plane(glm::dvec3(view.plane), view.plane.w + glm::dot(glm::dvec3(view.plane), view.eye));
   const double tie_step = double(float(gl_tie_step(scene_.objects.size())));  // as set_view gives it
   clipped_volume_.clear();
-  clip_faces_at_infinity(volume_infinite_[static_cast<size_t>(layer)], glm::dmat4(clip) * linear, view.eye, tie_step,
+  clip_faces_at_infinity(volumes_[static_cast<size_t>(layer)], *scene_.triangles, glm::dmat4(clip) * linear, view.eye, tie_step,
                          view.level > 0 ? &plane : nullptr, &clipped_volume_);
   if (clipped_volume_.empty()) return;
   const glm::mat4 identity(1.f);
@@ -526,7 +561,8 @@ void GlScene::make_exact_programs() {
   groups_program_->use();
   glUniform1i(groups_program_->uniform("u_keys"), 0);
   fill_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"fill.frag"});
-  volume_program_ = std::make_unique<GlProgram>(scene_vert, std::vector<const char*>{"shadow_volume.frag"});
+  volume_program_ = std::make_unique<GlProgram>(std::vector<const char*>{"volume_caps.glsl", "scene.vert"},
+                                                std::vector<const char*>{"shadow_volume.frag"});
   resolve_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"resolve_samples.frag"});
   glGenBuffers(1, &recursed_);
 }

@@ -224,8 +224,7 @@ GlScene::~GlScene() {
   glDeleteBuffers(1, &portal_vbo_);
   glDeleteBuffers(1, &portal_ebo_);
   glDeleteBuffers(1, &recursed_);
-  glDeleteBuffers(static_cast<GLsizei>(volume_vbos_.size()), volume_vbos_.data());
-  glDeleteVertexArrays(static_cast<GLsizei>(volume_vaos_.size()), volume_vaos_.data());
+  glDeleteBuffers(static_cast<GLsizei>(volume_caps_.size()), volume_caps_.data());
   glDeleteBuffers(1, &clipped_vbo_);
   glDeleteVertexArrays(1, &clipped_vao_);
   glDeleteTextures(static_cast<GLsizei>(texture_arrays_.size()), texture_arrays_.data());

@@ -233,8 +233,8 @@ class GlScene {
   std::unique_ptr<Target> target_;
   GpuTimings timings_;
   // The exact camera pass: the planar reflectors, each one's triangles as an index range of
-  // portal_ebo_, the per-vertex reflector ids (portal_vbo_); the shadow volumes, one vertex
-  // buffer per volume light (its index in volume_lights_ is its bit); its programs and buffers.
+  // portal_ebo_, the per-vertex reflector ids (portal_vbo_); the shadow volumes, one per
+  // volume light (its index in volume_lights_ is its bit); its programs and buffers.
   ExactCameraOptions exact_;
   ExactCameraStats exact_stats_;
   std::vector<uint8_t> exact_pixels_;
@@ -246,14 +246,21 @@ class GlScene {
   std::vector<int> volume_lights_;        // light index per count (its layer)
   std::vector<int> volume_bit_;           // per light: its opaque blockers' count, or -1
   std::vector<int> translucent_bit_;      // per light: its translucent blockers' count, or -1
-  std::vector<GLuint> volume_vaos_, volume_vbos_;
-  std::vector<GLsizei> volume_vertices_;  // the finite triangles (near caps) of each
-  // Each volume's triangles with a corner at infinity (shadow_volume.hpp), clipped per view
+  // Each volume light's volume (shadow_volume.hpp): its caps' codes, also in a storage
+  // buffer each (volume_caps_, read by scene.vert's VOLUME_CAPS when the scene's own vertex
+  // buffer draws the near caps), and its sides; its faces at infinity are clipped per view
   // and tile on the CPU into clipped_volume_ and drawn from clipped_vbo_.
-  std::vector<std::vector<ShadowVolumeVertex>> volume_infinite_;
+  std::vector<ShadowVolume> volumes_;
+  std::vector<GLuint> volume_caps_;
+  struct CapRuns {  // runs of consecutive casting triangles, as vertex ranges of the scene's buffer
+    std::vector<GLint> first;
+    std::vector<GLsizei> count;
+  };
+  std::vector<CapRuns> cap_runs_;
   std::vector<ShadowVolumeVertex> clipped_volume_;
   GLuint clipped_vao_ = 0, clipped_vbo_ = 0;
   void draw_faces_at_infinity(int layer, const glm::mat4& clip, const MirrorView& view);
+  std::string volume_caps_why_not() const;
   std::unique_ptr<GlProgram> exact_program_, fill_program_, volume_program_, probe_program_, resolve_program_;
   std::unique_ptr<GlProgram> ids_program_, groups_program_, depth_program_;  // per-group shading (camera_ids, camera_groups)
   struct VisibilityBuffers;

@@ -35,6 +35,11 @@ static_assert(TEXTURE_UNIT + MAX_TEXTURE_ARRAYS <= 16, "texture units");
 // The shadow volumes' counts in the camera pass: unit 16 (llvmpipe and NVIDIA offer 32; the
 // exact pass checks GL_MAX_TEXTURE_IMAGE_UNITS).
 constexpr GLenum VOLUME_COUNT_UNIT = 16;
+// Storage buffer bindings: 0 materials, 1 lights (common_scene.glsl), 2 the recursed
+// reflectors (camera_surface.glsl), 3-5 the vertices, uvs and portals (camera_groups.frag);
+// 6 a shadow volume's caps' codes, read by the volume program's vertex stage
+// (volume_caps.glsl; the exact pass checks GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS).
+constexpr GLuint VOLUME_CAPS_BINDING = 6;
 
 // The state every pass relies on: infinite reversed-Z (cube_map.hpp: depth in [0, 1], 1 at
 // the near plane, GL_GREATER), no culling (the map holds every surface), no blending.

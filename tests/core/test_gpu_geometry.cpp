@@ -111,7 +111,8 @@ TEST(PlanarReflectors, FacetedObjectsAndTheSmallestPastTheCapAreCurved) {
 // Every directed edge of the volume, a vertex being its float bits (a point, or a
 // direction at infinity), oriented outward (a near cap turned when `reversed`): a closed
 // oriented surface has each edge as often as its reverse.
-bool closed_and_oriented(const ShadowVolume& v, std::string* why) {
+bool closed_and_oriented(const SceneData& s, const ShadowVolume& volume, std::string* why) {
+  const std::vector<ShadowVolumeVertex> v = volume_triangles(volume, *s.triangles);
   using Key = std::array<uint32_t, 4>;
   auto key = [](const glm::vec4& p) {
     Key k;
@@ -119,9 +120,9 @@ bool closed_and_oriented(const ShadowVolume& v, std::string* why) {
     return k;
   };
   std::map<std::pair<Key, Key>, long> edges;
-  for (size_t t = 0; t < v.vertices.size(); t += 3) {
-    std::array<glm::vec4, 3> p = {v.vertices[t].position, v.vertices[t + 1].position, v.vertices[t + 2].position};
-    if (v.vertices[t].reversed) std::swap(p[1], p[2]);
+  for (size_t t = 0; t < v.size(); t += 3) {
+    std::array<glm::vec4, 3> p = {v[t].position, v[t + 1].position, v[t + 2].position};
+    if (v[t].reversed) std::swap(p[1], p[2]);
     for (int e = 0; e < 3; ++e) ++edges[{key(p[e]), key(p[(e + 1) % 3])}];
   }
   for (const auto& [e, n] : edges) {
@@ -140,13 +141,15 @@ TEST(ShadowVolume, AQuadIsTwoPrismsWithTheirCommonSideLeftOut) {
   EXPECT_EQ(v.blockers, 2u);
   EXPECT_EQ(v.sides, 4u);             // the quad's outline
   EXPECT_EQ(v.sides_cancelled, 2u);   // the diagonal, once from each triangle
-  EXPECT_EQ(v.vertices.size(), 2u * 6 + 4u * 6);
+  EXPECT_EQ(volume_triangles(v, *s.triangles).size(), 2u * 6 + 4u * 6);
+  EXPECT_EQ(v.triangle_count(), 2u * 2 + 4u * 2);
+  EXPECT_EQ(v.caps, (std::vector<uint8_t>{CAP, CAP}));
   std::string why;
-  EXPECT_TRUE(closed_and_oriented(v, &why)) << why;
+  EXPECT_TRUE(closed_and_oriented(s, v, &why)) << why;
   // A light below the quad: the same count, seen from the other side.
   const ShadowVolume below = build_shadow_volume(s, glm::dvec3(0.2, -3, 0.1));
   EXPECT_EQ(below.blockers, 2u);
-  EXPECT_TRUE(closed_and_oriented(below, &why)) << why;
+  EXPECT_TRUE(closed_and_oriented(s, below, &why)) << why;
 }
 
 TEST(ShadowVolume, BlockersByKindAndLightsOnSurfacesLeftOut) {
@@ -158,10 +161,10 @@ TEST(ShadowVolume, BlockersByKindAndLightsOnSurfacesLeftOut) {
   const ShadowVolume opaque = build_shadow_volume(s, glm::dvec3(0.3, 4, 0.2));
   EXPECT_EQ(opaque.blockers, 2u);  // the matte box alone: its top, the face towards the light
   EXPECT_EQ(opaque.facing_away_left_out, 10u);
-  EXPECT_TRUE(closed_and_oriented(opaque, &why)) << why;
+  EXPECT_TRUE(closed_and_oriented(s, opaque, &why)) << why;
   const ShadowVolume translucent = build_shadow_volume(s, glm::dvec3(0.3, 4, 0.2), Blockers::translucent);
   EXPECT_EQ(translucent.blockers, 4u + 2u);  // the glass box's top and its face x = 2, and the veil
-  EXPECT_TRUE(closed_and_oriented(translucent, &why)) << why;
+  EXPECT_TRUE(closed_and_oriented(s, translucent, &why)) << why;
   // A light on the floor's plane y = 0 (rule "shadows": plane_holds_light): the veil casts
   // nothing, nor the glass box's bottom face (two triangles) in the same plane.
   const ShadowVolume on = build_shadow_volume(s, glm::dvec3(0.3, 0, 4), Blockers::translucent);
@@ -179,21 +182,21 @@ TEST(ShadowVolume, AClosedBoxCastsFromEveryFaceUnlessTheLightIsOutside) {
   std::string why;
   const ShadowVolume inside = build_shadow_volume(s, glm::dvec3(0.1, 0.5, 0.2));
   EXPECT_EQ(inside.blockers, 12u);
-  EXPECT_TRUE(closed_and_oriented(inside, &why)) << why;
+  EXPECT_TRUE(closed_and_oriented(s, inside, &why)) << why;
   const ShadowVolume on_top = build_shadow_volume(s, glm::dvec3(0.1, 1.0, 0.2));
   EXPECT_EQ(on_top.blockers, 10u);  // every face but the top, whose plane holds the light
-  EXPECT_TRUE(closed_and_oriented(on_top, &why)) << why;
+  EXPECT_TRUE(closed_and_oriented(s, on_top, &why)) << why;
   // At a corner: the three faces there hold the light, the other three (all facing away)
   // cast; with none facing the light, leaving them out would leave no shadow at all.
   const ShadowVolume corner = build_shadow_volume(s, glm::dvec3(1, 1, 1));
   EXPECT_EQ(corner.blockers, 6u);
   EXPECT_EQ(corner.facing_away_left_out, 0u);
-  EXPECT_TRUE(closed_and_oriented(corner, &why)) << why;
+  EXPECT_TRUE(closed_and_oriented(s, corner, &why)) << why;
   // Strictly outside, off a corner: the three faces towards it.
   const ShadowVolume outside = build_shadow_volume(s, glm::dvec3(3, 3, 3));
   EXPECT_EQ(outside.blockers, 6u);
   EXPECT_EQ(outside.facing_away_left_out, 6u);
-  EXPECT_TRUE(closed_and_oriented(outside, &why)) << why;
+  EXPECT_TRUE(closed_and_oriented(s, outside, &why)) << why;
   // The winding number itself: 0 outside, 1 inside, a plane through the light rules it out.
   EXPECT_EQ(lights_outside_closed(s, glm::dvec3(3, 3, 3)), std::vector<uint8_t>{1});
   EXPECT_EQ(lights_outside_closed(s, glm::dvec3(0.1, 0.5, 0.2)), std::vector<uint8_t>{0});
@@ -228,7 +231,7 @@ TEST(ShadowVolume, ALightInAConcavityIsOutside) {
   const ShadowVolume v = build_shadow_volume(s, glm::dvec3(1.6, 1.7, 0.4));
   EXPECT_GT(v.facing_away_left_out, 0u);
   EXPECT_EQ(v.blockers + v.facing_away_left_out, s.triangles->triangle_count());
-  EXPECT_TRUE(closed_and_oriented(v, &why)) << why;
+  EXPECT_TRUE(closed_and_oriented(s, v, &why)) << why;
 }
 
 // The faces at infinity clipped in double (shadow_volume.hpp): a light 1e-6 above an open
@@ -247,13 +250,18 @@ TEST(ShadowVolume, FacesAtInfinityClippedCountTheShadowEverywhere) {
   const glm::dvec3 light(-0.067170248, 0.57461157, -0.040167352);
   const glm::dvec3 eye(-1.14215524, 2.12445066, 2.85335192), look_at(0, 0.4, 0);
   const ShadowVolume v = build_shadow_volume(s, light);
-  std::vector<ShadowVolumeVertex> finite = v.vertices, infinite, clipped;
-  split_at_infinity(&finite, &infinite);
-  EXPECT_EQ(finite.size(), 6u);              // the two near caps
-  EXPECT_EQ(infinite.size(), 3u * (2 + 8));  // two far caps, four sides of two triangles
+  std::vector<ShadowVolumeVertex> finite, clipped;  // the near caps: every corner a point
+  const std::vector<ShadowVolumeVertex> all = volume_triangles(v, *s.triangles);
+  for (size_t i = 0; i < all.size(); i += 3) {
+    if (all[i].position.w == 1.f && all[i + 1].position.w == 1.f && all[i + 2].position.w == 1.f) {
+      finite.insert(finite.end(), all.begin() + static_cast<std::ptrdiff_t>(i), all.begin() + static_cast<std::ptrdiff_t>(i + 3));
+    }
+  }
+  EXPECT_EQ(finite.size(), 6u);                // the two near caps
+  EXPECT_EQ(all.size(), 6u + 3u * (2 + 8));    // two far caps, four sides of two triangles
   const glm::dmat4 m(camera_clip_matrix(glm::dvec3(0.0), look_at - eye, glm::dvec3(0, 1, 0), glm::radians(49.419),
                                         640.0 / 480.0, 1e-4));
-  const size_t triangles = clip_faces_at_infinity(infinite, m, eye, 0.0, nullptr, &clipped);
+  const size_t triangles = clip_faces_at_infinity(v, *s.triangles, m, eye, 0.0, nullptr, &clipped);
   ASSERT_EQ(clipped.size(), 3 * triangles);
   // Every face, in window space (x, y in [-1, 1], depth): the clipped ones as given, the
   // near caps through the same matrix.
@@ -324,7 +332,7 @@ TEST(ShadowVolume, SmoothMeshesStayClosed) {
   EXPECT_EQ(v.blockers + v.facing_away_left_out, s.triangles->triangle_count());
   EXPECT_GT(v.sides_cancelled, 0u);
   std::string why;
-  EXPECT_TRUE(closed_and_oriented(v, &why)) << why;
+  EXPECT_TRUE(closed_and_oriented(s, v, &why)) << why;
 }
 
 }  // namespace

@@ -912,15 +912,17 @@ TEST(SceneLoadMemory, EstimateAndBudget) {
   SceneData gpu = s;
   gpu.render.method = Method::gpu;
   // and a cube shadow map of N x N floats per shadow-casting light (the scene has one),
-  // and its shadow volume: near and far caps, 6 vertices of 24 bytes a triangle, held
-  // for each volume light and built for one more, and the side pairing's 48.
+  // and its shadow volumes (two at most, opaque and translucent blockers): a cap's code on
+  // the CPU and in the GL and 8 bytes of runs a triangle each; the side pairing's bucket byte
+  // a corner, and its edges of 32 bytes (3 a triangle, at most 2^20 of them).
   ASSERT_EQ(gpu.lights.size(), 1u);
-  const uint64_t volume = 6 * 24;
-  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90 + 2 * volume + 48) + 6u * 100 * 100 * 4);
+  const uint64_t volume = 2 * (2 + 8);
+  const uint64_t pairing = 960u * 3 * 32;
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90 + volume + 3) + pairing + 6u * 100 * 100 * 4);
   gpu.lights.push_back(gpu.lights.front());
-  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90 + 3 * volume + 48) + 2 * 6u * 100 * 100 * 4);
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90 + 2 * volume + 3) + pairing + 2 * 6u * 100 * 100 * 4);
   gpu.lights.back().cast_shadows = false;
-  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90 + 2 * volume + 48) + 6u * 100 * 100 * 4);
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90 + volume + 3) + pairing + 6u * 100 * 100 * 4);
   gpu.lights.front().cast_shadows = false;  // no shadows: no volumes, no maps
   EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90));
   // A huge cube map is refused by its estimate, not by an allocation failure.
