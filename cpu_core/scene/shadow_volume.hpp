@@ -18,10 +18,11 @@
 // triangles facing the light alone: every segment to the light that meets it enters it
 // through one of those.
 //
-// The near caps keep their triangle's vertex order (a flag says when their orientation is
-// reversed): the GL draws them with the same vertices, in the same order, as the surface
-// itself, so a cap and its surface have the same depth at every sample and a lit point of a
-// blocker counts its own cap (-1) against the exit of its own prism (+1).
+// The near caps are the scene's own triangles (a code says when their orientation is
+// reversed): the GL draws them from the scene's own vertex buffer, the same vertices in the
+// same order as the surface itself, so a cap and its surface have the same depth at every
+// sample and a lit point of a blocker counts its own cap (-1) against the exit of its own
+// prism (+1).
 #pragma once
 #include <cstdint>
 #include <vector>
