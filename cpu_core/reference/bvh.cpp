@@ -223,12 +223,18 @@ struct Query {
   }
 };
 
+// The first of the primitives of a chunk's geometry (its user data): Embree numbers a
+// geometry's primitives from 0.
+uint32_t chunk_first(const void* geometry_user) { return static_cast<const Bvh::Chunk*>(geometry_user)->first; }
+
 // Embree's callback for rtcIntersect1 (visible_hit): the double test of one candidate.
 void visible_candidate(const RTCIntersectFunctionNArguments* args) {
   if (!args->valid[0]) return;  // rtcIntersect1: N = 1
   Query* q = reinterpret_cast<Query*>(args->context);
   TriangleHit h;
-  if (!intersect_triangle(*q->ray, *q->soup, q->triangle(args->primID), q->cull, &h)) return;
+  if (!intersect_triangle(*q->ray, *q->soup, q->triangle(chunk_first(args->geometryUserPtr) + args->primID), q->cull, &h)) {
+    return;
+  }
   q->add(h);
   float& tfar = RTCRayN_tfar(RTCRayHitN_RayN(args->rayhit, args->N), args->N, 0);
   tfar = std::min(tfar, q->er.to_embree(q->cull));  // never widened: a wider window is the second traversal's
@@ -241,7 +247,9 @@ void visit_candidate(const RTCOccludedFunctionNArguments* args) {
   Query* q = reinterpret_cast<Query*>(args->context);
   if (q->stopped) return;
   TriangleHit h;
-  if (!intersect_triangle(*q->ray, *q->soup, q->triangle(args->primID), q->tmax, &h)) return;
+  if (!intersect_triangle(*q->ray, *q->soup, q->triangle(chunk_first(args->geometryUserPtr) + args->primID), q->tmax, &h)) {
+    return;
+  }
   if (q->visit(q->state, h)) return;
   q->stopped = true;
   RTCRayN_tfar(args->ray, args->N, 0) = -INFINITY;
@@ -250,8 +258,9 @@ void visit_candidate(const RTCOccludedFunctionNArguments* args) {
 // A primitive's box, in Embree's units: the triangle's float bounds widened by BOX_PAD M,
 // rounded outwards.
 void triangle_bounds(const RTCBoundsFunctionArguments* args) {
-  const Bvh* bvh = static_cast<const Bvh*>(args->geometryUserPtr);
-  const glm::vec3* p = &bvh->soup().positions[3 * static_cast<size_t>(bvh->triangle(args->primID))];
+  const Bvh::Chunk& chunk = *static_cast<const Bvh::Chunk*>(args->geometryUserPtr);
+  const Bvh* bvh = chunk.bvh;
+  const glm::vec3* p = &bvh->soup().positions[3 * static_cast<size_t>(bvh->triangle(chunk.first + args->primID))];
   const double unit = embree_unit(bvh->magnitude());  // Bvh::unit_
   const glm::dvec3 lo = glm::dvec3(glm::min(p[0], glm::min(p[1], p[2]))) * unit;
   const glm::dvec3 hi = glm::dvec3(glm::max(p[0], glm::max(p[1], p[2]))) * unit;
@@ -301,28 +310,61 @@ void Bvh::build() {
   if (n == 0 || !(magnitude_ > 0.0)) return;  // nothing to hit (all vertices at the origin: all degenerate)
   unit_ = embree_unit(magnitude_);
   const RTCDevice device = embree_device();
-  RTCScene scene = rtcNewScene(device);
-  check_embree(device, "rtcNewScene");
-  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_COMPACT);
-  rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_MEDIUM);
-  RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
-  rtcSetGeometryUserPrimitiveCount(geometry, static_cast<unsigned>(n));
-  rtcSetGeometryUserData(geometry, this);
-  rtcSetGeometryBoundsFunction(geometry, triangle_bounds, nullptr);
-  rtcSetGeometryIntersectFunction(geometry, visible_candidate);
-  rtcSetGeometryOccludedFunction(geometry, visit_candidate);
-  rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_MEDIUM);
-  rtcCommitGeometry(geometry);
-  rtcAttachGeometry(scene, geometry);
-  rtcReleaseGeometry(geometry);
-  rtcSetSceneProgressMonitorFunction(scene, build_may_go_on, const_cast<Deadline*>(current_deadline()));
-  rtcCommitScene(scene);
-  const std::string e = embree_error(device);
-  if (!e.empty()) {
+  const uint32_t chunks = (n + BUILD_CHUNK - 1) / BUILD_CHUNK;
+  chunks_.clear();
+  chunks_.reserve(chunks);  // never moved: each is its geometry's user data
+  for (uint32_t c = 0; c < chunks; ++c) chunks_.push_back({this, c * BUILD_CHUNK});
+  const auto new_scene = [&] {
+    RTCScene scene = rtcNewScene(device);
+    check_embree(device, "rtcNewScene");
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_COMPACT);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_MEDIUM);
+    rtcSetSceneProgressMonitorFunction(scene, build_may_go_on, const_cast<Deadline*>(current_deadline()));
+    return scene;
+  };
+  const auto commit = [&](RTCScene scene, RTCScene also_release) {
+    rtcCommitScene(scene);
+    const std::string e = embree_error(device);
+    if (e.empty()) return;
     rtcReleaseScene(scene);
+    if (also_release) rtcReleaseScene(also_release);
     check_deadline();  // a cancelled build: RenderTimeout or Interrupted
     throw RuntimeFailure("embree: building the tree over " + std::to_string(n) + " triangles: " + e);
+  };
+  // Chunk c's triangles as a user geometry of `scene`.
+  const auto attach_chunk = [&](RTCScene scene, uint32_t c) {
+    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+    rtcSetGeometryUserPrimitiveCount(geometry, std::min(BUILD_CHUNK, n - chunks_[c].first));
+    rtcSetGeometryUserData(geometry, &chunks_[c]);
+    rtcSetGeometryBoundsFunction(geometry, triangle_bounds, nullptr);
+    rtcSetGeometryIntersectFunction(geometry, visible_candidate);
+    rtcSetGeometryOccludedFunction(geometry, visit_candidate);
+    rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_MEDIUM);
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(scene, geometry);
+    rtcReleaseGeometry(geometry);
+  };
+  RTCScene scene = new_scene();
+  if (chunks == 1) {
+    attach_chunk(scene, 0);
+  } else {
+    // Each chunk built on its own, then held by an identity instance (exact in float: x * 1
+    // + y * 0 + z * 0 + 0 = x) of the top scene.
+    const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    for (uint32_t c = 0; c < chunks; ++c) {
+      RTCScene part = new_scene();
+      attach_chunk(part, c);
+      commit(part, scene);
+      RTCGeometry instance = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(instance, part);
+      rtcSetGeometryTransform(instance, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity);
+      rtcCommitGeometry(instance);
+      rtcAttachGeometry(scene, instance);
+      rtcReleaseGeometry(instance);
+      rtcReleaseScene(part);  // held by its instance
+    }
   }
+  commit(scene, nullptr);
   scene_ = scene;
 }
 

@@ -37,6 +37,13 @@
 // So the answers do not depend on which instruction set Embree picks (SSE, AVX2, AVX-512),
 // the threads that built the tree, or the order the tree is walked in.
 //
+// Memory. Embree holds, besides its tree, 32 bytes of primitive references a triangle and
+// its builder's scratch while it builds (a peak of about 60 bytes a triangle above the
+// tree, the map methods' largest, bench/memory.py). Over more than BUILD_CHUNK triangles the
+// tree is built a chunk of consecutive triangles at a time, each chunk its own scene, held
+// by an identity instance of the top scene (a transform exact in float): the build's peak
+// is one chunk's. The answers are the same: every box the ray meets is still visited.
+//
 // Thread safety: queries are const and may run from any number of threads at once (one
 // RTCScene, read only; a context per call).
 #pragma once
@@ -101,6 +108,14 @@ class Bvh {
 
   // Widening of every primitive box, relative to the largest absolute vertex coordinate.
   static constexpr double BOX_PAD = 0x1p-16;
+  // Triangles a tree is built over at once (bvh.hpp "Memory").
+  static constexpr uint32_t BUILD_CHUNK = uint32_t{1} << 18;
+  // A run of its triangles, Embree's user data for their geometry: primitive k of it is
+  // triangle(first + k).
+  struct Chunk {
+    const Bvh* bvh;
+    uint32_t first;
+  };
 
  private:
   using VisitFn = bool (*)(void* state, const TriangleHit& hit);
@@ -110,6 +125,7 @@ class Bvh {
   const TriangleSoup* soup_;
   bool all_ = true;                 // every triangle of the soup, else triangles_
   std::vector<uint32_t> triangles_;
+  std::vector<Chunk> chunks_;
   RTCSceneTy* scene_ = nullptr;  // null when there is nothing to hit
   double magnitude_ = 0;         // the largest absolute vertex coordinate, M
   double unit_ = 1;              // Embree's units: 2^-ilogb(M) (bvh.hpp "Exactness")

@@ -281,7 +281,10 @@ void compare_searches(const SceneData& scene, const SearchContext& ctx, const Ra
 }
 
 // The scenes: the repository's, the hard-case regressions, and seeded generated ones.
-std::vector<std::string> scene_files() {
+// `tag` names the folder the generated scenes go to: one per test, since ctest runs the
+// tests of this file in parallel processes (one folder for both: one removed it while the
+// other read it, a failure seen once in a -j2 run).
+std::vector<std::string> scene_files(const std::string& tag) {
   const std::string src = ABCUBE_SOURCE_DIR;
   std::vector<std::string> files;
   for (const char* s : {"default.json", "cornell.json", "hidden_point.json", "shadows.json"}) {
@@ -292,7 +295,7 @@ std::vector<std::string> scene_files() {
     if (e.path().extension() == ".json") more.push_back(e.path().string());
   }
   // tools/hard_scenes.py, seed 1414: one scene of each template.
-  const std::string out = std::string(ABCUBE_BINARY_DIR) + "/test_search_hierarchy_scenes";
+  const std::string out = std::string(ABCUBE_BINARY_DIR) + "/test_search_hierarchy_scenes_" + tag;
   fs::remove_all(out);
   const std::string gen = "/usr/bin/python3 " + src + "/tools/hard_scenes.py --seed 1414 --count 11 --out " + out +
                           " --size 64x48 > /dev/null";
@@ -308,7 +311,7 @@ std::vector<std::string> scene_files() {
 }
 
 TEST(SearchHierarchy, SearchesGiveThePlainWalksAnswers) {
-  const std::vector<std::string> files = scene_files();
+  const std::vector<std::string> files = scene_files("searches");
   EXPECT_GE(files.size(), 4u + 12u + 11u);
   Tally tally;
   unsigned seed = 1;
@@ -356,7 +359,7 @@ Image render(const SceneData& s, const CubeABuffer& cube, const ABuffer& camera,
 }
 
 TEST(SearchHierarchy, RendersAreIdentical) {
-  const std::vector<std::string> files = scene_files();
+  const std::vector<std::string> files = scene_files("renders");
   int compared = 0;
   for (const std::string& file : files) {
     SceneData s = load_scene(file);
