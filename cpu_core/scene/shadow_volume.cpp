@@ -240,7 +240,7 @@ void clip_polygon(const std::vector<Corner>& in, const glm::dvec4& plane, std::v
 
 size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& soup, const glm::dmat4& clip_from_relative,
                               const glm::dvec3& eye, double tie_step, const glm::dvec4* plane,
-                              std::vector<ShadowVolumeVertex>* out) {
+                              std::vector<ShadowVolumeVertex>* out, size_t first, size_t count) {
   const glm::dmat4 t = glm::transpose(clip_from_relative);
   size_t written = 0;
   std::vector<Corner> a, b;
@@ -277,11 +277,15 @@ size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& so
       ++written;
     }
   };
-  for (uint32_t f = 0; f < soup.triangle_count(); ++f) {
-    if (volume.caps[f] != NO_CAP) clip_face(far_cap(soup, f, volume.caps[f], volume.light), soup.object_id[f], 0u);
+  const size_t triangles = volume.caps.size();
+  const size_t end = first + std::min(count, faces_at_infinity(volume) - std::min(first, faces_at_infinity(volume)));
+  for (size_t f = first; f < std::min(end, triangles); ++f) {
+    const uint32_t t = static_cast<uint32_t>(f);
+    if (volume.caps[t] != NO_CAP) clip_face(far_cap(soup, t, volume.caps[t], volume.light), soup.object_id[t], 0u);
   }
   const std::vector<ShadowVolumeVertex>& sides = volume.side_vertices;
-  for (size_t i = 0; i + 2 < sides.size(); i += 3) {
+  for (size_t f = std::max(first, triangles); f < end; ++f) {
+    const size_t i = 3 * (f - triangles);
     clip_face({sides[i].position, sides[i + 1].position, sides[i + 2].position}, sides[i].object, sides[i].reversed);
   }
   return written;

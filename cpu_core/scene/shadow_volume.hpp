@@ -24,6 +24,7 @@
 // sample and a lit point of a blocker counts its own cap (-1) against the exit of its own
 // prism (+1).
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -110,8 +111,16 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
 // positions in clip coordinates of w = 1. `tie_step`: THE TIE RULE's depth scale (z times
 // 1 + tie_step (object + 1), scene.vert). `plane` (n, d), when given: keep n . (p - eye) + d w
 // >= 0 (a virtual view's mirror, relative to its eye). Returns the triangles written.
+// Faces [first, first + count) only, when given: face t < soup.triangle_count() is
+// triangle t's far cap (nothing when it casts none), the others the sides in order; the
+// caller clips and draws a run at a time (the clipped faces of a million far caps in view
+// were 72 MB, and as much again in the GL's copy).
 size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& soup, const glm::dmat4& clip_from_relative,
                               const glm::dvec3& eye, double tie_step, const glm::dvec4* plane,
-                              std::vector<ShadowVolumeVertex>* out);
+                              std::vector<ShadowVolumeVertex>* out, size_t first = 0, size_t count = SIZE_MAX);
+// The faces clip_faces_at_infinity numbers: the soup's triangles, then the side triangles.
+inline size_t faces_at_infinity(const ShadowVolume& volume) {
+  return volume.caps.size() + volume.side_vertices.size() / 3;
+}
 
 }  // namespace abcube

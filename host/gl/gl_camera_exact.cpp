@@ -305,10 +305,6 @@ void GlScene::draw_faces_at_infinity(int layer, const glm::mat4& clip, const Mir
   linear[3] = glm::dvec4(0.0, 0.0, 0.0, 1.0);
   const glm::dvec4 plane(glm::dvec3(view.plane), view.plane.w + glm::dot(glm::dvec3(view.plane), view.eye));
   const double tie_step = double(float(gl_tie_step(scene_.objects.size())));  // as set_view gives it
-  clipped_volume_.clear();
-  clip_faces_at_infinity(volumes_[static_cast<size_t>(layer)], *scene_.triangles, glm::dmat4(clip) * linear, view.eye, tie_step,
-                         view.level > 0 ? &plane : nullptr, &clipped_volume_);
-  if (clipped_volume_.empty()) return;
   const glm::mat4 identity(1.f);
   glUniformMatrix4fv(volume_program_->uniform("u_clip"), 1, GL_FALSE, &identity[0][0]);
   glUniform3d(volume_program_->uniform("u_center"), 0.0, 0.0, 0.0);
@@ -316,9 +312,18 @@ void GlScene::draw_faces_at_infinity(int layer, const glm::mat4& clip, const Mir
   glUniform4f(volume_program_->uniform("u_clip_plane"), 0.f, 0.f, 0.f, 1.f);
   glBindVertexArray(clipped_vao_);
   glBindBuffer(GL_ARRAY_BUFFER, clipped_vbo_);
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(clipped_volume_.size() * sizeof(ShadowVolumeVertex)),
-               clipped_volume_.data(), GL_STREAM_DRAW);
-  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(clipped_volume_.size()));
+  // A run of faces at a time: their clipped triangles, then the GL's copy, stay small.
+  constexpr size_t RUN = 65536;
+  const ShadowVolume& volume = volumes_[static_cast<size_t>(layer)];
+  for (size_t first = 0; first < faces_at_infinity(volume); first += RUN) {
+    clipped_volume_.clear();
+    clip_faces_at_infinity(volume, *scene_.triangles, glm::dmat4(clip) * linear, view.eye, tie_step,
+                           view.level > 0 ? &plane : nullptr, &clipped_volume_, first, RUN);
+    if (clipped_volume_.empty()) continue;
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(clipped_volume_.size() * sizeof(ShadowVolumeVertex)),
+                 clipped_volume_.data(), GL_STREAM_DRAW);
+    glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(clipped_volume_.size()));
+  }
 }
 
 void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* views_left) {
