@@ -281,15 +281,16 @@ void triangle_bounds(const RTCBoundsFunctionArguments* args) {
 
 }  // namespace
 
-Bvh::Bvh(const TriangleSoup& soup) : soup_(&soup) { build(); }
+Bvh::Bvh(const TriangleSoup& soup, uint32_t build_chunk) : soup_(&soup) { build(build_chunk); }
 
-Bvh::Bvh(const TriangleSoup& soup, std::vector<uint32_t> triangles)
+Bvh::Bvh(const TriangleSoup& soup, std::vector<uint32_t> triangles, uint32_t build_chunk)
     : soup_(&soup), all_(false), triangles_(std::move(triangles)) {
   for (const uint32_t t : triangles_) ABCUBE_CHECK(t < soup.triangle_count(), "triangle index out of range");
-  build();
+  build(build_chunk);
 }
 
-void Bvh::build() {
+void Bvh::build(uint32_t build_chunk) {
+  ABCUBE_CHECK(build_chunk > 0, "build chunk");
   const TriangleSoup& soup = *soup_;
   ABCUBE_CHECK(soup.positions.size() == 3 * soup.triangle_count(), "positions must hold 3 vertices per triangle");
   ABCUBE_CHECK(soup.triangle_count() < UINT32_MAX / 3, "too many triangles for 32-bit indices");
@@ -310,10 +311,10 @@ void Bvh::build() {
   if (n == 0 || !(magnitude_ > 0.0)) return;  // nothing to hit (all vertices at the origin: all degenerate)
   unit_ = embree_unit(magnitude_);
   const RTCDevice device = embree_device();
-  const uint32_t chunks = (n + BUILD_CHUNK - 1) / BUILD_CHUNK;
+  const uint32_t chunks = static_cast<uint32_t>((uint64_t{n} + build_chunk - 1) / build_chunk);
   chunks_.clear();
   chunks_.reserve(chunks);  // never moved: each is its geometry's user data
-  for (uint32_t c = 0; c < chunks; ++c) chunks_.push_back({this, c * BUILD_CHUNK});
+  for (uint32_t c = 0; c < chunks; ++c) chunks_.push_back({this, c * build_chunk});
   const auto new_scene = [&] {
     RTCScene scene = rtcNewScene(device);
     check_embree(device, "rtcNewScene");
@@ -334,7 +335,7 @@ void Bvh::build() {
   // Chunk c's triangles as a user geometry of `scene`.
   const auto attach_chunk = [&](RTCScene scene, uint32_t c) {
     RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
-    rtcSetGeometryUserPrimitiveCount(geometry, std::min(BUILD_CHUNK, n - chunks_[c].first));
+    rtcSetGeometryUserPrimitiveCount(geometry, std::min(build_chunk, n - chunks_[c].first));
     rtcSetGeometryUserData(geometry, &chunks_[c]);
     rtcSetGeometryBoundsFunction(geometry, triangle_bounds, nullptr);
     rtcSetGeometryIntersectFunction(geometry, visible_candidate);

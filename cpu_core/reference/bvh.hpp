@@ -63,10 +63,11 @@ class Bvh {
   // Builds Embree's tree over `soup`, which is read by every query, never copied: it must
   // outlive the Bvh and not change. Throws RuntimeFailure when Embree fails (std::bad_alloc
   // when out of memory).
-  explicit Bvh(const TriangleSoup& soup);
+  // `build_chunk`: the triangles built over at once ("Memory" above; tests set it small).
+  explicit Bvh(const TriangleSoup& soup, uint32_t build_chunk = BUILD_CHUNK);
   // The same over the soup's triangles `triangles` only (hits name them by their index in
   // the soup; the searches' side structure).
-  Bvh(const TriangleSoup& soup, std::vector<uint32_t> triangles);
+  Bvh(const TriangleSoup& soup, std::vector<uint32_t> triangles, uint32_t build_chunk = BUILD_CHUNK);
   ~Bvh();
   Bvh(const Bvh&) = delete;
   Bvh& operator=(const Bvh&) = delete;
@@ -120,7 +121,7 @@ class Bvh {
  private:
   using VisitFn = bool (*)(void* state, const TriangleHit& hit);
   void visit_hits(const RayQuery& ray, double tmax, VisitFn visit, void* state) const;
-  void build();
+  void build(uint32_t build_chunk);
 
   const TriangleSoup* soup_;
   bool all_ = true;                 // every triangle of the soup, else triangles_

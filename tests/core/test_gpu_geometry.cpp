@@ -263,6 +263,18 @@ TEST(ShadowVolume, FacesAtInfinityClippedCountTheShadowEverywhere) {
                                         640.0 / 480.0, 1e-4));
   const size_t triangles = clip_faces_at_infinity(v, *s.triangles, m, eye, 0.0, nullptr, &clipped);
   ASSERT_EQ(clipped.size(), 3 * triangles);
+  // A run of faces at a time (as the GL draws them), one face a run: the same triangles.
+  std::vector<ShadowVolumeVertex> runs;
+  ASSERT_EQ(faces_at_infinity(v), 2u + 8u);  // the soup's two triangles' far caps, 8 side triangles
+  for (size_t first = 0; first < faces_at_infinity(v) + 2; ++first) {
+    clip_faces_at_infinity(v, *s.triangles, m, eye, 0.0, nullptr, &runs, first, 1);
+  }
+  ASSERT_EQ(runs.size(), clipped.size());
+  for (size_t i = 0; i < runs.size(); ++i) {
+    EXPECT_EQ(runs[i].position, clipped[i].position) << i;
+    EXPECT_EQ(runs[i].object, clipped[i].object) << i;
+    EXPECT_EQ(runs[i].reversed, clipped[i].reversed) << i;
+  }
   // Every face, in window space (x, y in [-1, 1], depth): the clipped ones as given, the
   // near caps through the same matrix.
   std::vector<std::array<glm::dvec3, 3>> faces;

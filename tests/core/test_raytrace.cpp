@@ -289,6 +289,17 @@ TEST(Raytrace, BvhMatchesBruteForce) {
     EXPECT_EQ(fast.triangle, brute.triangle) << "ray " << r;
   }
   EXPECT_GT(hits, 500);  // the comparison is not vacuous
+  // Built in chunks (12 of 256 triangles, each under an identity instance, as a soup of more
+  // than Bvh::BUILD_CHUNK is): the same answers.
+  const Bvh chunked(soup, 256);
+  std::vector<uint32_t> every(soup.triangle_count());
+  std::iota(every.begin(), every.end(), 0u);
+  int chunked_hits = 0;
+  for (int r = 0; r < 3000; ++r) {
+    const RayQuery q(2.0 * dvec3(u(rng), u(rng), u(rng)), dvec3(u(rng), u(rng), u(rng)));
+    chunked_hits += check_query(chunked, every, q, "chunked, ray " + std::to_string(r));
+  }
+  EXPECT_GT(chunked_hits, 500);
 }
 
 // A Bvh over some of a soup's triangles (the searches' side structure) answers for those
@@ -307,11 +318,14 @@ TEST(Raytrace, BvhOverASubsetAnswersForItsTrianglesOnly) {
   std::vector<uint32_t> subset;
   for (uint32_t t = 1; t < soup.triangle_count(); t += 3) subset.push_back(t);
   const Bvh bvh(soup, subset);
+  const Bvh chunked(soup, subset, 50);  // 4 chunks, the last one short
   ASSERT_EQ(bvh.triangle_count(), subset.size());
+  ASSERT_EQ(chunked.triangle_count(), subset.size());
   int hits = 0;
   for (int r = 0; r < 3000; ++r) {
     const RayQuery q(2.0 * dvec3(u(rng), u(rng), u(rng)), dvec3(u(rng), u(rng), u(rng)));
     hits += check_query(bvh, subset, q, "ray " + std::to_string(r));
+    check_query(chunked, subset, q, "chunked, ray " + std::to_string(r));
   }
   EXPECT_GT(hits, 100);
 }
@@ -337,6 +351,7 @@ TEST(Raytrace, BvhMatchesBruteForceAtEdgesFarAndAtEveryScale) {
     }
     const TriangleSoup& soup = *s.triangles;
     const Bvh bvh(soup);
+    const Bvh chunked(soup, 37);  // in chunks under identity instances: the same answers
     std::vector<uint32_t> all(soup.triangle_count());
     std::iota(all.begin(), all.end(), 0u);
     std::vector<dvec3> targets;
@@ -351,6 +366,7 @@ TEST(Raytrace, BvhMatchesBruteForceAtEdgesFarAndAtEveryScale) {
       const RayQuery q(o, targets[k] - o);
       ++queries;
       hits += check_query(bvh, all, q, "scale " + std::to_string(scale) + " target " + std::to_string(k));
+      check_query(chunked, all, q, "chunked, scale " + std::to_string(scale) + " target " + std::to_string(k));
     }
   }
   EXPECT_GT(hits, queries * 9 / 10);  // aimed at the triangles: nearly every ray hits
