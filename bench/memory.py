@@ -6,13 +6,14 @@ under a mirror sphere, a glass sphere and two shadow-casting lights) into a temp
 folder, renders each with every method at a small image and cube resolution, and reads
 the peak RSS of each whole process from `/usr/bin/time -v` (maximum resident set size).
 The baseline is `abcube --version`: bytes per triangle = (peak - baseline) / triangles.
-The marginal figure is the slope between the two largest scenes: what one more triangle
+The marginal figures are the slopes between consecutive scenes: what one more triangle
 costs, free of every per-process constant (the GL driver, the cube map, the image).
+`gpu:maps` is gpu with `--gpu-shadows maps` (cube shadow maps instead of volumes).
 
 Nothing large is committed: the scenes live in a temporary folder (--keep DIR keeps them).
 
-Usage: bench/memory.py [--abcube build/abcube] [--grids 469,707] [--size 64] [--cube-res 128]
-                       [--methods raytrace,abuffer,zbuffer,envmap,gpu] [--out bench/results/memory]
+Usage: bench/memory.py [--abcube build/abcube] [--grids 469,707,1000] [--size 64] [--cube-res 128]
+                       [--methods raytrace,abuffer,zbuffer,envmap,gpu,gpu:maps] [--out bench/results/memory]
 """
 import argparse
 import datetime
@@ -25,7 +26,13 @@ import subprocess
 import sys
 import tempfile
 
-METHODS = ["raytrace", "abuffer", "zbuffer", "envmap", "gpu"]
+METHODS = ["raytrace", "abuffer", "zbuffer", "envmap", "gpu", "gpu:maps"]
+# A method name, or METHOD:SHADOWS for gpu with --gpu-shadows SHADOWS (volumes, its default, or maps).
+
+
+def method_arguments(method):
+    name, _, shadows = method.partition(":")
+    return ["--method", name] + (["--gpu-shadows", shadows] if shadows else [])
 
 
 def write_terrain_scene(folder, grid, seed, size, cube_res):
@@ -100,7 +107,8 @@ def peak_rss_kib(cmd):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--abcube", default="build/abcube")
-    ap.add_argument("--grids", default="469,707", help="terrain cells per side (469: 440k, 707: 1M triangles)")
+    ap.add_argument("--grids", default="469,707,1000",
+                    help="terrain cells per side (469: 440k, 707: 1M, 1000: 2M triangles)")
     ap.add_argument("--size", type=int, default=64, help="image width and height")
     ap.add_argument("--cube-res", type=int, default=128)
     ap.add_argument("--methods", default=",".join(METHODS))
@@ -124,9 +132,9 @@ def main():
             scene, triangles = write_terrain_scene(folder, grid, args.seed, args.size, args.cube_res)
             scenes.append((scene, triangles))
             for method in methods:
-                out = os.path.join(folder, "out_%d_%s.png" % (grid, method))
-                status, kib, seconds = peak_rss_kib([args.abcube, "render", scene, "-o", out, "--method", method,
-                                                     "--threads", "2"])
+                out = os.path.join(folder, "out_%d_%s.png" % (grid, method.replace(":", "_")))
+                status, kib, seconds = peak_rss_kib([args.abcube, "render", scene, "-o", out] +
+                                                    method_arguments(method) + ["--threads", "2"])
                 rows.append((os.path.basename(scene), triangles, method, status, kib, seconds))
                 print("%-18s %8d %-9s exit %d  peak %8.1f MB  %6.1f B/tri  %.1f s" % (
                     os.path.basename(scene), triangles, method, status, kib / 1024,
@@ -144,19 +152,23 @@ def main():
              "Scenes: seeded terrain OBJ (vertex normals, quads) + mirror sphere + glass sphere, 2 shadow-casting lights; "
              "image %dx%d, cube N = %d, max_depth 4, 2 threads." % (args.size, args.size, args.cube_res),
              "Baseline `abcube --version`: %.1f MB peak RSS. B/tri = (peak - baseline) / triangles; marginal = slope "
-             "between the two scenes (per-process constants removed)." % (base_kib / 1024), "",
+             "between consecutive scenes (per-process constants removed); gpu:maps is gpu with --gpu-shadows maps." % (base_kib / 1024), "",
              "| scene | triangles | method | exit | peak RSS MB | B/tri above baseline | s |",
              "|---|---:|---|---:|---:|---:|---:|"]
     for name, triangles, method, status, kib, seconds in rows:
         lines.append("| %s | %d | %s | %d | %.1f | %.0f | %.1f |" % (
             name, triangles, method, status, kib / 1024, (kib - base_kib) * 1024 / triangles, seconds))
     if len(scenes) >= 2:
-        (_, t0), (_, t1) = scenes[-2], scenes[-1]
-        lines += ["", "| method | marginal B/tri (%d -> %d triangles) |" % (t0, t1), "|---|---:|"]
+        pairs = list(zip(scenes, scenes[1:]))
+        lines += ["", "| method | " + " | ".join("marginal B/tri (%d -> %d triangles)" % (a[1], b[1]) for a, b in pairs)
+                  + " |", "|---|" + "---:|" * len(pairs)]
         for method in methods:
-            k0 = [r[4] for r in rows if r[1] == t0 and r[2] == method][0]
-            k1 = [r[4] for r in rows if r[1] == t1 and r[2] == method][0]
-            lines.append("| %s | %.0f |" % (method, (k1 - k0) * 1024 / (t1 - t0)))
+            slopes = []
+            for (_, t0), (_, t1) in pairs:
+                k0 = [r[4] for r in rows if r[1] == t0 and r[2] == method][0]
+                k1 = [r[4] for r in rows if r[1] == t1 and r[2] == method][0]
+                slopes.append("%.0f" % ((k1 - k0) * 1024 / (t1 - t0)))
+            lines.append("| %s | %s |" % (method, " | ".join(slopes)))
     text = "\n".join(lines) + "\n"
     os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
     with open(args.out + ".txt", "w") as f:
