@@ -231,6 +231,7 @@ def main(argv=None):
     text = "\n".join(lines) + "\n"
     print(text)
     if args.report:
+        os.makedirs(os.path.dirname(args.report) or ".", exist_ok=True)
         with open(args.report + ".md", "w") as fh:
             fh.write(text)
         with open(args.report + ".csv", "w", newline="") as fh:

@@ -39,7 +39,6 @@ struct DirectedEdge {
   }
 };
 
-
 glm::vec4 at_infinity(const glm::vec3& p, const glm::dvec3& light) {
   const glm::dvec3 d = glm::dvec3(p) - light;
   return glm::vec4(glm::vec3(d), 0.f);

@@ -43,7 +43,6 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "base/error.hpp"
-#include "base/memory.hpp"
 #include "base/parallel.hpp"
 #include "base/timer.hpp"
 #include "gl/gl_passes.hpp"
@@ -187,7 +186,6 @@ void volume_attributes() {
 void GlScene::build_volumes() {
   if (volumes_built_) return;
   volumes_built_ = true;
-  release_free_memory();  // what the GL freed after the shadow maps, before the volumes are built
   const Clock::time_point t0 = Clock::now();
   volume_bit_.assign(scene_.lights.size(), -1);
   translucent_bit_.assign(scene_.lights.size(), -1);
