@@ -12,7 +12,7 @@ costs, free of every per-process constant (the GL driver, the cube map, the imag
 
 Nothing large is committed: the scenes live in a temporary folder (--keep DIR keeps them).
 
-Usage: bench/memory.py [--abcube build/abcube] [--grids 469,707,1000] [--size 64] [--cube-res 128]
+Usage: bench/memory.py [--abcube build/abcube] [--grids 469,707,1000,1414] [--size 64] [--cube-res 128]
                        [--methods raytrace,abuffer,zbuffer,envmap,gpu,gpu:maps] [--out bench/results/memory]
 """
 import argparse
@@ -107,8 +107,8 @@ def peak_rss_kib(cmd):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--abcube", default="build/abcube")
-    ap.add_argument("--grids", default="469,707,1000",
-                    help="terrain cells per side (469: 440k, 707: 1M, 1000: 2M triangles)")
+    ap.add_argument("--grids", default="469,707,1000,1414",
+                    help="terrain cells per side (469: 440k, 707: 1M, 1000: 2M, 1414: 4M triangles)")
     ap.add_argument("--size", type=int, default=64, help="image width and height")
     ap.add_argument("--cube-res", type=int, default=128)
     ap.add_argument("--methods", default=",".join(METHODS))
