@@ -76,9 +76,12 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube, co
     }
   }
   build_pyramid();
-  build_side_structure(std::move(seen));
+  // The neighbours first: their build's hash table (up to 12 bytes a triangle for a moment)
+  // then comes before the side structure's tree, whose build holds one chunk at a time
+  // (bvh.hpp "Memory"), and the peak is the smaller.
   if (neighbours) neighbours_ = neighbours();
   if (!neighbours_) neighbours_ = std::make_shared<const MeshNeighbours>(build_mesh_neighbours(soup));
+  build_side_structure(std::move(seen));
 }
 
 // THE Z PYRAMID (search.hpp): each level from the 2 x 2 nodes of the one below, halving
