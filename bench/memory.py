@@ -6,6 +6,10 @@ under a mirror sphere, a glass sphere and two shadow-casting lights) into a temp
 folder, renders each with every method at a small image and cube resolution, and reads
 the peak RSS of each whole process from `/usr/bin/time -v` (maximum resident set size).
 The baseline is `abcube --version`: bytes per triangle = (peak - baseline) / triangles.
+A method's own baseline is the same render of a near-empty scene (the terrain of 1 cell:
+2 triangles beside the spheres): what that method holds before any scene data (for gpu,
+the GL driver, its compiled shaders and its render targets). Bytes per triangle above it
+= (peak - its peak) / (triangles - its triangles).
 The marginal figures are the slopes between consecutive scenes: what one more triangle
 costs, free of every per-process constant (the GL driver, the cube map, the image).
 `gpu:maps` is gpu with `--gpu-shadows maps` (cube shadow maps instead of volumes).
@@ -126,6 +130,16 @@ def main():
         status, base_kib, _ = peak_rss_kib([args.abcube, "--version"])
         if status != 0:
             sys.exit("abcube --version failed")
+        own_base = {}  # method -> (peak KiB, triangles) of the 1-cell terrain
+        base_scene, base_triangles = write_terrain_scene(folder, 1, args.seed, args.size, args.cube_res)
+        for method in methods:
+            out = os.path.join(folder, "out_1_%s.png" % method.replace(":", "_"))
+            status, kib, _ = peak_rss_kib([args.abcube, "render", base_scene, "-o", out] +
+                                          method_arguments(method) + ["--threads", "2"])
+            if status != 0:
+                sys.exit("the near-empty scene failed under " + method)
+            own_base[method] = (kib, base_triangles)
+            print("%-18s %8d %-9s own baseline %8.1f MB" % ("terrain_1.json", base_triangles, method, kib / 1024), flush=True)
         rows = []  # (scene, triangles, method, status, peak KiB, seconds)
         scenes = []
         for grid in grids:
@@ -153,11 +167,15 @@ def main():
              "image %dx%d, cube N = %d, max_depth 4, 2 threads." % (args.size, args.size, args.cube_res),
              "Baseline `abcube --version`: %.1f MB peak RSS. B/tri = (peak - baseline) / triangles; marginal = slope "
              "between consecutive scenes (per-process constants removed); gpu:maps is gpu with --gpu-shadows maps." % (base_kib / 1024), "",
-             "| scene | triangles | method | exit | peak RSS MB | B/tri above baseline | s |",
-             "|---|---:|---|---:|---:|---:|---:|"]
+             "Own baseline: each method's peak on terrain_1.json (%d triangles): %s." % (
+                 base_triangles, ", ".join("%s %.1f MB" % (m, own_base[m][0] / 1024) for m in methods)), "",
+             "| scene | triangles | method | exit | peak RSS MB | B/tri above baseline | B/tri above own baseline | s |",
+             "|---|---:|---|---:|---:|---:|---:|---:|"]
     for name, triangles, method, status, kib, seconds in rows:
-        lines.append("| %s | %d | %s | %d | %.1f | %.0f | %.1f |" % (
-            name, triangles, method, status, kib / 1024, (kib - base_kib) * 1024 / triangles, seconds))
+        own_kib, own_triangles = own_base[method]
+        lines.append("| %s | %d | %s | %d | %.1f | %.0f | %.0f | %.1f |" % (
+            name, triangles, method, status, kib / 1024, (kib - base_kib) * 1024 / triangles,
+            (kib - own_kib) * 1024 / (triangles - own_triangles), seconds))
     if len(scenes) >= 2:
         pairs = list(zip(scenes, scenes[1:]))
         lines += ["", "| method | " + " | ".join("marginal B/tri (%d -> %d triangles)" % (a[1], b[1]) for a, b in pairs)

@@ -23,19 +23,18 @@ layout(rgba32f, binding = 0) uniform image2D u_target;
 uniform bool u_pixels;  // the camera's own view: uniform pixels go to the two images below
 layout(rgba32f, binding = 1) uniform writeonly image2D u_pixel_color;
 layout(rgba32f, binding = 2) uniform writeonly image2D u_pixel_weight;
-struct VertexGpu {  // gl_passes.cpp Vertex
-  float position[3];
-  float normal[3];
-  uint object;
-  uint material;
-};
-layout(std430, binding = 3) readonly buffer Vertices { VertexGpu vertices[]; };
+// The scene's vertex arrays (gl_passes.cpp): positions and normals as the soup holds them,
+// 3 floats a vertex; each vertex's object and material (VertexIds).
+layout(std430, binding = 3) readonly buffer Positions { float positions[]; };
 layout(std430, binding = 4) readonly buffer Uvs { vec2 uvs[]; };
 layout(std430, binding = 5) readonly buffer Portals { uint portals[]; };  // per vertex (0: none)
+layout(std430, binding = 6) readonly buffer Normals { float normals[]; };
+layout(std430, binding = 7) readonly buffer Ids { uvec2 ids[]; };  // (object, material)
+
+vec3 normal_of(uint v) { return vec3(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]); }
 
 vec3 corner(uint v) {
-  VertexGpu c = vertices[v];
-  return vec3(dvec3(c.position[0], c.position[1], c.position[2]) - u_center);
+  return vec3(dvec3(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]) - u_center);
 }
 
 // The barycentrics where the ray from the eye (the origin) through the point `grid` of the
@@ -56,9 +55,8 @@ vec3 barycentrics(vec2 grid, vec3 r0, vec3 r1, vec3 r2) {
 // Whether triangle t's vertex normals differ (a smooth-shaded facet, whose shading turns
 // fastest at a silhouette, where a pixel holds more than one key).
 bool curved(uint t) {
-  VertexGpu a = vertices[3u * t], b = vertices[3u * t + 1u], c = vertices[3u * t + 2u];
-  vec3 na = vec3(a.normal[0], a.normal[1], a.normal[2]);
-  return na != vec3(b.normal[0], b.normal[1], b.normal[2]) || na != vec3(c.normal[0], c.normal[1], c.normal[2]);
+  vec3 na = normal_of(3u * t);
+  return na != normal_of(3u * t + 1u) || na != normal_of(3u * t + 2u);
 }
 
 ivec2 base;
@@ -73,11 +71,9 @@ void shade(uvec2 key, uint members, bool pixel) {
   uint v0 = 3u * (key.x - 1u);
   vec3 r0 = corner(v0), r1 = corner(v0 + 1u), r2 = corner(v0 + 2u);
   vec3 b = barycentrics(at, r0, r1, r2);
-  VertexGpu c0 = vertices[v0], c1 = vertices[v0 + 1u], c2 = vertices[v0 + 2u];
   vec3 p = b.x * r0 + b.y * r1 + b.z * r2;
-  vec3 normal = b.x * vec3(c0.normal[0], c0.normal[1], c0.normal[2]) + b.y * vec3(c1.normal[0], c1.normal[1], c1.normal[2]) +
-                b.z * vec3(c2.normal[0], c2.normal[1], c2.normal[2]);
-  uint material = c0.material;
+  vec3 normal = b.x * normal_of(v0) + b.y * normal_of(v0 + 1u) + b.z * normal_of(v0 + 2u);
+  uint material = ids[v0].y;
   vec3 od = materials[material].color_ambient.rgb;
   if (u_uvs && materials[material].transmission.w >= 0.0) {
     // The texture at each sample of the group, with the footprint of one sample (as dFdx

@@ -18,11 +18,13 @@ constexpr uint64_t MIB = uint64_t{1} << 20;
 // and the A-buffer's per-pixel index (offsets and counts) with room for the AOVs and the
 // reference image; a cube texel its distance, the A-buffer's index, the block bounds and
 // pyramid of the searches (or the gpu method's cube textures). A triangle:
-// SCENE_TRIANGLE_BYTES, and the gpu method adds the GL vertex buffer (3 vertices of 32
-// bytes, gl_passes.cpp) and what llvmpipe holds while it draws them (about 90 more,
+// SCENE_TRIANGLE_BYTES, and the gpu method adds the GL vertex buffers (gl_passes.cpp: 3
+// vertices of 32 bytes where the GL copies the soup's positions and normals, 3 of 8 where
+// it takes them as they are, GL_AMD_pinned_memory; counted as copies: the estimate is made
+// before the GL is opened) and what llvmpipe holds while it draws them (about 90 more,
 // measured from /proc/self/statm around the first draw; gpu with --gpu-shadows maps
-// measured a marginal 239 a triangle, 2026-11-25). A shadow-casting light under gpu: a
-// cube map of N x N floats.
+// measured a marginal 239 a triangle, 2026-11-25, with the copies). A shadow-casting light
+// under gpu: a cube map of N x N floats.
 // Shadow volumes (gpu and hybrid, gl_camera_exact.cpp, shadow_volume.hpp): a light has at
 // most two (its opaque and its translucent blockers), each a code a triangle on the CPU and
 // in a GL buffer, and its runs of casting triangles (8 bytes a run, a run a triangle at

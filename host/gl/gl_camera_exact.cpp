@@ -164,9 +164,9 @@ std::string GlScene::shade_pixels_why_not() const {
   }
   GLint64 block = 0;
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
-  const uint64_t bytes = static_cast<uint64_t>(vertex_count_) * VERTEX_BYTES;
+  const uint64_t bytes = static_cast<uint64_t>(vertex_count_) * VERTEX_ARRAY_BYTES;
   if (bytes > static_cast<uint64_t>(block)) {
-    return "the vertex buffer's " + std::to_string(bytes) + " bytes exceed GL_MAX_SHADER_STORAGE_BLOCK_SIZE " +
+    return "the vertex positions' " + std::to_string(bytes) + " bytes exceed GL_MAX_SHADER_STORAGE_BLOCK_SIZE " +
            std::to_string(block);
   }
   return "";
@@ -526,9 +526,11 @@ void GlScene::shade_groups(const glm::mat4& clip, const MirrorView& view, bool v
   glUniform1i(p.uniform("u_environment"), environment_ != 0 && view.level < exact_.max_depth);
   glUniform1i(p.uniform("u_uvs"), uv_vbo_ != 0);
   glUniform1i(p.uniform("u_portals"), portal_vbo_ != 0);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, vbo_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, uv_vbo_ != 0 ? uv_vbo_ : vbo_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, portal_vbo_ != 0 ? portal_vbo_ : vbo_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, POSITIONS_BINDING, positions_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, UVS_BINDING, uv_vbo_ != 0 ? uv_vbo_ : positions_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, PORTALS_BINDING, portal_vbo_ != 0 ? portal_vbo_ : positions_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, NORMALS_BINDING, normals_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IDS_BINDING, ids_);
   glUniform1i(p.uniform("u_pixels"), view.level == 0);
   glBindImageTexture(0, t.color0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(1, v.pixel_color, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);

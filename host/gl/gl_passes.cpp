@@ -21,13 +21,13 @@ namespace abcube {
 
 namespace {
 
-struct Vertex {
-  float position[3];
-  float normal[3];
+// What the scene's vertex arrays hold besides the soup's positions and normals: a vertex's
+// object and material (camera_groups.frag's Ids).
+struct VertexIds {
   uint32_t object;
   uint32_t material;
 };
-static_assert(sizeof(Vertex) == VERTEX_BYTES, "camera_groups.frag reads the vertices as 8 words");
+static_assert(sizeof(VertexIds) == 8, "camera_groups.frag reads a vertex's ids as 2 words");
 
 struct MaterialGpu {
   float color_ambient[4];
@@ -43,50 +43,76 @@ struct LightGpu {
 
 }  // namespace
 
-GlScene::GlScene(const SceneData& scene) : scene_(scene) {
+GLuint GlScene::soup_buffer(const void* data, size_t bytes) {
+  GLuint buffer = 0;
+  glGenBuffers(1, &buffer);
+  const GLsizeiptr size = static_cast<GLsizeiptr>(std::max<size_t>(bytes, 4));
+  if (GLAD_GL_AMD_pinned_memory && bytes > 0 && pin_soup_) {
+    check_gl("the GL state before the scene upload");  // so that an error below is the pinning's
+    // The buffer is the memory at `data` from here on (read only: no pass writes it).
+    glBindBuffer(GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD, buffer);
+    glBufferData(GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD, static_cast<GLsizeiptr>(bytes), data, GL_STATIC_DRAW);
+    glBindBuffer(GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD, 0);
+    if (glGetError() == GL_NO_ERROR) return buffer;
+    // Refused (the driver takes no memory of this alignment or size): copied, as elsewhere.
+    pinned_ = false;
+    pin_soup_ = false;
+    glDeleteBuffers(1, &buffer);
+    glGenBuffers(1, &buffer);
+  }
+  glBindBuffer(GL_ARRAY_BUFFER, buffer);
+  glBufferData(GL_ARRAY_BUFFER, size, bytes > 0 ? data : nullptr, GL_STATIC_DRAW);
+  if (bytes > 0) pinned_ = false;
+  return buffer;
+}
+
+GlScene::GlScene(const SceneData& scene, bool pin_soup)
+    : scene_(scene), pin_soup_(pin_soup), pinned_(pin_soup && GLAD_GL_AMD_pinned_memory) {
   const Clock::time_point t0 = Clock::now();
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size_);
   const double radius = max_distance_from(scene, scene.camera.position);
   near_ = default_near_distance(radius);
 
-  // Uploaded in chunks: a copy of the whole vertex array beside the soup and the GL
-  // buffer cost 96 bytes a triangle at the peak.
+  // Positions and normals are the soup's own arrays: with GL_AMD_pinned_memory (Mesa's
+  // llvmpipe, where a GL buffer is process memory) the buffers are the soup's memory, not
+  // a copy of it (72 bytes a triangle saved); elsewhere they are copied as they are. The
+  // soup outlives this GlScene (the SceneData it reads). Each vertex's ids are copied in
+  // chunks: a whole array of them at once beside the GL buffer was 24 bytes a triangle more
+  // at the peak.
   const TriangleSoup& t = *scene.triangles;
   constexpr size_t CHUNK = 3 * 16384;  // vertices
   vertex_count_ = static_cast<GLsizei>(t.positions.size());
   glGenVertexArrays(1, &vao_);
   glBindVertexArray(vao_);
-  glGenBuffers(1, &vbo_);
-  glBindBuffer(GL_ARRAY_BUFFER, vbo_);
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(t.positions.size() * sizeof(Vertex)), nullptr,
-               GL_STATIC_DRAW);
-  std::vector<Vertex> vertices;
+  positions_ = soup_buffer(t.positions.data(), t.positions.size() * sizeof(glm::vec3));
+  normals_ = soup_buffer(t.normals.data(), t.normals.size() * sizeof(glm::vec3));
+  glGenBuffers(1, &ids_);
+  glBindBuffer(GL_ARRAY_BUFFER, ids_);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(std::max<size_t>(t.positions.size(), 1) * sizeof(VertexIds)),
+               nullptr, GL_STATIC_DRAW);
+  std::vector<VertexIds> chunk;
   for (size_t first = 0; first < t.positions.size(); first += CHUNK) {
-    vertices.resize(std::min(CHUNK, t.positions.size() - first));
-    for (size_t i = 0; i < vertices.size(); ++i) {
-      const size_t v = first + i;
-      Vertex& o = vertices[i];
-      std::memcpy(o.position, &t.positions[v].x, sizeof o.position);
-      std::memcpy(o.normal, &t.normals[v].x, sizeof o.normal);
-      o.object = t.object_id[v / 3];
-      o.material = t.material_id[v / 3];
+    chunk.resize(std::min(CHUNK, t.positions.size() - first));
+    for (size_t i = 0; i < chunk.size(); ++i) {
+      const size_t triangle = (first + i) / 3;
+      chunk[i] = {t.object_id[triangle], t.material_id[triangle]};
     }
-    glBufferSubData(GL_ARRAY_BUFFER, static_cast<GLintptr>(first * sizeof(Vertex)),
-                    static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data());
+    glBufferSubData(GL_ARRAY_BUFFER, static_cast<GLintptr>(first * sizeof(VertexIds)),
+                    static_cast<GLsizeiptr>(chunk.size() * sizeof(VertexIds)), chunk.data());
   }
   const auto offset = [](size_t bytes) { return reinterpret_cast<const void*>(bytes); };
-  glBindBuffer(GL_ARRAY_BUFFER, vbo_);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), offset(offsetof(Vertex, position)));
-  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), offset(offsetof(Vertex, normal)));
-  glVertexAttribIPointer(2, 1, GL_UNSIGNED_INT, sizeof(Vertex), offset(offsetof(Vertex, object)));
-  glVertexAttribIPointer(3, 1, GL_UNSIGNED_INT, sizeof(Vertex), offset(offsetof(Vertex, material)));
+  glBindBuffer(GL_ARRAY_BUFFER, positions_);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(glm::vec3), nullptr);
+  glBindBuffer(GL_ARRAY_BUFFER, normals_);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(glm::vec3), nullptr);
+  glBindBuffer(GL_ARRAY_BUFFER, ids_);
+  glVertexAttribIPointer(2, 1, GL_UNSIGNED_INT, sizeof(VertexIds), offset(offsetof(VertexIds, object)));
+  glVertexAttribIPointer(3, 1, GL_UNSIGNED_INT, sizeof(VertexIds), offset(offsetof(VertexIds, material)));
   for (GLuint a = 0; a < 4; ++a) glEnableVertexAttribArray(a);
   // Texture coordinates: their own buffer, straight from the soup, only when it has them.
   if (!t.uvs.empty()) {
-    glGenBuffers(1, &uv_vbo_);
+    uv_vbo_ = soup_buffer(t.uvs.data(), t.uvs.size() * sizeof(glm::vec2));
     glBindBuffer(GL_ARRAY_BUFFER, uv_vbo_);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(t.uvs.size() * sizeof(glm::vec2)), t.uvs.data(),
-                 GL_STATIC_DRAW);
     glVertexAttribPointer(4, 2, GL_FLOAT, GL_FALSE, sizeof(glm::vec2), nullptr);
     glEnableVertexAttribArray(4);
   } else {
@@ -234,7 +260,8 @@ GlScene::~GlScene() {
   glDeleteTextures(static_cast<GLsizei>(shadow_peels_.size()), shadow_peels_.data());
   glDeleteRenderbuffers(1, &lookup_depth_);
   glDeleteFramebuffers(1, &lookup_fbo_);
-  glDeleteBuffers(1, &vbo_);
+  const GLuint scene_buffers[] = {positions_, normals_, ids_};
+  glDeleteBuffers(3, scene_buffers);
   glDeleteBuffers(1, &materials_);
   glDeleteBuffers(1, &lights_);
   glDeleteVertexArrays(1, &vao_);

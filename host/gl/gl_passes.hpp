@@ -104,7 +104,9 @@ int gl_shadow_light_limit();
 // whole life (gl_context.hpp).
 class GlScene {
  public:
-  explicit GlScene(const SceneData& scene);
+  // pin_soup: the vertex buffers over the soup's own memory where the GL can
+  // (GL_AMD_pinned_memory); false copies them (as every GL without the extension does).
+  explicit GlScene(const SceneData& scene, bool pin_soup = true);
   ~GlScene();
   GlScene(const GlScene&) = delete;
   GlScene& operator=(const GlScene&) = delete;
@@ -183,6 +185,8 @@ class GlScene {
   void set_texture_level0(bool on) { texture_level0_ = on; }
 
   const GpuTimings& timings() const { return timings_; }
+  // Whether the vertex buffers are the soup's own memory (GL_AMD_pinned_memory), not a copy.
+  bool soup_pinned() const { return pinned_; }
   double near_distance() const { return near_; }
   int max_size() const { return max_size_; }
 
@@ -210,7 +214,14 @@ class GlScene {
   Target& target(int width, int height, bool distance_pass);
 
   const SceneData& scene_;
-  GLuint vao_ = 0, vbo_ = 0, uv_vbo_ = 0, materials_ = 0, lights_ = 0;
+  // The scene's vertex arrays: positions, normals and texture coordinates are the soup's
+  // (soup_buffer), ids_ each vertex's object and material.
+  GLuint vao_ = 0, positions_ = 0, normals_ = 0, ids_ = 0, uv_vbo_ = 0, materials_ = 0, lights_ = 0;
+  bool pin_soup_ = true;
+  bool pinned_ = false;  // every soup buffer is the soup's memory
+  // A GL buffer holding `bytes` at `data`: that memory itself when pin_soup_ and the GL
+  // can (the soup must then outlive the buffer), else a copy.
+  GLuint soup_buffer(const void* data, size_t bytes);
   std::vector<GLuint> texture_arrays_;  // by size class; the material's code names array and layer
   std::vector<float> upload_textures();  // per material: -1, or array + MAX_TEXTURE_ARRAYS * layer
   GLuint shadow_maps_ = 0, environment_ = 0, lookup_fbo_ = 0, lookup_depth_ = 0;

@@ -22,9 +22,9 @@ namespace abcube {
 // (tools/flat_mirror_scenes.py --seed 2, one run each); a mirror's scissor is tighter, and
 // the tile's buffers stay in cache.
 constexpr int CAMERA_TILE = 1024;
-// The scene's GL vertex (gl_passes.cpp Vertex, camera_groups.frag VertexGpu): position,
-// normal, object, material.
-constexpr size_t VERTEX_BYTES = 32;
+// The largest of the scene's per-vertex arrays, which camera_groups.frag reads as storage
+// buffers: a position or a normal (3 floats; a vertex's ids are 2 words).
+constexpr size_t VERTEX_ARRAY_BYTES = 12;
 // Texture units: 1 the opaque shadow maps, 2 the environment, 3.. the translucent peels,
 // then the camera's previous layer.
 constexpr GLenum PEEL_UNIT = 3;
@@ -36,9 +36,15 @@ static_assert(TEXTURE_UNIT + MAX_TEXTURE_ARRAYS <= 16, "texture units");
 // exact pass checks GL_MAX_TEXTURE_IMAGE_UNITS).
 constexpr GLenum VOLUME_COUNT_UNIT = 16;
 // Storage buffer bindings: 0 materials, 1 lights (common_scene.glsl), 2 the recursed
-// reflectors (camera_surface.glsl), 3-5 the vertices, uvs and portals (camera_groups.frag);
-// 6 a shadow volume's caps' codes, read by the volume program's vertex stage
-// (volume_caps.glsl; the exact pass checks GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS).
+// reflectors (camera_surface.glsl), 3-7 the positions, uvs, portals, normals and ids
+// (camera_groups.frag); 6 also a shadow volume's caps' codes, read by the volume program's
+// vertex stage (volume_caps.glsl; the exact pass checks GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS),
+// bound before each draw that reads it. 8 bindings: GL 4.5's minimum.
+constexpr GLuint POSITIONS_BINDING = 3;
+constexpr GLuint UVS_BINDING = 4;
+constexpr GLuint PORTALS_BINDING = 5;
+constexpr GLuint NORMALS_BINDING = 6;
+constexpr GLuint IDS_BINDING = 7;
 constexpr GLuint VOLUME_CAPS_BINDING = 6;
 
 // The state every pass relies on: infinite reversed-Z (cube_map.hpp: depth in [0, 1], 1 at

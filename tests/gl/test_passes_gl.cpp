@@ -2,6 +2,7 @@
 // of a quad, and the GLSL Phong mirror against cpu_core/shading/shading.hpp.
 #include <cmath>
 
+#include <glad/gl.h>
 #include <gtest/gtest.h>
 
 #include "scene/camera.hpp"
@@ -282,6 +283,47 @@ TEST(ZbufferGl, TexturedFloorMatchesCpuShading) {
   EXPECT_LT(worst, 4e-3);
   EXPECT_LT(trilinear_sum / (3.0 * checked), 0.02);
   EXPECT_GT(trilinear_worst, worst) << "the mipmaps are used";
+}
+
+// The vertex buffers over the soup's own memory (GL_AMD_pinned_memory, where the GL offers
+// it) draw exactly what copies of it draw: every pass that reads them (the vertex stage,
+// the exact camera pass's storage buffers: positions, normals, ids, texture coordinates),
+// on a textured scene with a mirror and shadow volumes, and on the Cornell box.
+TEST(ZbufferGl, PinnedSoupDrawsAsCopiedSoup) {
+  GlContext& ctx = test::test_context();
+  for (const char* name : {"textured.json", "cornell.json"}) {
+    SceneData s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/" + name);
+    s.camera.width = 80;
+    s.camera.height = 60;
+    ExactCameraOptions exact;
+    exact.planar_mirrors = true;
+    exact.shadow_volumes = true;
+    exact.max_depth = 2;
+    exact.always = true;
+    std::vector<Image> images;
+    std::vector<std::vector<uint32_t>> objects;
+    for (const bool pin : {true, false}) {
+      GlScene gl(s, pin);
+      EXPECT_EQ(gl.soup_pinned(), pin && GLAD_GL_AMD_pinned_memory) << name << " on " << ctx.info().api;
+      gl.build_shadow_maps(64);
+      gl.build_environment(s.camera.position, 64);
+      images.push_back(gl.camera_color(s.camera, CameraSamples::pixel_centre));
+      gl.set_exact_camera(exact);
+      images.push_back(gl.camera_color(s.camera, CameraSamples::mask_4x8));
+      EXPECT_TRUE(gl.exact_camera_stats().volumes) << name << ": " << gl.exact_camera_stats().volumes_why;
+      objects.push_back(gl.camera_objects(s.camera));
+    }
+    ASSERT_EQ(images.size(), 4u);
+    for (size_t k = 0; k < 2; ++k) {
+      const Image& a = images[k];
+      const Image& b = images[k + 2];
+      ASSERT_EQ(a.data.size(), b.data.size());
+      size_t differ = 0;
+      for (size_t i = 0; i < a.data.size(); ++i) differ += a.data[i] != b.data[i];
+      EXPECT_EQ(differ, 0u) << name << (k == 0 ? " Z-buffer pass" : " exact pass") << ": values that differ";
+    }
+    EXPECT_EQ(objects[0], objects[1]) << name;
+  }
 }
 
 }  // namespace
