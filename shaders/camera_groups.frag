@@ -23,13 +23,13 @@ layout(rgba32f, binding = 0) uniform image2D u_target;
 uniform bool u_pixels;  // the camera's own view: uniform pixels go to the two images below
 layout(rgba32f, binding = 1) uniform writeonly image2D u_pixel_color;
 layout(rgba32f, binding = 2) uniform writeonly image2D u_pixel_weight;
-// The scene's vertex arrays (gl_passes.cpp): positions and normals as the soup holds them,
-// 3 floats a vertex; each vertex's object and material (VertexIds).
+// The scene's arrays (gl_passes.cpp): positions and normals as the soup holds them, 3 floats
+// a vertex; each triangle's material.
 layout(std430, binding = 3) readonly buffer Positions { float positions[]; };
 layout(std430, binding = 4) readonly buffer Uvs { vec2 uvs[]; };
 layout(std430, binding = 5) readonly buffer Portals { uint portals[]; };  // per vertex (0: none)
 layout(std430, binding = 6) readonly buffer Normals { float normals[]; };
-layout(std430, binding = 7) readonly buffer Ids { uvec2 ids[]; };  // (object, material)
+layout(std430, binding = 7) readonly buffer TriangleMaterials { uint material_ids[]; };
 
 vec3 normal_of(uint v) { return vec3(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]); }
 
@@ -73,7 +73,7 @@ void shade(uvec2 key, uint members, bool pixel) {
   vec3 b = barycentrics(at, r0, r1, r2);
   vec3 p = b.x * r0 + b.y * r1 + b.z * r2;
   vec3 normal = b.x * normal_of(v0) + b.y * normal_of(v0 + 1u) + b.z * normal_of(v0 + 2u);
-  uint material = ids[v0].y;
+  uint material = material_ids[key.x - 1u];
   vec3 od = materials[material].color_ambient.rgb;
   if (u_uvs && materials[material].transmission.w >= 0.0) {
     // The texture at each sample of the group, with the footprint of one sample (as dFdx

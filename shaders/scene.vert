@@ -12,7 +12,7 @@
 // at every sample; their faces at infinity come clipped on the CPU, as window-space points.
 layout(location = 0) in vec4 a_position;  // the scene's buffer gives xyz: w = 1
 layout(location = 1) in vec3 a_normal;
-layout(location = 2) in uint a_object;
+layout(location = 2) in uint a_object;    // where the triangle's ids are not read (triangle_ids.glsl)
 layout(location = 3) in uint a_material;
 layout(location = 4) in vec2 a_uv;  // texture coordinates (v up); (0, 0) when the scene has none
 layout(location = 5) in uint a_portal;    // planar reflector + 1 (planar_reflectors.hpp); 0: none
@@ -39,10 +39,18 @@ flat out uint v_portal;
 flat out uint v_reversed;
 
 void main() {
+  uint object = a_object, material = a_material;
+#ifdef TRIANGLE_IDS
+  if (!u_vertex_ids) {
+    const uint triangle = uint(gl_VertexID) / 3u;
+    object = object_ids[triangle];
+    material = material_ids[triangle];
+  }
+#endif
   // A point at infinity (w = 0, the shadow volumes') is a direction: nothing to subtract.
   vec4 relative = a_position.w == 0.0 ? a_position : vec4(vec3(dvec3(a_position.xyz) - u_center), 1.0);
   gl_Position = u_clip * relative;
-  gl_Position.z *= 1.0 + u_tie_step * float(a_object + 1u);
+  gl_Position.z *= 1.0 + u_tie_step * float(object + 1u);
   if (u_skip_portal != 0u && a_portal == u_skip_portal) gl_Position = vec4(0.0);
   uint reversed = a_reversed;
 #ifdef VOLUME_CAPS
@@ -55,8 +63,8 @@ void main() {
   gl_ClipDistance[0] = dot(u_clip_plane, relative);  // at infinity: its direction's side
   v_relative = relative.xyz;
   v_normal = a_normal;
-  v_object = a_object;
-  v_material = a_material;
+  v_object = object;
+  v_material = material;
   v_uv = a_uv;
   v_portal = a_portal;
   v_reversed = reversed;

@@ -18,12 +18,13 @@ constexpr uint64_t MIB = uint64_t{1} << 20;
 // and the A-buffer's per-pixel index (offsets and counts) with room for the AOVs and the
 // reference image; a cube texel its distance, the A-buffer's index, the block bounds and
 // pyramid of the searches (or the gpu method's cube textures). A triangle:
-// SCENE_TRIANGLE_BYTES, and the gpu method adds the GL vertex buffers (gl_passes.cpp: 3
-// vertices of 32 bytes where the GL copies the soup's positions and normals, 3 of 8 where
-// it takes them as they are, GL_AMD_pinned_memory; counted as copies: the estimate is made
-// before the GL is opened) and what llvmpipe holds while it draws them (about 90 more,
-// measured from /proc/self/statm around the first draw; gpu with --gpu-shadows maps
-// measured a marginal 239 a triangle, 2026-11-25, with the copies). A shadow-casting light
+// SCENE_TRIANGLE_BYTES, and the gpu method adds the GL's arrays (gl_passes.cpp): none where
+// the GL takes the soup's own memory (GL_AMD_pinned_memory), 80 bytes where it copies the
+// soup's positions, normals and ids, 104 where every vertex carries its ids too; counted as
+// the last (the estimate is made before the GL is opened) and what llvmpipe holds while it
+// draws them (about 90 more, measured from /proc/self/statm around the first draw; gpu with
+// --gpu-shadows maps measured a marginal 239 a triangle, 2026-11-25, with 96-byte copies;
+// 105-168 with the soup's memory, bench/results/memory.txt). A shadow-casting light
 // under gpu: a cube map of N x N floats.
 // Shadow volumes (gpu and hybrid, gl_camera_exact.cpp, shadow_volume.hpp): a light has at
 // most two (its opaque and its translucent blockers), each a code a triangle on the CPU and
@@ -38,7 +39,7 @@ constexpr uint64_t VOLUME_PAIRING_TRIANGLE_BYTES = 3;
 constexpr uint64_t VOLUME_PAIRING_EDGES_BYTES = PAIRING_BUCKET_EDGES * PAIRING_EDGE_BYTES;
 constexpr uint64_t PIXEL_BYTES = 3 * sizeof(float) + 64;
 constexpr uint64_t TEXEL_BYTES = 64;
-constexpr uint64_t GL_TRIANGLE_BYTES = 3 * 32 + 90;
+constexpr uint64_t GL_TRIANGLE_BYTES = 104 + 90;
 constexpr uint64_t GL_SHADOW_TEXEL_BYTES = 6 * sizeof(float);  // six faces
 static_assert(SCENE_TRIANGLE_BYTES >= 6 * sizeof(glm::vec3) + 2 * sizeof(uint32_t), "the soup alone");
 

@@ -308,6 +308,7 @@ void GlScene::draw_faces_at_infinity(int layer, const glm::mat4& clip, const Mir
   glUniform3d(volume_program_->uniform("u_center"), 0.0, 0.0, 0.0);
   glUniform1f(volume_program_->uniform("u_tie_step"), 0.f);
   glUniform4f(volume_program_->uniform("u_clip_plane"), 0.f, 0.f, 0.f, 1.f);
+  glUniform1i(volume_program_->uniform("u_vertex_ids"), 1);  // -1 without triangle_ids.glsl: ignored
   glBindVertexArray(clipped_vao_);
   glBindBuffer(GL_ARRAY_BUFFER, clipped_vbo_);
   // A run of faces at a time: their clipped triangles, then the GL's copy, stay small.
@@ -322,6 +323,7 @@ void GlScene::draw_faces_at_infinity(int layer, const glm::mat4& clip, const Mir
                  clipped_volume_.data(), GL_STREAM_DRAW);
     glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(clipped_volume_.size()));
   }
+  glUniform1i(volume_program_->uniform("u_vertex_ids"), 0);
 }
 
 void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* views_left) {
@@ -530,7 +532,7 @@ void GlScene::shade_groups(const glm::mat4& clip, const MirrorView& view, bool v
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, UVS_BINDING, uv_vbo_ != 0 ? uv_vbo_ : positions_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, PORTALS_BINDING, portal_vbo_ != 0 ? portal_vbo_ : positions_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, NORMALS_BINDING, normals_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, IDS_BINDING, ids_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, TRIANGLE_MATERIALS_BINDING, material_ids_);
   glUniform1i(p.uniform("u_pixels"), view.level == 0);
   glBindImageTexture(0, t.color0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(1, v.pixel_color, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
@@ -550,7 +552,7 @@ void GlScene::shade_groups(const glm::mat4& clip, const MirrorView& view, bool v
 
 void GlScene::make_exact_programs() {
   if (exact_program_) return;
-  const std::vector<const char*> scene_vert{"scene.vert"}, fill_vert{"fill.vert"};
+  const std::vector<const char*> scene_vert = scene_vertex_stage(), fill_vert{"fill.vert"};
   exact_program_ = std::make_unique<GlProgram>(
       scene_vert, std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "camera_surface.glsl", "camera_exact.frag"});
   groups_program_ = std::make_unique<GlProgram>(
@@ -566,8 +568,8 @@ void GlScene::make_exact_programs() {
   groups_program_->use();
   glUniform1i(groups_program_->uniform("u_keys"), 0);
   fill_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"fill.frag"});
-  volume_program_ = std::make_unique<GlProgram>(std::vector<const char*>{"volume_caps.glsl", "scene.vert"},
-                                                std::vector<const char*>{"shadow_volume.frag"});
+  volume_program_ =
+      std::make_unique<GlProgram>(scene_vertex_stage("volume_caps.glsl"), std::vector<const char*>{"shadow_volume.frag"});
   resolve_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"resolve_samples.frag"});
   glGenBuffers(1, &recursed_);
 }

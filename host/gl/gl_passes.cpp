@@ -66,49 +66,63 @@ GLuint GlScene::soup_buffer(const void* data, size_t bytes) {
   return buffer;
 }
 
-GlScene::GlScene(const SceneData& scene, bool pin_soup)
-    : scene_(scene), pin_soup_(pin_soup), pinned_(pin_soup && GLAD_GL_AMD_pinned_memory) {
+GlScene::GlScene(const SceneData& scene, const GlSceneOptions& options)
+    : scene_(scene), pin_soup_(options.pin_soup), pinned_(options.pin_soup && GLAD_GL_AMD_pinned_memory) {
   const Clock::time_point t0 = Clock::now();
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size_);
   const double radius = max_distance_from(scene, scene.camera.position);
   near_ = default_near_distance(radius);
 
-  // Positions and normals are the soup's own arrays: with GL_AMD_pinned_memory (Mesa's
-  // llvmpipe, where a GL buffer is process memory) the buffers are the soup's memory, not
-  // a copy of it (72 bytes a triangle saved); elsewhere they are copied as they are. The
-  // soup outlives this GlScene (the SceneData it reads). Each vertex's ids are copied in
-  // chunks: a whole array of them at once beside the GL buffer was 24 bytes a triangle more
-  // at the peak.
+  // The soup's own arrays: positions, normals (per vertex) and each triangle's object and
+  // material (read by scene.vert at the vertex's triangle, triangle_ids.glsl). With
+  // GL_AMD_pinned_memory (Mesa's llvmpipe, where a GL buffer is process memory) the buffers
+  // are the soup's memory, not a copy of it (96 bytes a triangle saved); elsewhere they are
+  // copied as they are. The soup outlives this GlScene (the SceneData it reads).
   const TriangleSoup& t = *scene.triangles;
-  constexpr size_t CHUNK = 3 * 16384;  // vertices
   vertex_count_ = static_cast<GLsizei>(t.positions.size());
   glGenVertexArrays(1, &vao_);
   glBindVertexArray(vao_);
   positions_ = soup_buffer(t.positions.data(), t.positions.size() * sizeof(glm::vec3));
   normals_ = soup_buffer(t.normals.data(), t.normals.size() * sizeof(glm::vec3));
-  glGenBuffers(1, &ids_);
-  glBindBuffer(GL_ARRAY_BUFFER, ids_);
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(std::max<size_t>(t.positions.size(), 1) * sizeof(VertexIds)),
-               nullptr, GL_STATIC_DRAW);
-  std::vector<VertexIds> chunk;
-  for (size_t first = 0; first < t.positions.size(); first += CHUNK) {
-    chunk.resize(std::min(CHUNK, t.positions.size() - first));
-    for (size_t i = 0; i < chunk.size(); ++i) {
-      const size_t triangle = (first + i) / 3;
-      chunk[i] = {t.object_id[triangle], t.material_id[triangle]};
-    }
-    glBufferSubData(GL_ARRAY_BUFFER, static_cast<GLintptr>(first * sizeof(VertexIds)),
-                    static_cast<GLsizeiptr>(chunk.size() * sizeof(VertexIds)), chunk.data());
-  }
-  const auto offset = [](size_t bytes) { return reinterpret_cast<const void*>(bytes); };
+  object_ids_ = soup_buffer(t.object_id.data(), t.object_id.size() * sizeof(uint32_t));
+  material_ids_ = soup_buffer(t.material_id.data(), t.material_id.size() * sizeof(uint32_t));
   glBindBuffer(GL_ARRAY_BUFFER, positions_);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(glm::vec3), nullptr);
   glBindBuffer(GL_ARRAY_BUFFER, normals_);
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(glm::vec3), nullptr);
-  glBindBuffer(GL_ARRAY_BUFFER, ids_);
-  glVertexAttribIPointer(2, 1, GL_UNSIGNED_INT, sizeof(VertexIds), offset(offsetof(VertexIds, object)));
-  glVertexAttribIPointer(3, 1, GL_UNSIGNED_INT, sizeof(VertexIds), offset(offsetof(VertexIds, material)));
-  for (GLuint a = 0; a < 4; ++a) glEnableVertexAttribArray(a);
+  for (GLuint a = 0; a < 2; ++a) glEnableVertexAttribArray(a);
+  GLint vertex_blocks = 0, bindings = 0;
+  GLint64 block = 0;
+  glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &vertex_blocks);
+  glGetIntegerv(GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS, &bindings);
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
+  triangle_ids_ = options.triangle_ids && vertex_blocks >= 3 && bindings > static_cast<GLint>(MATERIAL_IDS_BINDING) &&
+                  t.triangle_count() * sizeof(uint32_t) <= static_cast<uint64_t>(block);
+  if (!triangle_ids_) {
+    // Each vertex carries its ids (8 bytes), copied a chunk at a time: a whole array of them
+    // at once beside the GL buffer was 24 bytes a triangle more at the peak.
+    constexpr size_t CHUNK = 3 * 16384;  // vertices
+    glGenBuffers(1, &vertex_ids_);
+    glBindBuffer(GL_ARRAY_BUFFER, vertex_ids_);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(std::max<size_t>(t.positions.size(), 1) * sizeof(VertexIds)),
+                 nullptr, GL_STATIC_DRAW);
+    std::vector<VertexIds> chunk;
+    for (size_t first = 0; first < t.positions.size(); first += CHUNK) {
+      chunk.resize(std::min(CHUNK, t.positions.size() - first));
+      for (size_t i = 0; i < chunk.size(); ++i) {
+        const size_t triangle = (first + i) / 3;
+        chunk[i] = {t.object_id[triangle], t.material_id[triangle]};
+      }
+      glBufferSubData(GL_ARRAY_BUFFER, static_cast<GLintptr>(first * sizeof(VertexIds)),
+                      static_cast<GLsizeiptr>(chunk.size() * sizeof(VertexIds)), chunk.data());
+    }
+    const auto offset = [](size_t bytes) { return reinterpret_cast<const void*>(bytes); };
+    glVertexAttribIPointer(2, 1, GL_UNSIGNED_INT, sizeof(VertexIds), offset(offsetof(VertexIds, object)));
+    glVertexAttribIPointer(3, 1, GL_UNSIGNED_INT, sizeof(VertexIds), offset(offsetof(VertexIds, material)));
+    for (GLuint a = 2; a < 4; ++a) glEnableVertexAttribArray(a);
+  } else {
+    for (GLuint a = 2; a < 4; ++a) glDisableVertexAttribArray(a);
+  }
   // Texture coordinates: their own buffer, straight from the soup, only when it has them.
   if (!t.uvs.empty()) {
     uv_vbo_ = soup_buffer(t.uvs.data(), t.uvs.size() * sizeof(glm::vec2));
@@ -161,12 +175,10 @@ GlScene::GlScene(const SceneData& scene, bool pin_soup)
                materials.data(), GL_STATIC_DRAW);
   glGenBuffers(1, &lights_);
 
-  distance_program_ = std::make_unique<GlProgram>(std::vector<const char*>{"scene.vert"},
-                                                  std::vector<const char*>{"cube_distance.frag"});
+  distance_program_ = std::make_unique<GlProgram>(scene_vertex_stage(), std::vector<const char*>{"cube_distance.frag"});
   phong_program_ = std::make_unique<GlProgram>(
-      std::vector<const char*>{"scene.vert"},
-      std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "phong.frag"});
-  shadow_program_ = std::make_unique<GlProgram>(std::vector<const char*>{"scene.vert"},
+      scene_vertex_stage(), std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "phong.frag"});
+  shadow_program_ = std::make_unique<GlProgram>(scene_vertex_stage(),
                                                 std::vector<const char*>{"common_scene.glsl", "shadow_caster.frag"});
   // Every sampler of the phong program on a unit of its own type (two sampler types on one
   // unit is an error at draw time, even when one is never read).
@@ -260,8 +272,8 @@ GlScene::~GlScene() {
   glDeleteTextures(static_cast<GLsizei>(shadow_peels_.size()), shadow_peels_.data());
   glDeleteRenderbuffers(1, &lookup_depth_);
   glDeleteFramebuffers(1, &lookup_fbo_);
-  const GLuint scene_buffers[] = {positions_, normals_, ids_};
-  glDeleteBuffers(3, scene_buffers);
+  const GLuint scene_buffers[] = {positions_, normals_, object_ids_, material_ids_, vertex_ids_};
+  glDeleteBuffers(5, scene_buffers);
   glDeleteBuffers(1, &materials_);
   glDeleteBuffers(1, &lights_);
   glDeleteVertexArrays(1, &vao_);
@@ -319,9 +331,21 @@ void GlScene::draw_reflector(const GlProgram& program, const glm::mat4& clip, co
                  reinterpret_cast<const void*>(first * sizeof(uint32_t)));
 }
 
+std::vector<const char*> GlScene::scene_vertex_stage(const char* before) const {
+  std::vector<const char*> files;
+  if (before) files.push_back(before);
+  if (triangle_ids_) files.push_back("triangle_ids.glsl");
+  files.push_back("scene.vert");
+  return files;
+}
+
 void GlScene::set_view(const GlProgram& program, const glm::mat4& clip, const MirrorView& view) {
   const glm::dvec3& center = view.eye;
   program.use();
+  if (triangle_ids_) {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, OBJECT_IDS_BINDING, object_ids_);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MATERIAL_IDS_BINDING, material_ids_);
+  }
   // `clip` has the eye at the origin (scene.vert subtracts it); a virtual view's reflections
   // then act on the relative vertex by their linear part alone (M (p) - E = R (p - eye), the
   // view's eye being the camera's unfolded through them).

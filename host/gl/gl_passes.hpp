@@ -100,13 +100,21 @@ void check_gl_limits(const SceneData& scene);
 // That limit: shadow-casting lights the current GL context holds for the gpu method.
 int gl_shadow_light_limit();
 
+// How GlScene gives the GL the soup (both off: as a GL without the features gets it).
+struct GlSceneOptions {
+  // The buffers over the soup's own memory where the GL can (GL_AMD_pinned_memory); false
+  // copies them, as every GL without the extension does.
+  bool pin_soup = true;
+  // Each triangle's ids read by the vertex stage from the soup's per-triangle arrays where
+  // the GL allows (triangle_ids.glsl); false gives every vertex its ids as attributes.
+  bool triangle_ids = true;
+};
+
 // The scene uploaded to the current GL context. Needs a current GL 4.5 context for its
 // whole life (gl_context.hpp).
 class GlScene {
  public:
-  // pin_soup: the vertex buffers over the soup's own memory where the GL can
-  // (GL_AMD_pinned_memory); false copies them (as every GL without the extension does).
-  explicit GlScene(const SceneData& scene, bool pin_soup = true);
+  explicit GlScene(const SceneData& scene, const GlSceneOptions& options = {});
   ~GlScene();
   GlScene(const GlScene&) = delete;
   GlScene& operator=(const GlScene&) = delete;
@@ -187,6 +195,8 @@ class GlScene {
   const GpuTimings& timings() const { return timings_; }
   // Whether the vertex buffers are the soup's own memory (GL_AMD_pinned_memory), not a copy.
   bool soup_pinned() const { return pinned_; }
+  // Whether the vertex stage reads each triangle's ids from the soup's arrays (triangle_ids.glsl).
+  bool triangle_ids() const { return triangle_ids_; }
   double near_distance() const { return near_; }
   int max_size() const { return max_size_; }
 
@@ -214,9 +224,14 @@ class GlScene {
   Target& target(int width, int height, bool distance_pass);
 
   const SceneData& scene_;
-  // The scene's vertex arrays: positions, normals and texture coordinates are the soup's
-  // (soup_buffer), ids_ each vertex's object and material.
-  GLuint vao_ = 0, positions_ = 0, normals_ = 0, ids_ = 0, uv_vbo_ = 0, materials_ = 0, lights_ = 0;
+  // The scene's arrays: positions, normals, texture coordinates, each triangle's object and
+  // material are the soup's (soup_buffer); vertex_ids_ each vertex's ids, where the vertex
+  // stage reads no storage buffer of triangle ids (triangle_ids_ false).
+  GLuint vao_ = 0, positions_ = 0, normals_ = 0, object_ids_ = 0, material_ids_ = 0, vertex_ids_ = 0;
+  GLuint uv_vbo_ = 0, materials_ = 0, lights_ = 0;
+  bool triangle_ids_ = false;
+  // scene.vert and what goes before it: `before`, then triangle_ids.glsl where it is used.
+  std::vector<const char*> scene_vertex_stage(const char* before = nullptr) const;
   bool pin_soup_ = true;
   bool pinned_ = false;  // every soup buffer is the soup's memory
   // A GL buffer holding `bytes` at `data`: that memory itself when pin_soup_ and the GL

@@ -315,6 +315,8 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
       mc.gl_scene = &impl_->gl_scene_for(scene, &uploaded);
       // The soup's positions and normals as the GL's vertex buffers: the same memory, or a copy.
       stats["gl"]["scene_buffers"] = mc.gl_scene->soup_pinned() ? "pinned" : "copied";
+      // Each triangle's ids: read by the vertex stage from the soup's arrays, or carried by every vertex.
+      stats["gl"]["scene_ids"] = mc.gl_scene->triangle_ids() ? "per triangle" : "per vertex";
       if (!uploaded) mc.gl_before = mc.gl_scene->timings();  // else its upload is this render's
       image = view.render.method == Method::gpu ? render_gpu(mc) : render_hybrid(mc);
       break;
