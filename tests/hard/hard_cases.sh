@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Hard cases (issue 12, part 5): scenes from tools/hard_scenes.py, one of each template per
-# seed, for a FIXED seed list plus ONE seed new each run ($RANDOM, or ABCUBE_HARD_SEED to
-# repeat one), and the kept regression scenes in tests/hard/regressions/. Each scene is
-# rendered with `abcube render --method abuffer` and `--method raytrace` (and, for the
-# first fixed seed, `--method gpu --gl egl` when EGL works), all to EXR. Checked by
+# seed, for a FIXED seed list plus ONE seed new to each commit (from the commit's hash, so a
+# run repeats: CI and a local run of one commit render the same scenes; $RANDOM outside a
+# git checkout; ABCUBE_HARD_SEED chooses one), and the kept regression scenes in
+# tests/hard/regressions/. Each scene is rendered with `abcube render --method abuffer` and
+# `--method raytrace` (and, for the first fixed seed, `--method gpu --gl egl` when EGL works), all to EXR. Checked by
 # check_renders.py: exit status 0, no NaN or Inf float, and abuffer against raytrace at or
 # above the template's PSNR floor in tests/hard/floors.txt (measured by
 # bench/hard_cases.py; its reason column says why a floor is low). Every seed is printed; a
@@ -16,12 +17,15 @@ REPO=$2
 PY=/usr/bin/python3
 FIXED_SEEDS="1 2"
 METHOD=${ABCUBE_HARD_METHOD:-abuffer}   # the method held to the floors (another one: to see the floors catch it)
-RANDOM_SEED=${ABCUBE_HARD_SEED:-$RANDOM}
+COMMIT=$(git -C "$REPO" rev-parse --short=4 HEAD 2>/dev/null || true)
+if [ -n "${ABCUBE_HARD_SEED:-}" ]; then RANDOM_SEED=$ABCUBE_HARD_SEED
+elif [ -n "$COMMIT" ]; then RANDOM_SEED=$((16#$COMMIT + 10000))   # 10000..75535: apart from the measured seeds
+else RANDOM_SEED=$RANDOM; fi
 TEMPLATE_COUNT=$($PY -c "import sys; sys.path.insert(0, '$REPO/tools'); import hard_scenes; print(len(hard_scenes.TEMPLATES))")
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/abcube_hard.XXXXXX")
 trap 'rm -rf "$WORK"' EXIT
 export PYTHONPATH="$(dirname "$ABCUBE")/python${PYTHONPATH:+:$PYTHONPATH}"
-echo "seeds: fixed $FIXED_SEEDS, this run's $RANDOM_SEED (ABCUBE_HARD_SEED=$RANDOM_SEED repeats it)"
+echo "seeds: fixed $FIXED_SEEDS, this run's $RANDOM_SEED${COMMIT:+ (from commit $COMMIT)} (ABCUBE_HARD_SEED=$RANDOM_SEED repeats it)"
 
 GPU=no
 if "$ABCUBE" info 2>/dev/null | grep -Eq '^\s*egl-(device [0-9]+|surfaceless)\s+yes'; then GPU=yes; fi
