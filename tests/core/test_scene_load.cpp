@@ -907,8 +907,9 @@ TEST(SceneLoadMemory, EstimateAndBudget) {
       EXPECT_NE(m.find(capped ? "above --max-memory " : "of memory available"), std::string::npos) << m;
     }
   }
-  // The gpu method counts the GL vertex buffer too (3 vertices of 32 bytes a triangle)
-  // and what llvmpipe holds while drawing (about 90).
+  // The gpu method counts the GL's copy of the soup too, at its largest (positions and
+  // normals 72 bytes a triangle, the soup's ids 8, each vertex's ids 24: a GL that neither
+  // pins the soup nor reads ids per triangle) and what llvmpipe holds while drawing (about 90).
   SceneData gpu = s;
   gpu.render.method = Method::gpu;
   // and a cube shadow map of N x N floats per shadow-casting light (the scene has one),
@@ -918,13 +919,13 @@ TEST(SceneLoadMemory, EstimateAndBudget) {
   ASSERT_EQ(gpu.lights.size(), 1u);
   const uint64_t volume = 2 * (2 + 8);
   const uint64_t pairing = 960u * 3 * 32;
-  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90 + volume + 3) + pairing + 6u * 100 * 100 * 4);
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (104 + 90 + volume + 3) + pairing + 6u * 100 * 100 * 4);
   gpu.lights.push_back(gpu.lights.front());
-  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90 + 2 * volume + 3) + pairing + 2 * 6u * 100 * 100 * 4);
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (104 + 90 + 2 * volume + 3) + pairing + 2 * 6u * 100 * 100 * 4);
   gpu.lights.back().cast_shadows = false;
-  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90 + volume + 3) + pairing + 6u * 100 * 100 * 4);
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (104 + 90 + volume + 3) + pairing + 6u * 100 * 100 * 4);
   gpu.lights.front().cast_shadows = false;  // no shadows: no volumes, no maps
-  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (96 + 90));
+  EXPECT_EQ(estimate_render_bytes(gpu), bytes + 960u * (104 + 90));
   // A huge cube map is refused by its estimate, not by an allocation failure.
   text.render = R"({"cube_resolution": 16384})";
   EXPECT_GT(estimate_render_bytes(load_text(text.str())), uint64_t{6} * 16384 * 16384 * 32);
