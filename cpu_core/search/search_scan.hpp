@@ -173,7 +173,10 @@ ScanCounts scan(const SearchContext& ctx, const SearchRay& q, const SearchOption
       for (const Fragment& f : list) {
         if (o.layers == SearchLayers::nearest && &f != only) continue;
         ++counts.fragments;
-        if (static_cast<double>(f.zmax) * f.zmax < range2.x || static_cast<double>(f.zmin) * f.zmin > range2.y) continue;
+        // ORDER (abuffer.hpp): the list runs by zmin, so past the range's far end every
+        // fragment left starts further still and would fail this test too.
+        if (static_cast<double>(f.zmin) * f.zmin > range2.y) break;
+        if (static_cast<double>(f.zmax) * f.zmax < range2.x) continue;
         if (!allowed(ctx, q, soup.object_id[f.triangle()])) continue;
         const SearchContext::Plane& p = ctx.plane(f.triangle());
         if (own_surface(p, q)) continue;

@@ -310,6 +310,21 @@ std::vector<std::string> scene_files(const std::string& tag) {
   return files;
 }
 
+// ORDER (abuffer.hpp), which the scan's z-interval test relies on to stop at the first
+// fragment starting past the ray's range: every list runs by zmin after its merges.
+void expect_lists_in_order(const CubeABuffer& cube, const std::string& name) {
+  long out_of_order = 0;
+  for (const ABuffer& face : cube.faces) {
+    for (int j = 0; j < face.height(); ++j) {
+      for (int i = 0; i < face.width(); ++i) {
+        const FragmentList list = face.list(i, j);
+        for (size_t k = 1; k < list.size(); ++k) out_of_order += list[k - 1].zmin > list[k].zmin;
+      }
+    }
+  }
+  EXPECT_EQ(out_of_order, 0) << name << ": fragments out of zmin order";
+}
+
 TEST(SearchHierarchy, SearchesGiveThePlainWalksAnswers) {
   const std::vector<std::string> files = scene_files("searches");
   EXPECT_GE(files.size(), 4u + 12u + 11u);
@@ -322,6 +337,7 @@ TEST(SearchHierarchy, SearchesGiveThePlainWalksAnswers) {
       const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, n);
       const SearchContext ctx(scene, cube);
       const std::string name = fs::path(file).filename().string() + " N=" + std::to_string(n);
+      expect_lists_in_order(cube, name);
       SearchOptions o;
       compare_searches(scene, ctx, tracer, o, 60, ++seed, &tally, name + " crossing");
       if (n == 100) {
