@@ -286,16 +286,23 @@ class SearchContext {
     if (!(len > 0.0 && std::isfinite(len))) return {};
     return {n / len, glm::dot(n / len, a)};
   }
-  // What the MESH REFINEMENT tests per triangle, relative to the centre: the in-plane
-  // inward unit normals of its edges (edge k from vertex k to k+1) with their offsets, and
-  // a bounding sphere (centroid, largest vertex distance). Zero for a degenerate triangle.
-  struct TriangleBounds {
+  // What the MESH REFINEMENT tests per triangle, relative to the centre, computed when asked
+  // from the soup's float vertices: for the crossing test, plane() with the in-plane inward
+  // unit normals of the edges (edge k from vertex k to k+1) and their offsets; for the
+  // flood, a bounding sphere (centroid, largest vertex distance). Zero for a degenerate
+  // triangle (plane()'s test). Two functions, not one: the flood asks for a sphere far more
+  // often than for a crossing, and the edges' three normalisations were most of the cost.
+  struct EdgePlanes {
+    Plane plane;
     std::array<glm::dvec3, 3> edge_normal{};
     std::array<double, 3> edge_offset{};
+  };
+  EdgePlanes edge_planes(uint32_t triangle) const;
+  struct Sphere {
     glm::dvec3 centroid{0.0};
     double radius = 0;
   };
-  TriangleBounds triangle_bounds(uint32_t triangle) const;
+  Sphere bounding_sphere(uint32_t triangle) const;
   // The vertices of a triangle relative to the centre.
   glm::dvec3 vertex(uint32_t triangle, int k) const {
     return glm::dvec3(positions_[3 * static_cast<size_t>(triangle) + static_cast<size_t>(k)]) - cube_->centre;
@@ -339,10 +346,13 @@ class SearchContext {
   size_t block_bounds_bytes() const;
 
  private:
+  EdgePlanes compute_edge_planes(uint32_t triangle) const;
+  Sphere compute_bounding_sphere(uint32_t triangle) const;
   const SceneData* scene_;
   const CubeABuffer* cube_;
   Media media_;
   const glm::vec3* positions_;  // the soup's, 3 per triangle
+  uint64_t memo_id_;             // names this context's triangles in the threads' MEMO (search_context.cpp)
   std::vector<uint32_t> zero_area_;
   std::shared_ptr<const Bvh> side_bvh_;  // over the side triangles (the scene's soup, not copied)
   std::vector<uint32_t> no_triangles_;

@@ -10,17 +10,19 @@ namespace detail {
 
 PlaneCrossing plane_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri) {
   PlaneCrossing c;
-  const SearchContext::Plane& p = ctx.plane(tri);
-  const SearchContext::TriangleBounds& b = ctx.triangle_bounds(tri);
-  const double den = glm::dot(p.normal, q.d);
-  if (den == 0.0 || !(b.radius > 0.0)) return c;
-  c.l = (p.offset - glm::dot(p.normal, q.w)) / den;
+  const SearchContext::EdgePlanes e = ctx.edge_planes(tri);
+  const double den = glm::dot(e.plane.normal, q.d);
+  if (den == 0.0) return c;  // parallel, or degenerate (a zero normal)
+  c.l = (e.plane.offset - glm::dot(e.plane.normal, q.w)) / den;
   const glm::dvec3 x = q.w + c.l * q.d;
+  double outside[3];
+  for (size_t k = 0; k < 3; ++k) outside[k] = glm::dot(e.edge_normal[k], x) - e.edge_offset[k];
+  // Inside every edge's line: on the triangle, whatever the tolerance (it is not negative).
+  if (!(outside[0] < 0.0 || outside[1] < 0.0 || outside[2] < 0.0)) return c;
   double worst = -ON_TRIANGLE_TEXELS * texel_size_at(x, ctx.cube().n);
   for (int k = 0; k < 3; ++k) {
-    const double outside = glm::dot(b.edge_normal[static_cast<size_t>(k)], x) - b.edge_offset[static_cast<size_t>(k)];
-    if (outside < worst) {
-      worst = outside;
+    if (outside[k] < worst) {
+      worst = outside[k];
       c.outside_edge = k;
     }
   }
@@ -37,7 +39,7 @@ double exact_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri
 }
 
 // Does a triangle's bounding sphere come within `radius` of the ray's stretch [l_lo, l_hi]?
-bool near_ray(const SearchContext::TriangleBounds& b, const SearchRay& q, double l_lo, double l_hi, double radius) {
+bool near_ray(const SearchContext::Sphere& b, const SearchRay& q, double l_lo, double l_hi, double radius) {
   const double along = std::clamp(glm::dot(b.centroid - q.w, q.d), l_lo, l_hi);
   const glm::dvec3 off = b.centroid - (q.w + along * q.d);
   const double reach = b.radius + radius;
@@ -59,7 +61,7 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
   // otherwise the flood cannot say. (Before, such fragments were never refined: a glass
   // ball's exit crossing seen only in a texel of a merged fragment was lost, speckles in
   // its shadow on scenes/cornell.json.)
-  const bool start_near = near_ray(ctx.triangle_bounds(start), q, l_lo, l_hi, radius);
+  const bool start_near = near_ray(ctx.bounding_sphere(start), q, l_lo, l_hi, radius);
   // First the straight way: from triangle to triangle across the edge the ray's crossing
   // of the current plane lies furthest outside of, while the next is near the ray. On a
   // smooth patch this reaches the triangle crossed in a few steps.
@@ -77,7 +79,7 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
       break;
     }
     const uint32_t nb = ctx.neighbour(walker, c.outside_edge);
-    if (nb == SearchContext::NO_NEIGHBOUR || (start_near && !near_ray(ctx.triangle_bounds(nb), q, l_lo, l_hi, radius))) break;
+    if (nb == SearchContext::NO_NEIGHBOUR || (start_near && !near_ray(ctx.bounding_sphere(nb), q, l_lo, l_hi, radius))) break;
     walker = nb;
   }
   if (!start_near) return a;
@@ -98,7 +100,7 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
       const uint32_t nb = ctx.neighbour(tri, k);
       const auto seen_end = seen.begin() + static_cast<std::ptrdiff_t>(count);
       if (nb == SearchContext::NO_NEIGHBOUR || std::find(seen.begin(), seen_end, nb) != seen_end) continue;
-      if (!near_ray(ctx.triangle_bounds(nb), q, l_lo, l_hi, radius)) continue;
+      if (!near_ray(ctx.bounding_sphere(nb), q, l_lo, l_hi, radius)) continue;
       if (count == seen.size()) {
         overflow = true;
         continue;

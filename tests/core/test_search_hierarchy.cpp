@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "raster/abuffer.hpp"
@@ -366,12 +367,35 @@ TEST(SearchHierarchy, SearchesGiveThePlainWalksAnswers) {
 // ---- Whole renders ----------------------------------------------------------------------
 
 Image render(const SceneData& s, const CubeABuffer& cube, const ABuffer& camera, bool hierarchy, Method method,
-             MapShadingStats* stats) {
+             MapShadingStats* stats, int threads = 2) {
   MapShadingOptions o;
   o.method = method;
   o.search.hierarchy = hierarchy;
   const MapShader shader(s, cube, o, nullptr);
-  return render_with_map(s, camera, shader, 2, stats);
+  return render_with_map(s, camera, shader, threads, stats);
+}
+
+// MEMO (search_context.cpp): each thread keeps the refinement's per-triangle geometry of the
+// context it searched last. A render's answers must not depend on what its thread searched
+// before: the same render on a fresh thread, and on this one after a map of the same
+// triangles around another centre (other values for the same triangle ids), one thread
+// each, so that the calling thread does all the work.
+TEST(SearchMemo, AnswersDoNotDependOnWhatTheThreadSearchedBefore) {
+  SceneData s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/cornell.json");
+  s.camera.width = 64;
+  s.camera.height = 64;
+  const ABuffer camera = build_camera_abuffer(s);
+  const CubeABuffer here = build_cube_abuffer(s, s.camera.position, 96);
+  const CubeABuffer there = build_cube_abuffer(s, s.camera.position + glm::dvec3(0.5, -0.3, 0.2), 96);
+  MapShadingStats stats;
+  Image fresh;
+  std::thread([&] { fresh = render(s, here, camera, true, Method::abuffer, &stats, 1); }).join();
+  EXPECT_GT(stats.searches.shadow.candidates, 0u);
+  const Image elsewhere = render(s, there, camera, true, Method::abuffer, nullptr, 1);
+  const Image after = render(s, here, camera, true, Method::abuffer, nullptr, 1);
+  ASSERT_EQ(fresh.data.size(), after.data.size());
+  EXPECT_NE(std::memcmp(fresh.data.data(), elsewhere.data.data(), fresh.data.size() * sizeof(float)), 0);
+  EXPECT_EQ(std::memcmp(fresh.data.data(), after.data.data(), fresh.data.size() * sizeof(float)), 0);
 }
 
 TEST(SearchHierarchy, RendersAreIdentical) {
