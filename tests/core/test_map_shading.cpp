@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <ostream>
 
 #include "raster/abuffer.hpp"
 #include "scene/camera.hpp"
@@ -111,6 +112,10 @@ struct MethodCase {
   double abuffer_min_psnr;
   double refine_gain;
 };
+
+// ctest's name for each case ends in this (the default would print the struct's bytes, a
+// pointer among them, so the name would change from build to build).
+void PrintTo(const MethodCase& c, std::ostream* os) { *os << c.scene; }
 
 class MethodsAgainstReference : public ::testing::TestWithParam<MethodCase> {};
 
