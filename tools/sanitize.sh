@@ -53,8 +53,8 @@ asan_ctest() {
     while IFS= read -r name; do
       echo "sanitize: '$name' failed only by LeakSanitizer's tracer crashing at exit; again, alone"
       retry=1
-      for round in 1 2 3; do
-        ctest --test-dir build-asan --output-on-failure -R "^$(printf '%s' "$name" | sed 's/[][().*+?^$|\\]/\\&/g')\$" 2>&1 | tee "$one"
+      for round in 1 2 3; do  # ctest gets /dev/null: the loop reads the names on stdin
+        ctest --test-dir build-asan --output-on-failure -R "^$(printf '%s' "$name" | sed 's/[][().*+?^$|\\]/\\&/g')\$" < /dev/null 2>&1 | tee "$one"
         if [[ ${PIPESTATUS[0]} -eq 0 ]] && grep -q '100% tests passed' "$one"; then retry=0; break; fi
         only_tracer_crashes "$one" || break
       done
