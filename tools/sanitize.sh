@@ -84,7 +84,15 @@ case $kind in
     # longjmps out of a corrupt image, and libstdc++'s missing frame pointers cut the stack
     # at two frames, too few for its entry in lsan.supp to match.
     decodes='^(Textures\.|TexturesApi\.|SceneLoadGltf\.|fuzz\.replay\.gltf$)'
-    asan_ctest -E "^(RendererApi\.HundredEglRenderersInARow|hard\.generated)$|$decodes" "$@" || exit 1
+    # cli.crosscheck_cli runs apart without LeakSanitizer (ASan and UBSan still on): at its
+    # `abcube crosscheck scenes/cornell.json --cube-res 96 --gl egl` LeakSanitizer's tracer
+    # crashes at exit every time, on a dynamic-TLS record of the main thread it cannot read
+    # ("DTLS 41 at 0x0000000035e1-0x0018000046e3" with LSAN_OPTIONS=verbosity=1, then
+    # "Tracer caught signal 11"; gcc 12's libasan). use_tls=0 avoids the crash but then
+    # reports what only thread-local storage holds (log4cplus's per-thread data) as leaked.
+    crosscheck='^cli\.crosscheck_cli$'
+    asan_ctest -E "^(RendererApi\.HundredEglRenderersInARow|hard\.generated)$|$decodes|$crosscheck" "$@" || exit 1
+    ASAN_OPTIONS=$ASAN_OPTIONS:detect_leaks=0 asan_ctest -R "$crosscheck" "$@" || exit 1
     ASAN_OPTIONS=$ASAN_OPTIONS:fast_unwind_on_malloc=0 asan_ctest -R "$decodes" "$@"
     ;;
   tsan)
