@@ -12,5 +12,6 @@ layout(location = 0, index = 0) out vec4 o_color;
 layout(location = 0, index = 1) out vec4 o_weight;
 
 void main() {
-  camera_surface(v_material, v_relative, v_normal, diffuse_color(materials[v_material], v_uv), v_portal, o_color, o_weight);
+  camera_surface(v_material, v_relative, v_normal, diffuse_color(materials[v_material], v_uv), v_portal,
+                 camera_environment(v_material, v_relative, v_normal, v_portal), o_color, o_weight);
 }

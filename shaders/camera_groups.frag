@@ -8,7 +8,9 @@
 // (b0, b1, b2), and position, normal and texture coordinates are interpolated with them, as
 // the rasteriser interpolates them perspective-correctly at a sample. Each sample of the
 // group then gets C = color + weight * C_sample (the per-sample pass's dual-source blend,
-// done here on the target's own texel).
+// done here on the target's own texel). A group's environment-map term is the mean of its
+// samples' lookups; a smooth-shaded triangle at a silhouette (a pixel of more than one key)
+// and a group seen too obliquely (FORESHORTENING) are shaded once a sample.
 // The camera's own view (u_pixels) writes a pixel whose samples all share one key as that
 // pixel's (color, weight) instead (u_pixel_color, u_pixel_weight): the box filter of its
 // samples is then color + weight * (the mean of what its samples show behind), which
@@ -37,12 +39,19 @@ vec3 corner(uint v) {
   return vec3(dvec3(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]) - u_center);
 }
 
+// A point on the ray from the view's eye through the point `grid` of the sample grid, in
+// homogeneous coordinates (affine in grid), and the ray's direction.
+vec4 far_through(vec2 grid) { return u_unproject * vec4(grid / u_grid * 2.0 - 1.0, 0.5, 1.0); }
+vec3 ray_through(vec2 grid) {
+  vec4 far = far_through(grid);
+  return far.xyz / far.w;
+}
+
 // The barycentrics where the ray from the eye (the origin) through the point `grid` of the
 // sample grid meets the plane of the triangle r0 r1 r2 (relative to the eye); its centroid
 // when the ray runs along the plane.
 vec3 barycentrics(vec2 grid, vec3 r0, vec3 r1, vec3 r2) {
-  vec4 far = u_unproject * vec4(grid / u_grid * 2.0 - 1.0, 0.5, 1.0);
-  vec3 d = far.xyz / far.w;
+  vec3 d = ray_through(grid);
   vec3 e1 = r1 - r0, e2 = r2 - r0;
   vec3 p = cross(d, e2);
   float det = dot(e1, p);
@@ -59,17 +68,74 @@ bool curved(uint t) {
   return na != normal_of(3u * t + 1u) || na != normal_of(3u * t + 2u);
 }
 
+// The portal word camera_surface gets for triangle t.
+uint portal_of(uint t) { return u_portals ? portals[3u * t] : 0u; }
+
 ivec2 base;
 ivec2 sample_at(int k) { return base + ivec2(k & 7, k >> 3); }
+const int MASK_LAST_COLUMN = 7, MASK_LAST_ROW = 3;  // sample_at(31) - base
+
+// A triangle's corners relative to the eye (read once a group: storage reads are dear on
+// llvmpipe), and its plane: its normal n (not unit) and dot(n, r0).
+struct Corners { vec3 r0, r1, r2; };
+Corners corners_of(uint t) { return Corners(corner(3u * t), corner(3u * t + 1u), corner(3u * t + 2u)); }
+vec4 plane_of(Corners c) {
+  vec3 n = cross(c.r1 - c.r0, c.r2 - c.r0);
+  return vec4(n, dot(n, c.r0));
+}
+
+// The distance from the eye to the plane along the ray through the point `far` of
+// far_through, times |n|; not above 0 (or not finite) where the ray runs along the plane or
+// meets it behind the eye.
+float ray_distance(vec4 plane, vec4 far) {
+  vec3 d = far.xyz / far.w;
+  return length(d) * (plane.w / dot(plane.xyz, d));
+}
+
+// Whether distances in [nearest, farthest] are too far apart (or not all in front).
+bool too_oblique(float nearest, float farthest) { return !(nearest > 0.0 && farthest <= nearest * (1.0 + 1.0 / 16.0)); }
+
+// FORESHORTENING. Whether samples of a triangle lie at distances from the eye that differ by
+// more than a ratio of 1 + 1/16: a group seen that obliquely (a floor toward its horizon)
+// spans a stretch of the surface as long as 1/16 of its distance or more, over which the
+// position is far from linear in the sample grid, so the shading at the samples' mean
+// position no longer stands for their mean shading to second order (km_scale_11106_9 of
+// hard_scenes: a row of pixels at the horizon of a 3.7 km floor, 0.333 shaded once a pixel,
+// 0.294-0.299 by samples and in the tracer). Such a group is shaded once a sample. A ray
+// that runs along the plane or meets it behind the eye counts as oblique.
+//
+// Over a rectangle of samples, whose corner samples are lo and hi (offsets in the pixel): the
+// distance from the eye is convex over the rectangle's footprint on the plane, so its
+// largest is at a corner; its least too, but where the eye looks at the plane head-on, where
+// the ratio is near 1 either way. ray_through is affine before its division, so the
+// corners' rays are the centre's plus or minus half the span in each axis.
+bool foreshortened(Corners c, ivec2 lo, ivec2 hi) {
+  vec4 plane = plane_of(c);
+  vec4 mid = far_through(vec2(base) + 0.5 + 0.5 * vec2(lo + hi));
+  vec2 half_span = vec2(hi - lo) / u_grid;  // corner - centre, in NDC
+  vec4 ex = u_unproject[0] * half_span.x, ey = u_unproject[1] * half_span.y;
+  float a0 = ray_distance(plane, mid - ex - ey), a1 = ray_distance(plane, mid + ex - ey);
+  float a2 = ray_distance(plane, mid - ex + ey), a3 = ray_distance(plane, mid + ex + ey);
+  return too_oblique(min(min(a0, a1), min(a2, a3)), max(max(a0, a1), max(a2, a3)));
+}
+
+// The same over the bounding rectangle of the samples `members`.
+bool group_foreshortened(Corners c, uint members) {
+  uint columns = (members | members >> 8 | members >> 16 | members >> 24) & 0xffu;
+  uint rows = uint((members & 0xffu) != 0u) | uint((members & 0xff00u) != 0u) << 1 |
+              uint((members & 0xff0000u) != 0u) << 2 | uint((members & 0xff000000u) != 0u) << 3;
+  return foreshortened(c, ivec2(findLSB(columns), findLSB(rows)), ivec2(findMSB(columns), findMSB(rows)));
+}
 
 // Shades the group of samples `members` (bit k: sample k), all showing `key`, and blends
-// each of its samples; with `pixel`, writes the pixel's colour and weight instead.
-void shade(uvec2 key, uint members, bool pixel) {
+// each of its samples; with `pixel`, writes the pixel's colour and weight instead. c: the
+// corners of key's triangle.
+void shade(uvec2 key, uint members, bool pixel, Corners c) {
   vec2 at = vec2(0.0);
   for (uint m = members; m != 0u; m &= m - 1u) at += vec2(sample_at(findLSB(m))) + 0.5;
   at /= float(bitCount(members));
   uint v0 = 3u * (key.x - 1u);
-  vec3 r0 = corner(v0), r1 = corner(v0 + 1u), r2 = corner(v0 + 2u);
+  vec3 r0 = c.r0, r1 = c.r1, r2 = c.r2;
   vec3 b = barycentrics(at, r0, r1, r2);
   vec3 p = b.x * r0 + b.y * r1 + b.z * r2;
   vec3 normal = b.x * normal_of(v0) + b.y * normal_of(v0 + 1u) + b.z * normal_of(v0 + 2u);
@@ -89,10 +155,26 @@ void shade(uvec2 key, uint members, bool pixel) {
     }
     od /= float(bitCount(members));
   }
+  // What a curved mirror or a refraction shows of the environment map can change within a
+  // pixel by a whole edge of the map's content: one lookup at the samples' mean is no
+  // second-order stand-in for the mean of theirs (seams_11322_10 of hard_scenes: a pixel of
+  // a mirror sphere 0.009 with one lookup, 0.214 shaded by samples, 0.588 in the tracer). So that term
+  // is the mean of the lookups at the group's samples, each at its own point and normal.
+  uint portal = portal_of(key.x - 1u);
+  vec3 environment = vec3(0.0);
+  if (camera_looks_up(material, portal)) {
+    vec3 n0 = normal_of(v0), n1 = normal_of(v0 + 1u), n2 = normal_of(v0 + 2u);
+    for (uint m = members; m != 0u; m &= m - 1u) {
+      vec3 bs = barycentrics(vec2(sample_at(findLSB(m))) + 0.5, r0, r1, r2);
+      environment += camera_environment(material, bs.x * r0 + bs.y * r1 + bs.z * r2, bs.x * n0 + bs.y * n1 + bs.z * n2,
+                                        portal);
+    }
+    environment /= float(bitCount(members));
+  }
   volume_from_set = true;
   volume_set = uvec4(key.y, 0u, 0u, 0u);
   vec4 color, weight;
-  camera_surface(material, p, normal, od, u_portals ? portals[v0] : 0u, color, weight);
+  camera_surface(material, p, normal, od, portal, environment, color, weight);
   if (pixel) {
     imageStore(u_pixel_color, ivec2(gl_FragCoord.xy), color);
     imageStore(u_pixel_weight, ivec2(gl_FragCoord.xy), weight);
@@ -113,8 +195,11 @@ void main() {
   uint same = 1u;
   for (int k = 1; k < 32; ++k) same &= uint(texelFetch(u_keys, sample_at(k), 0).xy == first);
   if (same != 0u && first.x != 0u) {
-    shade(first, 0xffffffffu, u_pixels);
-    return;
+    Corners c = corners_of(first.x - 1u);
+    if (!foreshortened(c, ivec2(0), ivec2(MASK_LAST_COLUMN, MASK_LAST_ROW))) {
+      shade(first, 0xffffffffu, u_pixels, c);
+      return;
+    }
   }
   if (u_pixels) imageStore(u_pixel_weight, ivec2(gl_FragCoord.xy), vec4(-1.0));
   // Else group by group: the first sample left names the next group.
@@ -131,7 +216,10 @@ void main() {
         members |= uint(texelFetch(u_keys, sample_at(k), 0).xy == key) << uint(k);
       }
     }
+    Corners c = corners_of(key.x - 1u);
+    // FORESHORTENING: its first sample alone; the rest are grouped again.
+    if (bitCount(members) > 1 && group_foreshortened(c, members)) members &= -members;
     left &= ~members;
-    shade(key, members, false);
+    shade(key, members, false, c);
   }
 }

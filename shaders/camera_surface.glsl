@@ -14,11 +14,26 @@ uniform bool u_bounces_left;        // this view's level is below max_depth: kr 
 uniform bool u_shadows_approximate; // shadows from maps here (no volume for a light), or lights past the volumes
 layout(std430, binding = 2) readonly buffer Recursed { uint recursed[]; };  // per reflector + 1
 
+// Whether a planar mirror's virtual view was drawn behind it (portal: its reflector + 1).
+bool drawn_behind(uint portal) { return portal != 0u && recursed[portal] != 0u; }
+
+// What a surface shows of the environment map (curved mirrors, refraction), the term
+// camera_surface adds (environment_terms; 0 where it looks nothing up), and whether it looks
+// anything up.
+vec3 camera_environment(uint material, vec3 p, vec3 normal, uint portal) {
+  return environment_terms(materials[material], p, normal, drawn_behind(portal) ? 1u : 0u);
+}
+bool camera_looks_up(uint material, uint portal) {
+  return environment_looked_up(materials[material], drawn_behind(portal) ? 1u : 0u);
+}
+
 // p: the point relative to the view's eye; normal: interpolated (not unit); od: its diffuse
-// colour (diffuse_color); portal: its planar reflector + 1, 0 none.
-void camera_surface(uint material, vec3 p, vec3 normal, vec3 od, uint portal, out vec4 color, out vec4 weight) {
+// colour (diffuse_color); portal: its planar reflector + 1, 0 none; environment: its
+// camera_environment (at the point, or the mean of a group's samples').
+void camera_surface(uint material, vec3 p, vec3 normal, vec3 od, uint portal, vec3 environment, out vec4 color,
+                    out vec4 weight) {
   MaterialGpu m = materials[material];
-  bool behind = portal != 0u && recursed[portal] != 0u;
+  bool behind = drawn_behind(portal);
   float kr = behind ? 0.0 : m.coefficients.w, kt = m.transmission.x;
   bool approximate = (u_bounces_left && (kr > 0.0 || kt > 0.0)) || u_shadows_approximate;
   // Light dimmed by a translucent blocker: its transmittances come from the shadow maps.
@@ -29,7 +44,7 @@ void camera_surface(uint material, vec3 p, vec3 normal, vec3 od, uint portal, ou
     approximate = u_volumes && translucent >= 0.0 && dot(n, lights[i].position.xyz - p) > 0.0 &&
                   volume_blocked(int(translucent)) && !volume_blocked(int(lights[i].color.w));
   }
-  color = vec4(phong_local(m, p, normal, od) + environment_terms(m, p, normal, behind ? 1u : 0u),
+  color = vec4(phong_local(m, p, normal, od) + environment,
                approximate ? 1.0 : 0.0);
   weight = vec4(vec3(behind ? m.coefficients.w : 0.0), behind ? 1.0 : 0.0);
 }

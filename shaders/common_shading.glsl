@@ -97,9 +97,15 @@ vec3 lookup_direction(vec3 p, vec3 r) {
   return u_lookup == 2 ? w : r;
 }
 
+// Whether environment_terms looks material m up in the map (portal as there).
+bool environment_looked_up(MaterialGpu m, uint portal) {
+  float kr = (u_portals_exact && portal != 0u) ? 0.0 : m.coefficients.w;
+  return u_environment && (kr > 0.0 || m.transmission.x > 0.0);
+}
+
 vec3 environment_terms(MaterialGpu m, vec3 p, vec3 n_in, uint portal) {
+  if (!environment_looked_up(m, portal)) return vec3(0.0);
   float kr = (u_portals_exact && portal != 0u) ? 0.0 : m.coefficients.w, kt = m.transmission.x;
-  if (!u_environment || (kr <= 0.0 && kt <= 0.0)) return vec3(0.0);
   vec3 i = normalize(p);
   vec3 n = normalize(n_in);
   if (dot(n, i) > 0.0) n = -n;
