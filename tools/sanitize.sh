@@ -90,9 +90,15 @@ case $kind in
     # ("DTLS 41 at 0x0000000035e1-0x0018000046e3" with LSAN_OPTIONS=verbosity=1, then
     # "Tracer caught signal 11"; gcc 12's libasan). use_tls=0 avoids the crash but then
     # reports what only thread-local storage holds (log4cplus's per-thread data) as leaked.
-    crosscheck='^cli\.crosscheck_cli$'
-    asan_ctest -E "^(RendererApi\.HundredEglRenderersInARow|hard\.generated)$|$decodes|$crosscheck" "$@" || exit 1
-    ASAN_OPTIONS=$ASAN_OPTIONS:detect_leaks=0 asan_ctest -R "$crosscheck" "$@" || exit 1
+    # The egl.* GL tests (test_gl on an EGL context) run apart so too: the same crash hits
+    # them by chance, more often in some builds than others (a fresh clone of 69400bf:
+    # egl.ZbufferGl.WhiteTriangleEdgesAreAliased crashed in all 4 of CI's runs, then 2 of 3
+    # by hand, alone; an earlier build of the same host code passed it 20 times in 20), so
+    # retrying is no answer.
+    # Their host code is the osmesa.* twins' (the context aside), which keep leak checking.
+    no_leaks='^cli\.crosscheck_cli$|^egl\.'
+    asan_ctest -E "^(RendererApi\.HundredEglRenderersInARow|hard\.generated)$|$decodes|$no_leaks" "$@" || exit 1
+    ASAN_OPTIONS=$ASAN_OPTIONS:detect_leaks=0 asan_ctest -R "$no_leaks" "$@" || exit 1
     ASAN_OPTIONS=$ASAN_OPTIONS:fast_unwind_on_malloc=0 asan_ctest -R "$decodes" "$@"
     ;;
   tsan)
