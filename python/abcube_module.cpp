@@ -1,4 +1,4 @@
-// The `abcube` Python module (../shared/python.md): the library API for Python, with the
+// The `abcube` Python module (docs/python.md): the library API for Python, with the
 // library's exceptions mapped to Python ones and numpy arrays for images.
 #include <string>
 
@@ -37,13 +37,18 @@ void register_exceptions(py::module_& m) {
 }  // namespace abcube
 
 PYBIND11_MODULE(abcube, m) {
+  // numpy's C API is set up here, once, with the GIL held: set up lazily by the first image
+  // two threads return at once, its import releases the GIL halfway and the other thread
+  // waits on the half-made API while holding it (a deadlock).
+  (void)pybind11::detail::npy_api::get();
   m.doc() = R"doc(abcube: a headless hybrid renderer (cube-map A-buffer searches, an exact ray
 tracer, a GPU Z-buffer path) for Python.
 
     scene = abcube.load_scene("scenes/cornell.json")   # or abcube.scene_from_dict({...})
     r = abcube.Renderer()                               # gl="auto", threads=0 (every core)
-    img = r.render(scene, method="abuffer", cube_res=256,
-                   camera={"position": [0, 1, -3]})    # float32 H x W x 3, linear
+    img = r.render(scene, method="abuffer", cube_res=256, width=320, height=240,
+                   camera={"position": [0, 1, 1.5], "look_at": [0, 0.8, -1]})  # inside the room
+    # img: float32 H x W x 3, linear RGB
     abcube.write_image("out.exr", img)
 
 Threads: the GIL is released while a render runs; renders on different Renderer objects

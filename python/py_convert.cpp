@@ -1,6 +1,9 @@
 // Conversions between Python objects and the library's types (py_convert.hpp).
 #include "py_convert.hpp"
 
+#include <nlohmann/json.hpp>
+
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -154,6 +157,52 @@ CameraOverride camera_arg(const py::handle& value) {
     }
   }
   return camera;
+}
+
+// A Python value as JSON text, for the option table: bool, int, float, str, os.PathLike,
+// sequences (lists, tuples, numpy arrays) and dicts; numpy scalars by their .item().
+std::string json_text(const py::handle& v, const std::string& what) {
+  if (v.is_none()) return "null";
+  if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
+  if (py::isinstance<py::int_>(v)) return std::string(py::str(v));
+  if (py::isinstance<py::float_>(v)) {
+    const double x = v.cast<double>();
+    if (!std::isfinite(x)) throw InputError(what + ": must be a finite number, got " + std::string(py::repr(v)));
+    return nlohmann::json(x).dump();
+  }
+  if (py::isinstance<py::str>(v)) return nlohmann::json(v.cast<std::string>()).dump();
+  if (py::hasattr(v, "__fspath__")) return nlohmann::json(path_arg(v, what)).dump();
+  if (py::isinstance<py::dict>(v)) {
+    std::string out = "{";
+    for (const auto& item : py::reinterpret_borrow<py::dict>(v)) {
+      const std::string key = string_arg(item.first, what + " key");
+      out += (out.size() > 1 ? "," : "") + nlohmann::json(key).dump() + ":" + json_text(item.second, what + "." + key);
+    }
+    return out + "}";
+  }
+  if (py::hasattr(v, "item") && py::hasattr(v, "dtype") && py::getattr(v, "ndim").cast<int>() == 0) {
+    return json_text(v.attr("item")(), what);  // a numpy scalar
+  }
+  if (py::isinstance<py::sequence>(v) || py::hasattr(v, "tolist")) {
+    const py::object list = py::hasattr(v, "tolist") ? v.attr("tolist")() : py::reinterpret_borrow<py::object>(v);
+    std::string out = "[";
+    for (const py::handle x : list) out += (out.size() > 1 ? "," : "") + json_text(x, what + "[]");
+    return out + "]";
+  }
+  throw InputError(what + ": unsupported value of type " + type_name(v));
+}
+
+SceneOverrides overrides_arg(const py::handle& set) {
+  SceneOverrides out;
+  if (set.is_none()) return out;
+  if (!py::isinstance<py::dict>(set)) {
+    throw InputError("set: must be a dict of scene values {\"camera.fov_y\": 30, ...}, got " + type_name(set));
+  }
+  for (const auto& item : py::reinterpret_borrow<py::dict>(set)) {
+    const std::string path = string_arg(item.first, "set key");
+    out.push_back({path, json_text(item.second, "set[" + path + "]")});
+  }
+  return out;
 }
 
 }  // namespace abcube

@@ -11,6 +11,7 @@
 
 #include <abcube/image.hpp>
 #include <abcube/renderer.hpp>
+#include <abcube/scene.hpp>
 
 namespace abcube {
 
@@ -37,6 +38,13 @@ std::array<double, 3> vec3_arg(const py::handle& value, const std::string& what)
 
 // A camera dict with any of position, look_at, up, fov_y, width, height.
 CameraOverride camera_arg(const py::handle& value);
+
+// A Python value as JSON text (bool, int, float, str, os.PathLike, sequences, numpy
+// arrays and scalars, dicts); InputError naming `what` for a NaN or another type.
+std::string json_text(const py::handle& value, const std::string& what);
+
+// A dict {"camera.fov_y": 30, ...} (or None) as scene overrides (<abcube/scene.hpp>).
+SceneOverrides overrides_arg(const py::handle& set);
 
 // The Python type name of a value, for messages ("got str").
 std::string type_name(const py::handle& value);

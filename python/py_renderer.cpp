@@ -1,9 +1,16 @@
 // abcube.Renderer and abcube.RenderResult: one render call with keyword overrides, the GIL
 // released while the library renders (include/abcube/renderer.hpp).
+#include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <abcube/options.hpp>
+#include <nlohmann/json.hpp>
+
+#include <pybind11/stl.h>
 
 #include "py_convert.hpp"
 
@@ -18,74 +25,71 @@ struct PyRenderResult {
   py::object stats;  // dict (json.loads of RenderStats::json) or None
 };
 
-// The keyword arguments of Renderer.render, in signature order (None: the default).
-struct RenderArgs {
-  py::object method, cube_res, max_depth, camera, aovs, stats, timeout, reference, threads,
-      search, refine, theta_max_deg, refraction, envmap_lookup, error_target, fresnel,
-      max_layers, max_memory_mib, max_pixels, plan_everything, reference_image, resolve, side_structure,
-      gpu_mirrors, gpu_shadows, gpu_max_views, gpu_shading;
-};
-
-// Copies the keyword arguments given into RenderOptions; the others keep the struct's
-// defaults, which mean "the scene's own value".
-RenderOptions options_from_args(const RenderArgs& a) {
-  RenderOptions o;
-  if (!a.method.is_none()) o.method = string_arg(a.method, "method");
-  if (!a.cube_res.is_none()) o.cube_resolution = int_arg(a.cube_res, "cube_res");
-  if (!a.max_depth.is_none()) o.max_depth = int_arg(a.max_depth, "max_depth");
-  if (!a.camera.is_none()) o.camera = camera_arg(a.camera);
-  if (!a.aovs.is_none()) {
-    if (py::isinstance<py::str>(a.aovs) || !py::isinstance<py::sequence>(a.aovs)) {
-      throw InputError("aovs: must be a list of names (distance, normal, object_id, fallback), got " +
-                       type_name(a.aovs));
-    }
-    for (const py::handle name : a.aovs) o.aovs.push_back(string_arg(name, "aovs[]"));
-  }
-  o.stats = bool_arg(a.stats, "stats");
-  if (!a.timeout.is_none()) {
-    o.timeout_s = float_arg(a.timeout, "timeout");
-    if (!(o.timeout_s > 0) || o.timeout_s > 1e9) {
-      throw InputError("timeout: must be a number of seconds > 0 (None: no limit), got " +
-                       std::string(py::str(a.timeout)));
-    }
-  }
-  o.reference = bool_arg(a.reference, "reference");
-  if (!a.threads.is_none()) o.threads = int_arg(a.threads, "threads");
-  if (!a.search.is_none()) o.search = string_arg(a.search, "search");
-  if (!a.refine.is_none()) o.refine = string_arg(a.refine, "refine");
-  if (!a.theta_max_deg.is_none()) o.theta_max_deg = float_arg(a.theta_max_deg, "theta_max_deg");
-  if (!a.refraction.is_none()) o.refraction = string_arg(a.refraction, "refraction");
-  if (!a.envmap_lookup.is_none()) o.envmap_lookup = string_arg(a.envmap_lookup, "envmap_lookup");
-  if (!a.resolve.is_none()) o.resolve = string_arg(a.resolve, "resolve");
-  if (!a.side_structure.is_none()) o.side_structure = bool_arg(a.side_structure, "side_structure");
-  if (!a.error_target.is_none()) o.error_target = float_arg(a.error_target, "error_target");
-  if (!a.fresnel.is_none()) o.fresnel = bool_arg(a.fresnel, "fresnel");
-  if (!a.max_layers.is_none()) {
-    const uint64_t layers = unsigned_arg(a.max_layers, "max_layers");
-    if (layers > UINT32_MAX) throw InputError("max_layers: must be < 2^32");
-    o.max_layers = static_cast<uint32_t>(layers);
-  }
-  if (!a.max_memory_mib.is_none()) o.max_memory_mib = unsigned_arg(a.max_memory_mib, "max_memory_mib");
-  if (!a.max_pixels.is_none()) o.max_pixels = unsigned_arg(a.max_pixels, "max_pixels");
-  o.plan_everything = bool_arg(a.plan_everything, "plan_everything");
-  if (!a.reference_image.is_none()) o.reference_image = path_arg(a.reference_image, "reference_image");
-  if (!a.gpu_mirrors.is_none()) o.gpu_mirrors = string_arg(a.gpu_mirrors, "gpu_mirrors");
-  if (!a.gpu_shadows.is_none()) o.gpu_shadows = string_arg(a.gpu_shadows, "gpu_shadows");
-  if (!a.gpu_max_views.is_none()) o.gpu_max_views = int_arg(a.gpu_max_views, "gpu_max_views");
-  if (!a.gpu_shading.is_none()) o.gpu_shading = string_arg(a.gpu_shading, "gpu_shading");
-  return o;
+std::string join(const std::vector<std::string>& names, const char* separator) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : separator) + n;
+  return out;
 }
 
-// A misspelt keyword is a bad argument (SceneError naming it), not a TypeError.
-void reject_unknown_keywords(const py::kwargs& unknown) {
-  if (unknown.empty()) return;
-  const std::string name = py::str(unknown.begin()->first);
-  throw InputError("render: unknown keyword '" + name +
-                   "' (method, cube_res, max_depth, camera, aovs, stats, timeout, reference, "
-                   "threads, search, refine, theta_max_deg, refraction, envmap_lookup, "
-                   "error_target, fresnel, max_layers, max_memory_mib, max_pixels, "
-                   "plan_everything, reference_image, resolve, side_structure, gpu_mirrors, "
-                   "gpu_shadows, gpu_max_views, gpu_shading)");
+// Sets one option of the table; a bad value is named as the keyword was (`shown`).
+void set_option(RenderSetup& setup, const std::string& key, const std::string& shown, const py::handle& value) {
+  try {
+    set_render_option(setup, key, json_text(value, shown));
+  } catch (const OptionError& e) {
+    throw InputError(shown + ": " + e.reason);
+  }
+}
+
+// The keywords of Renderer.render applied to a setup: every job option of the table by its
+// key, "camera" as a dict of position, look_at, up, fov_y, width, height, and the older
+// keywords plan_everything (plan="everything") and side_structure (not map_only).
+RenderSetup setup_from_kwargs(const py::kwargs& kwargs, bool* want_stats) {
+  RenderSetup setup;
+  for (const auto& item : kwargs) {
+    const std::string key = py::str(item.first);
+    const py::handle value = item.second;
+    if (key == "stats") {
+      *want_stats = bool_arg(value, "stats");
+      continue;
+    }
+    if (value.is_none()) continue;  // the default
+    if (key == "camera") {
+      if (!py::isinstance<py::dict>(value)) {
+        throw InputError("camera: must be a dict with any of position, look_at, up, fov_y, width, height, got " +
+                         type_name(value));
+      }
+      static const std::vector<std::string> known = {"position", "look_at", "up", "fov_y", "width", "height"};
+      for (const auto& c : py::reinterpret_borrow<py::dict>(value)) {
+        const std::string name = string_arg(c.first, "camera key");
+        if (std::find(known.begin(), known.end(), name) == known.end()) {
+          throw InputError("camera." + name + ": unknown key (" + join(known, ", ") + ")" + did_you_mean(name, known));
+        }
+        set_option(setup, name == "position" ? "camera_position" : name, "camera." + name, c.second);
+      }
+    } else if (key == "plan_everything") {
+      if (bool_arg(value, key)) set_render_option(setup, "plan", "\"everything\"");
+    } else if (key == "side_structure") {
+      set_render_option(setup, "map_only", bool_arg(value, key) ? "false" : "true");
+    } else {
+      const OptionSpec* spec = find_render_option(key);
+      if (!spec || spec->flag == key) {
+        std::vector<std::string> known = {"camera", "stats", "plan_everything", "side_structure"};
+        for (const OptionSpec& o : render_option_table()) {
+          if (o.scope == OptionScope::job) known.push_back(o.key);
+        }
+        throw InputError("render: unknown keyword '" + key + "'" + did_you_mean(key, known) +
+                         " (help(abcube.Renderer.render) lists them)");
+      }
+      if (spec->scope == OptionScope::process) {
+        throw InputError(key + ": a setting of the Renderer: abcube.Renderer(" + key + "=...)");
+      }
+      if (spec->scope == OptionScope::scene) {
+        throw InputError(key + ": a setting of loading: abcube.load_scene(path, " + key + "=...)");
+      }
+      set_option(setup, spec->key, key, value);
+    }
+  }
+  return setup;
 }
 
 // Ctrl-C during a render gives KeyboardInterrupt, as everywhere else in Python. While the
@@ -135,14 +139,23 @@ class SigintStopsRender {
 volatile std::sig_atomic_t SigintStopsRender::seen_ = 0;
 
 // Renders with the GIL released: arguments converted before, results after.
-py::object render(Renderer& renderer, const py::handle& scene_object, const RenderArgs& args) {
+py::object render(Renderer& renderer, const py::handle& scene_object, const py::kwargs& kwargs) {
   if (!py::isinstance<Scene>(scene_object)) {
     throw InputError("scene: must be an abcube.Scene (load_scene, scene_from_dict), got " +
                      type_name(scene_object));
   }
-  const Scene scene = scene_object.cast<Scene>();  // a cheap copy sharing the loaded data
-  const RenderOptions options = options_from_args(args);
-  const bool want_result = !args.aovs.is_none() || options.stats;
+  bool want_stats = false;
+  const RenderSetup setup = setup_from_kwargs(kwargs, &want_stats);
+  RenderOptions options = setup.render;
+  options.stats = want_stats;
+  const bool want_result = !options.aovs.empty() || options.stats;
+  // A cheap copy sharing the loaded data; loaded again only when set= replaces values.
+  const Scene scene = scene_object.cast<Scene>().with_overrides(setup.set);
+  try {
+    refuse_unused_options(scene, options);
+  } catch (const OptionError& e) {  // named as the keyword
+    throw InputError(e.key + ": " + e.reason);
+  }
   RenderResult result;
   SigintStopsRender sigint;
   try {
@@ -193,37 +206,84 @@ Renderer that opened GL must be used from the thread that opened it (GL contexts
 current per thread); from another thread render() raises RuntimeError. Give each thread
 (or each worker process) its own Renderer.)doc";
 
-constexpr const char* RENDER_DOC = R"doc(Renders `scene` and returns its image.
+constexpr const char* RENDER_DOC_HEAD = R"doc(render(scene, **options)
 
-Returns a float32 array H x W x 3 (linear RGB, row 0 at the top), identical to the float
-EXR `abcube render` writes for the same inputs. With `aovs` (a list of "distance",
-"normal", "object_id", "fallback") or stats=True it returns a RenderResult instead:
-.image, .aovs (name -> float32 H x W, H x W x 3 for "normal"), .stats (the CLI's --stats
-JSON as a dict, or None).
+Renders `scene` and returns its image: a float32 array H x W x 3 (linear RGB, row 0 at the
+top), identical to the float EXR `abcube render` writes for the same inputs. With `aovs`
+or stats=True it returns a RenderResult instead: .image, .aovs (name -> float32 H x W,
+H x W x 3 for "normal"), .stats (the CLI's --stats JSON as a dict, or None).
 
-Arguments left None take the scene's own value: method (abuffer | zbuffer | envmap |
-raytrace | gpu | hybrid), cube_res (texels per cube face edge), max_depth (bounces), camera (a dict
-with any of position, look_at, up, fov_y, width, height; only the keys given change),
-error_target, fresnel. timeout: seconds, RenderTimeout (a RuntimeError) past it.
-reference: also trace the exact image, error figures in the stats. The other keywords are
-the CLI's options by their RenderOptions names: search (crossing | thesis), refine (mesh |
-plane), theta_max_deg, refraction (search | thick_lens | thin_lens), envmap_lookup (R |
-bisector | position), max_layers, max_memory_mib, max_pixels, plan_everything,
-reference_image, resolve (exact | thesis: intersecting fragments by per-sample priority
-masks or by the thesis' Vis_front estimate), side_structure (default True; False is the
-CLI's --map-only: searches see only the map, no side structure for the triangles it cannot
-hold); and for gpu and hybrid: gpu_mirrors (stencil | envmap), gpu_shadows (volumes | maps),
-gpu_max_views, gpu_shading (pixels | samples: the camera pass's colour shaded once a pixel
-and surface or once a sample).
+Every option of `abcube render` is a keyword, by its snake_case name; None or absent means
+the default (mostly: the scene's own value). Values are checked as the command line and
+`abcube batch` check them, with the same messages; an option the render's method does not
+use is refused (SceneError), as it is there.
+  camera: a dict with any of position, look_at, up, fov_y, width, height (only the keys
+          given change).
+  set: a dict {"camera.fov_y": 30, "lights[0].position": [1, 4, 2], ...} of scene values
+       replaced before the scene is read (the scene is loaded again from its source).
+  stats: True for the stats dict.
+  plan_everything (True: plan="everything") and side_structure (False: map_only=True) are
+  taken too.
 
+The options:
+)doc";
+
+constexpr const char* RENDER_DOC_TAIL = R"doc(
 A bad argument or scene raises SceneError (a ValueError) naming it; other failures
 RuntimeError. The GIL is released while the render runs (see Renderer). Ctrl-C (SIGINT,
 with Python's default handler) stops a render called from the main thread at its next
 check and raises KeyboardInterrupt.)doc";
 
+// The render docstring: its head, one line per job option of the table, its tail.
+const std::string& render_doc() {
+  static const std::string doc = [] {
+    std::string d = RENDER_DOC_HEAD;
+    for (const OptionSpec& s : render_option_table()) {
+      if (s.scope != OptionScope::job) continue;
+      std::string line = "  " + s.key + ": " + s.help;
+      if (!s.choices.empty()) line += " (" + join(s.choices, " | ") + ")";
+      if (!s.unit.empty()) line += "; " + s.unit;
+      line += "; default: " + s.default_text;
+      if (!s.methods.empty()) line += "; methods: " + join(s.methods, ", ");
+      d += line + "\n";
+    }
+    return d + RENDER_DOC_TAIL;
+  }();
+  return doc;
+}
+
 }  // namespace
 
+// The option table as Python data: a list of dicts, one an option.
+py::list option_table() {
+  static const char* const KINDS[] = {"choice", "integer", "number", "flag", "path", "text", "vec3", "names", "setting"};
+  static const char* const SCOPES[] = {"job", "process", "scene"};
+  py::list out;
+  for (const OptionSpec& s : render_option_table()) {
+    py::dict d;
+    d["key"] = s.key;
+    d["flag"] = s.flag;
+    d["kind"] = KINDS[static_cast<int>(s.kind)];
+    d["scope"] = SCOPES[static_cast<int>(s.scope)];
+    d["choices"] = s.choices;
+    if (s.kind == OptionKind::integer || s.kind == OptionKind::number) d["range"] = py::make_tuple(s.min, s.max);
+    d["default"] = s.default_text;
+    d["unit"] = s.unit;
+    d["methods"] = s.methods;
+    d["help"] = s.help;
+    d["aliases"] = s.aliases;
+    out.append(d);
+  }
+  return out;
+}
+
 void bind_renderer(py::module_& m) {
+  m.def("render_options", &option_table,
+        R"doc(The render options, one dict each: key (the keyword of Renderer.render and the batch
+job key), flag (the command line's), kind, scope ("job": any render; "process": the
+Renderer's; "scene": load_scene's), choices, range, default, unit, methods (those that use
+it; empty: every method), help, aliases. The command line, abcube batch and this module
+all read their options, checks and help from this one table.)doc");
   py::class_<PyRenderResult>(m, "RenderResult",
                              "What Renderer.render returns when aovs or stats are asked for.")
       .def_readonly("image", &PyRenderResult::image, "float32 H x W x 3, linear RGB.")
@@ -243,43 +303,8 @@ void bind_renderer(py::module_& m) {
            py::arg("gl_device") = -1)
       .def(
           "render",
-          [](Renderer& self, const py::object& scene, const py::object& method,
-             const py::object& cube_res, const py::object& max_depth, const py::object& camera,
-             const py::object& aovs, const py::object& stats, const py::object& timeout,
-             const py::object& reference, const py::object& threads, const py::object& search,
-             const py::object& refine, const py::object& theta_max_deg,
-             const py::object& refraction, const py::object& envmap_lookup,
-             const py::object& error_target, const py::object& fresnel,
-             const py::object& max_layers, const py::object& max_memory_mib,
-             const py::object& max_pixels, const py::object& plan_everything,
-             const py::object& reference_image, const py::object& resolve,
-             const py::object& side_structure, const py::object& gpu_mirrors,
-             const py::object& gpu_shadows, const py::object& gpu_max_views,
-             const py::object& gpu_shading, const py::kwargs& unknown) {
-            reject_unknown_keywords(unknown);
-            return render(self, scene,
-                          RenderArgs{method, cube_res, max_depth, camera, aovs, stats, timeout,
-                                     reference, threads, search, refine, theta_max_deg,
-                                     refraction, envmap_lookup, error_target, fresnel,
-                                     max_layers, max_memory_mib, max_pixels, plan_everything,
-                                     reference_image, resolve, side_structure, gpu_mirrors,
-                                     gpu_shadows, gpu_max_views, gpu_shading});
-          },
-          py::arg("scene"), py::kw_only(), py::arg("method") = py::none(),
-          py::arg("cube_res") = py::none(), py::arg("max_depth") = py::none(),
-          py::arg("camera") = py::none(), py::arg("aovs") = py::none(),
-          py::arg("stats") = false, py::arg("timeout") = py::none(),
-          py::arg("reference") = false, py::arg("threads") = py::none(),
-          py::arg("search") = py::none(), py::arg("refine") = py::none(),
-          py::arg("theta_max_deg") = py::none(), py::arg("refraction") = py::none(),
-          py::arg("envmap_lookup") = py::none(), py::arg("error_target") = py::none(),
-          py::arg("fresnel") = py::none(), py::arg("max_layers") = py::none(),
-          py::arg("max_memory_mib") = py::none(), py::arg("max_pixels") = py::none(),
-          py::arg("plan_everything") = false, py::arg("reference_image") = py::none(),
-          py::arg("resolve") = py::none(), py::arg("side_structure") = py::none(),
-          py::arg("gpu_mirrors") = py::none(), py::arg("gpu_shadows") = py::none(),
-          py::arg("gpu_max_views") = py::none(), py::arg("gpu_shading") = py::none(),
-          RENDER_DOC)
+          [](Renderer& self, const py::object& scene, const py::kwargs& kwargs) { return render(self, scene, kwargs); },
+          py::arg("scene"), render_doc().c_str())
       .def_property_readonly("gl_path", &Renderer::gl_path,
                              "The GL path opened (\"\" before the first GL render; \"none\" "
                              "when GL was not wanted or not found under auto).")

@@ -19,11 +19,12 @@ SceneLimits limits_arg(const py::handle& root, const py::handle& max_triangles, 
 }
 
 Scene load_scene(const py::handle& path, const py::handle& root, const py::handle& max_triangles,
-                 const py::handle& max_memory_mib) {
+                 const py::handle& max_memory_mib, const py::handle& set) {
   const std::string file = path_arg(path, "load_scene: path");
   const SceneLimits limits = limits_arg(root, max_triangles, max_memory_mib);
+  const SceneOverrides overrides = overrides_arg(set);
   py::gil_scoped_release release;
-  return Scene::load(file, limits);
+  return Scene::load(file, limits, overrides);
 }
 
 Scene scene_from_json(const py::handle& text, const py::handle& name, const py::handle& base_dir,
@@ -64,7 +65,7 @@ std::string scene_repr(const Scene& s) {
 
 void bind_scene(py::module_& m) {
   py::class_<Scene>(m, "Scene",
-                    R"doc(A validated, tessellated scene (../shared/scene-format.md). Immutable:
+                    R"doc(A validated, tessellated scene (docs/scene-format.md). Immutable:
 any number of threads and Renderers may render one Scene at once; its per-scene data
 (mesh neighbours, lens fits, the tracer's BVH) is built once, by the first render that
 needs it. Made by load_scene, scene_from_dict or scene_from_json.)doc")
@@ -82,13 +83,15 @@ needs it. Made by load_scene, scene_from_dict or scene_from_json.)doc")
       .def("__repr__", &scene_repr);
 
   m.def("load_scene", &load_scene, py::arg("path"), py::arg("root") = py::none(),
-        py::arg("max_triangles") = 0, py::arg("max_memory_mib") = 0,
+        py::arg("max_triangles") = 0, py::arg("max_memory_mib") = 0, py::arg("set") = py::none(),
         R"doc(Loads a scene file, or a model file (.gltf, .glb, .obj: the model alone, framed and
-lit, 640 x 480, its own camera if it has one; README "Models"). Untrusted scenes: `root` confines every file the scene
-references to that folder, `max_triangles` (> 0) caps its size, `max_memory_mib` (> 0, else
-the memory available) the memory its triangles may take (170 bytes each); all are refused
-before anything is allocated. A bad scene raises SceneError naming the place
-("scene.json:12:5: ..." or "scene.json: objects[3].radius: ...").)doc");
+lit, 640 x 480, its own camera if it has one; docs/models-and-textures.md). Untrusted scenes:
+`root` confines every file the scene references to that folder, `max_triangles` (> 0) caps
+its size, `max_memory_mib` (> 0, else the memory available) the memory its triangles may
+take; all are refused before anything is allocated. `set`: a dict {"camera.fov_y": 30,
+"lights[0].position": [1, 4, 2], ...} of the file's values replaced before it is read, as
+`abcube render --set`. A bad scene raises SceneError naming the place ("scene.json:12:5:
+..." or "scene.json: objects[3].radius: ...").)doc");
   m.def("scene_from_dict", &scene_from_dict, py::arg("scene"), py::arg("name") = "<dict>",
         py::arg("base_dir") = ".", py::arg("root") = py::none(), py::arg("max_triangles") = 0,
         py::arg("max_memory_mib") = 0,

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 #include <string_view>
 
 #include <abcube/error.hpp>  // InputError, RuntimeFailure, InternalError
@@ -41,6 +42,13 @@ inline std::string quote_path(std::string_view path) { return quote(path, QUOTE_
 // a tab a blank, every other control byte is escaped as by printable (nothing is cut), and
 // trailing blanks are dropped.
 std::string one_line(std::string_view text, const char* line_break = " ");
+
+// The names with `separator` between them ("abuffer, zbuffer, ...").
+inline std::string join(const std::vector<std::string>& names, const char* separator) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : separator) + n;
+  return out;
+}
 
 }  // namespace abcube
 

@@ -50,9 +50,37 @@ bool image_format_supported(const std::string& path) {
   return static_cast<bool>(out);
 }
 
+std::vector<std::string> writable_image_extensions() {
+  // "tiff:tif,tiff;openexr:exr;...": every format OpenImageIO knows, readers included.
+  std::vector<std::string> out;
+  std::string list = OIIO::get_string_attribute("extension_list");
+  for (size_t start = 0; start < list.size();) {
+    size_t end = list.find(';', start);
+    if (end == std::string::npos) end = list.size();
+    const std::string format = list.substr(start, end - start);
+    start = end + 1;
+    const size_t colon = format.find(':');
+    if (colon == std::string::npos) continue;
+    std::string exts = format.substr(colon + 1);
+    for (size_t a = 0; a <= exts.size();) {
+      size_t b = exts.find(',', a);
+      if (b == std::string::npos) b = exts.size();
+      const std::string ext = exts.substr(a, b - a);
+      a = b + 1;
+      if (!ext.empty() && std::find(out.begin(), out.end(), ext) == out.end() && image_format_supported("x." + ext)) {
+        out.push_back(ext);
+      }
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 void write_image(const std::string& path, const Image& image) {
   auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw InputError(path + ": no image writer for this file extension");
+  if (!out) {
+    throw InputError(path + ": no image writer for this file extension (" + join(writable_image_extensions(), ", ") + ")");
+  }
   const bool linear = is_float_format(path);
   const int channels = image.channels;
   OIIO::ImageSpec spec(image.width, image.height, channels,

@@ -17,6 +17,15 @@ const char* method_name(Method m) { return enum_name(METHOD_NAMES, m); }
 
 bool parse_method(const std::string& s, Method* out) { return parse_enum(METHOD_NAMES, s, out); }
 
+const std::vector<std::string>& method_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const EnumName<Method>& e : METHOD_NAMES) n.emplace_back(e.name);
+    return n;
+  }();
+  return names;
+}
+
 Bounds SceneData::bounds() const {
   Bounds b;
   for (const glm::vec3& p : triangles->positions) b.extend(glm::dvec3(p));

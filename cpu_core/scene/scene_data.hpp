@@ -1,7 +1,8 @@
-// The scene after loading: validated, triangulated, in world space (scene-format.md).
+// The scene after loading: validated, triangulated, in world space (docs/scene-format.md).
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,8 @@ enum class Method { abuffer, zbuffer, envmap, raytrace, gpu, hybrid };
 const char* method_name(Method m);
 // Parses a method name; returns false for an unknown one.
 bool parse_method(const std::string& s, Method* out);
+// Every method's name, in the enum's order: the one list that messages and help print.
+const std::vector<std::string>& method_names();
 
 struct Camera {
   glm::dvec3 position{0, 1, -4};
@@ -33,7 +36,7 @@ struct PointLight {
   bool cast_shadows = true;
 };
 
-// Phong material (thesis ch. 6; scene-format.md "materials").
+// Phong material (thesis ch. 6; docs/scene-format.md "materials").
 struct Material {
   std::string name;
   glm::dvec3 color{0.8};  // Od, diffuse colour
@@ -122,6 +125,10 @@ struct SceneData {
   // no material has one. Shared between copies.
   std::shared_ptr<const TextureSet> textures;
   RenderSettings render;
+  // Set when the camera was placed by framing ("frame": "all", model files): the
+  // direction it looks along, so that a render that changes its size or field of view
+  // frames again rather than cropping the old frame.
+  std::optional<glm::dvec3> frame_direction;
   size_t dropped_triangles = 0;  // zero-area or non-finite triangles dropped at load
   // What loaded but is likely a mistake, one line each naming the place:
   // "scene.json: objects[2].file: warning: mesh \"empty.obj\" has no triangles".

@@ -8,6 +8,8 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "base/nearest_name.hpp"
+
 namespace abcube::detail {
 
 using Json = nlohmann::ordered_json;  // keeps the file's order: materials are numbered as written
@@ -69,7 +71,8 @@ class Fields {
       if (found) continue;
       std::string list;
       for (const char* k : known) list += std::string(list.empty() ? "" : ", ") + k;
-      fail(src, member_path(path_, member.key()), "unknown field (known here: " + list + ")");
+      fail(src, member_path(path_, member.key()),
+           "unknown field (known here: " + list + ")" + did_you_mean(member.key(), {known.begin(), known.end()}));
     }
   }
 

@@ -1,4 +1,4 @@
-// Scene file (scene-format.md, version 1) -> SceneData. Every value is checked where it is
+// Scene file (docs/scene-format.md, version 1) -> SceneData. Every value is checked where it is
 // read, and every message names its place: "FILE:LINE:COL: ..." for JSON syntax (from the
 // parser's byte offset, as nori does), "FILE: objects[3].radius: ..." for values.
 //
@@ -128,7 +128,7 @@ PointLight read_light(const Fields& f) {
   return l;
 }
 
-// Phong material with the format's defaults (scene-format.md "materials").
+// Phong material with the format's defaults (docs/scene-format.md "materials").
 Material read_material(const Fields& f, const std::string& name) {
   Material m;
   m.name = name;
@@ -153,7 +153,7 @@ RenderSettings read_render(const Fields& f) {
     const std::string name = read_string(f.src(), *v, f.at("method"));
     if (!parse_method(name, &r.method)) {
       fail(f.src(), f.at("method"),
-           "must be one of abuffer, zbuffer, envmap, raytrace, gpu, hybrid, got " + describe(*v));
+           "must be one of " + join(method_names(), ", ") + ", got " + describe(*v));
     }
   }
   r.cube_resolution = f.integer("cube_resolution", r.cube_resolution, 1, MAX_CUBE_RESOLUTION);
@@ -415,12 +415,14 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
   for (size_t i = 0; i < objects.size(); ++i) read_object(st, objects[i], i);
   if (camera.frame) {
     scene.camera = frame_camera(scene.bounds(), camera.direction, scene.camera);
+    scene.frame_direction = camera.direction;
     // A framed scene without lights of its own (no "lights", none in its glTF files) is lit
     // from the frame; an explicit "lights": [] stays dark.
     if (scene.lights.empty() && !top.find("lights")) scene.lights = frame_lights(scene.bounds(), scene.camera);
   }
   if (st.file_camera) {  // a gltf object's "use_camera": its first perspective camera
     const Camera& c = *st.file_camera;
+    scene.frame_direction.reset();
     scene.camera.position = c.position;
     scene.camera.look_at = c.look_at;
     scene.camera.up = c.up;
@@ -431,8 +433,8 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
   }
   load_textures(st);
   // The loaders' small blocks freed since the last object's trim (the closed-surface test's,
-  // the JSON's): measured 28 bytes a triangle still resident on a 1M-triangle OBJ terrain
-  // without this (bench/memory.py), which every method then carried through its peak.
+  // the JSON's): left resident, they would be carried by every method through its peak
+  // (bench/memory.py measures it).
   if (scene.triangles->triangle_count() > 0) release_free_memory();
   return scene;
 }
@@ -443,11 +445,85 @@ SceneData load_scene_text(const std::string& text, const std::string& name, cons
   return load_scene_text(text, name, base_dir, LoadLimits{});
 }
 
+namespace {
+
+// One step of an override's path: a member name, or an index when `is_index`.
+struct PathStep {
+  std::string name;
+  size_t index = 0;
+  bool is_index = false;
+};
+
+// "materials[\"my glass\"].ior" -> materials, my glass, ior; "lights[0].position" -> lights, 0, position.
+std::vector<PathStep> parse_override_path(const Source& src, const std::string& path) {
+  const auto bad = [&](const std::string& why) { fail(src, path, "cannot set: " + why); };
+  std::vector<PathStep> steps;
+  size_t i = 0;
+  while (i < path.size()) {
+    if (path[i] == '[') {
+      const size_t close = path.find(']', i);
+      if (close == std::string::npos) bad("a '[' without its ']'");
+      const std::string inside = path.substr(i + 1, close - i - 1);
+      if (inside.size() >= 2 && inside.front() == '"' && inside.back() == '"') {
+        steps.push_back({inside.substr(1, inside.size() - 2), 0, false});
+      } else if (!inside.empty() && inside.size() <= 9 && inside.find_first_not_of("0123456789") == std::string::npos) {
+        steps.push_back({"", static_cast<size_t>(std::stoul(inside)), true});
+      } else {
+        bad("[" + inside + "] is neither an index nor a quoted name");
+      }
+      i = close + 1;
+      if (i < path.size() && path[i] == '.') ++i;
+      continue;
+    }
+    const size_t end = path.find_first_of(".[", i);
+    const std::string name = path.substr(i, end == std::string::npos ? std::string::npos : end - i);
+    if (name.empty()) bad("an empty name");
+    steps.push_back({name, 0, false});
+    i = end == std::string::npos ? path.size() : (path[end] == '.' ? end + 1 : end);
+  }
+  if (steps.empty()) bad("an empty path");
+  return steps;
+}
+
+// The document with each override in place (see SceneOverride).
+void apply_overrides(Json& doc, const Source& src, const SceneOverrides& set) {
+  for (const SceneOverride& o : set) {
+    const std::vector<PathStep> steps = parse_override_path(src, o.path);
+    Json* at = &doc;
+    std::string where;
+    for (const PathStep& step : steps) {
+      if (step.is_index) {
+        if (!at->is_array()) fail(src, where, "is not an array: cannot set " + o.path);
+        if (step.index >= at->size()) {
+          fail(src, index_path(where, step.index),
+               "no such element (" + where + " has " + std::to_string(at->size()) + "): cannot set " + o.path);
+        }
+        at = &(*at)[step.index];
+        where = index_path(where, step.index);
+      } else {
+        if (at->is_null()) *at = Json::object();
+        if (!at->is_object()) fail(src, where, "is not an object: cannot set " + o.path);
+        at = &(*at)[step.name];
+        where = member_path(where, step.name);
+      }
+    }
+    try {
+      *at = Json::parse(o.value);
+    } catch (const Json::exception&) {
+      fail(src, o.path, "the value to set is not JSON, got " + quote(o.value));
+    }
+  }
+}
+
+}  // namespace
+
 SceneData load_scene_text(const std::string& text, const std::string& name, const std::string& base_dir,
-                          const LoadLimits& limits) {
+                          const LoadLimits& limits, const SceneOverrides& set) {
   const Source src{name, base_dir.empty() ? "." : base_dir};
   const std::string root = limits.root.empty() ? "" : canonical_root(limits.root);
-  return read_scene(parse_document(text, src), src, limits, root);
+  Json doc = parse_document(text, src);
+  apply_overrides(doc, src, set);
+  return read_scene(doc, src, limits, root);
 }
 
 SceneData load_scene(const std::string& path) { return load_scene(path, LoadLimits{}); }
@@ -463,10 +539,11 @@ std::string model_kind(const std::string& path) {
   return "";
 }
 
-// A model file given where a scene is expected: the scene of that one model, framed, lit
-// from the frame, 640 x 480 (README "Models and framing"). Messages name the model file
-// itself ("box.gltf: meshes[0]...") rather than the scene made for it.
-SceneData load_model_as_scene(const std::string& path, const std::string& kind, const LoadLimits& limits) {
+// A model file given where a scene is expected: the scene of that one model, framed, lit from
+// the frame, 640 x 480 (docs/models-and-textures.md "A model file as the scene"). Messages name
+// the model file itself ("box.gltf: meshes[0]...") rather than the scene made for it.
+SceneData load_model_as_scene(const std::string& path, const std::string& kind, const LoadLimits& limits,
+                              const SceneOverrides& set) {
   namespace fs = std::filesystem;
   const std::string file = fs::path(path).filename().string();
   Json object = {{"type", kind}, {"file", file}};
@@ -483,7 +560,7 @@ SceneData load_model_as_scene(const std::string& path, const std::string& kind, 
     return m;
   };
   try {
-    SceneData scene = load_scene_text(doc.dump(), path, dir.empty() ? "." : dir, limits);
+    SceneData scene = load_scene_text(doc.dump(), path, dir.empty() ? "." : dir, limits, set);
     for (std::string& w : scene.warnings) w = rename(w);
     return scene;
   } catch (const InputError& e) {
@@ -493,16 +570,16 @@ SceneData load_model_as_scene(const std::string& path, const std::string& kind, 
 
 }  // namespace
 
-SceneData load_scene(const std::string& path, const LoadLimits& limits) {
+SceneData load_scene(const std::string& path, const LoadLimits& limits, const SceneOverrides& set) {
   namespace fs = std::filesystem;
   if (!limits.root.empty() && !inside_root(canonical_root(limits.root), path)) {
     throw InputError(one_line(path + ": the scene file resolves outside --root " + canonical_root(limits.root)));
   }
   const std::string kind = model_kind(path);
-  if (!kind.empty()) return load_model_as_scene(path, kind, limits);
+  if (!kind.empty()) return load_model_as_scene(path, kind, limits, set);
   const std::string text = read_input_file(path, limits.max_scene_bytes, "scene");
   const std::string dir = fs::path(path).parent_path().string();
-  return load_scene_text(text, path, dir.empty() ? "." : dir, limits);
+  return load_scene_text(text, path, dir.empty() ? "." : dir, limits, set);
 }
 
 }  // namespace abcube

@@ -1,7 +1,10 @@
-// Loading a scene file (../shared/scene-format.md, version 1) into a SceneData.
+// Loading a scene file (docs/scene-format.md, version 1) into a SceneData.
 #pragma once
 #include <cstdint>
 #include <string>
+#include <vector>
+
+#include <abcube/scene.hpp>
 
 #include "scene/scene_data.hpp"
 
@@ -21,8 +24,8 @@ struct LoadLimits {
   // (available_memory_bytes). A scene whose triangles alone would exceed it, at
   // SCENE_TRIANGLE_BYTES each, is refused as max_triangles is, before they are made.
   uint64_t max_memory_bytes = 0;
-  // Input files larger than these are refused before they are read (README "Errors and
-  // hostile input"): a scene file (and an MTL file) is text of kilobytes, a mesh can be
+  // Input files larger than these are refused before they are read (docs/scene-format.md
+  // "Limits"): a scene file (and an MTL file) is text of kilobytes, a mesh can be
   // gigabytes (a 1M-triangle OBJ is about 100 MB). A mesh file larger than the memory
   // available is refused too: its triangles take more room than its text.
   uint64_t max_scene_bytes = MAX_SCENE_BYTES;
@@ -31,24 +34,26 @@ struct LoadLimits {
   static constexpr uint64_t MAX_MESH_BYTES = uint64_t{8} << 30;    // 8 GiB
 };
 
+// SceneOverride and SceneOverrides: <abcube/scene.hpp>.
+
 // Parses, validates, tessellates and transforms. Throws InputError with one line that
 // names the place: "FILE:LINE:COL: ..." for JSON syntax, "FILE: objects[3].radius: ..."
 // for values. Unknown fields, NaN/inf, degenerate cameras, missing mesh files, unknown
 // materials and out-of-range weights are errors; zero-area triangles are dropped and
 // counted in SceneData::dropped_triangles.
 SceneData load_scene(const std::string& path);
-SceneData load_scene(const std::string& path, const LoadLimits& limits);
+SceneData load_scene(const std::string& path, const LoadLimits& limits, const SceneOverrides& set = {});
 
 // Same, from text already in memory; `name` stands for the file in messages and
 // `base_dir` resolves relative mesh paths.
 SceneData load_scene_text(const std::string& text, const std::string& name, const std::string& base_dir);
 SceneData load_scene_text(const std::string& text, const std::string& name, const std::string& base_dir,
-                          const LoadLimits& limits);
+                          const LoadLimits& limits, const SceneOverrides& set = {});
 
 // Peak resident bytes a triangle of scene data costs above the process's own, whatever the
-// method (the soup, the mesh neighbours, the tracer's tree and its build): measured by
-// bench/memory.py on 440k- and 1M-triangle meshes (bench/results/memory.txt: at most 168),
-// rounded up.
+// method (the soup, the mesh neighbours, the tracer's tree and its build): the largest
+// bench/memory.py finds on large meshes, rounded up, so that the estimate does not fall
+// short (docs/performance.md has the measurements).
 constexpr uint64_t SCENE_TRIANGLE_BYTES = 170;
 
 // The memory a render may use: `max_memory_bytes` when it is set (--max-memory), else the

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/error.hpp"
+#include "base/nearest_name.hpp"
 #include "base/input_file.hpp"
 #include "io/image_io.hpp"
 
@@ -65,33 +66,29 @@ class JobReader {
     return (p.is_absolute() ? p : dir_ / p).lexically_normal().string();
   }
 
-  int integer(const json& v, size_t line, const std::string& key) const {
-    const bool fits = v.is_number_unsigned() ? v.get<uint64_t>() <= uint64_t{INT_MAX}
-                      : v.is_number_integer() && v.get<int64_t>() >= INT_MIN && v.get<int64_t>() <= INT_MAX;
-    if (!fits) fail(line, "\"" + key + "\": must be an integer (32 bits)");
-    return v.get<int>();
-  }
-
-  std::array<double, 3> vec3(const json& v, size_t line, const std::string& key) const {
-    if (!v.is_array() || v.size() != 3 || !std::all_of(v.begin(), v.end(), [](const json& x) { return x.is_number(); })) {
-      fail(line, "\"" + key + "\": must be 3 numbers");
+  // The table's option `key` (for "camera" members: the key they stand for) with value
+  // `v`, checked on a scratch setup so that a bad value is refused before anything renders,
+  // with the table's message under the name the line used.
+  void add_option(Job& job, const std::string& key, const std::string& shown, const json& v) const {
+    const std::string text = v.dump();
+    RenderSetup scratch;
+    try {
+      set_render_option(scratch, key, text);
+    } catch (const OptionError& e) {
+      fail(job.line, quote(shown) + ": " + e.reason);
     }
-    return {v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
+    job.options.emplace_back(key, text);
   }
 
   void read_camera(Job& job, const json& c) const {
     if (!c.is_object()) fail(job.line, "\"camera\": must be an object");
+    static const std::vector<std::string> known = {"position", "look_at", "up", "fov_y", "width", "height"};
     for (const auto& [key, v] : c.items()) {
       const std::string where = "camera." + key;
-      if (key == "position") job.camera.position = vec3(v, job.line, where);
-      else if (key == "look_at") job.camera.look_at = vec3(v, job.line, where);
-      else if (key == "up") job.camera.up = vec3(v, job.line, where);
-      else if (key == "fov_y") {
-        if (!v.is_number()) fail(job.line, "\"camera.fov_y\": must be a number");
-        job.camera.fov_y = v.get<double>();
-      } else if (key == "width") job.camera.width = integer(v, job.line, where);
-      else if (key == "height") job.camera.height = integer(v, job.line, where);
-      else fail(job.line, quote(where) + ": unknown key (position, look_at, up, fov_y, width, height)");
+      if (std::find(known.begin(), known.end(), key) == known.end()) {
+        fail(job.line, quote(where) + ": unknown key (" + join(known, ", ") + ")" + did_you_mean(key, known));
+      }
+      add_option(job, key == "position" ? "camera_position" : key, where, v);
     }
   }
 
@@ -99,20 +96,25 @@ class JobReader {
     if (key == "scene") job.scene = path(v, job.line, "scene");
     else if (key == "out") job.out = path(v, job.line, "out");
     else if (key == "stats") job.stats = path(v, job.line, "stats");
-    else if (key == "method") {
-      if (!v.is_string()) fail(job.line, "\"method\": must be a string");
-      job.method = v.get<std::string>();
-    } else if (key == "cube_res") job.cube_res = integer(v, job.line, key);
-    else if (key == "max_depth") job.max_depth = integer(v, job.line, key);
     else if (key == "camera") read_camera(job, v);
-    else if (key == "aovs") {
-      if (!v.is_array()) fail(job.line, "\"aovs\": must be a list of names");
-      for (const json& a : v) {
-        if (!a.is_string()) fail(job.line, "\"aovs\": must be a list of names");
-        job.aovs.push_back(a.get<std::string>());
+    else if (key == "reference_image" && v.is_string() && !v.get<std::string>().empty()) {
+      add_option(job, key, key, json(path(v, job.line, "reference_image")));  // relative to the jobs file
+    }
+    else {
+      const OptionSpec* spec = find_render_option(key);
+      if (!spec || spec->key != key) {  // flags ("--cube-res") and aliases are the command line's and Python's
+        std::vector<std::string> known = {"scene", "out", "stats", "camera"};
+        for (const OptionSpec& s : render_option_table()) {
+          if (s.scope == OptionScope::job) known.push_back(s.key);
+        }
+        fail(job.line, quote(key) + ": unknown key" + did_you_mean(key, known) +
+                           " (scene, out, stats, camera and the render options of `abcube render --help` by their "
+                           "snake_case names)");
       }
-    } else {
-      fail(job.line, quote(key) + ": unknown key (scene, out, method, cube_res, max_depth, camera, stats, aovs)");
+      if (spec->scope != OptionScope::job) {
+        fail(job.line, quote(key) + ": set for the whole batch on its command line (" + spec->flag + "), not per job");
+      }
+      add_option(job, key, key, v);
     }
   }
 
@@ -121,6 +123,12 @@ class JobReader {
 };
 
 }  // namespace
+
+RenderSetup Job::setup(const RenderSetup& base) const {
+  RenderSetup s = base;
+  for (const auto& [key, value] : options) set_render_option(s, key, value);
+  return s;
+}
 
 std::vector<Job> read_jobs(std::istream& in, const std::string& jobs_path, size_t shard_i, size_t shard_n) {
   const JobReader reader(jobs_path);

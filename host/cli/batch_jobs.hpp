@@ -6,8 +6,10 @@
 #include <istream>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include <abcube/options.hpp>
 #include <abcube/renderer.hpp>
 
 namespace abcube {
@@ -20,10 +22,12 @@ constexpr size_t MAX_JOB_LINE_BYTES = size_t{1} << 20;
 struct Job {
   size_t line = 0;
   std::string scene, out, stats;
-  std::optional<std::string> method;
-  std::optional<int> cube_res, max_depth;
-  CameraOverride camera;
-  std::vector<std::string> aovs;
+  // Every other key: a render option of the table (<abcube/options.hpp>), checked, as its
+  // key and its value's JSON text, in the line's order; "camera" {...} is given as its
+  // keys (fov_y, camera_position, ...), "set" as one object.
+  std::vector<std::pair<std::string, std::string>> options;
+  // The job's own settings over `base` (the command line's).
+  RenderSetup setup(const RenderSetup& base) const;
 };
 
 // Every job of `in` (the file named `jobs_path`, whose folder resolves relative paths),

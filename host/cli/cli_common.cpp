@@ -12,79 +12,66 @@
 
 namespace abcube {
 
-void RenderFlags::add_to(CLI::App* cmd) {
-  cmd->add_option("--method", options.method,
-                  "abuffer | zbuffer | envmap | raytrace | gpu | hybrid (default: the scene's render.method)");
-  cmd->add_option("--cube-res", options.cube_resolution,
-                  "cube map face edge N, texels (default: the scene's render.cube_resolution)")
-      ->check(CLI::Range(1, 16384));
-  cmd->add_option("--max-depth", options.max_depth, "bounces of reflection and refraction (default: the scene's)")
-      ->check(CLI::Range(0, 64));
-  cmd->add_option("--threads", renderer.threads, "worker threads, 0 = every core")
-      ->capture_default_str()->check(CLI::Range(0, 4096));
-  cmd->add_option("--gl", renderer.gl, "GL path: auto | egl | egl-device | egl-surfaceless | osmesa | none")
-      ->capture_default_str();
-  cmd->add_option("--gl-device", renderer.gl_device, "EGL device index (default: ABCUBE_EGL_DEVICE, else the first GPU)")
-      ->check(CLI::Range(0, 1024));
-  cmd->add_flag("--reference", options.reference,
-                "also trace the exact reference; error figures in the stats");
-  cmd->add_option("--reference-image", options.reference_image,
-                  "the exact image rendered before (implies --reference)");
-  cmd->add_option("--error-target", options.error_target,
-                  "Error_Parallax target: N from the bound 1/(2 N^2) (thesis 9.3.4), in (0, 0.5]")
-      ->check(CLI::Range(0.0, 0.5));
-  cmd->add_option("--plan", plan, "needed | everything (run and time what the plan skips)")->capture_default_str();
-  cmd->add_option("--search", options.search, "map search mode: crossing | thesis (thesis 7.4)")->capture_default_str();
-  cmd->add_option("--refine", options.refine, "crossing refinement: mesh | plane")->capture_default_str();
-  cmd->add_option("--theta-max", options.theta_max_deg, "thesis mode's acceptance angle, degrees")
-      ->capture_default_str()->check(CLI::Range(1e-6, 90.0));
-  cmd->add_option("--refraction", options.refraction, "search | thick_lens | thin_lens")->capture_default_str();
-  cmd->add_option("--envmap-lookup", options.envmap_lookup, "envmap method's lookup: R | bisector | position")
-      ->capture_default_str();
-  cmd->add_option("--resolve", options.resolve,
-                  "intersecting fragments: exact (per-sample priority masks, thesis 11.2.4) | thesis (Vis_front, 5.2.1.2)")
-      ->capture_default_str();
-  cmd->add_flag("--map-only", [this](int64_t) { options.side_structure = false; },
-                "searches see only the map: no side structure for triangles it cannot hold");
-  cmd->add_option("--gpu-mirrors", options.gpu_mirrors,
-                  "gpu: planar mirrors by the stencil test (exact) | envmap (the cube texture, as before)")
-      ->capture_default_str();
-  cmd->add_option("--gpu-shadows", options.gpu_shadows, "gpu: shadow volumes (exact) | maps (cube shadow maps)")
-      ->capture_default_str();
-  cmd->add_option("--gpu-max-views", options.gpu_max_views,
-                  "gpu: mirror views drawn per camera tile, at most (a mirror past it shows the cube texture)")
-      ->capture_default_str()->check(CLI::Range(0, 1 << 20));
-  cmd->add_option("--gpu-shading", options.gpu_shading,
-                  "gpu: shade once a pixel and surface, its samples grouped by triangle and shadow | once a sample")
-      ->capture_default_str();
-  cmd->add_flag("--fresnel", [this](int64_t) { options.fresnel = true; }, "Schlick weights for kr and kt");
-  cmd->add_option("--max-layers", options.max_layers, "A-buffer layers kept per list, 0 = all")
-      ->capture_default_str()->check(CLI::Range(0, 1 << 20));
-  cmd->add_option_function<uint64_t>(
-         "--max-memory",
-         [this](uint64_t mib) {
-           options.max_memory_mib = mib;
-           limits.max_memory_mib = mib;  // the scene's triangles are checked as they load
-         },
-         "the whole render's memory budget (scene, A-buffers, maps, images), MiB, 0 = the memory available")
-      ->default_str("0")->check(CLI::Range(uint64_t{0}, uint64_t{1} << 30));
-  cmd->add_option("--max-pixels", options.max_pixels, "refuse a larger camera image, pixels, 0 = no cap")
-      ->capture_default_str();
-  cmd->add_option("--max-triangles", limits.max_triangles, "refuse a scene with more triangles, 0 = no cap")
-      ->capture_default_str();
-  cmd->add_option("--root", limits.root, "untrusted scenes: every file they reference must resolve inside DIR");
-  cmd->add_option("--aovs", aovs, "extra outputs beside the image, comma-separated: distance, normal, object_id, fallback (OUT_STEM.NAME.exr)")
-      ->delimiter(',');
+namespace {
+
+// "--cube-res N": the help line from the table.
+std::string help_line(const OptionSpec& s) {
+  std::string h = s.help;
+  if (s.kind == OptionKind::choice || s.kind == OptionKind::names) h += ": " + join(s.choices, " | ");
+  std::string notes;
+  if (!s.unit.empty()) notes += s.unit;
+  if (!s.default_text.empty()) notes += std::string(notes.empty() ? "" : "; ") + "default: " + s.default_text;
+  if (!s.methods.empty()) notes += std::string(notes.empty() ? "" : "; ") + "methods: " + join(s.methods, ", ");
+  return notes.empty() ? h : h + " (" + notes + ")";
 }
 
-RenderOptions RenderFlags::render_options() const {
-  if (plan != "needed" && plan != "everything") {
-    throw InputError("--plan: must be needed or everything, got " + quote(plan));
+const char* value_name(OptionKind k) {
+  switch (k) {
+    case OptionKind::integer: return "INT";
+    case OptionKind::number: return "NUMBER";
+    case OptionKind::path: return "PATH";
+    case OptionKind::vec3: return "X,Y,Z";
+    case OptionKind::names: return "NAME,...";
+    case OptionKind::setting: return "KEY=VALUE";
+    case OptionKind::text: return "WxH";
+    default: return "NAME";
   }
-  RenderOptions o = options;
-  o.plan_everything = plan == "everything";
-  o.aovs = aovs;
-  return o;
+}
+
+}  // namespace
+
+[[noreturn]] void throw_as_flag(const OptionError& e) {
+  const OptionSpec* spec = find_render_option(e.key);
+  throw InputError((spec ? spec->flag : e.key) + ": " + e.reason);
+}
+
+void RenderFlags::add_to(CLI::App* cmd) {
+  cmd_ = cmd;
+  for (const OptionSpec& s : render_option_table()) {
+    std::vector<std::string>& texts = texts_[s.key];
+    if (s.kind == OptionKind::flag) {
+      cmd->add_flag_function(s.flag, [&texts](int64_t) { texts.assign(1, "true"); }, help_line(s));
+    } else if (s.kind == OptionKind::setting) {
+      cmd->add_option(s.flag, texts, help_line(s))->type_name(value_name(s.kind))->allow_extra_args(false);
+    } else {
+      // names take one comma-separated value (--aovs distance,normal)
+      cmd->add_option_function<std::string>(
+             s.flag, [&texts](const std::string& t) { texts.assign(1, t); }, help_line(s))
+          ->type_name(value_name(s.kind));
+    }
+  }
+}
+
+RenderSetup RenderFlags::setup() const {
+  RenderSetup setup;
+  try {
+    for (const OptionSpec& s : render_option_table()) {
+      for (const std::string& t : texts_.at(s.key)) set_render_option_text(setup, s.key, t);
+    }
+  } catch (const OptionError& e) {
+    throw_as_flag(e);
+  }
+  return setup;
 }
 
 bool stderr_is_terminal() { return isatty(STDERR_FILENO) == 1; }
@@ -125,20 +112,21 @@ std::string folder_problem(const std::filesystem::path& folder) {
 
 void check_output_path(const std::string& path, bool image) {
   if (path.empty()) return;
-  if (image && !image_format_supported(path)) throw InputError(path + ": no image writer for this file extension");
-  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  if (!dir.empty() && !std::filesystem::exists(dir)) {
-    throw InputError(path + ": folder " + quote_path(dir.string()) + " does not exist");
+  if (image && !image_format_supported(path)) {
+    throw InputError(path + ": no image writer for this file extension (" + join(writable_image_extensions(), ", ") + ")");
   }
+  std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  while (!dir.empty() && !std::filesystem::exists(dir, ec) && dir.has_relative_path()) dir = dir.parent_path();
   const std::string problem = folder_problem(dir);
   if (!problem.empty()) throw InputError(path + ": " + problem);
 }
 
-std::string creatable_output_problem(const std::string& path) {
-  std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  std::error_code ec;
-  while (!dir.empty() && !std::filesystem::exists(dir, ec) && dir.has_relative_path()) dir = dir.parent_path();
-  return folder_problem(dir);
+void make_output_folders(const std::vector<std::string>& paths) {
+  for (const std::string& p : paths) {
+    const std::filesystem::path dir = std::filesystem::path(p).parent_path();
+    if (!p.empty() && !dir.empty()) std::filesystem::create_directories(dir);
+  }
 }
 
 }  // namespace abcube

@@ -2,10 +2,12 @@
 // the render options render and batch both take, output writing and progress.
 #pragma once
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <abcube/options.hpp>
 #include <abcube/renderer.hpp>
 
 namespace abcube {
@@ -21,19 +23,22 @@ CommandRun add_info_command(CLI::App& app);
 CommandRun add_export_pov_command(CLI::App& app);
 CommandRun add_crosscheck_command(CLI::App& app);
 
-// The options of one render that render and batch share (renderer.hpp RenderOptions,
-// RendererOptions, SceneLimits), registered on a subcommand with their defaults and units.
+// The render options of the table (<abcube/options.hpp>) as command-line flags of a
+// subcommand: their help, defaults and units from the table; their values checked by it.
 struct RenderFlags {
-  RenderOptions options;
-  RendererOptions renderer;
-  SceneLimits limits;
-  std::string plan = "needed";
-  std::vector<std::string> aovs;
-  // `per_render`: the options a batch job can also set per line (method, sizes, ...).
+  // Registers every option of the table on `cmd`.
   void add_to(CLI::App* cmd);
-  // The options as parsed (validates --plan); InputError naming the option.
-  RenderOptions render_options() const;
+  // The options given, applied in the table's order (a repeated --set keeps each); an
+  // InputError naming the flag for a bad value.
+  RenderSetup setup() const;
+
+ private:
+  CLI::App* cmd_ = nullptr;
+  std::map<std::string, std::vector<std::string>> texts_;  // table key -> each value given
 };
+
+// An option the table refuses, named by its flag ("--cube-res: must be ...").
+[[noreturn]] void throw_as_flag(const OptionError& e);
 
 // True when stderr is a terminal (progress is shown only then).
 bool stderr_is_terminal();
@@ -49,11 +54,12 @@ std::string aov_path(const std::string& output, const std::string& aov);
 // once the work succeeded, so that a failure stays one line (cli.md).
 void print_warnings(const Scene& scene, const std::string& prefix);
 
-// Refuses before any work an output whose format has no writer or whose folder is missing
-// or not writable (InputError naming the output and the folder).
+// Refuses before any work an output whose format has no writer (naming those there are)
+// or whose folder cannot be made or written (InputError naming the output and the
+// folder). Render and batch share the rule: missing folders are made, once the work is done
+// (make_output_folders), so that a failed run leaves nothing behind.
 void check_output_path(const std::string& path, bool image);
-// For an output whose missing folders will be made (batch): why that cannot work (the
-// nearest existing folder on its path is no folder, or not writable), or "".
-std::string creatable_output_problem(const std::string& path);
+// The folders of these outputs ("" skipped), made where missing.
+void make_output_folders(const std::vector<std::string>& paths);
 
 }  // namespace abcube

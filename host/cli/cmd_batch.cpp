@@ -34,14 +34,17 @@ namespace fs = std::filesystem;
 class SceneShelf {
  public:
   explicit SceneShelf(size_t capacity, SceneLimits limits) : capacity_(capacity), limits_(std::move(limits)) {}
-  Scene get(const std::string& path) {
+  // The scene at `path` with the values `set` replaced: each distinct pair is loaded once.
+  Scene get(const std::string& path, const SceneOverrides& set) {
+    std::string key = path;
+    for (const SceneOverride& o : set) key += "\n" + o.path + "=" + o.value;
     for (auto it = scenes_.begin(); it != scenes_.end(); ++it) {
-      if (it->first == path) {
+      if (it->first == key) {
         scenes_.splice(scenes_.begin(), scenes_, it);
         return it->second;
       }
     }
-    scenes_.emplace_front(path, Scene::load(path, limits_));
+    scenes_.emplace_front(key, Scene::load(path, limits_, set));
     if (scenes_.size() > capacity_) scenes_.pop_back();
     ++loads_;
     return scenes_.front().second;
@@ -89,32 +92,24 @@ struct BatchCommand {
     return abcube::read_jobs(in, jobs_path, shard_i, shard_n);
   }
 
-  RenderOptions job_options(const RenderOptions& base, const Job& job) const {
-    RenderOptions o = base;
-    if (job.method) o.method = *job.method;
-    if (job.cube_res) o.cube_resolution = *job.cube_res;
-    if (job.max_depth) o.max_depth = *job.max_depth;
-    o.camera = job.camera;
-    if (!job.aovs.empty()) o.aovs = job.aovs;
-    o.timeout_s = job_timeout_s;
-    return o;
-  }
 
   int run() const {
     const Clock::time_point start = Clock::now();
     const auto [shard_i, shard_n] = parse_shard();
-    const RenderOptions base = flags.render_options();
+    RenderSetup base = flags.setup();
+    if (job_timeout_s > 0) base.render.timeout_s = job_timeout_s;
     const std::vector<Job> jobs = read_jobs(shard_i, shard_n);
     for (const Job& job : jobs) {  // before anything renders, as a malformed line
       for (const auto& [key, out] : {std::pair<const char*, const std::string*>{"out", &job.out}, {"stats", &job.stats}}) {
-        const std::string problem = out->empty() ? "" : creatable_output_problem(*out);
-        if (!problem.empty()) {
-          throw InputError(jobs_path + ":" + std::to_string(job.line) + ": \"" + key + "\": " + quote_path(*out) + ": " + problem);
+        try {
+          check_output_path(*out, out == &job.out);
+        } catch (const InputError& e) {
+          throw InputError(jobs_path + ":" + std::to_string(job.line) + ": \"" + key + "\": " + e.what());
         }
       }
     }
-    Renderer renderer(flags.renderer);
-    SceneShelf scenes(std::max<size_t>(scene_cache, 1), flags.limits);
+    Renderer renderer(base.renderer);
+    SceneShelf scenes(std::max<size_t>(scene_cache, 1), base.limits);
     const bool terminal = stderr_is_terminal();
     size_t done = 0, failed = 0, skipped = 0;
     std::vector<double> render_ms, overhead_ms;
@@ -136,11 +131,11 @@ struct BatchCommand {
       } else {
         try {
           const Clock::time_point t0 = Clock::now();
-          const Scene scene = scenes.get(job.scene);
-          for (const std::string* p : {&job.out, &job.stats}) {
-            if (!p->empty() && fs::path(*p).has_parent_path()) fs::create_directories(fs::path(*p).parent_path());
-          }
-          const RenderResult r = renderer.render(scene, job_options(base, job));
+          const RenderSetup setup = job.setup(base);
+          const Scene scene = scenes.get(job.scene, setup.set);
+          refuse_unused_options(scene, setup.render);
+          const RenderResult r = renderer.render(scene, setup.render);
+          make_output_folders({job.out, job.stats});
           write_outputs(job.out, r);
           if (!job.stats.empty()) write_text_atomic(job.stats, r.stats.json + "\n");
           render_ms.push_back(ms_since(t0));
@@ -151,6 +146,11 @@ struct BatchCommand {
         } catch (const Interrupted&) {
           stopped();
           throw;
+        } catch (const OptionError& e) {  // named as the line names it
+          ++failed;
+          if (terminal) std::fputc('\n', stderr);
+          std::fprintf(stderr, "%s:%zu: %s: %s\n", jobs_path.c_str(), job.line, quote(e.key).c_str(),
+                       one_line(e.reason, "; ").c_str());
         } catch (const std::exception& e) {
           ++failed;
           if (terminal) std::fputc('\n', stderr);
@@ -177,8 +177,9 @@ CommandRun add_batch_command(CLI::App& app) {
   auto c = std::make_shared<BatchCommand>();
   CLI::App* cmd = app.add_subcommand(
       "batch",
-      "many renders in one process: one JSON job per line, {\"scene\": ..., \"out\": ...} plus optional method, "
-      "cube_res, max_depth, camera, stats, aovs; paths relative to the jobs file");
+      "many renders in one process: one JSON job per line, {\"scene\": ..., \"out\": ...} plus optional stats (a "
+      "path), camera (an object) and any render option below by its snake_case name (cube_res, set, ...); paths "
+      "relative to the jobs file");
   cmd->add_option("JOBS", c->jobs_path, "jobs file (JSON lines)")->required();
   cmd->add_option("--shard", c->shard, "render the jobs whose 0-based index modulo N is I")->capture_default_str();
   cmd->add_flag("--skip-existing", c->skip_existing, "skip jobs whose output exists (resume an interrupted batch)");

@@ -15,7 +15,6 @@ namespace {
 
 struct RenderCommand {
   std::string scene, output, stats_path;
-  double timeout_s = 0;
   RenderFlags flags;
 
   int run() const {
@@ -23,15 +22,19 @@ struct RenderCommand {
     if (output.empty()) throw InputError("-o OUT: an output image is required");
     check_output_path(output, true);
     check_output_path(stats_path, false);
-    RenderOptions o = flags.render_options();
-    o.timeout_s = timeout_s;
-    o.progress = progress_printer();
-    Renderer renderer(flags.renderer);
-    const Scene s = Scene::load(scene, flags.limits);
-    refuse_unused_options(s, o);
-    const RenderResult r = renderer.render(s, o);
+    RenderSetup setup = flags.setup();
+    setup.render.progress = progress_printer();
+    Renderer renderer(setup.renderer);
+    const Scene s = Scene::load(scene, setup.limits, setup.set);
+    try {
+      refuse_unused_options(s, setup.render);
+    } catch (const OptionError& e) {
+      throw_as_flag(e);
+    }
+    const RenderResult r = renderer.render(s, setup.render);
 
     const Clock::time_point t0 = Clock::now();
+    make_output_folders({output, stats_path});
     write_outputs(output, r);
     if (!stats_path.empty()) {
       // The library's stats, with the CLI's own write time in the total.
@@ -51,11 +54,11 @@ struct RenderCommand {
 CommandRun add_render_command(CLI::App& app) {
   auto c = std::make_shared<RenderCommand>();
   CLI::App* cmd = app.add_subcommand("render", "render a scene into an image (PNG, EXR, TIFF, ... by extension)");
-  cmd->add_option("SCENE", c->scene, "scene file (../shared/scene-format.md), or a model file (.gltf, .glb, .obj) rendered framed and lit")->required();
-  cmd->add_option("-o,--output", c->output, "output image, written atomically");
+  cmd->add_option("SCENE", c->scene,
+                  "scene file (docs/scene-format.md), or a model file (.gltf, .glb, .obj) rendered framed and lit")
+      ->required();
+  cmd->add_option("-o,--output", c->output, "output image, written atomically; missing folders are made");
   cmd->add_option("--stats", c->stats_path, "stats JSON: plan, per-pass ms, counts, memory, GL path, errors");
-  cmd->add_option("--timeout", c->timeout_s, "stop the render past this many seconds, 0 = no limit (exit 1)")
-      ->capture_default_str()->check(CLI::Range(0.0, 1e9));
   c->flags.add_to(cmd);
   return [c] { return c->run(); };
 }

@@ -1,5 +1,6 @@
 // abcube: headless hybrid renderer. Subcommands: render, batch, compare, info,
-// export-pov, crosscheck (../shared/cli.md); one CLI11 parser, --help on each.
+// export-pov, crosscheck (docs/cli.md); one CLI11 parser, --help on each.
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <string>
@@ -8,6 +9,7 @@
 #include <abcube/renderer.hpp>
 
 #include "base/error.hpp"
+#include "base/nearest_name.hpp"
 #include "base/memory.hpp"
 #include "base/parallel.hpp"
 #include "base/temporary_file.hpp"
@@ -15,7 +17,7 @@
 
 namespace {
 
-// SIGINT and SIGTERM (README "Faults survived"): the first asks the work to stop at its
+// SIGINT and SIGTERM (docs/robustness.md): the first asks the work to stop at its
 // next check (the render throws Interrupted, no output is put in place, the temporaries
 // are removed by their owners, exit 128 + signal); a second one removes the temporary
 // files at once and ends the process by the signal's default action.
@@ -36,6 +38,22 @@ void install_stop_handlers() {
   action.sa_handler = on_stop_signal;
   sigemptyset(&action.sa_mask);
   for (const int s : {SIGINT, SIGTERM}) sigaction(s, &action, nullptr);
+}
+
+// "; did you mean --width?" for the first option of the command line that `sub` does not
+// know, or "".
+std::string unknown_option_hint(CLI::App& sub, int argc, char** argv) {
+  std::vector<std::string> known;
+  for (const CLI::Option* o : sub.get_options()) {
+    for (const std::string& name : o->get_lnames()) known.push_back("--" + name);
+  }
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.rfind("--", 0) != 0 || arg.size() < 3) continue;
+    const std::string name = arg.substr(0, arg.find('='));
+    if (std::find(known.begin(), known.end(), name) == known.end()) return abcube::did_you_mean(name, known);
+  }
+  return "";
 }
 
 }  // namespace
@@ -72,10 +90,13 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     // One line naming the option, exit 2 (cli.md); the subcommand's name when there is one.
-    std::string where;
-    for (const CLI::App* sub : app.get_subcommands()) where = sub->get_name() + ": ";
-    std::fprintf(stderr, "abcube: %s%s (see abcube %s--help)\n", where.c_str(), one_line(e.what(), "; ").c_str(),
-                 where.empty() ? "" : (where.substr(0, where.size() - 2) + " ").c_str());
+    std::string where, hint;
+    for (CLI::App* sub : app.get_subcommands()) {
+      where = sub->get_name() + ": ";
+      hint = unknown_option_hint(*sub, argc, argv);
+    }
+    std::fprintf(stderr, "abcube: %s%s%s (see abcube %s--help)\n", where.c_str(), one_line(e.what(), "; ").c_str(),
+                 hint.c_str(), where.empty() ? "" : (where.substr(0, where.size() - 2) + " ").c_str());
     return 2;
   }
   const CLI::App* chosen = app.get_subcommands().front();

@@ -10,22 +10,6 @@
 
 namespace abcube {
 
-namespace {
-
-const char* const AOVS[] = {"distance", "normal", "object_id", "fallback"};
-
-}  // namespace
-
-bool aov_known(const std::string& name) {
-  return std::find(std::begin(AOVS), std::end(AOVS), name) != std::end(AOVS);
-}
-
-std::string aov_names() {
-  std::string s;
-  for (const char* a : AOVS) s += (s.empty() ? "" : ", ") + std::string(a);
-  return s;
-}
-
 std::map<std::string, Image> render_aovs(MethodContext& mc, const std::vector<std::string>& names) {
   const RayTracer tracer(mc.scene, mc.cache.bvh());
   const CameraFrame frame = make_camera_frame(mc.scene.camera);

@@ -10,8 +10,6 @@
 
 namespace abcube {
 
-bool aov_known(const std::string& name);
-std::string aov_names();  // "distance, normal, object_id, fallback"
 std::map<std::string, Image> render_aovs(MethodContext& mc, const std::vector<std::string>& names);
 
 }  // namespace abcube

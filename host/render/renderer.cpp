@@ -2,6 +2,8 @@
 // module and the tests call it; each method's passes are in render_methods.cpp.
 #include <abcube/renderer.hpp>
 
+#include <abcube/options.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <mutex>
@@ -18,6 +20,7 @@
 #include "render/aovs.hpp"
 #include "render/render_methods.hpp"
 #include "render/stats_json.hpp"
+#include "scene/framing.hpp"
 #include "scene/plan.hpp"
 #include "scene/scene_load.hpp"
 #include "shading/scene_cache.hpp"
@@ -63,92 +66,66 @@ Camera override_camera(Camera c, const CameraOverride& o) {
   return c;
 }
 
+// A name the option table has checked (check_render_options) parsed into its enum.
 template <class Enum>
-Enum parse_named(const std::string& value, bool (*parse)(const std::string&, Enum*), const char* option,
-                 const char* what, const char* choices) {
+Enum parse_checked(const std::string& value, bool (*parse)(const std::string&, Enum*)) {
   Enum e{};
-  if (!parse(value, &e)) {
-    throw InputError(std::string(option) + ": unknown " + what + " " + quote(value) + " (" + choices + ")");
-  }
+  const bool known = parse(value, &e);
+  ABCUBE_CHECK(known, "a checked option's value " + quote(value) + " has no enum value");
   return e;
 }
 
-
 // The render request: the scene's settings with the options' overrides, validated.
 RenderRequest make_request(const SceneData& base, const RenderOptions& o, int renderer_threads, SceneData* view) {
+  check_render_options(o);  // every value in range, with the option table's messages
   RenderRequest r;
   *view = base;  // shares the triangles (SharedTriangles)
   RenderSettings& rs = view->render;
   if (!o.method.empty()) {
-    rs.method = parse_named(o.method, parse_method, "method", "method", "abuffer, zbuffer, envmap, raytrace, gpu, hybrid");
+    rs.method = parse_checked(o.method, parse_method);
   }
-  if (o.error_target >= 0) {
-    if (!(o.error_target <= 0.5)) throw InputError("error-target: must be in [0, 0.5], got " + std::to_string(o.error_target));
-    rs.error_target = o.error_target;
-  }
+  if (o.error_target >= 0) rs.error_target = o.error_target;
   if (rs.error_target > 0 && o.cube_resolution == 0) {
     // thesis 9.3.4: the N whose bound 1/(2 N^2) meets the target (plan.hpp).
     rs.cube_resolution = resolution_for_error(rs.error_target);
   }
-  if (o.cube_resolution != 0) {
-    if (o.cube_resolution < 1 || o.cube_resolution > 16384) {
-      throw InputError("cube-res: must be an integer in [1, 16384], got " + std::to_string(o.cube_resolution));
-    }
-    rs.cube_resolution = o.cube_resolution;
-  }
-  if (o.max_depth >= 0) {
-    if (o.max_depth > 64) throw InputError("max-depth: must be an integer in [0, 64], got " + std::to_string(o.max_depth));
-    rs.max_depth = o.max_depth;
-  }
+  if (o.cube_resolution != 0) rs.cube_resolution = o.cube_resolution;
+  if (o.max_depth >= 0) rs.max_depth = o.max_depth;
   if (o.fresnel) rs.fresnel = *o.fresnel;
   view->camera = override_camera(view->camera, o.camera);
+  // A framed camera (model files, "frame": "all") given a new size or field of view frames
+  // the scene again, as the file would have with those values, unless the render places
+  // the camera itself.
+  const CameraOverride& oc = o.camera;
+  if (base.frame_direction && !oc.position && !oc.look_at && (oc.width || oc.height || oc.fov_y || oc.up)) {
+    view->camera = frame_camera(view->bounds(), *base.frame_direction, view->camera);
+  }
   const uint64_t pixels = static_cast<uint64_t>(view->camera.width) * static_cast<uint64_t>(view->camera.height);
   if (o.max_pixels > 0 && pixels > o.max_pixels) {
     throw InputError(view->file + ": camera: " + std::to_string(view->camera.width) + "x" +
                      std::to_string(view->camera.height) + " = " + std::to_string(pixels) +
                      " pixels exceeds --max-pixels " + std::to_string(o.max_pixels));
   }
-  if (o.threads < 0) throw InputError("threads: must be >= 0, got " + std::to_string(o.threads));
   r.threads = o.threads > 0 ? o.threads : renderer_threads;
   r.reference_image = o.reference_image;
   r.reference = o.reference || !o.reference_image.empty();
   r.plan_everything = o.plan_everything;
   r.abuffer.threads = r.threads;
   r.map.threads = r.threads;
-  r.map.search.mode = parse_named(o.search, parse_search_mode, "search", "mode", "crossing, thesis");
-  r.map.search.refine = parse_named(o.refine, parse_search_refine, "refine", "refinement", "mesh, plane");
-  if (!(o.theta_max_deg >= 1e-6 && o.theta_max_deg <= 90)) {
-    throw InputError("theta-max: must be a number in [1e-06, 90], got " + std::to_string(o.theta_max_deg));
-  }
+  r.map.search.mode = parse_checked(o.search, parse_search_mode);
+  r.map.search.refine = parse_checked(o.refine, parse_search_refine);
   r.map.search.theta_max = glm::radians(o.theta_max_deg);
-  r.map.refraction = parse_named(o.refraction, parse_refraction_mode, "refraction", "mode", "search, thick_lens, thin_lens");
-  r.map.lookup = parse_named(o.envmap_lookup, parse_envmap_lookup, "envmap-lookup", "lookup", "R, bisector, position");
-  if (o.resolve != "exact" && o.resolve != "thesis") {
-    throw InputError("resolve: unknown rule " + quote(o.resolve) + " (exact, thesis)");
-  }
+  r.map.refraction = parse_checked(o.refraction, parse_refraction_mode);
+  r.map.lookup = parse_checked(o.envmap_lookup, parse_envmap_lookup);
   r.map.exact_priority = o.resolve == "exact";
   r.map.search.side_structure = o.side_structure;
-  if (o.gpu_mirrors != "stencil" && o.gpu_mirrors != "envmap") {
-    throw InputError("gpu-mirrors: unknown technique " + quote(o.gpu_mirrors) + " (stencil, envmap)");
-  }
-  if (o.gpu_shadows != "volumes" && o.gpu_shadows != "maps") {
-    throw InputError("gpu-shadows: unknown technique " + quote(o.gpu_shadows) + " (volumes, maps)");
-  }
-  if (o.gpu_shading != "pixels" && o.gpu_shading != "samples") {
-    throw InputError("gpu-shading: unknown mode " + quote(o.gpu_shading) + " (pixels, samples)");
-  }
-  if (o.gpu_max_views < 0) throw InputError("gpu-max-views: must be >= 0, got " + std::to_string(o.gpu_max_views));
   r.gpu.planar_mirrors = o.gpu_mirrors == "stencil";
   r.gpu.shadow_volumes = o.gpu_shadows == "volumes";
   r.gpu.max_views = o.gpu_max_views;
   r.gpu.shading = o.gpu_shading == "pixels" ? ExactCameraOptions::Shading::pixels : ExactCameraOptions::Shading::samples;
   r.gpu.max_depth = view->render.max_depth;
   r.abuffer.max_layers = o.max_layers;
-  if (o.max_memory_mib > (uint64_t{1} << 30)) throw InputError("max-memory: must be at most 2^30 MiB");
   r.abuffer.max_memory_bytes = o.max_memory_mib << 20;  // the whole render's budget
-  for (const std::string& a : o.aovs) {
-    if (!aov_known(a)) throw InputError("aovs: unknown AOV " + quote(a) + " (" + aov_names() + ")");
-  }
   r.aovs = o.aovs;
   // Everything but the A-buffers' fragments, from the declared sizes, before any pass; the
   // A-buffers get what is left when they have counted their fragments.
@@ -361,45 +338,9 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   return result;
 }
 
-// What each method honours (README "What each method honours"; renderer.hpp).
-void refuse_unused_options(const Scene& scene, const RenderOptions& o) {
-  Method m = scene.data().render.method;
-  if (!o.method.empty() && !parse_method(o.method, &m)) {
-    throw InputError("method: unknown method " + quote(o.method) + " (abuffer, zbuffer, envmap, raytrace, gpu, hybrid)");
-  }
-  // hybrid takes the map methods' options (its CPU part is abuffer's) and the gpu method's.
-  const bool map = m == Method::abuffer || m == Method::zbuffer || m == Method::envmap || m == Method::hybrid;
-  const RenderOptions defaults;
-  const auto refuse = [&](const std::string& option, const char* why) {
-    throw InputError(option + ": not used by --method " + method_name(m) + " (" + why + ")");
-  };
-  if (m == Method::raytrace) {
-    if (o.cube_resolution != 0) refuse("cube-res", "the exact tracer builds no cube map");
-    if (o.error_target > 0) refuse("error-target", "it picks the cube map's N; the exact tracer has no map");
-    if (o.plan_everything) refuse("plan everything", "the exact tracer skips no pass");
-  }
-  if (!map) {
-    const char* searches = "map searches only: abuffer, zbuffer, envmap";
-    if (o.search != defaults.search) refuse("search", searches);
-    if (o.refine != defaults.refine) refuse("refine", searches);
-    if (o.theta_max_deg != defaults.theta_max_deg) refuse("theta-max", searches);
-    if (o.side_structure != defaults.side_structure) refuse("map-only", searches);
-    if (o.resolve != defaults.resolve) refuse("resolve", "the CPU A-buffer's resolve: abuffer, zbuffer, envmap");
-    if (o.max_layers != defaults.max_layers) refuse("max-layers", "the CPU A-buffer's lists: abuffer, zbuffer, envmap");
-  }
-  if (o.refraction != defaults.refraction && m != Method::abuffer && m != Method::zbuffer && m != Method::hybrid) {
-    refuse("refraction", "the lens replaces an exit search: abuffer, zbuffer, hybrid");
-  }
-  if (o.envmap_lookup != defaults.envmap_lookup && m != Method::envmap && m != Method::gpu) {
-    refuse("envmap-lookup", "environment map lookups: envmap, gpu");
-  }
-  if (m != Method::gpu && m != Method::hybrid) {
-    const char* gpu = "the GPU's camera pass: gpu, hybrid";
-    if (o.gpu_mirrors != defaults.gpu_mirrors) refuse("gpu-mirrors", gpu);
-    if (o.gpu_shadows != defaults.gpu_shadows) refuse("gpu-shadows", gpu);
-    if (o.gpu_max_views != defaults.gpu_max_views) refuse("gpu-max-views", gpu);
-    if (o.gpu_shading != defaults.gpu_shading) refuse("gpu-shading", gpu);
-  }
+// What each method honours (docs/methods.md; renderer.hpp).
+void refuse_unused_options(const Scene& scene, const RenderOptions& options) {
+  refuse_options_unused_by(scene.method(), options);
 }
 
 }  // namespace abcube

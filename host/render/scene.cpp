@@ -21,17 +21,37 @@ LoadLimits load_limits(const SceneLimits& limits) {
 
 }  // namespace
 
-Scene Scene::load(const std::string& path, const SceneLimits& limits) {
+namespace {
+
+SceneData load_source(const SceneSource& s) {
+  if (!s.path.empty()) return load_scene(s.path, load_limits(s.limits), s.set);
+  return load_scene_text(s.text, s.name, s.base_dir, load_limits(s.limits), s.set);
+}
+
+}  // namespace
+
+Scene Scene::load(const std::string& path, const SceneLimits& limits, const SceneOverrides& set) {
   const Clock::time_point t0 = Clock::now();
-  SceneData data = load_scene(path, load_limits(limits));
-  return Scene(std::make_shared<const State>(std::move(data), ms_since(t0)));
+  SceneSource source{path, "", "", "", limits, set};
+  SceneData data = load_source(source);
+  return Scene(std::make_shared<const State>(std::move(data), ms_since(t0), std::move(source)));
 }
 
 Scene Scene::from_json(const std::string& json_text, const std::string& name, const std::string& base_dir,
-                       const SceneLimits& limits) {
+                       const SceneLimits& limits, const SceneOverrides& set) {
   const Clock::time_point t0 = Clock::now();
-  SceneData data = load_scene_text(json_text, name, base_dir, load_limits(limits));
-  return Scene(std::make_shared<const State>(std::move(data), ms_since(t0)));
+  SceneSource source{"", json_text, name, base_dir, limits, set};
+  SceneData data = load_source(source);
+  return Scene(std::make_shared<const State>(std::move(data), ms_since(t0), std::move(source)));
+}
+
+Scene Scene::with_overrides(const SceneOverrides& set) const {
+  if (set.empty()) return *this;
+  const Clock::time_point t0 = Clock::now();
+  SceneSource source = state_->source;
+  source.set.insert(source.set.end(), set.begin(), set.end());
+  SceneData data = load_source(source);
+  return Scene(std::make_shared<const State>(std::move(data), ms_since(t0), std::move(source)));
 }
 
 const std::string& Scene::name() const { return state_->data.file; }

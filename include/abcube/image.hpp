@@ -42,6 +42,8 @@ void write_image(const std::string& path, const Image& image);
 
 // Whether OpenImageIO has a writer for this file's extension.
 bool image_format_supported(const std::string& path);
+// The extensions that have a writer ("exr", "png", ...), for messages.
+std::vector<std::string> writable_image_extensions();
 
 // The error of `a` against `b` (same size): RMSE, PSNR, max abs error and the share of
 // pixels whose largest channel differs by more than 1/255 and 2/255, on sRGB-encoded values

@@ -40,7 +40,7 @@ std::string version_string();
 // Asks every render of the process to stop at its next check (before each tile, row or
 // pass: the checks of RenderOptions::timeout_s): each throws Interrupted(signal), and an
 // image being written is not put in place (its temporary is removed). Async-signal-safe:
-// made for a SIGINT or SIGTERM handler (the CLI's, README "Faults survived"). Renders
+// made for a SIGINT or SIGTERM handler (the CLI's, docs/robustness.md). Renders
 // started later stop at once too, until clear_stop_request().
 void request_stop(int signal);
 void clear_stop_request();
@@ -119,12 +119,14 @@ struct RenderResult {
   RenderStats stats;
 };
 
-// What each method honours (README "What each method honours"): throws InputError with
-// one line when `options` gives a setting that the render's method (options.method, or
-// the scene's) has no use for, e.g. --refraction thick_lens with raytrace. `abcube render`
-// calls it before rendering; Renderer::render itself leaves such settings unused, so that
-// one RenderOptions can serve renders of several methods. The scene file's own settings
-// (render.cube_resolution, ...) are every method's defaults and never refused.
+// What each method honours (docs/methods.md): throws OptionError (an InputError) with one
+// line when `options` gives a setting that the render's method (options.method, or the
+// scene's) has no use for, e.g. refraction "thick_lens" with raytrace; the methods each
+// option serves are in the option table (<abcube/options.hpp>). `abcube render`, `abcube
+// batch` and the Python module call it before rendering; Renderer::render itself leaves
+// such settings unused, so that one RenderOptions can serve renders of several methods.
+// The scene file's own settings (render.cube_resolution, ...) are every method's defaults
+// and never refused.
 void refuse_unused_options(const Scene& scene, const RenderOptions& options);
 
 struct RendererOptions {

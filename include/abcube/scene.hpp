@@ -1,4 +1,4 @@
-// A scene, loaded once and shared by every render of it (../shared/scene-format.md).
+// A scene, loaded once and shared by every render of it (docs/scene-format.md).
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -21,6 +21,18 @@ struct SceneLimits {
   uint64_t max_memory_mib = 0;
 };
 
+// One value of the scene file replaced before it is read (`abcube render --set KEY=VALUE`,
+// a batch job's "set", Python's set=): `path` in the messages' own notation
+// (camera.fov_y, lights[0].position, materials.glass.ior, materials["my glass"].ior) and
+// the new value as JSON text. Members missing on the way are made (render.max_depth in a
+// file without "render"); array elements must exist. The value is then validated as if
+// the file held it, and a bad one gets the same message.
+struct SceneOverride {
+  std::string path;
+  std::string value;  // JSON text: 30, "gpu", [0, 1, 2], {"color": [1, 0, 0]}
+};
+using SceneOverrides = std::vector<SceneOverride>;
+
 // A validated, tessellated scene in world space. Cheap to copy: copies share one loaded
 // scene and its per-scene data (the mesh neighbours of the searches, the lens fits, the
 // exact tracer's BVH), which are built once, on the first render that needs them, and
@@ -31,14 +43,18 @@ struct SceneLimits {
 class Scene {
  public:
   // A model file (.gltf, .glb, .obj) loads as the scene of that model alone, framed and lit
-  // (README "Models: glTF 2.0, OBJ and framing").
+  // (docs/models-and-textures.md "A model file as the scene").
   // Throws InputError with one line naming the place ("FILE:LINE:COL: ..." for JSON
   // syntax, "FILE: objects[3].radius: ..." for values, a file outside limits.root, ...).
-  static Scene load(const std::string& path, const SceneLimits& limits = {});
+  static Scene load(const std::string& path, const SceneLimits& limits = {}, const SceneOverrides& set = {});
   // The same from JSON text in memory: `name` stands for the file in messages and
   // `base_dir` resolves relative mesh paths.
   static Scene from_json(const std::string& json_text, const std::string& name = "<scene>",
-                         const std::string& base_dir = ".", const SceneLimits& limits = {});
+                         const std::string& base_dir = ".", const SceneLimits& limits = {},
+                         const SceneOverrides& set = {});
+  // The same scene loaded again from its source (its file, or its JSON text) with these
+  // values replaced; the scene itself when `set` is empty.
+  Scene with_overrides(const SceneOverrides& set) const;
 
   const std::string& name() const;   // the file as given, for messages
   int width() const;                 // camera image size in pixels

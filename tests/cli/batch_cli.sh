@@ -93,14 +93,26 @@ check "empty mesh: exit 0, both rendered (3)" [ -s w/2.png ]
 check "empty mesh: one warning naming job line 1" [ "$(cat err)" = "warn.jsonl:1: empty_mesh.json: objects[0].file: warning: mesh \"empty.obj\" has no triangles" ]
 
 # --- a failing job: its line on stderr, the others rendered, exit 1
-printf '{"scene": "cornell.json", "out": "f/1.png", "method": "raytrace"}\n{"scene": "nowhere.json", "out": "f/2.png"}\n{"scene": "cornell.json", "out": "f/3.png", "method": "photon"}\n{"scene": "cornell.json", "out": "f/4.png", "method": "raytrace", "camera": {"position": [0, 1, 0]}}\n' > fail.jsonl
+printf '{"scene": "cornell.json", "out": "f/1.png", "method": "raytrace"}\n{"scene": "nowhere.json", "out": "f/2.png"}\n{"scene": "cornell.json", "out": "f/3.png", "method": "raytrace", "cube_res": 64}\n{"scene": "cornell.json", "out": "f/4.png", "method": "raytrace", "camera": {"position": [0, 1, 0]}}\n' > fail.jsonl
 "$ABCUBE" batch fail.jsonl > summary 2> err; status=$?
 check "failing jobs: exit 1" [ $status -eq 1 ]
 check "failing job 2 named by line" grep -q "fail.jsonl:2: .*nowhere.json" err
-check "failing job 3 named by line" grep -q "fail.jsonl:3: method: unknown method \"photon\"" err
+check "failing job 3 named by line" grep -q "fail.jsonl:3: \"cube_res\": not used by method raytrace" err
 check "the other jobs rendered" [ -s f/1.png ]
 check "the other jobs rendered (2)" [ -s f/4.png ]
 check "summary counts failures" grep -q "4 jobs, 2 rendered, 2 failed" summary
+
+# --- a bad option value is a malformed line: exit 2 before anything renders, the table's
+# message under the line's own key, with the nearest name
+printf '{"scene": "cornell.json", "out": "g/1.png", "method": "raytrace"}\n{"scene": "cornell.json", "out": "g/2.png", "method": "photon"}\n' > badvalue.jsonl
+"$ABCUBE" batch badvalue.jsonl > /dev/null 2> err; status=$?
+check "bad value: exit 2" [ $status -eq 2 ]
+check "bad value: nothing rendered" [ ! -e g/1.png ]
+check "bad value: named by line and key" grep -q 'badvalue.jsonl:2: "method": must be one of abuffer, zbuffer, envmap, raytrace, gpu, hybrid, got "photon"' err
+printf '{"scene": "cornell.json", "out": "g/1.png", "cube_rez": 64}\n' > typo.jsonl
+"$ABCUBE" batch typo.jsonl > /dev/null 2> err; status=$?
+check "unknown key: exit 2" [ $status -eq 2 ]
+check "unknown key: did you mean" grep -q 'typo.jsonl:1: "cube_rez": unknown key; did you mean cube_res?' err
 
 # --- shards make the whole batch; --skip-existing resumes
 "$ABCUBE" batch jobs.jsonl --shard 0/2 --gl egl > s0 2>&1 && "$ABCUBE" batch jobs.jsonl --shard 1/2 --gl egl > s1 2>&1

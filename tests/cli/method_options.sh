@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# What each method honours (README "What each method honours", issue 12 part 4): every
+# What each method honours (docs/methods.md): every
 # option given to a method that has no use for it is refused with one line naming it (exit
 # 2, nothing written); the gpu method honours max_depth 0, --envmap-lookup, --fresnel,
 # --plan everything and coverage transparency, draws glass shadows as the CPU does, and
@@ -35,12 +35,12 @@ refused() {
   local status=$?
   check "$method $* exits 2 (got $status)" [ $status -eq 2 ]
   check "$method $*: one line" [ "$(wc -l < "$WORK/err")" -eq 1 ]
-  check "$method $*: names '$name' ($(cat "$WORK/err"))" grep -q "$name: not used by --method $method" "$WORK/err"
+  check "$method $*: names '$name' ($(cat "$WORK/err"))" grep -q -- "--$name: not used by method $method" "$WORK/err"
   check "$method $*: nothing written" [ ! -e "$WORK/x.png" ]
 }
 refused raytrace cube-res --cube-res 64
 refused raytrace error-target --error-target 0.001
-refused raytrace "plan everything" --plan everything
+refused raytrace plan --plan everything
 for m in raytrace gpu; do
   refused $m search --search thesis
   refused $m refine --refine plane

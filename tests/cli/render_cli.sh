@@ -61,8 +61,14 @@ check "--gl-device with --gl osmesa exits 2" [ $? -eq 2 ]
 "$ABCUBE" > /dev/null 2> "$WORK/err"
 check "no command exits 2" [ $? -eq 2 ]
 check "no command: one line" [ "$(wc -l < "$WORK/err")" -eq 1 ]
+# Missing folders are made (render and batch share the rule), once the render is done.
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --method gpu --stats "$WORK/no/such/s.json" > /dev/null 2> "$WORK/err"
-check "--stats into a missing folder exits 2 before any work" [ $? -eq 2 ]
+check "--stats into a missing folder: made, exit 0" [ $? -eq 0 ]
+check "--stats into a missing folder: the stats in it" [ -s "$WORK/no/such/s.json" ]
+rm -f "$WORK/x.png"
+# A file where a folder should be is refused before any work.
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --method gpu --stats "$WORK/small.json/s.json" > /dev/null 2> "$WORK/err"
+check "--stats under a file exits 2 before any work" [ $? -eq 2 ]
 check "--stats error leaves no image" [ ! -e "$WORK/x.png" ]
 
 # --- the exact tracer with --reference, no GL needed
@@ -109,7 +115,7 @@ check "--reference-image size message names the file" grep -q "tiny.exr: is 20x1
 check "--search sideways exits 2" [ $? -eq 2 ]
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --refine polygon > /dev/null 2> "$WORK/err"
 check "--refine polygon exits 2" [ $? -eq 2 ]
-check "--refine polygon names the option" grep -q -- "refine: unknown refinement \"polygon\"" "$WORK/err"
+check "--refine polygon names the option" grep -q -- "--refine: must be one of mesh, plane, got \"polygon\"" "$WORK/err"
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --refraction prism > /dev/null 2> "$WORK/err"
 check "--refraction prism exits 2" [ $? -eq 2 ]
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/x.png" --envmap-lookup up > /dev/null 2> "$WORK/err"
