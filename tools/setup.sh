@@ -1,23 +1,36 @@
 #!/usr/bin/env bash
-# Installs the Debian packages abcube needs (idempotent; skips what is present).
-# GL headers come from glad (generated at configure time); libEGL and libOSMesa are
-# opened at run time, so only their run-time packages are needed.
-# clang-14, its sanitizer run-times, libFuzzer and llvm-symbolizer (llvm-14) build and run
-# the fuzz harnesses (tools/fuzz.sh); assimp-testmodels' OBJ and MTL files seed them.
-# Run as root, or with sudo available. Safe to run many times.
+# Installs the Debian packages abcube needs, by need (idempotent; skips what is present):
+#   bash tools/setup.sh           building and rendering: compiler, CMake, GL run-times, the libraries
+#   bash tools/setup.sh --python  and the Python module: its headers, pybind11, numpy, pip, venv
+#   bash tools/setup.sh --test    and everything the tests and tools use: GoogleTest, pytest, Dask,
+#                                 clang-14 with libFuzzer and its sanitizers, POV-Ray, OpenImageIO's
+#                                 tools, the assimp test models
+# GL headers come from glad (generated at configure time); libEGL and libOSMesa are opened at
+# run time, so only their run-time packages are needed. Run as root, or with sudo available.
 set -euo pipefail
 
-PACKAGES=(
-  build-essential cmake ninja-build python3
+BASE=(
+  build-essential cmake ninja-build git python3
   libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6
   libglm-dev python3-glad
-  libopenimageio-dev openimageio-tools
-  nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libembree-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev
-  python3-dev pybind11-dev python3-numpy python3-pytest python3-distributed
-  clang-14 libclang-rt-14-dev libfuzzer-14-dev llvm-14 assimp-testmodels
-  povray
+  libopenimageio-dev
+  nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libembree-dev libcli11-dev
 )
+PYTHON=(python3-dev pybind11-dev python3-numpy python3-pip python3-venv python3-setuptools python3-wheel)
+TEST=(
+  libgtest-dev libgmock-dev python3-pytest python3-distributed openimageio-tools
+  clang-14 libclang-rt-14-dev libfuzzer-14-dev llvm-14 assimp-testmodels povray
+)
+
+usage() { echo "usage: bash tools/setup.sh [--python | --test]" >&2; exit 2; }
+PACKAGES=("${BASE[@]}")
+case "${1:-}" in
+  "") ;;
+  --python) PACKAGES+=("${PYTHON[@]}") ;;
+  --test) PACKAGES+=("${PYTHON[@]}" "${TEST[@]}") ;;
+  *) usage ;;
+esac
+[ $# -le 1 ] || usage
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# abcube installed as a user installs it, then used from a folder far from the tree:
+#   1. `cmake --install BUILD --prefix P`: P/bin/abcube renders every method with no
+#      variable set, and the Python module under P's site folder imports and renders;
+#   2. `pip install --no-build-isolation .` into a venv made with --system-site-packages
+#      (the build folder reused, ABCUBE_CMAKE_BUILD_DIR): `import abcube` from /tmp with no
+#      PYTHONPATH, and a render whose image is not black.
+# Usage: install_package.sh BUILD_DIR SOURCE_DIR PYTHON
+set -euo pipefail
+BUILD=$(cd "$1" && pwd)
+SRC=$(cd "$2" && pwd)
+PYTHON=$3
+WORK=$(mktemp -d /tmp/abcube_package.XXXXXX)
+trap 'rm -rf "$WORK"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# 1. The prefix.
+cmake --install "$BUILD" --prefix "$WORK/prefix" > "$WORK/install.log" || { cat "$WORK/install.log"; fail "cmake --install"; }
+[[ -x "$WORK/prefix/bin/abcube" ]] || fail "no bin/abcube installed"
+cd "$WORK"
+env -i PATH="$WORK/prefix/bin:/usr/bin:/bin" abcube --version | grep -q '^abcube ' || fail "installed abcube --version"
+for method in raytrace abuffer zbuffer envmap gpu hybrid; do
+  options=(--width 64 --height 48)
+  [[ $method == raytrace ]] || options+=(--cube-res 32)
+  env -i PATH="$WORK/prefix/bin:/usr/bin:/bin" abcube render "$SRC/scenes/cornell.json" -o "$WORK/p_$method.png" \
+    --method "$method" "${options[@]}" 2> "$WORK/err" || { cat "$WORK/err"; fail "installed abcube render --method $method"; }
+done
+module=$(find "$WORK/prefix" -name 'abcube*.so' -path '*-packages/*' | head -n 1)
+[[ -n $module ]] || fail "no Python module under the prefix's site folder"
+site=$(dirname "$module")
+PYTHONPATH="$site" "$PYTHON" -c "
+import abcube, sys
+assert abcube.__file__.startswith('$site'), abcube.__file__
+img = abcube.Renderer(gl='none').render(abcube.load_scene('$SRC/scenes/cornell.json'), method='raytrace', width=64, height=48)
+assert img.mean() > 0.05, img.mean()
+" || fail "the prefix's Python module"
+
+# 2. pip into a venv.
+"$PYTHON" -m venv --system-site-packages "$WORK/venv" || fail "python3 -m venv (Debian: python3-venv)"
+(cd "$SRC" && ABCUBE_CMAKE_BUILD_DIR="$BUILD" "$WORK/venv/bin/python" -m pip install --no-build-isolation --no-index \
+   --no-deps --quiet "$SRC") > "$WORK/pip.log" 2>&1 || { tail -n 30 "$WORK/pip.log"; fail "pip install"; }
+cd /tmp
+env -u PYTHONPATH "$WORK/venv/bin/python" -c "
+import abcube
+assert abcube.__file__.startswith('$WORK/venv'), abcube.__file__
+scene = abcube.load_scene('$SRC/scenes/cornell.json')
+img = abcube.Renderer(gl='none').render(scene, method='raytrace', width=64, height=48)
+assert img.shape == (48, 64, 3) and img.mean() > 0.05, (img.shape, img.mean())
+print('pip: abcube', abcube.__version__, 'from', abcube.__file__)
+" || fail "import abcube from the venv"
+echo "1 passed, 0 failed"
