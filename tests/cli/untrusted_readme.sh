@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# README "Rendering untrusted scenes": its block of commands runs as written, with its first
+# docs/untrusted-scenes.md "Running renders confined": its block of commands runs as written, with its first
 # three lines (ABCUBE, UPLOADS, RENDERS) pointed at a scratch folder and its /srv/abcube-ro
 # at one inside it, as root in a private mount namespace (the bind mount vanishes with it).
 # Then the same confinement is tried from the stranger's side: a job whose scene names a
@@ -21,11 +21,11 @@ if [ -z "${ABCUBE_UNTRUSTED_IN_NAMESPACE:-}" ]; then
 fi
 chmod 755 "$WORK"
 
-# The block, from the README: the fenced block after the section's heading.
-block=$(awk '/^### Rendering untrusted scenes/ {in_section = 1}
+# The block, from the page: the fenced block after the section's heading.
+block=$(awk '/^## Running renders confined/ {in_section = 1}
              in_section && /^```/ {if (in_block) exit; in_block = 1; next}
-             in_block {print}' "$REPO/README.md")
-check "the README has the block" [ -n "$block" ]
+             in_block {print}' "$REPO/docs/untrusted-scenes.md")
+check "docs/untrusted-scenes.md has the block" [ -n "$block" ]
 check "its first lines set ABCUBE, UPLOADS, RENDERS" \
   [ "$(printf '%s\n' "$block" | head -3 | cut -d= -f1 | tr '\n' ' ')" = "ABCUBE UPLOADS RENDERS " ]
 

@@ -1,0 +1,141 @@
+"""The documents a user reads: they stand on their own, their links resolve, and every
+command and code block they hold runs.
+
+Environment (set by tests/CMakeLists.txt): ABCUBE_SOURCE_DIR, ABCUBE_BIN (the program),
+PYTHONPATH (the built module), ABCUBE_TEST_OUT (a scratch folder).
+"""
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+SRC = Path(os.environ["ABCUBE_SOURCE_DIR"])
+BIN = Path(os.environ["ABCUBE_BIN"])
+OUT = Path(os.environ.get("ABCUBE_TEST_OUT", "/tmp")) / "docs"
+
+# Written in two pieces so that this file does not match itself.
+OUTSIDE = re.compile("|".join([r"\.\./" + "shared", "/work/" + "shared", r"\.\./" + "seeds"]))
+
+
+def tracked_files():
+    out = subprocess.run(["git", "-C", str(SRC), "ls-files", "-z"], capture_output=True, check=True).stdout
+    return [SRC / p for p in out.decode().split("\0") if p]
+
+
+def documents():
+    return [SRC / "README.md"] + sorted((SRC / "docs").rglob("*.md"))
+
+
+def test_nothing_points_outside_the_repository():
+    hits = []
+    for path in tracked_files():
+        try:
+            text = path.read_text(errors="strict")
+        except (UnicodeDecodeError, IsADirectoryError, FileNotFoundError):
+            continue
+        for number, line in enumerate(text.splitlines(), 1):
+            if OUTSIDE.search(line):
+                hits.append(f"{path.relative_to(SRC)}:{number}: {line.strip()[:100]}")
+    assert not hits, "\n".join(hits)
+
+
+def help_texts():
+    texts = {"abcube --help": subprocess.run([BIN, "--help"], capture_output=True, text=True).stdout}
+    for command in ["render", "batch", "compare", "info", "export-pov", "crosscheck"]:
+        texts[f"abcube {command} --help"] = subprocess.run([BIN, command, "--help"], capture_output=True, text=True).stdout
+    return texts
+
+
+def test_help_and_docstrings_name_no_path_outside():
+    texts = help_texts()
+    import abcube
+    for name in dir(abcube):
+        obj = getattr(abcube, name)
+        texts[f"abcube.{name}"] = getattr(obj, "__doc__", "") or ""
+        for member in dir(obj) if isinstance(obj, type) else []:
+            texts[f"abcube.{name}.{member}"] = getattr(getattr(obj, member), "__doc__", "") or ""
+    assert all(texts[k] for k in ["abcube --help", "abcube render --help"])
+    bad = [k for k, t in texts.items() if OUTSIDE.search(t) or "/work/" in t or "README \"" in t]
+    assert not bad, bad
+
+
+def test_readme_is_a_front_page():
+    lines = (SRC / "README.md").read_text().splitlines()
+    assert len(lines) < 200, len(lines)
+    blocks = re.findall(r"```[a-z]*\n(.*?)```", "\n".join(lines[:40]), re.S)
+    assert len(blocks) >= 2
+    assert "tools/setup.sh" in blocks[0] and "abcube render" in blocks[0], blocks[0]
+    assert "tools/setup.sh --test" in blocks[1] and "ctest" in blocks[1], blocks[1]
+    ci = (SRC / ".ci/run").read_text()
+    assert blocks[1].strip() in ci, "the README's test command is not what .ci/run runs"
+
+
+def test_every_link_resolves():
+    broken = []
+    for doc in documents():
+        text = re.sub(r"```.*?```", "", doc.read_text(), flags=re.S)
+        for target in re.findall(r"\]\(([^)\s]+)\)", text):
+            if re.match(r"[a-z]+:", target):
+                continue  # a web address or mailto: not followed here
+            path = target.split("#")[0]
+            if path and not (doc.parent / path).exists():
+                broken.append(f"{doc.relative_to(SRC)}: {target}")
+    assert not broken, "\n".join(broken)
+
+
+def test_every_option_of_help_is_in_the_cli_page():
+    page = (SRC / "docs" / "cli.md").read_text()
+    missing = []
+    for name, text in help_texts().items():
+        for flag in re.findall(r"^\s+(?:-\w, )?(--[a-z][a-z0-9-]*)", text, re.M):
+            if flag not in ("--help", "--help-all") and flag not in page:
+                missing.append(f"{name}: {flag}")
+    assert not missing, "\n".join(missing)
+
+
+def code_blocks():
+    """(document, line, language, code) of every ```sh and ```python block."""
+    for doc in documents():
+        text = doc.read_text()
+        for m in re.finditer(r"^```(sh|python)\n(.*?)^```", text, re.S | re.M):
+            yield doc, text[: m.start()].count("\n") + 1, m.group(1), m.group(2)
+
+
+def runnable(code):
+    # The set-up and build commands are what CI itself runs (.ci/run), and installs are
+    # tests/install's: a block holding one is read, not run, here.
+    return not re.search(r"tools/setup\.sh|cmake |pip install|apt-get", code)
+
+
+BLOCKS = [b for b in code_blocks() if runnable(b[3])]
+
+
+def test_the_documents_have_examples():
+    assert len(BLOCKS) >= 10, len(BLOCKS)
+
+
+@pytest.mark.parametrize("doc,line,language,code", BLOCKS,
+                         ids=[f"{b[0].relative_to(SRC)}:{b[1]}" for b in BLOCKS])
+def test_example_runs(doc, line, language, code, tmp_path):
+    # The block runs in a folder of its own, with the repository's scenes and examples
+    # beside it, `abcube` on PATH and the module importable, as after an install.
+    for name in ["scenes", "examples", "python"]:
+        (tmp_path / name).symlink_to(SRC / name)
+    # `python3` in a block is the interpreter the module was built for.
+    env = dict(os.environ, PATH=f"{BIN.parent}:{Path(sys.executable).parent}:{os.environ['PATH']}")
+    if language == "sh":
+        command = ["bash", "-euo", "pipefail", "-c", code]
+    else:
+        command = [sys.executable, "-c", code]
+    before = set(tmp_path.rglob("*"))
+    r = subprocess.run(command, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=240)
+    assert r.returncode == 0, f"{doc.relative_to(SRC)}:{line}: exit {r.returncode}\n{r.stdout[-2000:]}\n{r.stderr[-2000:]}"
+    # No image the example writes is black.
+    import abcube
+    for path in sorted(set(tmp_path.rglob("*")) - before):
+        if path.suffix in (".png", ".exr") and not path.is_symlink() and "." not in path.stem:
+            image = abcube.read_image(str(path))
+            assert image.mean() > 0.01, f"{path.name} from {doc.relative_to(SRC)}:{line} is black ({image.mean():.4f})"
