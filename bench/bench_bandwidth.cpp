@@ -2,7 +2,7 @@
 // (a[i] = b[i]) and triad (a[i] = b[i] + s c[i]) over arrays far larger than the caches,
 // split over T threads, best of K repetitions. Bytes counted as STREAM counts them (copy
 // 16 per element, triad 24), so the figures compare with published STREAM results.
-// The A-buffer's fragments per second are read against it (README "Speed against error").
+// The A-buffer's fragments per second are read against it (docs/performance.md).
 //
 //   bench_bandwidth [--mib 256] [--threads 2] [--reps 5]
 #include <algorithm>

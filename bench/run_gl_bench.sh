@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The GL passes benchmark on the bench scene, through each GL API (README "Benchmarks").
-# Usage: bash bench/run_gl_bench.sh [BUILD_DIR]   (after the README's first command)
+# The GL passes benchmark on the bench scene, through each GL API (docs/performance.md).
+# Usage: bash bench/run_gl_bench.sh [BUILD_DIR]   (after building)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}

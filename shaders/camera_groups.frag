@@ -1,20 +1,11 @@
 // The exact camera pass's colour, one shading a pixel and surface (gl_camera_exact.cpp,
-// ExactCameraOptions::Shading::pixels). One fragment a pixel of the view's region: its
-// 8 x 4 samples (raster/samples.hpp) fall into groups by their key (camera_ids.frag): the
-// triangle they show (0: not this view's sample) and the set of volume lights blocked there,
-// so that a shadow edge through a pixel stays as sharp as the samples. Each group is shaded
-// once (camera_surface.glsl) at its samples' mean position: the ray from the view's eye
-// through that point of the sample grid meets the triangle's plane at barycentrics
-// (b0, b1, b2), and position, normal and texture coordinates are interpolated with them, as
-// the rasteriser interpolates them perspective-correctly at a sample. Each sample of the
-// group then gets C = color + weight * C_sample (the per-sample pass's dual-source blend,
-// done here on the target's own texel). A group's environment-map term is the mean of its
-// samples' lookups; a smooth-shaded triangle at a silhouette (a pixel of more than one key)
-// and a group seen too obliquely (FORESHORTENING) are shaded once a sample.
-// The camera's own view (u_pixels) writes a pixel whose samples all share one key as that
-// pixel's (color, weight) instead (u_pixel_color, u_pixel_weight): the box filter of its
-// samples is then color + weight * (the mean of what its samples show behind), which
-// resolve_samples.frag computes; weight.a = -1 there: the samples hold the pixel.
+// ExactCameraOptions::Shading::pixels). One fragment a pixel of the view's region: its 8 x 4
+// samples fall into groups by their key (camera_ids.frag: the triangle they show and the set
+// of volume lights blocked there, so a shadow edge stays as sharp as the samples). Each group
+// is shaded once (camera_surface.glsl) at its samples' mean position, interpolated as the
+// rasteriser would there, and each of its samples gets C = color + weight * C_sample; a
+// silhouette of a smooth triangle and a group seen too obliquely (FORESHORTENING) are shaded
+// once a sample. docs/design/camera-groups.md has the whole argument.
 uniform usampler2D u_keys;
 uniform mat4 u_unproject;  // the view's clip coordinates -> position relative to its eye
 uniform vec2 u_grid;       // the target's size in samples
@@ -97,18 +88,14 @@ bool too_oblique(float nearest, float farthest) { return !(nearest > 0.0 && fart
 
 // FORESHORTENING. Whether samples of a triangle lie at distances from the eye that differ by
 // more than a ratio of 1 + 1/16: a group seen that obliquely (a floor toward its horizon)
-// spans a stretch of the surface as long as 1/16 of its distance or more, over which the
-// position is far from linear in the sample grid, so the shading at the samples' mean
-// position no longer stands for their mean shading to second order (km_scale_11106_9 of
-// hard_scenes: a row of pixels at the horizon of a 3.7 km floor, 0.333 shaded once a pixel,
-// 0.294-0.299 by samples and in the tracer). Such a group is shaded once a sample. A ray
-// that runs along the plane or meets it behind the eye counts as oblique.
-//
-// Over a rectangle of samples, whose corner samples are lo and hi (offsets in the pixel): the
-// distance from the eye is convex over the rectangle's footprint on the plane, so its
-// largest is at a corner; its least too, but where the eye looks at the plane head-on, where
-// the ratio is near 1 either way. ray_through is affine before its division, so the
-// corners' rays are the centre's plus or minus half the span in each axis.
+// spans a stretch of the surface over which the position is far from linear in the sample
+// grid, so the shading at the samples' mean position does not stand for their mean shading
+// to second order. Such a group is shaded once a sample. A ray that runs along the plane or
+// meets it behind the eye counts as oblique. Over a rectangle of samples (corner samples lo
+// and hi) the distance from the eye is convex over its footprint on the plane, so its
+// largest is at a corner (and its least too, except where the eye looks at the plane
+// head-on, where the ratio is near 1 either way). ray_through is affine before its division,
+// so the corners' rays are the centre's plus or minus half the span in each axis.
 bool foreshortened(Corners c, ivec2 lo, ivec2 hi) {
   vec4 plane = plane_of(c);
   vec4 mid = far_through(vec2(base) + 0.5 + 0.5 * vec2(lo + hi));
@@ -157,9 +144,9 @@ void shade(uvec2 key, uint members, bool pixel, Corners c) {
   }
   // What a curved mirror or a refraction shows of the environment map can change within a
   // pixel by a whole edge of the map's content: one lookup at the samples' mean is no
-  // second-order stand-in for the mean of theirs (seams_11322_10 of hard_scenes: a pixel of
-  // a mirror sphere 0.009 with one lookup, 0.214 shaded by samples, 0.588 in the tracer). So that term
-  // is the mean of the lookups at the group's samples, each at its own point and normal.
+  // second-order stand-in for the mean of theirs (a pixel of a mirror sphere across such an
+  // edge would take one side's colour). So that term is the mean of the lookups at the
+  // group's samples, each at its own point and normal.
   uint portal = portal_of(key.x - 1u);
   vec3 environment = vec3(0.0);
   if (camera_looks_up(material, portal)) {

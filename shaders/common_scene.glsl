@@ -38,7 +38,7 @@ uniform samplerCubeArray u_shadow_peel_maps[MAX_SHADOW_PEELS];
 uniform bool u_environment;
 uniform samplerCube u_environment_map;
 
-// Base-colour textures (README "Textures"; cpu_core/scene/texture.hpp THE RULE): Od =
+// Base-colour textures (cpu_core/scene/texture.hpp THE RULE): Od =
 // colour * texture(uv), linear RGB, repeat, trilinear over GL's mipmaps. The images are
 // grouped by size into up to MAX_TEXTURE_ARRAYS 2D arrays (gl_passes.cpp); a material's
 // transmission.w = array + MAX_TEXTURE_ARRAYS * layer. Each array is sampled in its own

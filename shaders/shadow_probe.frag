@@ -1,8 +1,8 @@
-// abcube crosscheck (issue 19 part 4): at the visible surface of each camera sample, for the
-// first 16 shadow-casting lights (the light's probe index u_probe[i], -1: not probed), whether
-// the shadow volumes' count and the cube shadow map each say an opaque blocker lies between
-// the surface and the light, and whether the surface faces the light (N.L > 0, N turned to
-// the eye): three 16-bit sets, as exact floats. common_shading.glsl's rules, taken apart.
+// abcube crosscheck: at the visible surface of each camera sample, for the first 16
+// shadow-casting lights (the light's probe index u_probe[i], -1: not probed), whether the
+// shadow volumes' count and the cube shadow map each say an opaque blocker lies between the
+// surface and the light, and whether the surface faces the light (N.L > 0, N turned to the
+// eye): three 16-bit sets, as exact floats. common_shading.glsl's rules, taken apart.
 in vec3 v_relative;
 in vec3 v_normal;
 flat in uint v_material;

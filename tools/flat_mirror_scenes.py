@@ -10,8 +10,8 @@ mirror boxes (mirrors facing mirrors: rays bounce to max_depth); a wide flat wat
 seen at a grazing angle; a point light lying on a mirror box; a point light on, or 1e-6
 above or below, an open mirror quad (its shadow volume reaches infinity in nearly the
 quad's plane, across every camera tile). No material refracts, no mirror
-is curved, nothing is coverage-transparent (those keep the cube maps: README "The gpu
-method at its best").
+is curved, nothing is coverage-transparent (those keep the cube maps:
+docs/design/gpu-exact-paths.md).
 
 Deterministic: the same arguments give the same bytes (standard library only; the
 helpers of tools/hard_scenes.py).

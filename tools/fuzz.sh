@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs the libFuzzer harnesses of tests/fuzz (README "Robustness") for SECONDS each
+# Runs the libFuzzer harnesses of tests/fuzz (docs/robustness.md) for SECONDS each
 # (default 60), one after the other, each on one core.
 #   tools/fuzz.sh [SECONDS] [HARNESS...]     HARNESS: scene_json obj gltf batch_jobs (default all)
 # Builds build-fuzz with clang-14 (address and undefined-behaviour checks, ABCUBE_FUZZ=ON),
@@ -8,7 +8,7 @@
 # the OBJ/MTL and glTF files of assimp-testmodels. What a run finds new is kept in
 # build-fuzz/corpus/HARNESS and seeds the next run. A crash, a leak, a failed check or an
 # input slower than 10 s: exit 1, the input saved as build-fuzz/artifacts/HARNESS/crash-*
-# (copy it into tests/fuzz/regressions/HARNESS/ with the fix, README "Robustness").
+# (copy it into tests/fuzz/regressions/HARNESS/ with the fix, docs/robustness.md).
 # For hours: tools/fuzz.sh 14400 obj (or run build-fuzz/tests/fuzz/fuzz_obj with -jobs=N -workers=N).
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -3,7 +3,7 @@
 
 Each scene comes from one template: a function that draws its parameters from
 random.Random(seed + k) and returns a scene dict in the format of
-../shared/scene-format.md (version 1): a floor, a light or two and a few objects with
+docs/scene-format.md (version 1): a floor, a light or two and a few objects with
 plausible materials, arranged around one case the map searches find hard (a decal just
 above a floor, z-fighting quads, a plane containing the camera, a camera inside a room,
 shallow intersections, features thinner than a texel, grazing mirrors, nested glass, a

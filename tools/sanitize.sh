@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The checked builds of README "Robustness", each in its own build folder with gcc:
+# The checked builds of docs/robustness.md, each in its own build folder with gcc:
 #   tools/sanitize.sh asan   AddressSanitizer + UndefinedBehaviorSanitizer (build-asan): every
 #                            target but the benchmarks and the Python module, the ctest suite
 #                            but two long repetitive tests (below)

@@ -1,24 +1,10 @@
-// Error measures, usable by every method (design.md "Error measures"; thesis ch. 9).
-//
-// Image error. Two images are compared AS DISPLAYED: each RGB channel is clamped to
-// [0, 1] and sRGB-encoded (image_io.hpp srgb_encode, the encoding an 8-bit output file
-// gets) before differencing, so a difference of 1/255 is one code value of the written
-// PNG, and errors in the darks weigh as much as the eye sees them. Alpha and channels
-// beyond the third are ignored; a one-channel image counts as grey. Over all pixels and
-// the three channels:
-//   rmse     sqrt(mean of d^2)
-//   psnr     20 log10(1 / rmse)  (peak 1); +infinity for identical images (callers print
-//            "inf" or a large number)
-//   max_abs  largest |d|
-//   share_over_1, share_over_2: share of PIXELS whose largest channel |d| exceeds 1/255,
-//            2/255 (plus 1e-6, so that exact 8-bit round trips do not count).
-//
-// Ray error (thesis 9.2 eq. 5 and 9.3 eq. 7), with [[A]] = A/|A|:
-//   Error_CP       = (1 - [[P']] . [[Sigma]]) / 2   P' the lookup direction, Sigma the true
-//                                                    point, both relative to the cube centre
-//   Error_Parallax = (1 - [[X' - W]] . [[R]]) / 2   X' the point the method found, W the ray
-//                                                    origin, R the ray direction
-// Both are 0 when exact, 1/2 at a right angle, 1 when opposite.
+// Error measures, usable by every method (thesis ch. 9). Image error: two images are
+// compared AS DISPLAYED, each RGB channel clamped to [0, 1] and sRGB-encoded (as an 8-bit
+// output file gets it) before differencing, so 1/255 is one code value of the written PNG;
+// rmse, psnr (peak 1, +infinity for identical images), max_abs, and the shares of pixels over
+// 1/255 and 2/255. Ray error (thesis 9.2 eq. 5, 9.3 eq. 7): Error_CP of the lookup direction
+// and Error_Parallax of the found point, 0 when exact, 1 when opposite.
+// docs/design/metrics.md has the definitions.
 #pragma once
 #include <cstdint>
 #include <vector>

@@ -136,8 +136,8 @@ bool before(const Fragment& a, const Fragment& b) {
   return a.zmin < b.zmin || (a.zmin == b.zmin && a.triangle_and_facing < b.triangle_and_facing);
 }
 
-// Thesis 5.2.1 merge (abuffer.hpp, "MERGE"): same object, material and facing, z ranges
-// overlapping, masks disjoint; and, our addition, no crease between them.
+// Thesis 5.2.1 merge (docs/design/abuffer-lists.md, "MERGE"): same object, material and
+// facing, z ranges overlapping, masks disjoint; and, our addition, no crease between them.
 bool mergeable(const TriangleSoup& soup, const Fragment& a, const Fragment& b) {
   const uint32_t ta = a.triangle(), tb = b.triangle();
   return a.back_face() == b.back_face() && (a.mask & b.mask) == 0 && b.zmin <= a.zmax &&
@@ -369,8 +369,8 @@ CubeABuffer build_cube_abuffer(const SceneData& scene, const glm::dvec3& centre,
   for (int f = 0; f < CUBE_FACES; ++f) rasters.push_back(cube_face_view(f, centre, n, near));
   std::vector<ABuffer> faces = build_views(scene, std::move(rasters), "cube A-buffer", options, stats);
   // The build's bins and its workers' small blocks, freed in their threads' heaps: handed
-  // back before the searches' own structures are built (bench/memory.py: 17 bytes a
-  // triangle of a 1M-triangle terrain still resident without this).
+  // back before the searches' own structures are built, so that they do not stay resident
+  // through the render's peak (bench/memory.py measures it).
   release_free_memory();
   CubeABuffer cube;
   cube.n = n;

@@ -1,44 +1,11 @@
 // The A-buffer (thesis 5.2; Carpenter 1984): per pixel, the list of every triangle's
-// fragment, front AND back faces, sorted front to back, for the six faces of a cube
-// around a centre (the environment map) or for the camera view.
-//
-// STORAGE. One ABuffer per raster (a cube face or the camera image): `offsets` (pixels + 1
-// prefix sums) and one flat `fragments` array; pixel p's list is
-// fragments[offsets[p] .. offsets[p+1]). No heap node per fragment. Built in three passes
-// over row bands, in parallel (bands of all faces are handed to threads dynamically):
-//   1. count: rasterise coverage only, count fragments per pixel;
-//   2. prefix sum, memory estimate, budget check (InputError above the budget, before
-//      the fragment array is allocated);
-//   3. fill: rasterise again, writing each fragment into its pixel's slot in triangle
-//      order; then per pixel sort, merge, cap, and compact.
-// A pixel belongs to exactly one band and a band's triangles are visited in index order,
-// so the bytes are identical for any number of threads.
-//
-// ORDER. A list is sorted by zmin, ties by triangle index (with the facing bit), so it is
-// a total order (a triangle has at most one fragment per pixel).
-//
-// MERGE (thesis 5.2.1: "mezclados si y sólo si tienen el mismo identificador de objeto y
-// se superponen en Z", with the front/back bit completing the id). Two fragments merge
-// iff same object, same material (a fragment stores no colour, so two materials cannot be
-// blended into one), same facing, overlapping [zmin, zmax] (closed intervals: fragments of
-// a shared edge touch), and DISJOINT masks (M1 & M2 == 0, the thesis' usual case). Then:
-// mask = M1 | M2, zmin = min, zmax = max, normal = popcount-weighted mean of the normals
-// (the thesis' C = C1 A1 + C2 A2 with areas from the masks), triangle = the one covering
-// more of the four CENTRE_SAMPLES, then more samples (ties: the lower index), so that
-// look-ups at the pixel centre use the plane that is there. Fragments whose masks overlap
-// (a surface folding over itself within the pixel) stay separate; the resolve sees them as
-// layers. Merging runs front to back; each fragment merges into the first earlier kept
-// fragment it may.
-// OUR ADDITION: the two shading normals must also agree within 20 degrees
-// (MERGE_MIN_NORMAL_COS). On a smooth surface the interpolated normal is continuous across
-// triangle edges, so this changes nothing there; across a crease (a box's edge) the
-// thesis rule would shade both faces with one averaged normal and one triangle's plane:
-// `abcube crosscheck` measured up to 0.44 (display units) against the GPU raster on the
-// pillar and box edges of scenes/shadows.json before this rule, and the later searches
-// would refine hits on the wrong plane.
-//
-// CAP. max_layers > 0 keeps the first max_layers fragments of each merged list and counts
-// the rest in ABufferStats::dropped_by_cap. 0 (the default) keeps every layer.
+// fragment, front AND back faces, sorted front to back, for the six faces of a cube around a
+// centre (the environment map) or for the camera view. STORAGE: prefix-sum offsets and one
+// flat fragment array, built in count, budget-check and fill passes over row bands, so the
+// bytes are identical for any number of threads. ORDER: by zmin, then triangle and facing (a
+// total order). MERGE (thesis 5.2.1): same object, material and facing, overlapping z and
+// disjoint masks, plus OUR ADDITION (normals within MERGE_MIN_NORMAL_COS, so a crease keeps
+// both planes). CAP: max_layers. docs/design/abuffer-lists.md has the whole argument.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -142,7 +109,7 @@ struct ABufferStats {
   int threads = 0;
 };
 
-// The cube A-buffer of `scene` around `centre` (the environment map; design.md), n x n
+// The cube A-buffer of `scene` around `centre` (the environment map), n x n
 // per face. Throws InputError for n < 1, a bad option, or when the estimate exceeds the
 // budget: "cube A-buffer needs N MiB (F fragments at 20 bytes) beside R MiB for the rest of
 // the render, above --max-memory M MiB" (or "the M MiB of memory available").

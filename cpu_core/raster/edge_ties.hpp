@@ -2,20 +2,17 @@
 // rules (raster.hpp's coverage, the tracer's ray through the sample): where a triangle's
 // edge passes within `eps` samples of a sample centre.
 //
-// GL rasterisers snap window coordinates to a sub-pixel grid (llvmpipe and D3D-class GPUs:
-// 8 bits, 1/256 of a target pixel, which the exact camera pass makes one sample:
-// gl_camera_exact.cpp), so an edge may move by up to half a step, 1/512 of a sample, before
-// its samples are tested: a sample that close to an edge can fall on either side. Alone,
-// such a sample is 1/32 of its pixel; an edge parallel to a sample row (the horizontal top
-// of an upright mirror seen level, the generated "seams" scenes) puts a whole row of
-// samples that close at once, a line of pixels a quarter wrong. The hybrid method hands
+// GL rasterisers snap window coordinates to a sub-pixel grid (8 bits on llvmpipe and
+// D3D-class GPUs: 1/256 of a target pixel, which the exact camera pass makes one sample), so
+// an edge may move by up to 1/512 of a sample before its samples are tested. An edge
+// parallel to a sample row (the top of an upright mirror seen level) puts a whole row of
+// samples that close at once: a line of pixels a quarter wrong. The hybrid method hands
 // every marked pixel to the CPU's A-buffer, whose coverage follows the exact rules.
 //
 // Every edge of every triangle (hidden or not: conservative), in double, projected by the
-// camera (camera.hpp) onto the sample grid (samples.hpp: sample centres at (i + 0.5, j + 0.5)
-// in units of 1/8 pixel across and 1/4 pixel down); the part behind the eye is cut at depth
-// 1e-6 of the scene's reach from the eye. Cost: one step per sample column (or row) an edge
-// spans on screen (engine_room, 110k triangles at 640x480: 27 ms).
+// camera (camera.hpp) onto the sample grid (samples.hpp); the part behind the eye is cut at
+// depth 1e-6 of the scene's reach from the eye. Cost: one step per sample column (or row)
+// an edge spans on screen.
 #pragma once
 #include <cstdint>
 #include <functional>

@@ -32,7 +32,7 @@ RasterView make_view(const glm::dvec3& centre, const glm::dvec3& row_x, const gl
 
 bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-// D3D top-left rule in pixel coordinates with y down (raster.hpp, "TIE RULE").
+// D3D top-left rule in pixel coordinates with y down (docs/design/raster.md, "TIE RULE").
 bool owns_ties(const glm::dvec3& abc) { return abc.x > 0.0 || (abc.x == 0.0 && abc.y > 0.0); }
 
 glm::dvec3 raster_edge(const glm::dmat3& to_direction, const glm::dvec3& plane) {
@@ -207,7 +207,7 @@ CoverageMask pixel_mask(const TriangleSetup& s, int x, int y) {
 
   // Per sample: E = a x + (b y + c) > 0, or == 0 under the tie rule; the same operations
   // for every triangle, so the two sides of a shared edge see exactly opposite values
-  // (raster.hpp, "Watertight").
+  // (docs/design/raster.md, "Watertight").
   CoverageMask mask = FULL_MASK;
   for (int k = 0; k < s.edge_count && mask != 0; ++k) {
     const glm::dvec3& e = s.edge[static_cast<size_t>(k)];

@@ -1,53 +1,11 @@
-// The rasterizer: one triangle -> per-pixel 4x8 coverage masks and fragment geometry,
-// for a cube face or the camera view (thesis 5.2: "un fragmento es un polígono cortado
-// en los límites del pixel"). One implementation serves both: a RasterView is three
-// basis rows, a centre and a pixel grid.
-//
-// THE RULES
-//
-// Projection. For a world point P, r = P - centre; the view has rows (row_x, row_y, row_w),
-// row_w unit: w = dot(row_w, r), pixel coordinates x = dot(row_x, r)/w, y = dot(row_y, r)/w.
-// Pixel (px, py) covers [px, px+1) x [py, py+1). A cube face (cube_map.hpp) has
-// row_w = forward, x = N s, y = N t (column i, row j); the camera view (camera.hpp) has
-// x right and y down, row 0 at the top.
-//
-// Coverage (homogeneous rasterisation, Olano & Greer 1997). Sample k of pixel (px, py) is
-// the direction d = to_direction * (px + sample_dx(k), py + sample_dy(k), 1) (samples.hpp).
-// Each edge (r_a, r_b) of a triangle spans a plane through the centre with normal
-// cross(r_a, r_b), turned (by the sign of the triangle's orientation seen from the centre)
-// to point at the triangle's inside; in pixel coordinates it is the linear edge function
-// E(x, y) = a x + b y + c = dot(normal, to_direction * (x, y, 1)). A sample is covered
-// iff every edge function is > 0 at it, or == 0 under the TIE RULE: an edge owns the
-// samples exactly on it iff a > 0, or a == 0 and b > 0 (D3D's top-left rule: left edges
-// and top edges, with y down; on a cube face "top" is smaller t). The rule is the limit
-// of moving every sample by (+eps, +eps^2), so in exact arithmetic a vertex shared by a
-// closed fan has exactly one owner too. The near line keeps its ties (w == near is kept).
-// Watertight: the two triangles on either side of a shared edge compute the edge plane
-// normals n and -n exactly (cross products and their dot products negate exactly in IEEE
-// arithmetic), so every sample is owned by exactly one of them, whatever the winding of
-// the mesh; this holds in floating point, not only in exact arithmetic. (Only a sample
-// within rounding, ~1e-16 relative, of a vertex shared by three or more triangles could be
-// owned by none or two.) No vertex is ever moved by clipping, so clipping cannot open a
-// crack.
-//
-// Near plane. The part of a triangle with w < near is cut away by a fourth edge function
-// (the line where the triangle's plane meets w = near, in the same homogeneous form), so
-// triangles that surround or straddle the centre are normal: each face gets the part in
-// front of it, and what lies behind the centre on one face appears on the opposite face.
-// A triangle with every vertex at w < near is culled on that view.
-//
-// Dropped triangles (never a crash): non-finite vertices, zero area (cross product exactly
-// zero), and edge-on triangles whose plane passes within 1e-9 * (farthest vertex) of the
-// centre (zero area in every view of this centre). They are counted, not rasterised.
-//
-// Fragment geometry. zmin and zmax are Euclidean distances |P - centre| over the
-// triangle clipped to the pixel's frustum (and to w >= near): the exact 3D polygon, so the
-// GPU prepass distance at the texel centre (perspective-correct |P - centre| there) lies
-// in [zmin, zmax] whenever the triangle covers the texel centre. zmax is the farthest
-// polygon vertex; zmin is the plane distance when the foot of the perpendicular from the
-// centre lies in the polygon, else the nearest point of the polygon's boundary. The
-// normal is the vertex normals' perspective-correct (3D barycentric) interpolation at the
-// centroid of the covered samples.
+// The rasterizer: one triangle -> per-pixel 4x8 coverage masks and fragment geometry, for a
+// cube face or the camera view (thesis 5.2), one implementation for both: a RasterView is
+// three basis rows, a centre and a pixel grid. THE RULES: homogeneous coverage (Olano &
+// Greer 1997) with D3D's top-left TIE RULE for samples on an edge, watertight in floating
+// point (the two sides of a shared edge get exactly negated edge planes); a fourth edge
+// function cuts the near plane, so no vertex is moved by clipping; degenerate and edge-on
+// triangles are counted and dropped; zmin and zmax bound the exact 3D polygon in the pixel.
+// docs/design/raster.md has the whole argument.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -113,7 +71,7 @@ SetupResult setup_triangle(const RasterView& view, const TriangleSoup& soup, uin
 // inside the setup's bounds); empty when *x_begin >= *x_end.
 void row_span(const TriangleSetup& setup, int y, int* x_begin, int* x_end);
 
-// The samples of pixel (x, y) that the triangle covers (the rules above).
+// The samples of pixel (x, y) that the triangle covers (THE RULES).
 CoverageMask pixel_mask(const TriangleSetup& setup, int x, int y);
 
 // Calls visit(x, y, mask) for every pixel of rows [y_begin, y_end) with a non-empty mask,

@@ -62,7 +62,8 @@ bool build_may_go_on(void* deadline, double /*done*/) {
 #endif
 
 // One device for the process (Embree's thread pool and settings), made on first use.
-// Leaves of up to 4 user primitives: 27 instead of 80 bytes a triangle, as fast.
+// Leaves of up to 4 user primitives: a tree a fraction of the size of one with a primitive a
+// leaf, and as fast to traverse.
 RTCDevice embree_device() {
   struct Device {
     RTCDevice device = rtcNewDevice("verbose=0,object_accel_max_leaf_size=4" ABCUBE_EMBREE_THREADS);
@@ -101,9 +102,9 @@ double max3(const glm::dvec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
 // Embree's box tests, no denormals).
 double embree_unit(double magnitude) { return std::ldexp(1.0, -std::ilogb(magnitude)); }
 
-// Embree's ray for a query (bvh.hpp "Exactness"): origin o_e = origin + t0 dir, both in
-// Embree's units, and the direction (scaled by a power of two when its size is extreme),
-// so that Embree's t is (t - t0) * scale.
+// Embree's ray for a query (docs/design/bvh.md "Exactness"): origin o_e = origin + t0 dir,
+// both in Embree's units, and the direction (scaled by a power of two when its size is
+// extreme), so that Embree's t is (t - t0) * scale.
 struct EmbreeRay {
   double t0 = 0, scale = 1;
   float to_embree(double t) const { return t == INF ? INFINITY : round_up((t - t0) * scale); }

@@ -161,7 +161,7 @@ Interface RayTracer::crossing_set(const glm::dvec3& origin, const glm::dvec3& d,
   if (!media_->is_medium(hit.triangle)) return media_->resolve(stack, &first, 1);
   // Every surface crossed within the coincident tolerance of the nearest hit (media.hpp), on
   // both sides: the nearest hit's t and a coincident triangle's may differ by rounding
-  // either way (measured: 3e-17 below it on a face shared by two boxes).
+  // either way (a face shared by two boxes can come out a rounding below it).
   const double tol = media_->tolerance(hit.point);
   std::vector<TriangleHit> hits;
   bvh_->for_each_hit(RayQuery(origin, d), hit.t + tol, [&](const TriangleHit& th) {

@@ -1,72 +1,11 @@
-// The exact reference: a Whitted ray tracer (Whitted 1980) over the scene's triangles,
-// in double precision, against which every other method's images and searches are
-// measured (design.md, "Error measures"; thesis ch. 9).
-//
-// THE RULES (shared by every method; the per-rule functions live in shading.hpp)
-//
-// Camera rays. Sample k of pixel (px, py) goes through image point
-//   (px + sample_dx(k), py + sample_dy(k)),  k = 0..31   (samples.hpp, the A-buffer's 4x8)
-// along CameraFrame::direction (camera.hpp), from the eye; the pixel is the plain mean of
-// its samples (box filter). samples_per_pixel = 1 shoots the pixel centre (px+.5, py+.5).
-//
-// A ray that hits nothing returns SceneData::background (primary and secondary rays alike).
-//
-// Hit shading, at the nearest hit with t > 0 of ray (o, d), d unit, depth k; of surfaces
-// at the same distance (coplanar ones), the one THE TIE RULE picks (scene/tie_rule.hpp:
-// the later object, then the higher triangle; Bvh::visible_hit):
-//   N_g  unit geometric normal cross(b-a, c-a) (outward for closed objects)
-//   N_s  barycentric interpolation of TriangleSoup::normals, renormalised (N_g if that
-//        interpolation vanishes)
-//   V = -d,  N = face_forward(N_s, V)  (two-sided lighting, as phong_local)
-//   C_surface = phong_ambient + sum_l S_l * phong_light(N, V, L_l)       (shading.hpp)
-//             + kr * trace(reflected, k+1)                    if kr > 0 and k < max_depth
-//             + kt * trace(transmitted, k+1)                  if kt > 0 and k < max_depth
-//   C = blend_coverage(opacity, C_surface, trace(continued straight on, k))  if opacity < 1
-//   reflected: reflect_dir(d, N_s). transmitted: transmission_between() in shading.hpp,
-//   eta = n_from / n_to of the media on the two sides (NESTED DIELECTRICS below), bent
-//   about N_s flipped to the incoming side of N_g; on total internal reflection the kt
-//   weight follows the mirror direction instead.
-//
-// Nested dielectrics (media.hpp: Schmidt & Budge 2002 with priorities). Every ray carries
-// the stack of media it is inside (camera rays: none). The nearest hit and every surface
-// the ray crosses within coincident_tolerance of it (Bvh::for_each_hit) form one crossing
-// set, resolved by Media::resolve: a plain surface in it is the surface hit; a set of
-// medium surfaces with the same medium on both sides is no interface (the ray goes on
-// straight from past the set, same depth, unshaded); else one interface n_from -> n_to
-// shaded with the tie winner's triangle. Reflected rays keep the stack before the set and
-// start before it; transmitted and coverage-continued rays take the stack after it and
-// start past its furthest crossing. Only a set whose nearest hit is a medium's surface is
-// searched for coincident crossings (a plain nearest hit is the surface hit).
-//   A direction bent by an interpolated N_s may cross to the other side of the triangle's
-//   plane (near silhouettes of coarse meshes); it is traced as it is, from the side it
-//   travels into (no correction).
-//
-// Depth. Primary rays have depth 0; reflected and refracted rays depth k+1. At depth
-// max_depth (SceneData::render.max_depth) no reflected or refracted ray is spawned: those
-// terms contribute nothing (black), not the background. The opacity continuation keeps
-// the depth of the ray it continues (it is the same ray), so it never runs out.
-//
-// Shadows. For a light with cast_shadows, S_l is the product, over every surface the
-// segment from P to the light crosses, of blocker_transmittance = (1-op) + op*kt*Od
-// (opaque: 0, glass: kt*Od, veil: 1-op); shadow rays go straight (no refraction). Two
-// crossings of one object at the same distance with the same facing (a ray through a
-// shared edge) count once. Lights with cast_shadows false: S_l = 1. S_l is only
-// evaluated where phong_light is non-zero.
-//
-// Self-intersection. Every secondary ray (reflected, transmitted, continued, shadow)
-// starts at the hit point moved by self_intersection_offset(P, scene_scale) =
-// 1e-9 * (max|P_i| + scene_scale) along N_g, to the side the new ray travels into
-// (offset_origin in shading.hpp); there is no t_min besides t > 0. The hit point is the
-// barycentric combination of the double vertices, so it lies on the triangle's plane to
-// within rounding and the offset ray cannot see that plane again, grazing or not.
-//
-// Exactness. RayTracer::intersect is the double-precision watertight test (Woop et al.
-// 2013, triangle_test.hpp) on the float vertex data, through Embree's BVH, which returns
-// the same visible hit as the tie rule over a loop over all triangles (bvh.hpp). Later
-// methods measure Error_Parallax against it.
-//
-// Determinism. Pixels are independent and shaded in a fixed order, rows are handed to
-// threads dynamically, so the image is bit-identical for any number of threads.
+// The exact reference: a Whitted ray tracer (Whitted 1980) over the scene's triangles, in
+// double precision, against which every other method's images and searches are measured
+// (metrics.hpp; thesis ch. 9). THE RULES, shared by every method (their functions live in
+// shading.hpp): 4x8 camera samples a pixel, box-filtered; the nearest hit, ties by THE TIE
+// RULE; Phong plus kr, kt terms to max_depth; nested dielectrics (media.hpp); shadows as the
+// product of blocker transmittances; secondary rays offset off the surface. Hits are the
+// watertight double test through Embree's BVH (bvh.hpp), and the image is bit-identical for
+// any number of threads. docs/design/raytrace.md has the rules in full.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -142,11 +81,11 @@ class RayTracer {
   // `counts` when given (the ray itself is counted by the caller: see render_raytrace).
   glm::dvec3 trace(const glm::dvec3& origin, const glm::dvec3& dir, int depth,
                    RayCounts* counts = nullptr) const;
-  // The same for a ray inside the media of `stack` (NESTED DIELECTRICS above).
+  // The same for a ray inside the media of `stack` (media.hpp, NESTED DIELECTRICS).
   glm::dvec3 trace(const glm::dvec3& origin, const glm::dvec3& dir, int depth, const MediumStack& stack,
                    RayCounts* counts) const;
 
-  // The colour of a hit seen along unit dir, at depth `depth`, by a ray in air (the rules above).
+  // The colour of a hit seen along unit dir, at depth `depth`, by a ray in air (THE RULES).
   glm::dvec3 shade(const Hit& hit, const glm::dvec3& dir, int depth, RayCounts* counts) const;
 
   // The path of the transmitted weight alone from origin along dir (camera in air): the ray
@@ -158,7 +97,7 @@ class RayTracer {
   // S_l: the light's visibility from surface point `hit` (1 when it casts no shadows).
   glm::dvec3 light_visibility(const Hit& hit, const PointLight& light, RayCounts* counts) const;
 
-  // The secondary rays of a hit seen along unit dir (rules above; transmitted_ray: the
+  // The secondary rays of a hit seen along unit dir (THE RULES; transmitted_ray: the
   // hit's object in air).
   Ray reflected_ray(const Hit& hit, const glm::dvec3& dir) const;
   Ray transmitted_ray(const Hit& hit, const glm::dvec3& dir, bool* total_internal_reflection) const;
@@ -192,7 +131,7 @@ class RayTracer {
   std::shared_ptr<const Media> media_;
 };
 
-// Renders the scene's camera view with the rules above. Throws InputError for a bad
+// Renders the scene's camera view with THE RULES. Throws InputError for a bad
 // option (samples_per_pixel not 1 or 32, negative threads).
 Image render_raytrace(const SceneData& scene, const RaytraceOptions& options = {},
                       RaytraceStats* stats = nullptr);

@@ -1,5 +1,5 @@
-// Framing (scene-format "camera.frame", README "Models and framing"): a camera placed to
-// see the whole scene from a given direction, and the lights a scene without any gets.
+// Framing (docs/scene-format.md "Framing", "camera.frame"): a camera placed to see the
+// whole scene from a given direction, and the lights a scene without any gets.
 #pragma once
 #include <vector>
 

@@ -1,5 +1,5 @@
-// What a scene needs (design.md "What a scene needs"): the cube resolution from an error
-// target, and which passes and searches can be skipped.
+// What a scene needs: the cube resolution from an error target, and which passes and
+// searches can be skipped.
 #pragma once
 #include <string>
 #include <vector>

@@ -1,5 +1,5 @@
-// The flat mirrors of a scene (issue 19): each a portal that the gpu method renders exactly,
-// by virtual objects and the stencil test (course notes 4.1.2; Kilgard 1999, "Improving
+// The flat mirrors of a scene: each a portal that the gpu method renders exactly, by
+// virtual objects and the stencil test (course notes 4.1.2; Kilgard 1999, "Improving
 // shadows and reflections via the stencil buffer"), where the cube-map methods approximate.
 //
 // A triangle belongs to a planar reflector when its material reflects (kr > 0) and neither

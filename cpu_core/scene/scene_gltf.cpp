@@ -2,7 +2,7 @@
 // tinygltf (Debian's libtinygltf-dev, implementation in tiny_gltf_impl.cpp), flattened into
 // one LocalMesh in the file's space: the node hierarchy, triangle primitives, materials,
 // KHR_lights_punctual point lights and the first perspective camera. What is mapped and
-// what is not is in README.md ("glTF models").
+// what is not is in docs/models-and-textures.md ("glTF 2.0").
 //
 // Before tinygltf sees the file, its JSON is checked here: the version (2.x), the required
 // extensions, the types of the members this loader uses (so that a number where an array

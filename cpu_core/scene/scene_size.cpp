@@ -14,26 +14,16 @@ namespace {
 
 constexpr uint64_t MIB = uint64_t{1} << 20;
 
-// Bytes per unit of work, beside the A-buffers' fragments: a camera pixel holds its colour
-// and the A-buffer's per-pixel index (offsets and counts) with room for the AOVs and the
-// reference image; a cube texel its distance, the A-buffer's index, the block bounds and
-// pyramid of the searches (or the gpu method's cube textures). A triangle:
-// SCENE_TRIANGLE_BYTES, and the gpu method adds the GL's arrays (gl_passes.cpp): none where
-// the GL takes the soup's own memory (GL_AMD_pinned_memory), 80 bytes where it copies the
-// soup's positions, normals and ids, 104 where every vertex carries its ids too; counted as
-// the last (the estimate is made before the GL is opened) and what llvmpipe holds while it
-// draws them (about 90 more, measured from /proc/self/statm around the first draw; gpu with
-// --gpu-shadows maps measured a marginal 239 a triangle, 2026-11-25, with 96-byte copies;
-// 105-168 with the soup's memory, bench/results/memory.txt). A shadow-casting light
-// under gpu: a cube map of N x N floats.
-// Shadow volumes (gpu and hybrid, gl_camera_exact.cpp, shadow_volume.hpp): a light has at
-// most two (its opaque and its translucent blockers), each a code a triangle on the CPU and
-// in a GL buffer, and its runs of casting triangles (8 bytes a run, a run a triangle at
-// worst); the side pairing, while a volume is built, a bucket's byte a corner and at most
-// PAIRING_BUCKET_EDGES edges of 32 bytes at once. Sides beyond a mesh's silhouettes are not
-// counted (a soup of disjoint triangles has more). --gpu-shadows maps needs none of it; the
-// estimate, made before the method's options are read, counts it for every gpu render.
-// (The volumes held 6 vertices of 24 bytes a triangle before, 144 a light.)
+// Bytes per unit of work, beside the A-buffers' fragments: a camera pixel holds its colour,
+// the A-buffer's per-pixel index and room for the AOVs and the reference image; a cube texel
+// its distance, the A-buffer's index and the searches' block bounds and pyramid (or the gpu
+// method's cube textures); a triangle SCENE_TRIANGLE_BYTES. The gpu method adds the GL's
+// arrays (gl_passes.cpp), counted at their largest, a copy with ids on every vertex, since
+// the estimate is made before the GL is opened, plus an allowance for what a software GL
+// holds while it draws them; a shadow-casting light's cube map of N x N floats; and its
+// shadow volumes (shadow_volume.hpp: a code a triangle and the runs of casting triangles,
+// twice, and the side pairing's buckets), counted for every gpu render since the method's
+// options are not read yet. docs/design/scene-size.md has the accounting.
 constexpr uint64_t VOLUME_TRIANGLE_BYTES = 2 * (2 + 8);
 constexpr uint64_t VOLUME_PAIRING_TRIANGLE_BYTES = 3;
 constexpr uint64_t VOLUME_PAIRING_EDGES_BYTES = PAIRING_BUCKET_EDGES * PAIRING_EDGE_BYTES;

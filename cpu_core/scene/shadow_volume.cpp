@@ -103,11 +103,11 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
     // A closed object's triangles facing away from a light strictly outside it add nothing:
     // a segment from a point to the light that meets the object enters it, seen from the
     // light, through a triangle facing the light (the winding faces out: tessellate.hpp),
-    // whose prism holds the point; theirs only doubled the count and the fill. With the
+    // whose prism holds the point; theirs would only double the count and the fill. With the
     // light on the object's surface (a face there casts nothing) or inside it, that segment
-    // may cross no light-facing triangle, so every triangle casts: leaving them out for
-    // every closed object was tried and wrong (tests/cli/flat_mirrors.sh, light_on_mirror_1_4:
-    // gpu 18.5 dB against abuffer's 47.1; ShadowVolume.AClosedBoxCastsFromEveryFace).
+    // may cross no light-facing triangle, so every triangle casts there, and only objects
+    // strictly outside which the light lies drop theirs (tests/cli/flat_mirrors.sh,
+    // light_on_mirror_1_4; ShadowVolume.AClosedBoxCastsFromEveryFace).
     if (*reversed && outside[soup.object_id[t]]) {
       ++left_out;
       return false;
@@ -127,7 +127,7 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
   // The oriented caps' edges u -> w, sorted: per edge, the directions that do not cancel in
   // pairs are its sides. In buckets by a hash of the edge's endpoints, a bucket sorted at a
   // time, so that about PAIRING_BUCKET_EDGES edges are held at once whatever the scene's
-  // size (all of them at once were 96 bytes a triangle, the gpu method's peak).
+  // size (all of them at once would set the gpu method's peak memory).
   const auto for_each_edge = [&](const auto& f) {
     uint64_t i = 0;
     for (uint32_t t = 0; t < soup.triangle_count(); ++t) {

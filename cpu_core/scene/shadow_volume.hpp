@@ -1,28 +1,12 @@
-// The shadow volume of a point light (issue 19 part 3; course notes 3.3; Everitt & Kilgard
-// 2002, "Practical and Robust Stenciled Shadow Volumes"): what the gpu method counts, per
-// camera sample, to decide whether an opaque blocker lies between the sample's point and
-// the light, exactly where shadow maps compare depths at a texel's resolution.
-//
-// Every blocker triangle (opaque: blocker_transmittance 0; its plane not through the light,
-// plane_holds_light) bounds the prism of points behind it as seen from the light: its near
-// cap (the triangle), its far cap (its corners pushed to infinity along the light's rays:
-// homogeneous w = 0), and one side per edge (the edge and its two rays to infinity). Each
-// prism is closed and oriented outward (near cap towards the light), so along any ray the
-// faces it crosses are entries and exits in turn: depth-fail counting (+1 per back face,
-// -1 per front face behind or at the visible surface) gives the number of prisms that hold
-// the surface point, whichever side of the volumes the eye is on. Open surfaces (a quad)
-// need nothing special: their triangles are prisms like any other. Two sides on one edge
-// with opposite directions (two neighbours oriented alike, the inside of a mesh) are the
-// same quad traversed both ways: they cancel on every ray and are left out. A closed
-// object strictly outside which the light lies (lights_outside_closed) casts from its
-// triangles facing the light alone: every segment to the light that meets it enters it
-// through one of those.
-//
-// The near caps are the scene's own triangles (a code says when their orientation is
-// reversed): the GL draws them from the scene's own vertex buffer, the same vertices in the
-// same order as the surface itself, so a cap and its surface have the same depth at every
-// sample and a lit point of a blocker counts its own cap (-1) against the exit of its own
-// prism (+1).
+// The shadow volume of a point light (course notes 3.3; Everitt & Kilgard 2002, "Practical
+// and Robust Stenciled Shadow Volumes"): what the gpu method counts, per camera sample, to
+// decide whether an opaque blocker lies between the sample's point and the light, exactly
+// where shadow maps compare depths at a texel's resolution. Every blocker triangle bounds the
+// closed, outward-oriented prism of points behind it (near cap, far cap at infinity, one side
+// per edge), so depth-fail counting gives the number of prisms holding a surface point
+// wherever the eye is. Sides that cancel in pairs are left out, and a closed object with the
+// light outside casts from its triangles facing the light alone.
+// docs/design/shadow-volume.md has the whole argument.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -40,11 +24,11 @@ struct ShadowVolumeVertex {
   uint32_t reversed;   // 1: the face's outward orientation is opposite to its winding
 };
 
-// A volume is kept as little as the GL and the clipping need (issue 14 part 6: it held 6
-// vertices of 24 bytes a blocker, 144 bytes a triangle a light, copies of what the scene
-// already has). Its near caps are the scene's own triangles, drawn from the scene's vertex
-// buffer with a code each (scene.vert, VOLUME_CAPS); its far caps are made from the soup
-// when they are clipped; only its sides, along the edges that do not cancel, are stored.
+// A volume is kept as small as the GL and the clipping need: copies of what the scene
+// already has would cost more memory a light than the scene's own triangles. Its near caps
+// are the scene's own triangles, drawn from the scene's vertex buffer with a code each
+// (scene.vert, VOLUME_CAPS); its far caps are made from the soup when they are clipped; only
+// its sides, along the edges that do not cancel, are stored.
 enum CapCode : uint8_t {
   NO_CAP = 0,        // the triangle casts nothing in this volume
   CAP = 1,           // it casts; its prism is oriented as it is wound
@@ -91,30 +75,27 @@ constexpr uint64_t PAIRING_EDGE_BYTES = 32;
 // The volume of the light at `light` over the scene's blockers of that kind.
 ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light, Blockers kind = Blockers::opaque);
 
-// THE FACES AT INFINITY, CLIPPED ON THE CPU. A side (two corners at infinity) or a far cap
-// (three) of a light almost in its caster's plane reaches infinity in directions nearly
-// perpendicular to the view, or behind the eye: clip coordinates with w near 0 or below,
-// which the GL's clipper (in float) cuts at the viewport's edges with vertices off by far
-// more than a sample. The far cap that should cover the whole camera tile then missed wedges
-// at its edges, and the shadow there with it (a light 1e-6 above an open quad: 37.2 dB
-// against the tracer where abuffer reached 58.3; tests/cli/flat_mirrors.sh). So these faces
-// are clipped here, in double, to the view's (the tile's) clip volume: -w <= x, y <= w, the near plane
-// (z <= w, the window depth of reversed Z at most 1) and, in a mirror's virtual view, the
-// mirror's plane; then given to the GL as window-space points (x/w, y/w, z/w, 1), which it
-// need not clip again. An edge two faces share is cut from its endpoints in one canonical
-// order, so both get the same new vertices: no crack, no overlap (Sutherland-Hodgman keeps
-// each edge's part as a run of the polygon's boundary).
+// THE FACES AT INFINITY, CLIPPED ON THE CPU. A side or a far cap of a light almost in its
+// caster's plane reaches infinity nearly perpendicular to the view, or behind the eye: clip
+// coordinates with w near 0 or below, which the GL's float clipper cuts with vertices off by
+// far more than a sample, so a far cap covering the whole tile would miss wedges at its
+// edges (and the shadow there). These faces are clipped here, in double, to the view's clip
+// volume (-w <= x, y <= w, the near plane and, in a mirror's virtual view, the mirror's
+// plane), then given to the GL as window-space points it need not clip again. An edge two
+// faces share is cut from its endpoints in one canonical order: no crack, no overlap.
+// docs/design/shadow-volume.md has the whole argument.
 
 // The volume's faces with a corner at infinity (its far caps, made from `soup`, then its
-// sides; corners: points w = 1 in world coordinates, directions w = 0) seen through `clip_from_relative` (the view's clip matrix applied to a point relative to
-// `eye`, or to a direction), clipped as above, triangulated as fans into `out` with
-// positions in clip coordinates of w = 1. `tie_step`: THE TIE RULE's depth scale (z times
-// 1 + tie_step (object + 1), scene.vert). `plane` (n, d), when given: keep n . (p - eye) + d w
-// >= 0 (a virtual view's mirror, relative to its eye). Returns the triangles written.
-// Faces [first, first + count) only, when given: face t < soup.triangle_count() is
-// triangle t's far cap (nothing when it casts none), the others the sides in order; the
-// caller clips and draws a run at a time (the clipped faces of a million far caps in view
-// were 72 MB, and as much again in the GL's copy).
+// sides; corners: points w = 1 in world coordinates, directions w = 0) seen through
+// `clip_from_relative` (the view's clip matrix applied to a point relative to `eye`, or to a
+// direction), clipped as above, triangulated as fans into `out` with positions in clip
+// coordinates of w = 1. `tie_step`: THE TIE RULE's depth scale (z times 1 + tie_step
+// (object + 1), scene.vert). `plane` (n, d), when given: keep n . (p - eye) + d w >= 0 (a
+// virtual view's mirror, relative to its eye). Returns the triangles written. Faces
+// [first, first + count) only, when given: face t < soup.triangle_count() is triangle t's
+// far cap (nothing when it casts none), the others the sides in order; the caller clips and
+// draws a run at a time, so that neither the clipped faces nor the GL's copy of them grow
+// with the whole volume.
 size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& soup, const glm::dmat4& clip_from_relative,
                               const glm::dvec3& eye, double tie_step, const glm::dvec4* plane,
                               std::vector<ShadowVolumeVertex>* out, size_t first = 0, size_t count = SIZE_MAX);

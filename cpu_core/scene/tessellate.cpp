@@ -33,9 +33,9 @@ void push_uvs(LocalMesh* m, const glm::dvec2& a, const glm::dvec2& b, const glm:
 constexpr double QUAD_UV[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
 glm::dvec2 quad_uv(int corner) { return {QUAD_UV[corner][0], QUAD_UV[corner][1]}; }
 
-// Rounds to float, out of line: GCC 12 -O3 (SLP vectorizer) inlined into append_triangles
-// once kept the double x and y where they were rounded, converted back (the soup's
-// normals then differed from the positions' by an ulp; tests/golden caught it).
+// Rounds to float, out of line: inlined into append_triangles, GCC 12 -O3 (SLP vectorizer)
+// can keep the double x and y where they are rounded, converted back, and the soup's
+// normals then differ from the positions' by an ulp (tests/golden would catch it).
 [[gnu::noinline]] glm::vec3 to_float(const glm::dvec3& v) { return glm::vec3(v); }
 
 bool finite3(const glm::dvec3& v) {

@@ -1,5 +1,5 @@
 // Scene primitives as triangles, the object transform, and closed-surface tests
-// (scene-format.md "objects"). Winding: the geometric normal is cross(b-a, c-a); on a
+// (docs/scene-format.md "objects"). Winding: the geometric normal is cross(b-a, c-a); on a
 // closed object it points outward.
 #pragma once
 #include <array>
@@ -44,9 +44,10 @@ struct LocalMesh {
   }
 };
 
-// The primitives carry texture coordinates (README "Textures"): a triangle's corners
-// (0, 0), (1, 0), (0, 1); a quad's corners in the order given (0, 0), (1, 0), (1, 1),
-// (0, 1); each face of a box the same square, seen from outside; a sphere latitude-longitude.
+// The primitives carry texture coordinates (docs/models-and-textures.md "Textures"): a
+// triangle's corners (0, 0), (1, 0), (0, 1); a quad's corners in the order given
+// (0, 0), (1, 0), (1, 1), (0, 1); each face of a box the same square, seen from outside; a
+// sphere latitude-longitude.
 LocalMesh tessellate_triangle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
 
 // How far the four quad vertices are from their best plane, relative to the quad's size

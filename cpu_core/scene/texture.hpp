@@ -1,6 +1,6 @@
-// Base-colour textures (README "Textures"): decoded once when the scene loads, sampled by
-// every CPU path through one function (diffuse_color) and uploaded by the GL passes from
-// the same linear pixels.
+// Base-colour textures (docs/models-and-textures.md "Textures"): decoded once when the scene
+// loads, sampled by every CPU path through one function (diffuse_color) and uploaded by the GL
+// passes from the same linear pixels.
 //
 // THE RULE. The diffuse colour at a point of a triangle is
 //   Od = material.color * texture(u, v)            (RGB; the texture's alpha is ignored)

@@ -1,35 +1,11 @@
 // THE TIE RULE for coincident surfaces, defined once; every path that decides which of two
-// surfaces a ray meets first calls these functions (README "Coincident surfaces").
-//
-//   Two surfaces a, b met by one ray origin + t dir at t_a and t_b are AT THE SAME DISTANCE
-//   iff their separation along their normals
-//       |t_a - t_b| * max(|n_a . dir|, |n_b . dir|)        (n unit geometric normals)
-//   is at most tie_bound(a, b) = TIE_RELATIVE * M, M the largest absolute vertex coordinate
-//   of the two triangles. Then the one RANKING higher wins: the object listed later in the
-//   scene, then the higher triangle index. Otherwise the nearer one wins.
-//
-// Why that bound. Vertices are stored in float (TriangleSoup): each coordinate within
-// 2^-24 |x| of the value the scene meant (round to nearest), each vertex within
-// sqrt(3) 2^-24 M. A point of a triangle is a convex combination of its vertices, so it
-// lies within sqrt(3) 2^-24 M of the plane the scene meant; two triangles meant to be
-// coplanar are then at most 2 sqrt(3) 2^-24 M = 3.46 2^-24 M apart along their normal at
-// any point they share. TIE_RELATIVE = 4 2^-24 = 2^-22 (2.4e-7) covers that. The
-// comparisons themselves run in double (the tracer's watertight test, the A-buffer's
-// per-sample planes, the searches' planes): their rounding, about 2^-52 of the distances,
-// is 2^-30 of the bound for any origin within 10^6 M, so it never decides a tie.
-// What is NOT a tie: a decal h above a floor of half size S/2 has separation h along the
-// normal; it ties only for h <= 2^-22 S/2 = 1.2e-7 S, 800 times below the thinnest decal of
-// the hard suite (1e-4 S, tests/api/test_hard_cases.cpp); mm detail on km terrain (1e-3 at
-// M = 2000: bound 4.8e-4) stays apart too. Two surfaces that cross are at the same distance
-// only within the bound of their intersection line (the rule then picks one side a hair
-// early, below the float precision of the vertices).
-//
-// Paths (each cites this header): the exact tracer (Bvh::visible_hit), the A-buffer's exact
-// priority masks (SampleDepth::nearer, resolve.cpp) and nearest layer (abuffer.cpp), the map
-// searches (search_candidates.cpp, the side structure), and the GL passes, whose depth is
-// float and interpolated: there every object's window depth is scaled by 1 + GL_TIE_STEP *
-// (its rank + 1) (shaders/scene.vert), so at equal depth the later object is nearer, while
-// any separation above the GL bias, GL_TIE_SPAN relative, is kept (gl_passes.cpp).
+// surfaces a ray meets first calls these functions. Two surfaces met along one ray are AT
+// THE SAME DISTANCE iff their separation along their normals is at most tie_bound =
+// TIE_RELATIVE * M (M the largest absolute vertex coordinate of the two): the float rounding
+// of the vertices, far above the double rounding of the comparisons and far below any
+// modelled detail. Then the one RANKING higher wins (the object listed later, then the
+// higher triangle); otherwise the nearer one. The GL passes scale each object's depth by
+// gl_tie_step (below). docs/design/tie-rule.md has the bound's proof and the paths.
 #pragma once
 #include <algorithm>
 #include <cmath>

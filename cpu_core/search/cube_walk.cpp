@@ -66,7 +66,7 @@ CubeWalk::CubeWalk(const glm::dvec3& w, const glm::dvec3& d, int n, double l_max
     done_ = true;
     return;
   }
-  // The ball |X| < r around the centre, skipped (header, rule 4).
+  // The ball |X| < r around the centre, skipped (rule 4, docs/design/cube-walk.md).
   const double r = std::max(skip_radius, CENTRE_PASS_REL * glm::length(w));
   const double lc = -glm::dot(w, d);
   const double h = glm::length(glm::cross(w, d));
@@ -208,9 +208,10 @@ bool CubeWalk::pending(WalkTexel* texel) {
   return true;
 }
 
-// The boundaries one axis may cross inside a square (SQUARE EXIT, header 5.): from its head
-// on, along its step, those of 1 .. n-1 up to the square's edge whose plane the ray reaches
-// (den of the step's sign: den is monotone along the boundaries, so they are a prefix).
+// The boundaries one axis may cross inside a square (SQUARE EXIT, rule 5 of
+// docs/design/cube-walk.md): from its head on, along its step, those of 1 .. n-1 up to the
+// square's edge whose plane the ray reaches (den of the step's sign: den is monotone along
+// the boundaries, so they are a prefix).
 struct CubeWalk::AxisRun {
   int first = 0;        // the head: the next boundary the axis crosses
   int count = 0;        // boundaries first, first + step, ... the walk may cross in the square
@@ -218,7 +219,7 @@ struct CubeWalk::AxisRun {
   double exit_l = INF;  // where it is crossed, max(l, r(last)), when it exits
 };
 
-// False when the run's crossings cannot be proven to increase along the walk (header 5.).
+// False when the run's crossings cannot be proven to increase along the walk (rule 5).
 bool CubeWalk::axis_run(int axis, int lo, int hi, AxisRun* run) const {
   const int s = step_[axis];
   *run = AxisRun{};
@@ -245,7 +246,7 @@ bool CubeWalk::axis_run(int axis, int lo, int hi, AxisRun* run) const {
   if (run->exits) run->exit_l = std::max(l_, raw_crossing(axis, head + s * (count - 1)));
   if (count < 2) return true;
   // Do the computed crossings increase along the walk? The exact gap between consecutive
-  // ones, 2 n |rate| / (den den'), against twice the roundings' bound on each (header 5.).
+  // ones, 2 n |rate| / (den den'), against twice the roundings' bound on each (rule 5).
   constexpr double EPS = std::numeric_limits<double>::epsilon() / 2;  // unit roundoff
   const int b_last = head + s * (count - 1);
   const double d0 = std::fabs(denominator(axis, head)), d1 = std::fabs(denominator(axis, b_last));

@@ -1,67 +1,11 @@
 // The texel walk: the texels of an n x n cube map (cube_map.hpp) that a ray's projection
-// crosses, in order of increasing ray parameter (thesis 7.4.1 "usar un algoritmo que dibuje
-// líneas para indexar el mapa", 7.5, 8.3).
-//
-// GEOMETRY. Coordinates are relative to the cube centre C. The ray is X(l) = W + l D, D unit,
-// l in [0, l_max]. Seen from C its points sweep the great-circle arc from [[W]] towards D
-// (thesis 7.4, theorem 1: [[X(l)]] = [[(1-t) D + t W]], t = 1/(1+l)). Every texel boundary is
-// a plane through C, so the ray crosses it at one exact parameter l; on a face the projection
-// (s(l), t(l)) is a straight segment whose s and t are monotone in l (ds/dl has the constant
-// sign of (F x S) . (W x D), F the face's forward axis and S its s axis).
-//
-// ALGORITHM (no 3D march, no fixed step).
-//  1. Faces. The face of X(l) is the argmax of the six linear functions F_k . X(l) =
-//     F_k . W + l F_k . D (their max is |X(l)|_inf). Their upper envelope is convex in l, so
-//     the faces follow in order of increasing slope F_k . D, each at most once; the switch
-//     from face k to face m is where the two lines meet. Ties at an l: the larger slope (the
-//     face the ray enters), then the lower face index (cube_map.hpp's x-before-y-before-z).
-//  2. Texels on a face: a 2D DDA (Amanatides & Woo 1987) on the face's (s, t) grid, the
-//     parameter of each crossing computed exactly from the boundary plane
-//     N (S . X) - (2k - N) (F . X) = 0 (integer coefficients on the axis-aligned frame).
-//     The entry texel is the projection of X(l) where the ray enters the face, clamped to
-//     the face. Only the interior boundaries 1..n-1 are stepped; the face's own edges are
-//     left by step 1, so a seam, edge or corner is crossed exactly once.
-//  3. TIE RULES. Two crossings at the same l (the ray through a texel corner): both indices
-//     step at once (a diagonal move; the two texels touching only the corner point are
-//     not visited). A crossing computed behind the current l (rounding on a boundary) is
-//     taken at the current l. Texels whose interval has zero length are not reported (a
-//     ray along a seam or exactly through a corner touches them at one point only). Each
-//     step moves i or j one way only and the faces never repeat (a face is convex on the
-//     sphere: the arc meets it once; the centre's gap may split one face in two segments),
-//     so a walk takes at most 6 * 2 (n - 1) steps and 7 face ends: 12 n - 5 iterations;
-//     max_texels (default 16 n + 64, never reached) is a safety cap, `aborted` says when it
-//     was hit.
-//  4. THE CENTRE. A ray whose line passes within r of C (closest approach h = |W x D| < r)
-//     skips the part inside the ball |X| < r: l in (l_c - sqrt(r^2 - h^2), l_c +
-//     sqrt(r^2 - h^2)), l_c = -W . D. r = max(skip_radius, CENTRE_PASS_REL |W|). The searches
-//     pass the map's near distance as skip_radius (the map holds nothing closer to C); the
-//     relative floor is the degenerate case D . [[W]] = -1 (the ray through C: its direction
-//     jumps to the antipode D) and its neighbours, where the arc's sweep past C cannot be
-//     resolved in double precision. The first texel after a skip has `after_gap` set.
-//     D . [[W]] = +1 needs no rule: no boundary plane is crossed, the walk is one texel.
-//     W = 0 (the ray starts at C): the walk is the one texel of D.
-//  5. SQUARE EXIT (the searches' HIERARCHICAL SKIP, search_scan.hpp): where the walk leaves
-//     an axis-aligned square of texels of the current face, computed without visiting its
-//     texels and EXACTLY as the steps of 2. would leave it (same texel, same l), or refused.
-//     Why it can be exact: with r_a(b) the unclamped parameter of boundary b on axis a (the
-//     division of 2.) and L the walk's l at the pending texel, the next crossing of axis a
-//     is always max(l, r_a(head)) (a crossing behind l is taken at l), so the walk is a
-//     merge of the two axes' crossings by value and l is the running maximum of the ones
-//     merged: boundary b is crossed at max(L, max of r_a over the boundaries up to b). When
-//     each axis's r_a increases along the walk, that is max(L, r_a(b)): the square is left
-//     at E = min over axes of max(L, r_a(exit boundary)), or by the face's end when that
-//     comes first, and an axis that does not leave there has crossed exactly its boundaries
-//     with r_a <= E (counted with the same division). That each r_a increases is proven,
-//     not assumed: exactly, consecutive crossings differ by 2 n |rate| / (den den') (the
-//     plane pencil is a Moebius map of the boundary), den monotone along the boundaries so
-//     the smallest gap is at an end of the run; the computed r_a are within a bound of the
-//     roundings (a few units in the last place of the terms, widened eightfold) of the exact
-//     ones; a run whose smallest gap is not more than twice that bound is refused, as is one
-//     whose den comes near 0 or a walk whose cap was lowered (the cap counts steps).
-//
-// Each reported texel has the exact parameter interval [l0, l1] the ray spends in its
-// frustum (l1 = +inf for the last texel of an unbounded ray); consecutive intervals meet
-// (l1 of one = l0 of the next), except across a gap.
+// crosses, in order of increasing ray parameter (thesis 7.4.1, 7.5, 8.3). Every texel
+// boundary is a plane through the centre C, so the ray X(l) = W + l D crosses it at one exact
+// l: faces in order of the upper envelope of F_k . X(l) (rule 1), a 2D DDA on each face
+// (rule 2), TIE RULES at corners and on boundaries (rule 3), THE CENTRE skipped (rule 4), and
+// the SQUARE EXIT of the searches' HIERARCHICAL SKIP (rule 5). Each reported texel has the
+// exact interval [l0, l1] the ray spends in its frustum; consecutive intervals meet except
+// across a gap. docs/design/cube-walk.md has the whole argument, rule by rule.
 #pragma once
 #include <cstdint>
 #include <limits>
@@ -85,7 +29,7 @@ class CubeWalk {
  public:
   // w: ray origin relative to the cube centre; d: unit direction; n: face resolution;
   // l_max: end of the ray (+inf for a ray, |L - P| for a shadow segment);
-  // skip_radius: ball around the centre to skip (see 4.); max_texels: 0 = 16 n + 64.
+  // skip_radius: ball around the centre to skip (rule 4); max_texels: 0 = 16 n + 64.
   CubeWalk(const glm::dvec3& w, const glm::dvec3& d, int n,
            double l_max = std::numeric_limits<double>::infinity(), double skip_radius = 0.0,
            uint32_t max_texels = 0);
@@ -107,7 +51,7 @@ class CubeWalk {
   // Where the walk leaves the square of texels [i0, i0 + size) x [j0, j0 + size) (clipped to
   // the face) that holds the pending texel, exactly as next() would leave it: the walk's l
   // there and its next texel, or the end of the face segment inside the square. False when
-  // exactness cannot be guaranteed (SQUARE EXIT below): the caller then walks on.
+  // exactness cannot be guaranteed (SQUARE EXIT, rule 5): the caller then walks on.
   struct SquareExit {
     double l_end = 0;        // the texels of the square the walk passes lie in [l, l_end]
     bool face_ends = false;  // the face segment ends inside the square (l_end = its end)
@@ -119,7 +63,7 @@ class CubeWalk {
   // Goes on from `exit` (of square_exit at the current pending texel): the walk's state is
   // then the one next() reaches after the square's texels.
   void jump(const SquareExit& exit);
-  // Whether square_exit may be used: the cap cannot stop the plain walk (3. above), so
+  // Whether square_exit may be used: the cap cannot stop the plain walk (rule 3), so
   // leaving texels out cannot change where it stops.
   bool can_jump() const { return cap_ >= default_cap(n_); }
 

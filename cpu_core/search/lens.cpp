@@ -167,7 +167,7 @@ SurfaceFit fit_surface(const std::vector<LensSurfacePoint>& pts_world, double z_
   return fit;
 }
 
-// The object's deduplicated vertices and those of each surface (header: "Surfaces").
+// The object's deduplicated vertices and those of each surface (docs/design/lens.md, "Surfaces").
 struct LensPoints {
   std::vector<glm::dvec3> all, upper, lower;
 };
@@ -216,8 +216,8 @@ LensFit invalid(LensFit f, const std::string& why) {
   return f;
 }
 
-// Principal plane of the points (header: "Principal plane P"); false when they do not span
-// a plane.
+// Principal plane of the points (docs/design/lens.md, "Principal plane P"); false when
+// they do not span a plane.
 bool fit_principal_plane(const std::vector<glm::dvec3>& all, LensFit* f) {
   glm::dvec3 centroid(0.0);
   for (const glm::dvec3& p : all) centroid += p;
@@ -296,7 +296,7 @@ LensFit fit_lens(const SceneData& scene, uint32_t object, const LensFitOptions& 
   if (!s1.ok || !s2.ok) return invalid(f, obj.path + ": the curvature fit failed (degenerate points)");
 
   // z runs along +axis; light from the +axis side travels along -axis, so the Cartesian
-  // curvature along its travel is -rho of F (header: "SIGNS").
+  // curvature along its travel is -rho of F (docs/design/lens.md, "Signs").
   f.rho1 = -s1.rho;
   f.rho2 = -s2.rho;
   f.vertex1 = s1.z0;
@@ -342,7 +342,8 @@ LensMatrix thin_lens_matrix(double rho1, double rho2, double nu) {
 
 LensMatrix lens_matrix(const LensFit& lens, RefractionMode mode, bool along_axis) {
   ABCUBE_CHECK(mode != RefractionMode::search, "lens_matrix needs thick_lens or thin_lens");
-  // Travelling along +axis the ray meets surface 2 first: the mirrored lens (header: "SIGNS").
+  // Travelling along +axis the ray meets surface 2 first: the mirrored lens
+  // (docs/design/lens.md, "Signs").
   const double entry = along_axis ? -lens.rho2 : lens.rho1;
   const double exit = along_axis ? -lens.rho1 : lens.rho2;
   return mode == RefractionMode::thick_lens ? thick_lens_matrix(entry, exit, lens.thickness, lens.nu)

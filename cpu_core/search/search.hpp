@@ -1,164 +1,11 @@
-// The searches in the A-buffered cube map (thesis 7.4, 7.5, 8.3, 9.3.4; design.md
-// "Searches in the A-buffered cube map"): reflection, refraction exit and shadow rays
-// answered from ONE cube A-buffer (abuffer.hpp) centred on C, by walking the texels of the
-// ray's projection (cube_walk.hpp) in order of increasing ray parameter l.
-//
-// CANDIDATES. In each texel the walk gives the parameter interval [l0, l1] the ray spends
-// there, hence the ray's distance range [dmin, dmax] from C (thesis 7.5: "podemos descartar
-// totalmente una lista ... si la posición del rayo para ese pixel es mayor que la mayor
-// distancia guardada o menor que la menor"). A fragment is tested iff its [zmin, zmax]
-// overlaps [dmin, dmax]. Layers: SearchLayers::all tests every fragment of the list (the
-// A-buffer, thesis 7.5); SearchLayers::nearest tests only the fragment nearest_layer()
-// would keep (centre sample covered, nearest plane along the texel centre): the one-layer
-// Z-buffered map of Patow 1995 (thesis 7.4), same walk, same rules.
-//
-// HIERARCHICAL SKIP (SearchOptions::hierarchy, default on; search_scan.hpp skip_node).
-// THE Z PYRAMID (SearchContext::node_bounds) holds the smallest zmin and largest zmax of
-// the fragments under squares of 8, 16, ... texels up to a whole face (the BLOCK BOUNDS and
-// the levels above them: a third more bytes). Before it visits a texel the walk tries the
-// nodes holding it and steps over a whole node when the ray's distance range across it,
-// widened against every rounding, cannot meet the node's [zmin, zmax] (or it is empty),
-// landing on the very texel and l where the plain walk leaves the node (CubeWalk::
-// square_exit, exact or refused); it descends otherwise (maximum mipmaps, Tevs et al. 2008;
-// hierarchical-Z tracing, McGuire & Mara 2014). The texels stepped over are ones whose
-// lists the plain walk would not have read either, so the answers, fragments tested and
-// candidates are the same bit for bit (tests/core/test_search_hierarchy.cpp): only the
-// texels visited change (SearchResult::nodes_skipped counts the nodes). Off: the plain walk.
-//
-// MODE crossing (default). Each tested fragment is refined with its triangle's exact plane
-// (the fragment stores the triangle index): X' = X(l') where the ray meets the plane. Its
-// error is its distance e from the triangle (0 inside), in texels at X' (texel_size_at).
-// It is accepted iff X' lies in the texel holding the fragment (l' in [l0, l1]: the map's
-// evidence that a surface is there) and e <= tolerance_texels. e > 0 happens when the
-// fragment's triangle is a neighbour of the surface the ray really crosses there (merged
-// fragments; a triangle too thin to cover a sample of that texel). The hit is the first
-// crossing: after the first texel with an accepted candidate the walk goes on for
-// CROSSING_WINDOW_TEXELS more texels (and while l0 <= the best l'); the result is the
-// accepted candidate ON its triangle (e ~ 0) with the smallest l' if there is one, else the
-// accepted one with the smallest l'. So a surface's neighbouring triangle, whose extended
-// plane the ray meets a little before the triangle it really crosses, does not win over
-// it, and a silhouette missed by less than the tolerance only wins when no exact crossing
-// lies just behind it. The point X' is on the ray: Error_Parallax is 0 to rounding; the
-// error of this mode is the wrong surface within the tolerance of silhouettes. Tolerance
-// candidates closer to W than 2 * tolerance_texels texels are ignored: there the extended
-// planes of W's own neighbouring triangles (a tessellated convex mirror) pass within the
-// tolerance of the ray and cannot be told from another surface; exact crossings are kept.
-// MERGED MAPS: a merged fragment keeps one triangle's plane for a patch of several
-// (abuffer.hpp MERGE); a ray crossing the patch at a grazing angle meets that plane more
-// than the tolerance away from its triangle and the crossing is lost (a threshold
-// rejection): bench_search measures it on the terrain of scenes/bench/spheres_terrain.json
-// (--merge off for the unmerged map).
-//
-// MESH REFINEMENT (crossing mode, SearchRefine::mesh, the default; --refine mesh|plane; the
-// same flood moves camera fragments' shading points onto the mesh, map_shading.hpp).
-// The plane of one triangle says little near that triangle's edges: a ray passing within
-// the tolerance outside a silhouette, or crossing the extension of a box's top face just
-// beyond the crease, was accepted as a crossing (a false hit, a false shadow); and a
-// merged fragment's triangle is often not the one the ray crosses. So a candidate whose
-// ray does not cross its own triangle asks the mesh around it: the triangles
-// edge-connected to it (SearchContext::neighbour: same object, shared vertex positions
-// bit for bit) whose bounding spheres come within max(tolerance, 1) texel of the ray's
-// stretch in that texel (widened by the same), each tested for an exact crossing (on the
-// triangle to ON_TRIANGLE_TEXELS, anywhere on the ray past the self offset): first a
-// straight walk across the edge the ray's crossing of the current plane lies furthest
-// outside of (a smooth patch's crossing in a few steps), then, if that ends without one,
-// all of them breadth-first. A crossing found is an exact candidate (its triangle and facing replace
-// the fragment's); a flood that ends with none rejects the candidate (the ray passes by
-// that surface here); a flood that reaches REFINE_MAX_TRIANGLES, or a fragment triangle
-// whose sphere is not near the ray, leaves the plane rule above to decide. Plain meshes
-// without shared vertices (triangle soups) therefore behave as before. Measured on the
-// repository scenes (abuffer, N = 512): default 37.3 -> 41.3 dB, cornell 34.3 -> 39.4 dB
-// (the rest of the gain there is map_shading.hpp's per-quarter shading).
-//
-// MODE thesis (thesis 7.4.1 pseudo-code, 9.3.4). Each tested fragment gives the point
-// a V, V the texel-centre direction and a its distance to the fragment's plane along V
-// (the Z-buffer's alpha); the angle between R and (a V - W) is its error. The best
-// approximator is the smallest angle, accepted iff <= theta_max (default 2 degrees), else a
-// threshold rejection (the thesis reflects the background). OUR RESTRICTION: the thesis
-// takes the minimum over the whole arc, which can pick a surface hidden behind the first
-// one the ray meets; we take it over the first candidates: from the first texel holding a
-// candidate under theta_max to THESIS_WINDOW_TEXELS texels after it. Error_Parallax of an
-// accepted point is (1 - cos angle)/2 <= theta_max^2/4 (thesis 9.3.4); the 1/(2 N^2) bound
-// holds only where the angle seen from W is no larger than seen from C: the thesis takes
-// the half texel diagonal seen from C, atan(sqrt(2)/N), as the angle seen from W; seen from
-// W it is amplified by about |S - C| / (|S - W| cos(view angle on the hit plane)), S the
-// true point (tests/core/test_search.cpp measures it; bench_search reports it).
-//
-// SELF-HITS (rule "offset", in texel units instead of shading.hpp's absolute epsilon).
-// s = self_offset_texels * texel_size_at(W - C): one texel at W's distance is 2 |W - C|_inf / N
-// world units (cube_walk.hpp). Ignored: (1) W's own surface: a fragment whose plane passes
-// within s of W and that the ray leaves, runs along, or meets again within s (a ray cannot
-// meet the plane it leaves; a face near W that the ray crosses further on is kept); (2) any
-// found point closer than s to W. The default depends on the mode. Crossing mode:
-// SELF_OFFSET_CROSSING_TEXELS = 1e-3, far above the rounding of a W computed on its
-// triangle's plane (1e-16 |W|; even float rounding, 6e-8 |W|, is under 1e-3 texel up to
-// N = 16384), so a grazing ray never finds its own plane while a surface meeting W's
-// at a concave corner is found from 1e-3 texel on. Thesis mode: SELF_OFFSET_THESIS_TEXELS =
-// 0.5: its points a V are texel centres, and those of W's own surface or of its neighbours
-// within half a texel of W are at arbitrary angles from R; surfaces closer to W than that
-// (concave corners) are not found (with N = 512 and |W - C| = 5, s = 0.005 world units).
-//
-// THE SIDE STRUCTURE (SearchOptions::side_structure, default on; --map-only turns it off).
-// What the map cannot hold, kept exactly beside it in SearchContext: (a) the triangles whose
-// plane contains C (the raster's edge-on rule: no area in the map), (b) the non-degenerate
-// triangles that produced no fragment in any of the six faces (thinner or smaller than the
-// samples of a texel: they fall between them), found by marking every triangle index seen
-// in the faces' lists. Only these, so the list is short; it is held in a small BVH of its
-// own (reference/bvh.hpp, Embree's, built over just these triangles: a huge mesh at low N
-// can leave many), and each ray is tested with the watertight ray-triangle test (Woop et
-// al. 2013, reference/triangle_test.hpp) in double. Every search asks it after its walk: reflection_search and
-// refraction_exit_search (restricted to the object) take the nearest side crossing with
-// self < l < the map's answer (or anywhere when the map found nothing), not on W's own
-// surface (the SELF-HITS rule), as THE answer: that triangle, its object and material, the
-// point on the ray, and the facing the map would give (seen from C; for a plane through C,
-// which C cannot face, the ray's direction against the geometric normal); SearchResult::side
-// says so. shadow_search counts every side crossing on the segment as a blocker (once, as
-// the map's; stops at an opaque one). The answers are counted per kind
-// (SearchKindStats::side_hits; shadows: rays with a side blocker). When the list is empty
-// (most scenes at their N) the searches branch out before any test: the images are those of
-// the map alone. Map only, a zero-area surface met before the answer gives a miss with
-// reason zero_area_surface (counted, never a silent wrong hit); with the side structure
-// that never happens. Measured (abuffer against raytrace, N = 512): default 44.70 -> 44.71
-// dB, cornell 43.93 -> 44.12 dB (their small spheres' triangles that cover no sample),
-// hidden_point 52.66 and shadows 50.17 unchanged (no side answer); a plane through C seen
-// in a tilted mirror 6 dB -> identical to raytrace, the shadow of a fin through C 14 ->
-// 33 dB (tests/api/test_hard_cases.cpp). What it does not cover: a triangle with fragments
-// that misses some texels it crosses (a sliver that covers a sample here and there) is
-// found only where it has fragments.
-//
-// THE CENTRE. The walk skips the ball |X| < near_distance around C (the map holds nothing
-// there). A ray through C (R . [[W]] = -1) jumps from the texel of [[W]] to the texel of
-// its antipode R; R . [[W]] = +1 is a walk of one texel (cube_walk.hpp).
-//
-// SHADOWS (thesis 8.3). The segment from P to the light: every accepted candidate with
-// s <= |X' - P| < |L - P| is a blocker (crossing mode: accepted as above; thesis mode: angle
-// under theta_max); blockers multiply the light by blocker_transmittance (shading.hpp); the
-// walk stops at the first opaque one. Shadow rays are not refracted. One triangle counts
-// once; so do crossings of one object with the same facing within (tolerance_texels + 1)
-// texels of each other (a ray through a shared edge, one surface found in two texels) or,
-// in thesis mode, anywhere on the segment (its points under theta_max spread along a grazing
-// surface; a concave transparent object crossed twice with one facing then counts once).
-// A blocker within the tolerance of a silhouette darkens (the crossing mode's silhouette
-// error, as for reflections).
-//
-// REFRACTION. A ray inside a closed object meets next either that object's own surface
-// (back faces are in the map) or a surface lying inside it or touching it: another medium
-// nested in it or sharing a face with it (media.hpp, NESTED DIELECTRICS), an opaque object
-// inside the glass. refraction_exit_search finds the first crossing along the refracted
-// direction among the surfaces of the object and of every object whose bounding box meets
-// the object's: right by construction, since any surface the exact ray crosses before
-// leaving the object lies inside the object's bounds, so its object's bounds meet them;
-// and no nearer surface outside the object (a silhouette within the tolerance) can answer
-// it, as when the search was restricted to the object alone. The crossings coincident with
-// the answer (a face shared by two touching objects) are found by coincident_crossings.
-// The caller resolves the crossing set (media.hpp), bends the ray there (shading.hpp
-// transmission_between; total internal reflection gives a mirror direction, searched again
-// from inside) and searches what the emerging ray sees, with refraction_exit_search while it
-// is inside a medium and reflection_search once in air. With
-// SearchLayers::nearest the back faces are rarely the nearest layer: the one-layer map
-// finds few exits (its limitation, thesis 7.4.2).
-//
-// Every search is a pure function of its inputs (thread safe); stats are per caller.
+// The searches in the A-buffered cube map (thesis 7.4, 7.5, 8.3, 9.3.4): reflection,
+// refraction exit and shadow rays answered from ONE cube A-buffer (abuffer.hpp) centred on
+// C, by walking the texels of the ray's projection (cube_walk.hpp) in order of increasing
+// ray parameter l and testing the fragments whose depth range meets the ray's. The rules are
+// named in capitals (CANDIDATES, HIERARCHICAL SKIP, MODE crossing, MESH REFINEMENT, MODE
+// thesis, SELF-HITS, THE SIDE STRUCTURE, THE CENTRE, SHADOWS, REFRACTION);
+// docs/design/search.md has the whole argument of each. Every search is a pure function of
+// its inputs (thread safe); stats are per caller.
 #pragma once
 #include <algorithm>
 #include <array>
@@ -202,7 +49,7 @@ bool parse_search_refine(const std::string& s, SearchRefine* out);  // "mesh" | 
 // past its first candidate under theta_max.
 constexpr int CROSSING_WINDOW_TEXELS = 2;
 constexpr int THESIS_WINDOW_TEXELS = 2;
-// Default self offsets per mode, in texels at W (SELF-HITS above).
+// Default self offsets per mode, in texels at W (SELF-HITS, docs/design/search.md).
 constexpr double SELF_OFFSET_CROSSING_TEXELS = 1e-3;
 constexpr double SELF_OFFSET_THESIS_TEXELS = 0.5;
 // MESH REFINEMENT: the most triangles one refinement floods before it gives up (unknown).
@@ -213,7 +60,7 @@ struct SearchOptions {
   SearchLayers layers = SearchLayers::all;
   double theta_max = 0.034906585039886591;  // thesis mode: 2 degrees, in radians
   double tolerance_texels = 1.0;            // crossing mode: largest accepted e
-  SearchRefine refine = SearchRefine::mesh;  // MESH REFINEMENT (header)
+  SearchRefine refine = SearchRefine::mesh;  // MESH REFINEMENT (docs/design/search.md)
   double self_offset_texels = 0;            // W's own surface and points closer; 0 = the mode's default
   uint32_t max_texels = 0;                  // walk cap; 0 = CubeWalk's default
   bool side_structure = true;               // THE SIDE STRUCTURE answers what the map cannot hold
@@ -236,8 +83,8 @@ class SearchContext {
   SearchContext(const SceneData& scene, const CubeABuffer& cube,
                 std::shared_ptr<const MeshNeighbours> neighbours = nullptr);
   // The same, the adjacency asked of `neighbours` (null: built here) only once THE SIDE
-  // STRUCTURE's tree is built: the two are never being built at once (peak memory: 12
-  // bytes a triangle less on a 1M-triangle terrain, bench/memory.py).
+  // STRUCTURE's tree is built: the two are never being built at once, so the
+  // peak holds the scratch of one build only (bench/memory.py measures it).
   using NeighboursSource = std::function<std::shared_ptr<const MeshNeighbours>()>;
   SearchContext(const SceneData& scene, const CubeABuffer& cube, const NeighboursSource& neighbours);
 
@@ -246,8 +93,9 @@ class SearchContext {
   // The scene's media (NESTED DIELECTRICS, media.hpp): what an exit search may cross.
   const Media& media() const { return media_; }
   const std::vector<uint32_t>& zero_area_triangles() const { return zero_area_; }
-  // THE SIDE STRUCTURE (header): the non-degenerate triangles the map cannot hold (zero
-  // area, or no fragment in any face), ascending, and a BVH over them (null when none).
+  // THE SIDE STRUCTURE (docs/design/search.md): the non-degenerate triangles the map cannot
+  // hold (zero area, or no fragment in any face), ascending, and a BVH over them (null when
+  // none).
   const std::vector<uint32_t>& side_triangles() const { return side_bvh_ ? side_bvh_->subset() : no_triangles_; }
   bool has_side_triangles() const { return side_bvh_ != nullptr; }
   // tie_rule.hpp's bound for a side triangle against any (0 when there is none).
@@ -273,7 +121,7 @@ class SearchContext {
 
   // Per-triangle geometry is computed from the soup's float vertices on each call, in
   // double, by the same expressions every time (bit for bit the same answer): storing it
-  // took 160 bytes a triangle.
+  // would cost more memory a triangle than the soup itself.
   struct Plane {
     glm::dvec3 normal{0.0};  // unit geometric normal, cross(b-a, c-a) direction
     double offset = 0;       // normal . X for X on the plane, X relative to the centre
@@ -291,7 +139,7 @@ class SearchContext {
   // unit normals of the edges (edge k from vertex k to k+1) and their offsets; for the
   // flood, a bounding sphere (centroid, largest vertex distance). Zero for a degenerate
   // triangle (plane()'s test). Two functions, not one: the flood asks for a sphere far more
-  // often than for a crossing, and the edges' three normalisations were most of the cost.
+  // often than for a crossing, and the edges' three normalisations are the costly part.
   struct EdgePlanes {
     Plane plane;
     std::array<glm::dvec3, 3> edge_normal{};
@@ -416,9 +264,9 @@ struct ShadowResult {
 SearchResult reflection_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& r,
                                const SearchOptions& options = {});
 
-// The next surface met by a ray inside object `object_id`: its first crossing, along
-// W + l T (W world space, on the entry surface; T unit, refracted inwards), of that
-// object's surface or of a surface of an object whose bounds meet its (REFRACTION above).
+// The next surface met by a ray inside object `object_id`: its first crossing, along W + l T (W
+// world space, on the entry surface; T unit, refracted inwards), of that object's surface or of
+// a surface of an object whose bounds meet its (REFRACTION, docs/design/search.md).
 SearchResult refraction_exit_search(const SearchContext& ctx, const glm::dvec3& w,
                                     const glm::dvec3& t, uint32_t object_id,
                                     const SearchOptions& options = {});
@@ -447,7 +295,7 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p,
 bool same_answer(const SearchResult& a, const SearchResult& b);
 bool same_answer(const ShadowResult& a, const ShadowResult& b);
 
-// Counters of one kind of search (issue item 10).
+// Counters of one kind of search.
 struct SearchKindStats {
   uint64_t rays = 0;
   uint64_t texels = 0, max_texels = 0;  // texels visited: sum and max per ray

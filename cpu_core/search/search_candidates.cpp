@@ -1,5 +1,5 @@
-// One fragment's answer for a ray (search.hpp MODE crossing, MODE thesis), the zero-area
-// check, THE SIDE STRUCTURE's crossings, and the result a search returns.
+// One fragment's answer for a ray (docs/design/search.md: MODE crossing, MODE thesis), the
+// zero-area check, THE SIDE STRUCTURE's crossings, and the result a search returns.
 #include <algorithm>
 #include <cmath>
 
@@ -51,8 +51,8 @@ SearchResult make_result(const SearchContext& ctx, const SearchRay& q, const Can
 
 }  // namespace
 
-// Crossing mode (header): the ray meets the fragment's triangle plane at X(l'); refined on
-// the mesh around that triangle unless the ray crosses the triangle itself there.
+// Crossing mode (docs/design/search.md): the ray meets the fragment's triangle plane at X(l');
+// refined on the mesh around that triangle unless the ray crosses the triangle itself there.
 Candidate crossing_candidate(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o, const WalkTexel& t,
                              const Fragment& f) {
   Candidate c;

@@ -1,6 +1,6 @@
 // SearchContext: the geometry the searches need per cube map (planes, refinement bounds,
 // zero-area triangles, where each face holds fragments, BLOCK BOUNDS), and the scene's
-// mesh neighbours (search.hpp MESH REFINEMENT).
+// mesh neighbours (docs/design/search.md, MESH REFINEMENT).
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -17,13 +17,12 @@ namespace abcube {
 namespace {
 
 // MEMO. The refinement asks for the same triangles' geometry again and again: neighbouring
-// rays refine on the same patch, and a flood meets each triangle from up to three sides.
-// On scenes/bench/spheres_terrain.json at N = 128 a render asked 79M times for a sphere
-// and 59M times for edge planes, 96% of them for a triangle among the last 4096 its own
-// thread had asked for (98% on bench/race_scenes.py's room). Each thread keeps the values
-// it computed last, for one context at a time (SearchContext::memo_id_, never reused), in
-// 4096 slots by a hash of the triangle: the values are the functions' own, so every answer
-// is the same bit for bit, for any thread count. 656 KiB a thread that searches.
+// rays refine on the same patch, and a flood meets each triangle from up to three sides, so
+// nearly every ask is for a triangle among the last few thousand its own thread asked for.
+// Each thread keeps the values it computed last, for one context at a time
+// (SearchContext::memo_id_, never reused), in 4096 slots by a hash of the triangle: the
+// values are the functions' own, so every answer is the same bit for bit, for any thread
+// count. The slots are a fixed cost a thread that searches, whatever the scene's size.
 template <class Value>
 struct Memo {
   static constexpr int BITS = 12;
@@ -122,9 +121,9 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube, co
     }
   }
   build_pyramid();
-  // The neighbours first: their build's hash table (up to 12 bytes a triangle for a moment)
+  // The neighbours first: their build's hash table (a few bytes a triangle for a moment)
   // then comes before the side structure's tree, whose build holds one chunk at a time
-  // (bvh.hpp "Memory"), and the peak is the smaller.
+  // (docs/design/bvh.md "Memory"), and the peak is the smaller.
   if (neighbours) neighbours_ = neighbours();
   if (!neighbours_) neighbours_ = std::make_shared<const MeshNeighbours>(build_mesh_neighbours(soup));
   build_side_structure(std::move(seen));

@@ -21,7 +21,7 @@ constexpr double ON_TRIANGLE_TEXELS = 1e-6;
 struct SearchRay {
   glm::dvec3 w{0.0}, d{0.0};  // origin and unit direction
   double l_max = INF;         // end of the ray (shadow segments)
-  double self = 0;            // self offset in world units (header, SELF-HITS)
+  double self = 0;            // self offset in world units (SELF-HITS, docs/design/search.md)
   double self_tolerance = 0;  // nearest tolerance candidate accepted, world units (SELF-HITS)
   bool restrict_object = false;  // refraction exit: only `object` and what may lie inside it
   uint32_t object = 0;
@@ -69,8 +69,8 @@ struct PlaneCrossing {
 // The crossing of the ray with triangle `tri`'s plane (search_refine.cpp).
 PlaneCrossing plane_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri);
 
-// MESH REFINEMENT (crossing mode; header). The answer of the mesh around a fragment's
-// triangle when the ray does not cross that triangle itself.
+// MESH REFINEMENT (crossing mode; docs/design/search.md). The answer of the mesh around a
+// fragment's triangle when the ray does not cross that triangle itself.
 enum class Refined { hit, miss, unknown };
 struct MeshAnswer {
   Refined result = Refined::unknown;
@@ -82,8 +82,8 @@ struct MeshAnswer {
 MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t start, double l_lo, double l_hi,
                           double radius);
 
-// A fragment's candidate in crossing mode (header, MODE crossing) and in thesis mode
-// (thesis 7.4.1, 9.3.4) (search_candidates.cpp).
+// A fragment's candidate in crossing mode (MODE crossing, docs/design/search.md) and in thesis
+// mode (thesis 7.4.1, 9.3.4) (search_candidates.cpp).
 Candidate crossing_candidate(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o, const WalkTexel& t,
                              const Fragment& f);
 Candidate thesis_candidate(const SearchContext& ctx, const SearchRay& q, const WalkTexel& t, const Fragment& f,
@@ -92,7 +92,7 @@ Candidate thesis_candidate(const SearchContext& ctx, const SearchRay& q, const W
 // Does the exact ray meet a triangle the map cannot hold before parameter l_end?
 bool meets_zero_area(const SearchContext& ctx, const SearchRay& q, double l_end);
 
-// A side triangle the ray crosses (THE SIDE STRUCTURE), and its facing (header).
+// A side triangle the ray crosses (THE SIDE STRUCTURE), and its facing (docs/design/search.md).
 struct SideCrossing {
   uint32_t triangle = 0;
   double l = INF;

@@ -12,7 +12,7 @@ namespace {
 
 using namespace detail;
 
-// Crossing mode: the first crossing, exact ones first (header).
+// Crossing mode: the first crossing, exact ones first (docs/design/search.md).
 SearchResult search_crossing(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o) {
   Candidate exact, near;
   bool rejected = false;
@@ -39,7 +39,8 @@ SearchResult search_crossing(const SearchContext& ctx, const SearchRay& q, const
                 rejected ? MissReason::threshold_rejection : MissReason::no_crossing, counts);
 }
 
-// Thesis mode: the smallest angle over the first candidates under theta_max (header).
+// Thesis mode: the smallest angle over the first candidates under theta_max
+// (docs/design/search.md).
 SearchResult search_thesis(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o) {
   Candidate best;
   int64_t first = -1;
@@ -72,15 +73,15 @@ struct ShadowCrossing {
   bool exact;  // on its triangle (crossing mode, or the side structure)
 };
 
-// Is c the same surface crossing as one already counted? The same triangle always (a plane
-// is crossed once); in crossing mode the same object and facing within (tolerance + 1)
-// texels (a shared edge, or one surface found in two texels), but two crossings both on
-// their triangles are one only at the same l to rounding (a shared edge): a chord of a
-// sphere crosses its front twice a texel apart where the segment grazes it, and counting
-// that once left speckles of kt Od instead of (kt Od)^2 in a glass ball's shadow
-// (scenes/cornell.json, issue 12 part 4); in thesis mode the same object and facing
-// anywhere on the segment (its points under theta_max spread along a grazing surface, so
-// a concave transparent object crossed twice with one facing counts once).
+// Is c the same surface crossing as one already counted? The same triangle always (a plane is
+// crossed once); in crossing mode the same object and facing within (tolerance + 1) texels (a
+// shared edge, or one surface found in two texels), but two crossings both on their triangles
+// are one only at the same l to rounding (a shared edge): a chord of a sphere crosses its
+// front twice a texel apart where the segment grazes it, and counting that once would leave
+// speckles of kt Od instead of (kt Od)^2 in a glass ball's shadow (scenes/cornell.json); in
+// thesis mode the same object and facing anywhere on the segment (its points under theta_max
+// spread along a grazing surface, so a concave transparent object crossed twice with one
+// facing counts once).
 bool already_counted(const std::vector<ShadowCrossing>& counted, const SearchContext& ctx, const SearchOptions& o,
                      const Candidate& c) {
   const uint32_t tri = c.triangle;

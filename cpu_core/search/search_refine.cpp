@@ -58,9 +58,9 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
   // A start triangle away from the ray: the mesh near the ray may be elsewhere in the
   // fragment's patch (merged). The straight walk below may still reach it, across
   // triangles away from the ray, and its crossing counts if it lies in [l_lo, l_hi];
-  // otherwise the flood cannot say. (Before, such fragments were never refined: a glass
-  // ball's exit crossing seen only in a texel of a merged fragment was lost, speckles in
-  // its shadow on scenes/cornell.json.)
+  // otherwise the flood cannot say. (Such fragments must still be refined: a glass ball's
+  // exit crossing seen only in a texel of a merged fragment would otherwise be lost,
+  // speckles in its shadow on scenes/cornell.json.)
   const bool start_near = near_ray(ctx.bounding_sphere(start), q, l_lo, l_hi, radius);
   // First the straight way: from triangle to triangle across the edge the ray's crossing
   // of the current plane lies furthest outside of, while the next is near the ray. On a

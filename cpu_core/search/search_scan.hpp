@@ -1,6 +1,6 @@
-// Internal to the search stage: the walk of one ray over the cube A-buffer and the tests
-// every fragment it meets must pass before it is a candidate (search.hpp CANDIDATES,
-// SELF-HITS, BLOCK BOUNDS). A template, so each search's callbacks are inlined.
+// Internal to the search stage: the walk of one ray over the cube A-buffer and the tests every
+// fragment it meets must pass before it is a candidate (docs/design/search.md: CANDIDATES,
+// SELF-HITS; search.hpp BLOCK BOUNDS). A template, so each search's callbacks are inlined.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -33,9 +33,9 @@ inline const Fragment* nearest_fragment(const SearchContext& ctx, FragmentList l
   return best;
 }
 
-// W's own surface (header, SELF-HITS): a plane passing within the self offset of W that the
-// ray leaves, runs along, or crosses again within the offset. A neighbouring face near W
-// that the ray really crosses further on is not.
+// W's own surface (SELF-HITS, docs/design/search.md): a plane passing within the self offset of
+// W that the ray leaves, runs along, or crosses again within the offset. A neighbouring face
+// near W that the ray really crosses further on is not.
 inline bool own_surface(const SearchContext::Plane& p, const SearchRay& q) {
   const double delta = glm::dot(p.normal, q.w) - p.offset;
   if (!(std::fabs(delta) <= q.self)) return false;
@@ -45,8 +45,9 @@ inline bool own_surface(const SearchContext::Plane& p, const SearchRay& q) {
 
 // The squares of ray_distance_range (cube_walk.hpp) along one ray: [dmin^2, dmax^2] of
 // |W + l D| over a texel's [l0, l1], with the value at the last texel's end kept
-// (consecutive texels share it). Squares, because a square root per texel was a tenth
-// of a render's time; a fragment's float zmin and zmax square exactly in double.
+// (consecutive texels share it). Squares, because a square root per texel would be a
+// noticeable share of a render's time; a fragment's float zmin and zmax square exactly in
+// double.
 class SquaredDistanceRange {
  public:
   SquaredDistanceRange(const glm::dvec3& w, const glm::dvec3& d) : w_(w), d_(d), closest_(-glm::dot(w, d)) {}
@@ -90,19 +91,19 @@ class SquaredDistanceRange {
   double cached_l_ = std::numeric_limits<double>::quiet_NaN(), cached_length2_ = 0;
 };
 
-// HIERARCHICAL SKIP (issue 14; maximum mipmaps, Tevs et al. 2008; hierarchical-Z tracing,
-// McGuire & Mara 2014, on the thesis's arc walk). Before the pending texel is visited, the
-// nodes of THE Z PYRAMID (search.hpp) holding it are tried, from one level above the last
-// success down to the block: a node is stepped over, the walk jumping to where it leaves the
-// node's square (CubeWalk::square_exit, exact), when it is empty or when the ray's squared
-// distance range over that stretch, widened against every rounding
-// (SquaredDistanceRange::widened), misses [zmin^2, zmax^2] of the node. Every texel of the
-// square would then have had its block passed by the BLOCK BOUNDS test (its block's bounds
-// lie in the node's, its range in the widened one), so no fragment is read or counted
-// either way: the answers, fragments tested and candidates are the plain walk's bit for
-// bit; only the texels visited fall (and the nodes stepped over are counted). A node whose
-// range holds |X(l0)| is not tried (it cannot pass), nor one whose exit the walk cannot
-// prove; the walk then descends or visits the texel.
+// HIERARCHICAL SKIP (maximum mipmaps, Tevs et al. 2008; hierarchical-Z tracing, McGuire &
+// Mara 2014, on the thesis's arc walk). Before the pending texel is visited, the nodes of
+// THE Z PYRAMID (search.hpp) holding it are tried, from one level above the last success
+// down to the block: a node is stepped over, the walk jumping to where it leaves the node's
+// square (CubeWalk::square_exit, exact), when it is empty or when the ray's squared distance
+// range over that stretch, widened against every rounding (SquaredDistanceRange::widened),
+// misses [zmin^2, zmax^2] of the node. Every texel of the square would then have had its
+// block passed by the BLOCK BOUNDS test (its block's bounds lie in the node's, its range in
+// the widened one), so no fragment is read or counted either way: the answers, fragments
+// tested and candidates are the plain walk's bit for bit; only the texels visited fall (and
+// the nodes stepped over are counted). A node whose range holds |X(l0)| is not tried (it
+// cannot pass), nor one whose exit the walk cannot prove; the walk then descends or visits
+// the texel.
 inline bool skip_node(const SearchContext& ctx, CubeWalk& walk, const WalkTexel& t, SquaredDistanceRange& distances2,
                       int* level) {
   const double at_l0 = distances2.at(t.l0);

@@ -285,7 +285,7 @@ glm::dvec3 MapShader::envmap_direction(const glm::dvec3& w, const glm::dvec3& r)
 // fragment lit by local Phong and the shadow searches, seen from the centre. Computed on
 // first lookup and kept (texel_state_: 0 not yet, 1 being computed, 2 done): the picture
 // of all 6 N^2 texels, each with shadow walks of ~N texels, costs N^3 and is mostly never
-// looked at (cornell at N = 2048 ran for over 10 minutes before this).
+// looked at (computed whole, it would dominate a render at large N).
 glm::dvec3 MapShader::envmap_at(const glm::dvec3& direction) const {
   const int n = cube_.n;
   const CubeTexel t = direction_to_texel(direction, n);

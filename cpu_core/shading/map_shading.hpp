@@ -1,37 +1,11 @@
 // Shading with the cube map: the `abuffer`, `zbuffer` and `envmap` methods (thesis 7, 8.3,
-// 9; design.md). The SAME rules as the exact tracer (raytrace.hpp "THE RULES"), with every
-// ray query but the camera's answered from the one cube map centred on the camera:
-//
-//   C = phong_ambient + sum_l S_l phong_light(N, V, L_l) + kr C_reflected + kt C_transmitted
-//   (and, for a surface found by a search, the coverage blend with what lies behind it)
-//
-//   method    S_l                  C_reflected / C_transmitted
-//   abuffer   shadow_search, all   the surface found by the search (all layers), shaded
-//             layers               by these same rules one bounce deeper (multi-bounce,
-//                                  thesis 11.2.2), or the background on a miss
-//   zbuffer   same, nearest layer  same, nearest layer only (Patow 1995)
-//   envmap    shadow_search, all   the map's colour looked up in one direction (Blinn &
-//             layers               Newell 1976): R, the bisector [[R + [[W]]]] or [[W]]
-//                                  (--envmap-lookup, thesis 9.2); no bounce
-//
-// Secondary rays start on the surface (the searches keep W's own surface out by their
-// texel-unit offset, search.hpp). NESTED DIELECTRICS (media.hpp), decided as the exact
-// tracer decides them: every ray carries the stack of media it is inside (camera fragments:
-// none). A ray inside a medium is searched with refraction_exit_search from inside the
-// medium of highest priority (its own surfaces and those of the objects whose bounds meet
-// its: back faces, nested and touching media, search.hpp REFRACTION), a ray in air with
-// reflection_search. A found surface of a medium is completed into its crossing set by
-// coincident_crossings (search.hpp) and resolved by Media::resolve: no interface (the
-// search goes on from the crossing, same depth), or one interface n_from -> n_to.
-// Refraction bends by shading.hpp transmission_between (total internal reflection follows
-// the mirror direction, bounded by max_depth). Reflected rays keep the stack before the
-// crossing, transmitted and coverage-continued rays take the stack after it. The lens
-// modes (--refraction thick_lens|thin_lens, lens.hpp) replace the entry-exit pair of a
-// closed transparent object entered from air by the paraxial lens transfer, then search
-// from the emerging ray.
-//
-// Which shadows the envmap method casts: the same shadow search as abuffer, so that
-// comparing the methods isolates the reflection and refraction lookups.
+// 9). The SAME rules as the exact tracer (raytrace.hpp "THE RULES"), with every ray query
+// but the camera's answered from the one cube map centred on the camera: abuffer searches
+// all layers (multi-bounce), zbuffer the nearest layer only (Patow 1995), envmap looks the
+// map's colour up in one direction (Blinn & Newell 1976; no bounce) and casts the same
+// shadows as abuffer, so that comparing the methods isolates the lookups. Nested dielectrics
+// are decided as the tracer decides them (media.hpp). docs/design/map-shading.md has the
+// whole argument.
 #pragma once
 #include <atomic>
 #include <cstdint>
@@ -93,15 +67,13 @@ struct MapShadingStats {
 // A point on a triangle: what the rules need to shade it.
 // Where a camera fragment is shaded (render_with_map): at up to four points of its
 // triangle's plane, the centroids of its covered samples in each 4x2 quarter of the 4x8
-// mask, weighted by their sample counts. One shading point per fragment is the A-buffer's
-// design, but an edge through the pixel of anything the point's shading depends on (a hard
-// shadow, a silhouette seen in a mirror or through glass) is then all or nothing where
-// the tracer averages its 32 samples: on scenes/default.json the shadows alone cost 5 dB
-// (35.6 dB; 40.7 without shadows), on cornell.json the edges of the room seen in its mirror
-// made most of the remaining error. ADAPTIVE: the first and last covered quarters (the
-// diagonal when all four are) are shaded; only where their colours differ by more than
-// QUARTER_SPLIT_SRGB (sRGB-encoded, any channel) are the others shaded too, else they take
-// the mean of the two.
+// mask, weighted by their sample counts. One shading point per fragment would make an edge
+// through the pixel of anything its shading depends on (a hard shadow, a silhouette seen in
+// a mirror or through glass) all or nothing, where the tracer averages its 32 samples.
+// ADAPTIVE: the first and last covered quarters (the diagonal when all four are) are
+// shaded; only where their colours differ by more than QUARTER_SPLIT_SRGB (sRGB-encoded, any
+// channel) are the others shaded too, else they take the mean of the two.
+// docs/design/map-shading.md says where this matters.
 constexpr double QUARTER_SPLIT_SRGB = 1.0 / 255.0;
 
 struct SurfacePoint {
@@ -135,8 +107,9 @@ class MapShader {
 
   const std::vector<LensFit>& lenses() const { return lenses_; }
   const SearchContext& context() const { return *ctx_; }
-  // SearchRefine::mesh (search.hpp MESH REFINEMENT): besides the crossing searches' candidates,
-  // camera fragments' shading points are moved onto the surface the same way (any mode).
+  // SearchRefine::mesh (docs/design/search.md, MESH REFINEMENT): besides the crossing searches'
+  // candidates, camera fragments' shading points are moved onto the surface the same way (any
+  // mode).
   bool refines_on_mesh() const { return options_.search.refine == SearchRefine::mesh; }
   bool exact_priority() const { return options_.exact_priority; }
 

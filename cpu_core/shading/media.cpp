@@ -137,7 +137,7 @@ Interface Media::resolve(const MediumStack& before, const MediumCrossing* c, siz
     } else if (now.contains(o)) {
       now.remove(o);
     } else {
-      from.add(o, n);  // left without having been entered: it was around the ray (header)
+      from.add(o, n);  // left without having been entered: it was around the ray (THE STACK)
     }
   }
   r.after = now;

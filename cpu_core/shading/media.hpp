@@ -1,52 +1,11 @@
-// NESTED DIELECTRICS (issue 12 part 2): touching and nested transparent objects, decided
-// the same way by the exact tracer (raytrace.hpp) and the map searches (map_shading.hpp).
-//
-// The model is Schmidt & Budge 2002, "Simple nested dielectrics in ray traced images"
-// (journal of graphics tools 7(2)), with one priority rule of ours:
-//
-// MEDIA. A medium is a closed object (SceneObject::closed) crossed on a triangle whose
-// material has kt > 0; its index is that material's ior. Every other surface (opaque, or
-// open: a single refractive quad) is a plain surface, as before this model: an open
-// refractive surface bends between air and its ior by its facing (shading.hpp transmission).
-//
-// THE STACK. A ray carries the media it is inside (MediumStack, in the order entered; a
-// camera ray starts with none: the camera is in air). Crossing a medium's surface against
-// its outward geometric normal enters it, along the normal leaves it. Leaving a medium the
-// stack does not hold (the camera inside a glass, or an entry lost to rounding) is taken as
-// if the ray had been inside it: that reproduces the single-object rule n -> 1.
-//
-// PRIORITY. Where a ray is inside several media at once, the medium it travels in is the
-// one of highest priority: an object outranks another iff its bounding box has the smaller
-// volume, and at equal volume iff it is listed later in the scene (the tie rule,
-// scene/tie_rule.hpp). So a medium nested inside another (its bounds inside the other's)
-// always wins: a ray inside a glass sphere that meets a water sphere inside it enters the
-// water, whatever the order of the objects in the file. Overlapping media (a modelling
-// choice, not nesting) are decided by the same rule: the smaller wins in the overlap.
-//
-// INTERFACES. A ray meets the surfaces along it one CROSSING SET at a time: the first
-// surface crossed and every other surface crossed within coincident_tolerance of it (a
-// face shared by two touching objects is two coincident triangles; a ray through a shared
-// edge of one object crosses two). A crossing set with a plain surface stops the ray at that
-// surface (a glass box standing on an opaque floor: the ray inside the glass sees the
-// floor); the plain surface shaded is the tie winner among them. A set of medium crossings
-// only updates the stack (in order along the ray, a leave before an entry at equal t): the medium
-// before is the top of the stack before, the medium after the top of the stack after, and
-//   - the same medium on both sides (a lower-priority medium's surface inside a higher
-//     one's): NO interface, the ray goes on straight, unshaded, at the same depth (Schmidt &
-//     Budge's false intersection);
-//   - different media: ONE interface from one medium into the other, shaded with the
-//     material of the tie winner among the set's triangles, refracted by Snell with the
-//     ratio n_from / n_to of the two media's indices (air is 1), not n / 1. A shared face
-//     between glass and water bends glass -> water once; between two glass boxes it does
-//     not bend at all.
-// Reflected rays, and the transmitted weight under total internal reflection, keep the
-// stack before the set; transmitted rays and coverage-continued rays (opacity < 1) take the
-// stack after it. Shadow rays are unchanged (every surface crossed filters the light).
-//
-// WHAT THE TIE RULE DECIDES HERE. Which of a crossing set's triangles is shaded: the one
-// ranking highest by the project's single tie rule (scene/tie_rule.hpp ranks_above: the
-// object listed later, then the higher triangle). The crossing set's own window,
-// coincident_tolerance, is wider than the rule's tie_bound (2^-22 of the coordinates): it
+// NESTED DIELECTRICS: touching and nested transparent objects, decided the same way by the
+// exact tracer (raytrace.hpp) and the map searches (map_shading.hpp); the model is Schmidt &
+// Budge 2002, "Simple nested dielectrics in ray traced images", with one priority rule of
+// ours. MEDIA: closed objects crossed on a kt > 0 triangle. THE STACK: the media a ray is
+// inside. PRIORITY: the smaller bounding box wins, then the later object. INTERFACES: the
+// surfaces crossed within coincident_tolerance form one crossing set, which is either no
+// interface or one interface n_from -> n_to, shaded with its tie winner (scene/tie_rule.hpp).
+// docs/design/media.md has the whole argument.
 // also gathers surfaces a few ulps of rounding apart after a transform, as one interface.
 #pragma once
 #include <array>
@@ -74,7 +33,7 @@ constexpr int MEDIA_MAX_PASSES = 64;
 // Largest absolute vertex coordinate plus the diagonal of the vertex bounds (0 when empty).
 double scene_scale(const SceneData& scene);
 
-// The coincident tolerance at point p (INTERFACES above), world units.
+// The coincident tolerance at point p (INTERFACES, docs/design/media.md), world units.
 double coincident_tolerance(const glm::dvec3& p, double scene_scale);
 
 struct MediumStack {
@@ -95,7 +54,7 @@ struct MediumCrossing {
   double t = 0;  // along the ray, for the order
 };
 
-// What a crossing set is (INTERFACES above).
+// What a crossing set is (INTERFACES, docs/design/media.md).
 struct Interface {
   uint32_t triangle = 0;     // the surface shaded
   bool pass = false;         // no interface: go on straight, unshaded, same depth
@@ -109,9 +68,9 @@ class Media {
   Media(const Media&) = delete;
   Media& operator=(const Media&) = delete;
 
-  // Is triangle `tri` a medium's surface (MEDIA above)?
+  // Is triangle `tri` a medium's surface (MEDIA, docs/design/media.md)?
   bool is_medium(uint32_t tri) const;
-  // PRIORITY above: does object a outrank object b?
+  // PRIORITY (docs/design/media.md): does object a outrank object b?
   bool outranks(uint32_t a, uint32_t b) const;
   // The medium a ray with this stack travels in (UINT32_MAX: air) and its index.
   uint32_t top(const MediumStack& s) const;

@@ -67,7 +67,8 @@ glm::dvec3 pack(FragmentList list, CoverageMask search, Shade&& shade, const Tri
     const bool intersecting = j < n && list[j].zmin <= f.zmax &&
                               triangles.object_id[list[j].triangle()] != triangles.object_id[f.triangle()];
     if (intersecting && depth) {
-      // EXACT PRIORITY MASKS (thesis 11.2.4; header): next is in front where its plane is nearer.
+      // EXACT PRIORITY MASKS (thesis 11.2.4; docs/design/resolve.md): next is in front where
+      // its plane is nearer.
       const CoverageMask behind = depth->nearer(f, list[j], in & list[j].mask), front = in & ~behind;
       if (behind != 0) {
         const double w_b = w_in * (mask_count(behind) / static_cast<double>(mask_count(in)));

@@ -1,45 +1,11 @@
-// Resolving an A-buffer list into a pixel colour: Pack_Under_Mask (Carpenter 1984;
-// thesis 5.2.1.1 and 5.2.1.2, the pseudo-code at the end of 5.2.1.2).
-//
-// pack(list, search):
-//   no fragment of the list overlaps `search` (or search is empty) -> the background;
-//   f = the first fragment with f.mask & search != 0;
-//   in = search & f.mask, out = search & ~f.mask, a_in, a_out their bit counts;
-//   C_out = pack(rest after f, out)                                  (if out != 0)
-//   next  = the first fragment after f with next.mask & in != 0;
-//   intersecting = next exists, next's object differs from f's, and next.zmin <= f.zmax
-//                  (thesis 5.2.1.2: "el identificador del objeto difiere y los fragmentos
-//                  se superponen en Z");
-//   intersecting, with the pixel's geometry (SampleDepth; every resolve_image): EXACT
-//   PRIORITY MASKS (thesis 11.2.4, "Exact A_Buffers", its p-masks): per sample of `in`, the two
-//   fragments' triangle planes are met along the sample's own eye ray; behind = the samples
-//   where next's plane is seen before f's by THE TIE RULE (scene/tie_rule.hpp: nearer, or
-//   at the same distance within its float bound and of a later object; so two coplanar
-//   surfaces give the later object every sample, and zmin == zmax ranges are compared
-//   too), front = in & ~behind. Then
-//     C_front  = op_f C_f + (1 - op_f) pack(rest after f, front)
-//     C_behind = op_n C_n + (1 - op_n) (op_f C_f + (1 - op_f) pack(rest after next, behind))
-//   weighted by their bit counts: per sample exact for two surfaces, whatever their angle or
-//   offset (a decal 1e-4 of the scene above a floor, two quads meeting at 1 degree).
-//   intersecting, without geometry (pack_under_mask with no SampleDepth), the thesis' own
-//   estimate from the z ranges (thesis 5.2.1.2):
-//     alpha = op_f * (Vis + (1 - Vis) * (1 - op_next)),
-//     Vis = (zmax_next - zmin_f) / ((zmax - zmin)_f + (zmax - zmin)_next), clamped to [0, 1]
-//     (1 when the denominator is 0). For an opaque front fragment this is the thesis'
-//     alpha_in = Vis*Opacity_front + (1 - Vis)*(1 - alpha_next); the factor op_f extends
-//     it to a transparent front fragment, whose hidden part is seen through `next`.
-//     It treats the whole of `in` alike, so where the z ranges overlap without the
-//     surfaces crossing (a decal on a floor seen at a grazing angle) it blends them.
-//   otherwise alpha = op_f                                            (thesis 5.2.1.1)
-//   C_in  = alpha * C_f + (1 - alpha) * pack(rest after f, in)      (if alpha < 1)
-//         = C_f                                                       (if alpha == 1)
-//   return (a_in * C_in + a_out * C_out) / (a_in + a_out)
-//
-// Every result is a weighted sum of fragment colours and the background, so pack is
-// evaluated with an explicit stack of (list position, mask, weight) items instead of
-// recursion: no stack overflow on long lists, and each fragment is shaded at most once.
-// The work is bounded: the masks of the items at one list position are disjoint, so
-// there are at most 32 items per position.
+// Resolving an A-buffer list into a pixel colour: Pack_Under_Mask (Carpenter 1984; thesis
+// 5.2.1.1 and 5.2.1.2). The first fragment over the search mask splits it into `in` and
+// `out`; where the next fragment of another object overlaps it in z, EXACT PRIORITY MASKS
+// (thesis 11.2.4) decide per sample by THE TIE RULE which plane is seen first (given the
+// pixel's SampleDepth), or the thesis' Vis estimate from the z ranges does (without it).
+// pack is evaluated with an explicit stack of (list position, mask, weight) items: no stack
+// overflow on long lists, each fragment shaded at most once, at most 32 items a position.
+// docs/design/resolve.md has the pseudo-code and the whole argument.
 #pragma once
 #include <functional>
 #include <vector>

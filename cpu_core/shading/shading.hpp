@@ -4,17 +4,14 @@
 //     + sum over lights l:  S_l * I_l * ( kd * Od * max(0, N.L) + ks * max(0, R.V)^n )
 //     + kr * C_reflected + kt * C_transmitted
 //
-// Od = the diffuse colour at the point: material colour times its base-colour texture at
-// the point's uv (diffuse_color in scene/texture.hpp; the material colour alone without
-// one; the functions below take it as `od`, m.color when not given), Ia = scene ambient, I_l = light colour (no distance attenuation),
-// L = unit vector to the light, V = unit vector to the viewer, R = reflect(-L, N).
-// N is the shading normal turned to face the viewer (two-sided lighting), so a surface
-// seen from behind is lit like its front. S_l in [0, 1] is the light's visibility: 1 when
-// unshadowed, 0 behind an opaque blocker, otherwise the product over the blockers of
-// blocker_transmittance = (1 - op) + op * kt * Od (kt * Od for glass, 1 - op for a veil;
-// shadow rays are not refracted). shaders/common_shading.glsl mirrors phong_local for the
-// GPU passes. The secondary-ray rules are at the end of this file; raytrace.hpp composes
-// all of them.
+// Od = material colour times its base-colour texture at the point's uv (diffuse_color in
+// scene/texture.hpp; the functions below take it as `od`, m.color when not given),
+// Ia = scene ambient, I_l = light colour (no distance attenuation), L, V unit vectors to the
+// light and the viewer, R = reflect(-L, N), N the shading normal turned to face the viewer
+// (two-sided lighting). S_l in [0, 1] is the light's visibility: the product over the
+// blockers of blocker_transmittance (shadow rays are not refracted).
+// shaders/common_shading.glsl mirrors phong_local for the GPU passes. The secondary-ray
+// rules are at the end of this file; raytrace.hpp composes all of them.
 #pragma once
 #include <cmath>
 #include <vector>
@@ -188,7 +185,8 @@ inline SecondaryWeights secondary_weights(const Material& m, bool fresnel, const
 
 // Light let through by one surface crossing the shadow segment P..L (rule "shadows";
 // shadow rays are not refracted):  (1 - op) + op * kt * Od, component-wise. Od is the
-// material colour here, untextured (a limit: README "Textures"), on every path alike.
+// material colour here, untextured, on every path alike (a known limit: a translucent
+// textured caster's shadow takes its material colour).
 // An opaque blocker (kt = 0, op = 1) gives 0; a refractive one (op = 1) gives kt * Od;
 // a coverage-transparent one (kt = 0) gives 1 - op. S_l is the product over every
 // crossing, so a closed glass object between P and L counts twice (entry and exit).

@@ -1,40 +1,12 @@
-// The camera pass of the gpu method where the GPU is exact (issue 19; gl_passes.hpp
-// ExactCameraOptions, README "The gpu method at its best").
-//
-// PLANAR MIRRORS (course notes 4.1.2; Kilgard 1999, "Improving shadows and reflections via
-// the stencil buffer"). The stencil value of a sample is the mirror level of the view it
-// shows. A view of level L is drawn where the stencil is L. Then, for each planar reflector
-// of the scene (planar_reflectors.hpp) while L < max_depth:
-//   1. mark: the reflector's own triangles, where they are the visible surface of the
-//      view's depth pass (depth EQUAL: the same vertex stage, invariant), raise the stencil
-//      to L + 1 (an occlusion query skips a mirror that covers no sample; the mirror's
-//      projected bounds become the scissor of what follows);
-//   2. clear that region: depth to the far plane, colour to the background;
-//   3. draw the level L + 1 view there: the scene reflected about the mirror's plane
-//      (model = model_L * R, R the reflection), only what lies in front of the mirror
-//      (gl_ClipDistance on the mirror's plane, turned towards the eye), the mirror itself
-//      left out, each point shaded as seen from the eye reflected (R eye_L), recursively;
-//   4. the mirror's depth written back over its region, the stencil lowered to L.
-// Then the view's colour pass: each surface shaded, a mirror whose view was drawn blended
-// over it, C = C_local + kr * C_behind (dual-source blending; constant kr: a planar
-// reflector neither refracts nor is transparent, so its weights are its material's).
-// This is Whitted's mirror term at the camera's own samples: the virtual view behind a
-// mirror is what the reflected rays of those samples meet (their depth is the unfolded path
-// length; gl_ClipDistance drops what lies between the mirror and the reflected eye). A
-// reflector's views at level max_depth show its local colour only, as the tracer's rays at
-// the depth limit. Past ExactCameraOptions::max_views views a tile, a mirror shows the
-// environment map instead (counted in the stats).
-//
-// SHADOW VOLUMES (course notes 3.3; Everitt & Kilgard 2002, shadow_volume.hpp). Before a
-// view's colour: its depth alone, then per volume light the count of its volume's faces
-// behind or at the visible surface (+1 back, -1 front), in the light's layer of a layered
-// float target (additive blending). The colour pass (depth EQUAL: the
-// same surfaces) reads them: S_l = 0 where the count is not 0 (common_shading.glsl). Virtual
-// views count the volumes through their own model matrix, clipped at their mirror like the
-// surfaces (so that a near cap cut by the clip plane keeps its surface's depths): the ray
-// counted, beyond a point in front of the mirror, never comes back across the mirror's
-// plane, so the prisms' parts behind it are never crossed and the count is the number of
-// prisms holding the reflected point.
+// The camera pass of the gpu method where the GPU is exact (gl_passes.hpp
+// ExactCameraOptions). PLANAR MIRRORS (course notes 4.1.2; Kilgard 1999): the stencil holds
+// the mirror level of the view a sample shows; each visible reflector marks its samples,
+// clears them, and draws the scene reflected about its plane there (clipped at the mirror,
+// recursively to max_depth), so the virtual view is what the reflected rays of those very
+// samples meet; the colour pass blends it in, C = C_local + kr * C_behind. SHADOW VOLUMES
+// (course notes 3.3; Everitt & Kilgard 2002): per volume light, a depth-fail count of its
+// faces at each sample, S_l = 0 where it is not 0. docs/design/gl-camera-exact.md has the
+// whole argument.
 #include <glad/gl.h>
 
 #include <algorithm>

@@ -48,8 +48,8 @@ class EglContext : public GlContext {
       if (context_ != EGL_NO_CONTEXT) eglDestroyContext(display_, context_);
       // The display stays initialised for the process: it is one per platform or device,
       // shared by every context on it (another Renderer's, on another thread, may still be
-      // using it), and Mesa 22 keeps about 15 KB per eglInitialize/eglTerminate cycle
-      // (bench_soak phase 2: +13 MB over 1000 Renderers; +0.09 MB without the cycle).
+      // using it), and Mesa keeps memory at every eglInitialize/eglTerminate cycle, which
+      // would grow with every Renderer made (bench_soak measures it).
       // eglInitialize on an initialised display is a no-op.
       eglReleaseThread();
     }

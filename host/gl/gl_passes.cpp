@@ -75,9 +75,9 @@ GlScene::GlScene(const SceneData& scene, const GlSceneOptions& options)
 
   // The soup's own arrays: positions, normals (per vertex) and each triangle's object and
   // material (read by scene.vert at the vertex's triangle, triangle_ids.glsl). With
-  // GL_AMD_pinned_memory (Mesa's llvmpipe, where a GL buffer is process memory) the buffers
-  // are the soup's memory, not a copy of it (96 bytes a triangle saved); elsewhere they are
-  // copied as they are. The soup outlives this GlScene (the SceneData it reads).
+  // GL_AMD_pinned_memory (Mesa's llvmpipe, where a GL buffer is process memory) the buffers are
+  // the soup's memory, not a second copy of it; elsewhere they are copied as they are. The soup
+  // outlives this GlScene (the SceneData it reads).
   const TriangleSoup& t = *scene.triangles;
   vertex_count_ = static_cast<GLsizei>(t.positions.size());
   glGenVertexArrays(1, &vao_);
@@ -99,8 +99,8 @@ GlScene::GlScene(const SceneData& scene, const GlSceneOptions& options)
   triangle_ids_ = options.triangle_ids && vertex_blocks >= 3 && bindings > static_cast<GLint>(MATERIAL_IDS_BINDING) &&
                   t.triangle_count() * sizeof(uint32_t) <= static_cast<uint64_t>(block);
   if (!triangle_ids_) {
-    // Each vertex carries its ids (8 bytes), copied a chunk at a time: a whole array of them
-    // at once beside the GL buffer was 24 bytes a triangle more at the peak.
+    // Each vertex carries its ids (8 bytes), copied a chunk at a time, so that the peak
+    // never holds a whole array of them beside the GL buffer.
     constexpr size_t CHUNK = 3 * 16384;  // vertices
     glGenBuffers(1, &vertex_ids_);
     glBindBuffer(GL_ARRAY_BUFFER, vertex_ids_);

@@ -1,5 +1,9 @@
-// The GL passes: the six cube faces around the camera (distance prepass, Z-buffer colour)
-// and the camera view (Z-buffer Phong). All read back into cpu_core image types.
+// The GL passes over one uploaded scene (GlScene): the six cube faces around a centre
+// (distance prepass, Z-buffer colour, the environment map), the cube shadow maps with their
+// translucent peels, and the camera view: Z-buffer Phong, or the exact camera pass (planar
+// mirrors by the stencil, shadow volumes, gl_camera_exact.cpp) with its per-pixel flags for
+// the hybrid method; and crosscheck's probes (camera objects, shadow probe). Results are
+// read back into cpu_core image types.
 #pragma once
 #include <glad/gl.h>
 
@@ -46,8 +50,8 @@ enum class CameraSamples { pixel_centre, mask_4x8 };
 // the limit). The uvs go in a vertex buffer of their own, made only when the scene has them.
 constexpr int MAX_TEXTURE_ARRAYS = 4;
 
-// What the camera pass renders exactly where the GPU can (issue 19; gl_camera_exact.cpp, README
-// "The gpu method at its best"): planar mirrors by virtual objects and the stencil test
+// What the camera pass renders exactly where the GPU can (gl_camera_exact.cpp;
+// docs/design/gl-camera-exact.md): planar mirrors by virtual objects and the stencil test
 // (course notes 4.1.2; Kilgard 1999), recursively to max_depth; hard shadows of opaque
 // blockers by shadow volumes counted depth-fail (course notes 3.3; Everitt & Kilgard 2002).
 // What it cannot (curved mirrors, refraction, coverage transparency, more than
@@ -166,11 +170,11 @@ class GlScene {
     fresnel_ = fresnel;
   }
 
-  // abcube crosscheck (issue 19 part 4): at the visible surface of each camera sample (the
-  // 4x8 grid, row 0 at the top, as camera_objects), for the first 16 shadow-casting lights
-  // (`lights`, probe bit k = lights[k]): the lights blocked by an opaque blocker according
-  // to the shadow volumes, according to the cube shadow maps (build_shadow_maps first), and
-  // the lights the surface faces.
+  // abcube crosscheck: at the visible surface of each camera sample (the 4x8 grid, row 0 at
+  // the top, as camera_objects), for the first 16 shadow-casting lights (`lights`, probe bit
+  // k = lights[k]): the lights blocked by an opaque blocker according to the shadow volumes,
+  // according to the cube shadow maps (build_shadow_maps first), and the lights the surface
+  // faces.
   struct ShadowProbe {
     std::vector<int> lights;
     std::vector<uint16_t> volume, map, lit;
@@ -251,9 +255,11 @@ class GlScene {
   int max_size_ = 0;
   void draw_shadow_casters(GLuint maps);
   void peel_translucent_casters(int n, int layers);
+  // The lookup target's size (bind_lookup_target).
   int n_of_lookup_ = 0;
+  // How camera passes look the environment up (set_environment_lookup).
   EnvmapLookup lookup_ = EnvmapLookup::reflected;
-  bool fresnel_ = false;  // the lookup target's size (bind_lookup_target)
+  bool fresnel_ = false;  // Schlick's weights for kr and kt (shading.hpp)
   bool texture_level0_ = false;
   std::unique_ptr<GlProgram> distance_program_, phong_program_, shadow_program_;
   std::unique_ptr<Target> target_;

@@ -17,10 +17,9 @@
 namespace abcube {
 
 // The camera pass renders at most this many samples a side at once (tiles beyond). 1024:
-// on llvmpipe the exact camera pass of the flat-mirror suite at 640 x 480 took 574-993 ms
-// a scene with tiles of 1024, 726-992 with 2048, 817-1308 with 4096, 484-897 with 512
-// (tools/flat_mirror_scenes.py --seed 2, one run each); a mirror's scissor is tighter, and
-// the tile's buffers stay in cache.
+// every tile repeats the passes and draw calls of each view, so smaller tiles cost more of
+// them; larger ones take more memory, give a mirror's scissor less to cut away, and let the
+// tile's buffers fall out of cache. docs/performance.md has the measurements.
 constexpr int CAMERA_TILE = 1024;
 // The largest of the scene's per-vertex arrays, which camera_groups.frag reads as storage
 // buffers: a position or a normal (3 floats; a vertex's ids are 2 words).
@@ -72,9 +71,6 @@ inline void set_pass_state() {
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 }
 
-// The clip coordinates of the full sample grid (full_w x full_h, GL window coordinates, y
-// up) scaled and shifted so that the tile at (x0, y0), tile_w x tile_h, fills the viewport
-// (one tile: identity).
 // The camera's sample grid (full_w x full_h, GL window coordinates, y up) cut into tiles of
 // at most CAMERA_TILE a side, each rendered with a margin of MARGIN_X columns and MARGIN_Y
 // rows around it that is not kept: a triangle far larger than the view (a kilometre of
@@ -92,7 +88,8 @@ struct SampleTiles {
   }
   int target_w() const { return tile_w + 2 * MARGIN_X; }
   int target_h() const { return tile_h + 2 * MARGIN_Y; }
-  // The tile at (x0, y0) of the grid, margins included, filling the viewport.
+  // The tile at (x0, y0) of the grid, margins included, filling the viewport: the full
+  // grid's clip coordinates scaled and shifted (one tile: identity).
   glm::mat4 matrix(int64_t x0, int64_t y0) const;
   // The index in a target-sized readback of sample (gx, gy) of the tile's kept part.
   size_t index(int64_t gx, int64_t gy) const {
@@ -202,8 +199,8 @@ struct GlScene::MirrorView {
 
 // The exact camera pass's buffers beside the camera Target (same size, same depth-stencil
 // texture): the shadow-volume counts, a layer of an R32F array per volume light (additive),
-// drawn through one framebuffer whose colour is the layer being counted. (Four lights a
-// layer of RGBA32F made the count pass of a one-light scene 4 times the bytes to blend.)
+// drawn through one framebuffer whose colour is the layer being counted. (A layer a light
+// rather than four lights a layer of RGBA32F: a scene blends only the bytes of its lights.)
 struct GlScene::ExactBuffers {
   int width = 0, height = 0, layers = 0;
   GLuint counts = 0, fbo = 0;
@@ -230,10 +227,11 @@ struct GlScene::ExactBuffers {
   }
 };
 
-// The per-group shading's buffers beside the camera Target (gl_camera_exact.cpp): the
-// key of each sample of a view (camera_ids.frag, RG32UI, drawn with the target's depth-stencil), and
-// a framebuffer with no attachment, one pixel of it per 8 x 4 samples of the target; the
-// colour and weight of the camera view's pixels shaded whole (RGBA32F, one texel a pixel).
+// The per-group shading's buffers beside the camera Target (gl_camera_exact.cpp): the key
+// of each sample of a view (camera_ids.frag, RG32UI, drawn with the target's
+// depth-stencil), and a framebuffer with no attachment, one pixel of it per 8 x 4 samples
+// of the target; the colour and weight of the camera view's pixels shaded whole (RGBA32F,
+// one texel a pixel).
 struct GlScene::VisibilityBuffers {
   int width = 0, height = 0;
   GLuint ids = 0, fbo = 0, pixels_fbo = 0, pixel_color = 0, pixel_weight = 0;

@@ -37,15 +37,15 @@ PixelShader local_phong_shader(const SceneData& scene, const ABuffer& buffer) {
 // is opaque, no fragment behind it reaches into its depth range, and its triangle alone
 // covers them all. The last rule leaves out the fragments the A-buffer merged (thesis
 // 5.2.1: two triangles of one smooth surface sharing the pixel become one fragment with
-// their area-weighted normal): there the CPU shades that averaged normal on one
-// triangle's plane, the GPU each triangle's own, and the two differ by as much as the
-// shading varies across the pixel (a sharp highlight on a coarse sphere: 0.017 of the
-// displayed range), which is the A-buffer's approximation, not a convention to check.
-// Interior pixels are shaded at one point on both sides: the pixel centre (the centroid
-// of the full mask) on the same triangle. The GPU image samples that centre, which is not
-// one of the 32 samples: a feature thinner than the samples' spacing can cover it and
-// none of them (thin wires: the GPU shows the wire, the A-buffer what is behind). So the
-// exact tracer's ray through the centre must meet the same triangle too.
+// their area-weighted normal): there the CPU shades that averaged normal on one triangle's
+// plane, the GPU each triangle's own, and the two differ by as much as the shading varies
+// across the pixel (a sharp highlight on a coarse sphere), which is the A-buffer's
+// approximation, not a convention to check. Interior pixels are shaded at one point on both
+// sides: the pixel centre (the centroid of the full mask) on the same triangle. The GPU
+// image samples that centre, which is not one of the 32 samples: a feature thinner than the
+// samples' spacing can cover it and none of them (thin wires: the GPU shows the wire, the
+// A-buffer what is behind). So the exact tracer's ray through the centre must meet the same
+// triangle too.
 bool interior_pixel(const SceneData& scene, const ABuffer& camera, const RayTracer& tracer, int x, int y) {
   const FragmentList list = camera.list(x, y);
   if (list.empty() || list[0].mask != FULL_MASK) return false;
@@ -299,7 +299,7 @@ void compare_shadows(const SceneData& scene, int n, int threads, GlScene& gl, Cr
 CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const CrosscheckTolerances& tol) {
   CrosscheckResult r;
   GlScene gl(scene);
-  gl.set_texture_level0(true);  // the CPU's point samples (README "Textures")
+  gl.set_texture_level0(true);  // the CPU's point samples (scene/texture.hpp)
   compare_cube(scene, n, threads, gl, &r);
   compare_camera(scene, threads, gl, &r);
   compare_shadows(scene, n, threads, gl, &r);

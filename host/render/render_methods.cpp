@@ -30,8 +30,8 @@ json gl_json(const GlContext* ctx) {
   return j;
 }
 
-// What the exact camera pass rendered (issue 19): per kind of surface, the path it took and
-// why. `curved`: what curved mirrors and refraction took; `maps`: shadow maps were built.
+// What the exact camera pass rendered: per kind of surface, the path it took and why.
+// `curved`: what curved mirrors and refraction took; `maps`: shadow maps were built.
 json gpu_paths_json(const GlScene& gl, const RenderRequest& request, const std::string& curved, bool maps) {
   const ExactCameraStats& ex = gl.exact_camera_stats();
   return {
@@ -94,7 +94,7 @@ Image render_gpu(MethodContext& mc) {
   gl.set_exact_camera(mc.request.gpu);
   check_deadline();
   // The camera view at the A-buffer's 4x8 sample positions, box-filtered as its resolve
-  // weighs the masks: the same edges as abuffer (issue 12 part 4).
+  // weighs the masks: the same edges as abuffer.
   Image image = gl.camera_color(scene.camera, CameraSamples::mask_4x8);
   passes.push_back("camera_raster");
   skipped.push_back({{"pass", "cube_distance"}, {"why", "method gpu does no map search"}});
@@ -130,14 +130,14 @@ void copy_pixels(const Image& from, const std::vector<uint8_t>& mask, Image* to)
 
 }  // namespace
 
-// HYBRID (issue 19 part 5): each kind of surface by the path that is exact and cheaper.
-// The GPU renders the camera view by its exact camera pass (planar mirrors by the stencil
-// test, opaque shadows by volumes, textures point-sampled as the CPU does), building no
-// cube map at all; each sample counts the surfaces on its path the GPU would only
-// approximate (curved mirrors, refraction, light through translucent casters:
-// camera_exact.frag). The pixels with such a sample are rendered again, alone, by the
-// abuffer method on the CPU (its cube map searches, its shadow searches); the others keep
-// the GPU's colour. So hybrid is abuffer wherever the GPU is not exact, and exact elsewhere.
+// HYBRID: each kind of surface by the path that is exact and cheaper. The GPU renders the
+// camera view by its exact camera pass (planar mirrors by the stencil test, opaque shadows
+// by volumes, textures point-sampled as the CPU does), building no cube map at all; each
+// sample counts the surfaces on its path the GPU would only approximate (curved mirrors,
+// refraction, light through translucent casters: camera_exact.frag). The pixels with such a
+// sample are rendered again, alone, by the abuffer method on the CPU (its cube map searches,
+// its shadow searches); the others keep the GPU's colour. So hybrid is abuffer wherever the
+// GPU is not exact, and exact elsewhere.
 Image render_hybrid(MethodContext& mc) {
   const SceneData& scene = mc.scene;
   json& stats = mc.stats;

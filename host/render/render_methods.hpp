@@ -49,7 +49,7 @@ Image render_gpu(MethodContext& mc);
 // needs it (a reflecting or refracting material, a shadow-casting light). `only`
 // (optional): the pixels to render, the others black.
 Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only = nullptr);
-// The hybrid method (README "The gpu method at its best"): the GPU's exact camera pass,
+// The hybrid method (docs/design/gpu-exact-paths.md): the GPU's exact camera pass,
 // and the abuffer method on the CPU for the pixels whose samples meet a surface the GPU
 // only approximates.
 Image render_hybrid(MethodContext& mc);

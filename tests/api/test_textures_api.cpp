@@ -1,4 +1,4 @@
-// Base-colour textures through the library (README "Textures"): the tracer and the
+// Base-colour textures through the library (docs/models-and-textures.md): the tracer and the
 // A-buffer map methods show the same texture, and every image is the same for any
 // thread count.
 #include <gtest/gtest.h>

@@ -30,7 +30,7 @@ done
 # checked again from the stats. (Before interior pixels had to be one triangle over the
 # whole pixel and its centre, and the nearest layer picked the triangle holding the texel
 # centre between coplanar neighbours, the interior colour and the cube's same-object share
-# failed on some templates: README "GPU against CPU".)
+# failed on some templates: docs/design/gpu-cpu-crosscheck.md.)
 scene=default
 "$ABCUBE" crosscheck "$REPO/scenes/$scene.json" --cube-res 96 --samples-image "$WORK/samples.exr" \
   --stats "$WORK/samples.json" > /dev/null 2>&1

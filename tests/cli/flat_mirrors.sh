@@ -82,7 +82,7 @@ for scene in "$WORK"/hard/*.json; do
 done
 # Many camera tiles (640x480: 5 x 2 tiles of 1024 samples). light_on_mirror_3_4: the light
 # 1e-6 above the mirror table's top. Casting from a closed object's light-facing faces alone
-# when the light is outside it (tried, README "Shadow volumes") lost the shadow in lines
+# when the light is outside it (tried, docs/design/gpu-exact-paths.md) lost the shadow in lines
 # along the tiles' seams there: hybrid 34.0 dB against abuffer's 55.3 (at N = 512; one tile,
 # 128x96, showed nothing). light_on_open_mirror: the light on, or 1e-6 above or below, an
 # open mirror quad, whose volume's sides and far caps reach infinity nearly in its plane and

@@ -6,7 +6,7 @@
 # by pixels must be as near the exact tracer as the one shaded by samples, less 0.5 dB, or
 # reach 60 dB (the shading point of a pixel is its samples' mean, a second-order change; the
 # environment map's term is the mean of the samples' lookups, and a group seen too obliquely
-# is shaded once a sample: README, "Shading once a pixel and surface", has the figures over
+# is shaded once a sample: docs/performance.md has the figures over
 # many seeds); and the two images must agree to 40 dB. Then the stats name the technique, and a
 # scene of 33 shadow-casting lights (a sample's key holds 32) falls back to samples, saying
 # why. Usage (ctest runs it so): bash gpu_shading.sh /path/to/abcube /path/to/repo

@@ -313,7 +313,7 @@ void restrict_to_shared_model(SceneData* s) {
     }
     if (m.opacity < 1.0) m.reflect = 0.0;
   }
-  s->textures = nullptr;  // export-pov writes no textures (README "Textures"): the material colour alone
+  s->textures = nullptr;  // export-pov writes no textures (docs/models-and-textures.md): the material colour alone
 }
 
 TEST(Pov, RepositoryScenesMatchOnTheSharedModel) {

@@ -1062,7 +1062,7 @@ TEST(SceneLoadLimits, MtllibOutsideTheRootIsRefusedBeforeItIsRead) {
   EXPECT_EQ(s.materials[s.objects[0].material].color, glm::dvec3(1, 0, 0));
 }
 
-// Textures under --root (README "Textures"): a scene material's texture, an MTL map_Kd
+// Textures under --root (docs/models-and-textures.md): a scene material's texture, an MTL map_Kd
 // and a symbolic link inside the root that points out of it; refused before the image is
 // read (the file outside holds no image: its content would show in a decode error).
 std::string textured_scene(const TempDir& dir, const std::string& texture) {

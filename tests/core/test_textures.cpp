@@ -1,4 +1,4 @@
-// Base-colour textures (scene/texture.hpp, README "Textures"): decoding and colour space,
+// Base-colour textures (scene/texture.hpp, docs/models-and-textures.md): decoding and colour space,
 // the sampler's known answers (texel centres, wrap, v up), uvs from OBJ vt and the
 // primitives, an embedded image, the rule Od = colour * texture in the tracer and the map
 // paths, and the errors a missing or corrupt image gives.

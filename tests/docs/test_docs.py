@@ -139,3 +139,11 @@ def test_example_runs(doc, line, language, code, tmp_path):
         if path.suffix in (".png", ".exr") and not path.is_symlink() and "." not in path.stem:
             image = abcube.read_image(str(path))
             assert image.mean() > 0.01, f"{path.name} from {doc.relative_to(SRC)}:{line} is black ({image.mean():.4f})"
+
+
+def test_product_source_holds_no_history():
+    """Comments state invariants and reasons: dates and issue numbers go to commit messages
+    and CHANGELOG.md, figures to bench/results and docs/performance.md."""
+    out = subprocess.run(["git", "-C", str(SRC), "grep", "-nE", r"20[0-9]{2}-[01][0-9]-[0-3][0-9]|[Ii]ssue [0-9]+",
+                          "--", "cpu_core", "host", "include", "python", "shaders"], capture_output=True, text=True)
+    assert out.returncode == 1 and not out.stdout, out.stdout[:2000]

@@ -1,4 +1,4 @@
-// What the fuzz harnesses check beyond "no crash" (README "Robustness"): a scene that
+// What the fuzz harnesses check beyond "no crash" (docs/robustness.md): a scene that
 // loads satisfies its invariants, and a refused input is refused with one short line that
 // says where. A broken rule prints what broke on stderr and aborts, which libFuzzer reports
 // as a crash (and keeps the input) and the replay test (fuzz_replay.cpp) as a failure.

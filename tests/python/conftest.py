@@ -1,4 +1,4 @@
-"""Shared fixtures of the Python module's tests (../shared/python.md).
+"""Shared fixtures of the Python module's tests (docs/python.md).
 
 ctest runs them with PYTHONPATH=build/python, ABCUBE_SOURCE_DIR (the repository) and
 ABCUBE_BIN (the abcube program); by hand:

@@ -1,4 +1,4 @@
-"""Every line of ../shared/python.md, on small images."""
+"""Every form docs/python.md promises, on small images."""
 import copy
 import math
 import shutil
