@@ -33,6 +33,17 @@ py::dict compare(const py::handle& a, const py::handle& b) {
   out["max_abs"] = error.max_abs;
   out["share_over_1_255"] = error.share_over_1;
   out["share_over_2_255"] = error.share_over_2;
+  out["share_over_8_255"] = error.share_over_8;
+  out["worst_pixel"] = py::make_tuple(error.worst_x, error.worst_y);
+  out["worst_channel"] = std::string(1, "RGB"[error.worst_channel]);
+  out["linear_rmse"] = error.linear_rmse;
+  out["linear_max_abs"] = error.linear_max_abs;
+  out["relative_mean"] = error.relative_mean;
+  out["hdr"] = error.hdr;
+  // The difference image: |a - b| per channel, linear, the shape of the inputs.
+  Image diff(image_a.width, image_a.height, image_a.channels);
+  for (size_t i = 0; i < diff.data.size(); ++i) diff.data[i] = std::abs(image_a.data[i] - image_b.data[i]);
+  out["diff"] = image_to_array(std::move(diff));
   return out;
 }
 
@@ -49,7 +60,9 @@ py::array read(const py::handle& path_object) {
 void write(const py::handle& path_object, const py::handle& array) {
   const std::string path = path_arg(path_object, "write_image: path");
   if (!image_format_supported(path)) {
-    throw InputError(path + ": no image writer for this file extension");
+    std::string known;
+    for (const std::string& e : writable_image_extensions()) known += (known.empty() ? "" : ", ") + e;
+    throw InputError(path + ": no image writer for this file extension (" + known + ")");
   }
   const Image image = array_to_image(array, "write_image: image");
   py::gil_scoped_release release;
@@ -62,8 +75,13 @@ void bind_image(py::module_& m) {
   m.def("compare", &compare, py::arg("a"), py::arg("b"),
         R"doc(Error of image `a` against image `b` (float arrays of one shape, H x W x C),
 as `abcube compare` prints it, on sRGB-encoded values clamped to [0, 1]:
-{"rmse", "psnr_db" (inf when identical), "max_abs", "share_over_1_255",
-"share_over_2_255" (share of pixels whose largest channel differs by more than 1/255, 2/255)}.)doc");
+"rmse", "psnr_db" (inf when identical), "max_abs", "share_over_1_255", "share_over_2_255",
+"share_over_8_255" (shares of pixels whose largest channel differs by more than 1/255,
+2/255, 8/255), "worst_pixel" ((x, y) of the largest difference, first in reading order)
+and "worst_channel" ("R", "G" or "B"); on the linear values themselves (HDR included):
+"linear_rmse", "linear_max_abs", "relative_mean" (mean of |a - b| / max(|b|, 1/255)) and
+"hdr" (a value above 1 in either); and "diff", the difference image |a - b| (float32, the
+inputs' shape).)doc");
   m.def("read_image", &read, py::arg("path"),
         R"doc(Reads an image file (format by extension) as a float32 array H x W x C
 (H x W for one channel), linear: sRGB-encoded files (PNG, JPEG) are decoded.)doc");

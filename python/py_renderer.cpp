@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <abcube/options.hpp>
+#include <abcube/report.hpp>
 #include <nlohmann/json.hpp>
 
 #include <pybind11/stl.h>
@@ -254,6 +255,43 @@ const std::string& render_doc() {
 
 }  // namespace
 
+// abcube.report: the comparison page, as `abcube report`.
+py::dict report(const py::handle& scene_object, const py::handle& dir, const py::handle& methods,
+                const py::handle& sweep, const py::handle& crosscheck, const py::handle& gl,
+                const py::handle& gl_device, const py::kwargs& kwargs) {
+  if (!py::isinstance<Scene>(scene_object)) {
+    throw InputError("scene: must be an abcube.Scene (load_scene, scene_from_dict), got " + type_name(scene_object));
+  }
+  ReportOptions o;
+  const std::string folder = path_arg(dir, "dir");
+  if (!methods.is_none()) {
+    if (py::isinstance<py::str>(methods) || !py::isinstance<py::sequence>(methods)) {
+      throw InputError("methods: must be a list of method names, got " + type_name(methods));
+    }
+    o.methods.clear();
+    for (const py::handle m : methods) o.methods.push_back(string_arg(m, "methods[]"));
+  }
+  if (!sweep.is_none()) {
+    if (!py::isinstance<py::sequence>(sweep)) throw InputError("sweep: must be a list of cube resolutions N");
+    for (const py::handle n : sweep) o.sweep.push_back(int_arg(n, "sweep[]"));
+  }
+  o.crosscheck = bool_arg(crosscheck, "crosscheck");
+  o.renderer.gl = string_arg(gl, "gl");
+  o.renderer.gl_device = int_arg(gl_device, "gl_device");
+  bool want_stats = false;
+  const RenderSetup setup = setup_from_kwargs(kwargs, &want_stats);
+  o.render = setup.render;
+  const Scene scene = scene_object.cast<Scene>().with_overrides(setup.set);
+  ReportResult r;
+  {
+    py::gil_scoped_release release;
+    r = write_report(scene, folder, o);
+  }
+  py::dict out = py::module_::import("json").attr("loads")(r.json);
+  out["index_html"] = r.index_html;
+  return out;
+}
+
 // The option table as Python data: a list of dicts, one an option.
 py::list option_table() {
   static const char* const KINDS[] = {"choice", "integer", "number", "flag", "path", "text", "vec3", "names", "setting"};
@@ -278,6 +316,18 @@ py::list option_table() {
 }
 
 void bind_renderer(py::module_& m) {
+  m.def("report", &report, py::arg("scene"), py::arg("dir"), py::kw_only(), py::arg("methods") = py::none(),
+        py::arg("sweep") = py::none(), py::arg("crosscheck") = true, py::arg("gl") = "auto", py::arg("gl_device") = -1,
+        R"doc(report(scene, dir, *, methods=None, sweep=None, crosscheck=True, gl="auto", gl_device=-1, **options)
+
+Writes the comparison page of `abcube report` into the folder `dir`: the scene rendered by
+each method (default: abuffer, gpu, hybrid, zbuffer, envmap) and by the exact tracer,
+their errors (per method, per kind of surface and per object), heat maps, time per pass,
+abuffer again at each cube resolution N of `sweep` (speed against error), and the GPU
+against the CPU (crosscheck=True, where GL works). The other keywords are render options,
+as Renderer.render takes them (width=, height=, camera=, set=, max_depth=, ...). Returns
+report.json's content as a dict, with "index_html" the page's path. SceneError for a bad
+argument; a method that cannot render here is on the page with its reason.)doc");
   m.def("render_options", &option_table,
         R"doc(The render options, one dict each: key (the keyword of Renderer.render and the batch
 job key), flag (the command line's), kind, scope ("job": any render; "process": the

@@ -40,22 +40,43 @@ ImageError image_error(const Image& a, const Image& b) {
     e.psnr = std::numeric_limits<double>::infinity();
     return e;
   }
-  double sum_sq = 0;
-  size_t over1 = 0, over2 = 0;
+  double sum_sq = 0, linear_sq = 0, relative = 0;
+  size_t over1 = 0, over2 = 0, over8 = 0;
   for (int y = 0; y < a.height; ++y) {
     for (int x = 0; x < a.width; ++x) {
       const glm::dvec3 d = glm::abs(displayed(a, x, y) - displayed(b, x, y));
       sum_sq += glm::dot(d, d);
       const double m = std::max(d.x, std::max(d.y, d.z));
-      e.max_abs = std::max(e.max_abs, m);
+      if (m > e.max_abs) {
+        e.max_abs = m;
+        e.worst_x = x;
+        e.worst_y = y;
+        e.worst_channel = d.x == m ? 0 : d.y == m ? 1 : 2;
+      }
       if (m > 1.0 / 255.0 + SHARE_SLACK) ++over1;
       if (m > 2.0 / 255.0 + SHARE_SLACK) ++over2;
+      if (m > 8.0 / 255.0 + SHARE_SLACK) ++over8;
+      const glm::dvec3 la(a.rgb(x, y)), lb(b.rgb(x, y));
+      const glm::dvec3 ld = glm::abs(la - lb);
+      linear_sq += glm::dot(ld, ld);
+      e.linear_max_abs = std::max(e.linear_max_abs, std::max(ld.x, std::max(ld.y, ld.z)));
+      for (int k = 0; k < 3; ++k) relative += ld[k] / std::max(std::abs(lb[k]), 1.0 / 255.0);
+      e.hdr = e.hdr || std::max(la.x, std::max(la.y, la.z)) > 1.0 || std::max(lb.x, std::max(lb.y, lb.z)) > 1.0;
     }
   }
-  e.rmse = std::sqrt(sum_sq / (3.0 * static_cast<double>(pixels)));
+  const double n = static_cast<double>(pixels);
+  e.rmse = std::sqrt(sum_sq / (3.0 * n));
   e.psnr = e.rmse > 0.0 ? 20.0 * std::log10(1.0 / e.rmse) : std::numeric_limits<double>::infinity();
-  e.share_over_1 = static_cast<double>(over1) / static_cast<double>(pixels);
-  e.share_over_2 = static_cast<double>(over2) / static_cast<double>(pixels);
+  e.share_over_1 = static_cast<double>(over1) / n;
+  e.share_over_2 = static_cast<double>(over2) / n;
+  e.share_over_8 = static_cast<double>(over8) / n;
+  e.linear_rmse = std::sqrt(linear_sq / (3.0 * n));
+  e.relative_mean = relative / (3.0 * n);
+  const glm::vec3 wa = a.rgb(e.worst_x, e.worst_y), wb = b.rgb(e.worst_x, e.worst_y);
+  for (int k = 0; k < 3; ++k) {
+    e.worst_a[k] = wa[k];
+    e.worst_b[k] = wb[k];
+  }
   return e;
 }
 
@@ -159,6 +180,74 @@ double ErrorStats::share_within(double bound) const {
 double ErrorStats::miss_share() const {
   const uint64_t n = total();
   return n == 0 ? 0.0 : static_cast<double>(misses_) / static_cast<double>(n);
+}
+
+namespace {
+
+// A 3 x 5 pixel font for the legend's numbers: each glyph's rows, top first, 3 bits each
+// (the high bit the left column).
+int glyph_row(char c, int row) {
+  static const char* const DIGITS = "0123456789/";
+  static const int GLYPHS[11][5] = {
+      {7, 5, 5, 5, 7}, {2, 6, 2, 2, 7}, {7, 1, 7, 4, 7}, {7, 1, 7, 1, 7}, {5, 5, 7, 1, 1}, {7, 4, 7, 1, 7},
+      {7, 4, 7, 5, 7}, {7, 1, 2, 2, 2}, {7, 5, 7, 5, 7}, {7, 5, 7, 1, 7}, {1, 1, 2, 4, 4}};
+  for (int i = 0; i < 11; ++i) {
+    if (DIGITS[i] == c) return GLYPHS[i][row];
+  }
+  return 0;
+}
+
+void draw_text(Image& img, int x0, int y0, const std::string& text, int scale, const glm::vec3& colour) {
+  for (size_t i = 0; i < text.size(); ++i) {
+    for (int row = 0; row < 5; ++row) {
+      const int bits = glyph_row(text[i], row);
+      for (int col = 0; col < 3; ++col) {
+        if (!(bits & (4 >> col))) continue;
+        for (int dy = 0; dy < scale; ++dy) {
+          for (int dx = 0; dx < scale; ++dx) {
+            const int x = x0 + (static_cast<int>(i) * 4 + col) * scale + dx, y = y0 + row * scale + dy;
+            if (x >= 0 && y >= 0 && x < img.width && y < img.height) img.set_rgb(x, y, colour);
+          }
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
+Image with_heatmap_legend(const Image& heat) {
+  // The ramp's stops, in 1/255 of a displayed value, evenly spaced along the bar.
+  static const int STOPS[] = {0, 1, 2, 4, 8, 32, 128};
+  constexpr int SEGMENTS = 6;
+  const int scale = heat.width >= 320 ? 2 : 1;
+  const int bar = 6 * scale, gap = 2 * scale, text = 5 * scale;
+  const int strip = gap + bar + gap + text + gap;
+  Image out(heat.width, heat.height + strip, 3, 0.f);
+  std::copy(heat.data.begin(), heat.data.end(), out.data.begin());
+  // Room for the first label's left half and for the last label, "128/255", after its stop.
+  const int margin = 4 * scale + 1;
+  const int span = std::max(1, heat.width - 2 * margin - 22 * scale);
+  const auto linear = [](const glm::dvec3& shown) {
+    return glm::vec3(srgb_decode(static_cast<float>(shown.r)), srgb_decode(static_cast<float>(shown.g)),
+                     srgb_decode(static_cast<float>(shown.b)));
+  };
+  for (int x = 0; x < heat.width; ++x) {
+    const double t = std::clamp(static_cast<double>(x - margin) / span, 0.0, 1.0) * SEGMENTS;
+    const int i = std::min(static_cast<int>(t), SEGMENTS - 1);
+    const double d = (STOPS[i] + (t - i) * (STOPS[i + 1] - STOPS[i])) / 255.0;
+    for (int y = 0; y < bar; ++y) out.set_rgb(x, heat.height + gap + y, linear(heatmap_ramp(d)));
+  }
+  if (heat.width >= 60) {  // narrower, the numbers would overlap: the bar alone
+    const glm::vec3 white(1.f);
+    for (int i = 0; i <= SEGMENTS; ++i) {
+      const std::string label = std::to_string(STOPS[i]) + (i == SEGMENTS ? "/255" : "");
+      const int digits = static_cast<int>(std::to_string(STOPS[i]).size());
+      const int x = margin + span * i / SEGMENTS - digits * 2 * scale;  // the number centred on its stop
+      draw_text(out, std::max(0, x), heat.height + gap + bar + gap, label, scale, white);
+    }
+  }
+  return out;
 }
 
 }  // namespace abcube

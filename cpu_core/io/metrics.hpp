@@ -28,6 +28,10 @@ double share_over(const Image& a, const Image& b, double threshold);
 // the image holds their linear values, so an 8-bit file shows exactly these).
 Image error_heatmap(const Image& a, const Image& b);
 
+// `heat` (an error_heatmap) with its legend drawn in beneath: the ramp as a bar with its
+// stops (0, 1, 2, 4, 8, 32, 128/255) written under it; the same width, a strip taller.
+Image with_heatmap_legend(const Image& heat);
+
 // The displayed colour ramp above for a difference d in [0, 1] (sRGB-encoded RGB).
 glm::dvec3 heatmap_ramp(double d);
 

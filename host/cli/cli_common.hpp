@@ -22,6 +22,7 @@ CommandRun add_compare_command(CLI::App& app);
 CommandRun add_info_command(CLI::App& app);
 CommandRun add_export_pov_command(CLI::App& app);
 CommandRun add_crosscheck_command(CLI::App& app);
+CommandRun add_report_command(CLI::App& app);
 
 // The render options of the table (<abcube/options.hpp>) as command-line flags of a
 // subcommand: their help, defaults and units from the table; their values checked by it.

@@ -5,10 +5,13 @@
 #include <cstdio>
 #include <memory>
 
+#include <nlohmann/json.hpp>
+
 #include "cli/cli_common.hpp"
 #include "base/error.hpp"
 #include "io/image_io.hpp"
 #include "io/metrics.hpp"
+#include "render/stats_json.hpp"
 
 namespace abcube {
 
@@ -20,7 +23,7 @@ struct CompareCommand {
   // 0..1; default one 8-bit code); the comparison fails when more than `fail_percent`
   // percent of pixels fail (default 0).
   double fail = 1.0 / 255.0, fail_percent = 0.0;
-  bool exact = false;
+  bool exact = false, json_output = false;
 
   int run() const {
     check_output_path(diff_path, true);
@@ -38,18 +41,34 @@ struct CompareCommand {
     }
     const ImageError e = image_error(ia, ib);
     const double failing = share_over(ia, ib, fail);
+    const bool pass = 100.0 * failing <= fail_percent;
+    if (!diff_path.empty()) write_image(diff_path, with_heatmap_legend(error_heatmap(ia, ib)));
+    if (json_output) {
+      nlohmann::json j = image_error_json(e);
+      j["a"] = a;
+      j["b"] = b;
+      j["width"] = ia.width;
+      j["height"] = ia.height;
+      j["fail"] = {{"threshold", fail}, {"share", failing}, {"allowed_percent", fail_percent}};
+      j["pass"] = pass;
+      std::printf("%s\n", j.dump(2).c_str());
+      return pass ? 0 : 1;
+    }
     std::printf("RMSE        %.6g\n", e.rmse);
     if (std::isfinite(e.psnr)) {
       std::printf("PSNR        %.2f dB\n", e.psnr);
     } else {
       std::printf("PSNR        inf (identical)\n");
     }
-    std::printf("max abs     %.6g (%.1f/255)\n", e.max_abs, e.max_abs * 255.0);
+    std::printf("max abs     %.6g (%.1f/255) at (%d, %d, %c): %.6g against %.6g (linear)\n", e.max_abs,
+                e.max_abs * 255.0, e.worst_x, e.worst_y, "RGB"[e.worst_channel], e.worst_a[e.worst_channel],
+                e.worst_b[e.worst_channel]);
     std::printf("over 1/255  %.4f%% of pixels\n", 100.0 * e.share_over_1);
     std::printf("over 2/255  %.4f%% of pixels\n", 100.0 * e.share_over_2);
+    std::printf("over 8/255  %.4f%% of pixels\n", 100.0 * e.share_over_8);
+    std::printf("linear      RMSE %.6g, max abs %.6g, mean relative %.6g%s\n", e.linear_rmse, e.linear_max_abs,
+                e.relative_mean, e.hdr ? " (values above 1: the displayed figures above clamp them)" : "");
     std::printf("over --fail %.6g: %.4f%% of pixels (allowed %.4f%%)\n", fail, 100.0 * failing, fail_percent);
-    if (!diff_path.empty()) write_image(diff_path, error_heatmap(ia, ib));
-    const bool pass = 100.0 * failing <= fail_percent;
     std::printf("%s\n", pass ? "PASS" : "FAIL");
     return pass ? 0 : 1;
   }
@@ -62,12 +81,14 @@ CommandRun add_compare_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("compare", "RMSE, PSNR, max abs error and the share of pixels over a threshold");
   cmd->add_option("A", c->a, "first image")->required();
   cmd->add_option("B", c->b, "second image")->required();
-  cmd->add_option("--diff", c->diff_path, "write a per-pixel error heat map here");
+  cmd->add_option("--diff", c->diff_path,
+                  "write a per-pixel error heat map here, its legend beneath (black 0 ... red 128/255)");
   cmd->add_option("--fail", c->fail, "a pixel fails above this difference, displayed values in [0, 1]")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--failpercent", c->fail_percent, "the comparison fails above this share of failing pixels, %")
       ->capture_default_str()->check(CLI::Range(0.0, 100.0));
   cmd->add_flag("--exact", c->exact, "pass only when every float is the same (bit for bit, before encoding)");
+  cmd->add_flag("--json", c->json_output, "print every figure as one JSON object instead of the text");
   return [c] { return c->run(); };
 }
 

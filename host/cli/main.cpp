@@ -65,7 +65,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", version_string());
   app.require_subcommand(1, 1);
   const CommandRun runs[] = {add_render_command(app),  add_batch_command(app),      add_compare_command(app),
-                             add_info_command(app),    add_export_pov_command(app), add_crosscheck_command(app)};
+                             add_info_command(app),    add_export_pov_command(app), add_crosscheck_command(app),
+                             add_report_command(app)};
   // A first word that is no option and no command is named as such (CLI11 would only say
   // that a subcommand is required).
   if (argc > 1 && argv[1][0] != '-') {

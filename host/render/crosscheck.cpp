@@ -123,6 +123,7 @@ void compare_camera(const SceneData& scene, int threads, GlScene& gl, Crosscheck
   ResolveOptions ro;
   ro.threads = threads;
   const Image cpu = resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera), scene.background, ro);
+  r->cpu_image = cpu;
   // Interior: one triangle over all 32 samples and the centre, none of them at an edge tie
   // (edge_ties.hpp).
   const std::vector<uint8_t> tie_pixels = edge_tie_pixels(scene);
@@ -372,6 +373,24 @@ Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options
                          {"triangles_degenerate", s.triangles_degenerate},
                          {"triangles_clipped", s.triangles_clipped}, {"triangles_culled", s.triangles_culled}};
   return image;
+}
+
+Image disagreement_overlay(const Image& share, const Image& base) {
+  Image out(share.width, share.height, 3);
+  const bool has_base = base.width == share.width && base.height == share.height;
+  for (int y = 0; y < share.height; ++y) {
+    for (int x = 0; x < share.width; ++x) {
+      const float s = share.at(x, y)[0];
+      if (s > 0) {
+        out.set_rgb(x, y, glm::vec3(1.f, std::min(1.f, s), 0.f));
+        continue;
+      }
+      const glm::vec3 c = has_base ? base.rgb(x, y) : glm::vec3(0.02f);
+      const float grey = 0.5f * (0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b);
+      out.set_rgb(x, y, glm::vec3(grey));
+    }
+  }
+  return out;
 }
 
 }  // namespace abcube

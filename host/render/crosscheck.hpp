@@ -78,6 +78,7 @@ struct CrosscheckResult {
   double sample_agreement = 0;
   // Per pixel, how many of its 32 samples disagree (an image for `crosscheck --samples-image`).
   Image sample_disagreement;
+  Image cpu_image;  // the CPU A-buffer's camera image with local Phong (what interior pixels compare)
   // Shadows: the GPU's shadow volumes and cube shadow maps, and the CPU's shadow search
   // in the cube A-buffer, each against the exact tracer, sample by sample, on the first
   // 16 shadow-casting lights; `shadow_disagreement`: per pixel, the share of its (sample,
@@ -93,6 +94,11 @@ struct CrosscheckResult {
 
 // Runs both paths on `scene` (a GL context must be current) with n x n faces.
 CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const CrosscheckTolerances& tol = {});
+
+// A one-channel share in [0, 1] a pixel (sample_disagreement, shadow_disagreement) drawn
+// so that a person sees where: `base` (same size, or empty for a dark grey) in grey at half
+// brightness, and every pixel whose share is above 0 in red, to yellow at a share of 1.
+Image disagreement_overlay(const Image& share, const Image& base);
 
 nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolerances& tol);
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -464,6 +465,38 @@ void refuse_options_unused_by(const std::string& scene_method, const RenderOptio
     if (m.empty() || std::find(m.begin(), m.end(), method) != m.end()) continue;
     if (!e.read(setup).is_null()) throw OptionError(e.spec.key, "not used by method " + method + " (" + e.spec.why + ")");
   }
+}
+
+RenderOptions without_unused_options(const RenderOptions& options, const std::string& method) {
+  const RenderOptions d;
+  // Each option some methods do not use, set back to its default (the table's "methods").
+  static const std::map<std::string, std::function<void(RenderOptions&, const RenderOptions&)>> RESET = {
+      {"cube_res", [](RenderOptions& o, const RenderOptions& x) { o.cube_resolution = x.cube_resolution; }},
+      {"error_target", [](RenderOptions& o, const RenderOptions& x) { o.error_target = x.error_target; }},
+      {"plan", [](RenderOptions& o, const RenderOptions& x) { o.plan_everything = x.plan_everything; }},
+      {"search", [](RenderOptions& o, const RenderOptions& x) { o.search = x.search; }},
+      {"refine", [](RenderOptions& o, const RenderOptions& x) { o.refine = x.refine; }},
+      {"theta_max_deg", [](RenderOptions& o, const RenderOptions& x) { o.theta_max_deg = x.theta_max_deg; }},
+      {"map_only", [](RenderOptions& o, const RenderOptions& x) { o.side_structure = x.side_structure; }},
+      {"refraction", [](RenderOptions& o, const RenderOptions& x) { o.refraction = x.refraction; }},
+      {"envmap_lookup", [](RenderOptions& o, const RenderOptions& x) { o.envmap_lookup = x.envmap_lookup; }},
+      {"resolve", [](RenderOptions& o, const RenderOptions& x) { o.resolve = x.resolve; }},
+      {"max_layers", [](RenderOptions& o, const RenderOptions& x) { o.max_layers = x.max_layers; }},
+      {"gpu_mirrors", [](RenderOptions& o, const RenderOptions& x) { o.gpu_mirrors = x.gpu_mirrors; }},
+      {"gpu_shadows", [](RenderOptions& o, const RenderOptions& x) { o.gpu_shadows = x.gpu_shadows; }},
+      {"gpu_max_views", [](RenderOptions& o, const RenderOptions& x) { o.gpu_max_views = x.gpu_max_views; }},
+      {"gpu_shading", [](RenderOptions& o, const RenderOptions& x) { o.gpu_shading = x.gpu_shading; }},
+  };
+  RenderOptions out = options;
+  out.method = method;
+  for (const Entry& e : entries()) {
+    const std::vector<std::string>& m = e.spec.methods;
+    if (m.empty() || std::find(m.begin(), m.end(), method) != m.end()) continue;
+    const auto reset = RESET.find(e.spec.key);
+    ABCUBE_CHECK(reset != RESET.end(), "option " + e.spec.key + " has methods but no reset");
+    reset->second(out, d);
+  }
+  return out;
 }
 
 }  // namespace abcube

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include <abcube/renderer.hpp>
 #include <nlohmann/json.hpp>
 
 #include "gl/gl_context.hpp"
@@ -59,5 +60,9 @@ Image render_reference(MethodContext& mc, const char* key);
 double add_reference_error(MethodContext& mc, const Image& image);
 
 nlohmann::json gl_json(const GlContext* ctx);
+
+// The scene as a render with `options` sees it: its camera and render settings with the
+// options' overrides, checked (renderer.cpp). Shares the triangles.
+SceneData scene_view(const SceneData& base, const RenderOptions& options);
 
 }  // namespace abcube

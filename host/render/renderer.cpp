@@ -339,6 +339,12 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
 }
 
 // What each method honours (docs/methods.md; renderer.hpp).
+SceneData scene_view(const SceneData& base, const RenderOptions& options) {
+  SceneData view;
+  make_request(base, options, 0, &view);
+  return view;
+}
+
 void refuse_unused_options(const Scene& scene, const RenderOptions& options) {
   refuse_options_unused_by(scene.method(), options);
 }

@@ -29,9 +29,18 @@ json error_stats_json(const ErrorStats& e) {
 
 json image_error_json(const ImageError& e) {
   const bool identical = !std::isfinite(e.psnr);
-  return {{"rmse", e.rmse}, {"psnr_db", identical ? json("inf") : json(e.psnr)}, {"max_abs", e.max_abs},
-          {"share_over_1_255", e.share_over_1}, {"share_over_2_255", e.share_over_2},
-          {"compared_as", "sRGB-encoded, clamped to [0,1] (metrics.hpp)"}};
+  const auto triple = [](const float* v) { return json::array({v[0], v[1], v[2]}); };
+  return {{"rmse", e.rmse},
+          {"psnr_db", identical ? json("inf") : json(e.psnr)},
+          {"max_abs", e.max_abs},
+          {"share_over_1_255", e.share_over_1},
+          {"share_over_2_255", e.share_over_2},
+          {"share_over_8_255", e.share_over_8},
+          {"compared_as", "sRGB-encoded, clamped to [0,1] (metrics.hpp)"},
+          {"worst_pixel", {{"x", e.worst_x}, {"y", e.worst_y}, {"channel", std::string(1, "RGB"[e.worst_channel])},
+                           {"a", triple(e.worst_a)}, {"b", triple(e.worst_b)}}},
+          {"linear", {{"rmse", e.linear_rmse}, {"max_abs", e.linear_max_abs}, {"relative_mean", e.relative_mean},
+                      {"hdr", e.hdr}}}};
 }
 
 json abuffer_json(const ABufferStats& s, bool full) {

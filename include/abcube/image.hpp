@@ -45,12 +45,21 @@ bool image_format_supported(const std::string& path);
 // The extensions that have a writer ("exr", "png", ...), for messages.
 std::vector<std::string> writable_image_extensions();
 
-// The error of `a` against `b` (same size): RMSE, PSNR, max abs error and the share of
-// pixels whose largest channel differs by more than 1/255 and 2/255, on sRGB-encoded values
-// clamped to [0, 1] (what a person sees). psnr is +infinity for identical images.
+// The error of `a` against `b` (same size). As displayed: RMSE, PSNR, max abs error and
+// the share of pixels whose largest channel differs by more than 1/255, 2/255 and 8/255,
+// on sRGB-encoded values clamped to [0, 1] (what a person sees); psnr is +infinity for
+// identical images. Linear: the RMSE and max abs error of the stored values themselves
+// (HDR values above 1 included, where the displayed figures see 1), and the mean relative
+// error |a - b| / max(|b|, 1/255) over every channel. The worst pixel: where the displayed
+// difference is largest (the first such pixel in reading order), its channel and both
+// images' values there.
 struct ImageError {
   double rmse = 0, psnr = 0, max_abs = 0;
-  double share_over_1 = 0, share_over_2 = 0;
+  double share_over_1 = 0, share_over_2 = 0, share_over_8 = 0;
+  double linear_rmse = 0, linear_max_abs = 0, relative_mean = 0;
+  bool hdr = false;  // a channel of either image above 1
+  int worst_x = 0, worst_y = 0, worst_channel = 0;
+  float worst_a[3] = {0, 0, 0}, worst_b[3] = {0, 0, 0};  // linear values at the worst pixel
 };
 ImageError image_error(const Image& a, const Image& b);
 

@@ -104,4 +104,9 @@ void check_render_options(const RenderOptions& options);
 // `scene_method`: OptionError "KEY: not used by method M (what uses it)".
 void refuse_options_unused_by(const std::string& scene_method, const RenderOptions& options);
 
+// `options` for a render by `method`: the method set, and every option that method does
+// not use back at its default (one set of options for renders of several methods, as
+// `abcube report` makes them).
+RenderOptions without_unused_options(const RenderOptions& options, const std::string& method);
+
 }  // namespace abcube

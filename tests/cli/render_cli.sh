@@ -131,6 +131,16 @@ check "identical images: PSNR inf" grep -q "PSNR        inf" "$WORK/cmp"
 "$ABCUBE" compare "$WORK/rt.png" "$WORK/gpu_old.png" --diff "$WORK/heat.png" > "$WORK/cmp"
 check "different images compare 1" [ $? -eq 1 ]
 check "heatmap written" [ -s "$WORK/heat.png" ]
+check "the worst pixel located" grep -qE "^max abs .* at \([0-9]+, [0-9]+, [RGB]\)" "$WORK/cmp"
+check "linear figures" grep -q "^linear      RMSE" "$WORK/cmp"
+"$ABCUBE" compare "$WORK/rt.png" "$WORK/gpu_old.png" --json > "$WORK/cmp.json"
+check "--json: exit 1 as the text" [ $? -eq 1 ]
+check "--json: every figure" /usr/bin/python3 -c "
+import json, sys
+j = json.load(open('$WORK/cmp.json'))
+assert j['pass'] is False and j['psnr_db'] > 0 and 0 <= j['worst_pixel']['x'] < j['width'], j
+assert set(j['linear']) == {'rmse', 'max_abs', 'relative_mean', 'hdr'} and j['share_over_8_255'] >= 0, j
+"
 "$ABCUBE" compare "$WORK/rt.png" "$WORK/gpu_egl.png" --fail 1 > /dev/null
 check "--fail 1 lets everything pass" [ $? -eq 0 ]
 "$ABCUBE" compare "$WORK/rt.png" "$WORK/gpu_egl.png" --failpercent 100 > /dev/null

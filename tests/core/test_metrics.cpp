@@ -66,6 +66,42 @@ TEST(Metrics, SharesCountPixelsOverThresholds) {
   EXPECT_NEAR(e.rmse, std::sqrt(sum_sq / 30.0), 1e-7);
 }
 
+TEST(Metrics, WorstPixelAndLinearFigures) {
+  Image a(4, 3, 3, 0.5f), b(4, 3, 3, 0.5f);
+  a.set_rgb(2, 1, glm::vec3(0.5f, 4.0f, 0.5f));   // HDR: displayed as 1, linear 3.5 away
+  a.set_rgb(0, 2, glm::vec3(0.5f, 0.5f, 0.25f));  // a smaller displayed difference
+  const ImageError e = image_error(a, b);
+  EXPECT_EQ(e.worst_x, 2);
+  EXPECT_EQ(e.worst_y, 1);
+  EXPECT_EQ(e.worst_channel, 1);
+  EXPECT_EQ(e.worst_a[1], 4.0f);
+  EXPECT_EQ(e.worst_b[1], 0.5f);
+  EXPECT_TRUE(e.hdr);
+  EXPECT_NEAR(e.linear_max_abs, 3.5, 1e-9);
+  EXPECT_NEAR(e.linear_rmse, std::sqrt((3.5 * 3.5 + 0.25 * 0.25) / 36.0), 1e-7);
+  EXPECT_NEAR(e.relative_mean, (3.5 / 0.5 + 0.25 / 0.5) / 36.0, 1e-7);
+  EXPECT_NEAR(e.max_abs, 1.0 - srgb_encode(0.5f), 1e-6);  // displayed values clamp at 1
+  EXPECT_DOUBLE_EQ(e.share_over_8, 2.0 / 12.0);
+}
+
+TEST(Metrics, TheLegendSitsBeneathTheHeatmap) {
+  Image heat(320, 10, 3, 0.f);
+  heat.set_rgb(5, 5, glm::vec3(1.f));
+  const Image l = with_heatmap_legend(heat);
+  ASSERT_EQ(l.width, 320);
+  ASSERT_GT(l.height, 10);
+  EXPECT_EQ(l.rgb(5, 5), glm::vec3(1.f));  // the heat map itself unchanged
+  // The bar runs from the ramp's black (left) to its red (right), its numbers in white below.
+  const int bar = 10 + 4 + 3;  // the strip's gap, then the middle of the bar (scale 2)
+  EXPECT_LT(srgb_encode(l.rgb(3, bar).r), 0.05);
+  EXPECT_GT(srgb_encode(l.rgb(300, bar).r), 0.9);
+  int white = 0;
+  for (int y = 10 + 16; y < l.height; ++y) {
+    for (int x = 0; x < l.width; ++x) white += l.rgb(x, y) == glm::vec3(1.f);
+  }
+  EXPECT_GT(white, 100);
+}
+
 TEST(Metrics, SizeMismatchIsAnInputError) {
   EXPECT_THROW(image_error(Image(4, 4), Image(4, 5)), InputError);
   EXPECT_THROW(error_heatmap(Image(3, 4), Image(4, 4)), InputError);
