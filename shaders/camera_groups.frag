@@ -1,4 +1,4 @@
-// The exact camera pass's colour, one shading a pixel and surface (gl_camera_exact.cpp,
+// The exact camera pass's colour, one shading a pixel and surface (gl_shading_groups.cpp,
 // ExactCameraOptions::Shading::pixels). One fragment a pixel of the view's region: its 8 x 4
 // samples fall into groups by their key (camera_ids.frag: the triangle they show and the set
 // of volume lights blocked there, so a shadow edge stays as sharp as the samples). Each group

@@ -1,4 +1,4 @@
-// The visibility pass of the exact camera pass's per-pixel shading (gl_camera_exact.cpp): at
+// The visibility pass of the exact camera pass's per-pixel shading (gl_shading_groups.cpp): at
 // the view's visible surface (depth EQUAL after its depth pass and its volume counts), the
 // triangle's index in the scene's vertex buffer + 1 (its primitive in the one draw of the
 // whole buffer; 0 is left where the view shows nothing) and the set of volume lights whose

@@ -8,7 +8,7 @@ struct MaterialGpu {
 struct LightGpu {
   vec4 position;  // xyz relative to the pass centre (the eye); w = shadow-map layer, -1 = none
   vec4 color;     // rgb intensity; w = the shadow-volume count of its opaque blockers, -1 = none
-  vec4 volumes;   // x = the count of its translucent blockers, -1 = none (gl_camera_exact.cpp)
+  vec4 volumes;   // x = the count of its translucent blockers, -1 = none (gl_shadow_volumes.cpp)
 };
 layout(std430, binding = 0) readonly buffer Materials { MaterialGpu materials[]; };
 layout(std430, binding = 1) readonly buffer Lights { LightGpu lights[]; };

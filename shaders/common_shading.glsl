@@ -2,7 +2,7 @@
 //   C = ka Ia Od + sum_l S_l I_l (kd Od max(0, N.L) + ks max(0, R.V)^n),  R = reflect(-L, N),
 // with N turned to face the viewer (two-sided lighting). p is relative to the eye.
 
-// Shadow volumes (gl_camera_exact.cpp): per camera sample and volume light (the light's
+// Shadow volumes (gl_shadow_volumes.cpp): per camera sample and volume light (the light's
 // color.w, -1: none; count b is layer b), the depth-fail count of its
 // volume's faces behind the surface (shadow_volume.frag): the number of opaque blockers'
 // prisms holding the surface point, 0 when none lies between it and the light. Camera

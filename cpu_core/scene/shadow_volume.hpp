@@ -63,7 +63,7 @@ std::vector<uint8_t> lights_outside_closed(const SceneData& scene, const glm::dv
 enum class Blockers { opaque, translucent };
 
 // Volumes a render counts at most (opaque, and translucent where any, per light): a layer
-// each of an R32F array (gl_camera_exact.cpp); lights past them keep their cube shadow
+// each of an R32F array (gl_shadow_volumes.cpp); lights past them keep their cube shadow
 // maps. The memory estimate (scene_size.cpp) counts no more.
 constexpr int MAX_VOLUME_LIGHTS = 128;
 

@@ -1,9 +1,11 @@
 // The GL passes over one uploaded scene (GlScene): the six cube faces around a centre
-// (distance prepass, Z-buffer colour, the environment map), the cube shadow maps with their
-// translucent peels, and the camera view: Z-buffer Phong, or the exact camera pass (planar
-// mirrors by the stencil, shadow volumes, gl_camera_exact.cpp) with its per-pixel flags for
-// the hybrid method; and crosscheck's probes (camera objects, shadow probe). Results are
-// read back into cpu_core image types.
+// (distance prepass, Z-buffer colour, the environment map: gl_environment.cpp), the cube
+// shadow maps with their translucent peels (gl_shadow_maps.cpp), and the camera view: Z-buffer
+// Phong, or the exact camera pass (planar mirrors by the stencil, gl_camera_exact.cpp; shadow
+// volumes, gl_shadow_volumes.cpp; the colour shaded once a pixel and surface,
+// gl_shading_groups.cpp) with its per-pixel flags for the hybrid method; and crosscheck's
+// probes (camera objects; shadow probe, gl_shadow_volumes.cpp). The upload, the draw calls and
+// the other passes are gl_passes.cpp's. Results are read back into cpu_core image types.
 #pragma once
 #include <glad/gl.h>
 
@@ -66,7 +68,7 @@ struct ExactCameraOptions {
   // Use the exact pass even with no planar mirror and no volume light (the hybrid method
   // reads its per-pixel flags).
   bool always = false;
-  // How the colour of a view is shaded (gl_camera_exact.cpp): once a pixel and surface (the
+  // How the colour of a view is shaded (gl_shading_groups.cpp): once a pixel and surface (the
   // samples grouped by triangle and shadow-volume set, camera_groups.frag), or once a sample
   // (camera_exact.frag).
   enum class Shading { pixels, samples } shading = Shading::pixels;

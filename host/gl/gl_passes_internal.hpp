@@ -1,5 +1,6 @@
-// Internal to the GL passes (gl_passes.cpp, gl_camera_exact.cpp): texture units, the pass
-// state, the framebuffers, the views of the exact camera pass.
+// Internal to the GL passes (gl_passes.cpp, gl_shadow_maps.cpp, gl_environment.cpp,
+// gl_camera_exact.cpp, gl_shadow_volumes.cpp, gl_shading_groups.cpp): texture units, the pass
+// state, the stencil test, the framebuffers, the views of the exact camera pass.
 #pragma once
 #include <glad/gl.h>
 
@@ -69,6 +70,14 @@ inline void set_pass_state() {
   glDisable(GL_COLOR_LOGIC_OP);
   glDisable(GL_SCISSOR_TEST);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+}
+
+// The stencil test of a view of level L: draw where the stencil is L, change nothing.
+inline void stencil_level(int level) {
+  glEnable(GL_STENCIL_TEST);
+  glStencilFunc(GL_EQUAL, level, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+  glStencilMask(0xff);
 }
 
 // The camera's sample grid (full_w x full_h, GL window coordinates, y up) cut into tiles of
@@ -227,7 +236,7 @@ struct GlScene::ExactBuffers {
   }
 };
 
-// The per-group shading's buffers beside the camera Target (gl_camera_exact.cpp): the key
+// The per-group shading's buffers beside the camera Target (gl_shading_groups.cpp): the key
 // of each sample of a view (camera_ids.frag, RG32UI, drawn with the target's
 // depth-stencil), and a framebuffer with no attachment, one pixel of it per 8 x 4 samples
 // of the target; the colour and weight of the camera view's pixels shaded whole (RGBA32F,
