@@ -43,7 +43,9 @@ void add_options(CLI::App& app, Options& o) {
   show_defaults(app);
   app.add_option("scenes", o.scenes, "scene files (SCENE.json...)")->required();
   app.add_option("--sizes", o.sizes, "cube resolutions N, texels per face edge (comma-separated)")
-      ->delimiter(',')->allow_extra_args(false)->check(CLI::Range(1, 65536));
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(CLI::Range(1, 65536));
   app.add_option("--runs", o.runs, "runs per configuration (median, min and max reported)")
       ->check(CLI::Range(1, 1000000));
   app.add_option("--threads", o.threads, "worker threads (0 = every core)")->check(CLI::Range(0, 4096));
@@ -118,17 +120,20 @@ void print(const std::string& path, int size, const Result& r) {
     return;
   }
   const double mib = 1.0 / (1024.0 * 1024.0);
-  std::printf("%-34s %-10s %11llu %11llu %8.2f %9.1f %9.1f %9.1f %8.1f %8.1f %7llu %4zu %9.1f %9.1f %3d\n", path.c_str(),
-              what.c_str(), static_cast<unsigned long long>(r.fragments), static_cast<unsigned long long>(r.raw_fragments),
-              static_cast<double>(r.fragments) / (r.median_ms * 1e-3) * 1e-6, r.median_ms, r.min_ms, r.max_ms, r.count_ms, r.fill_ms,
-              static_cast<unsigned long long>(r.max_list), sizeof(Fragment), static_cast<double>(r.bytes) * mib, static_cast<double>(r.peak_rss) * mib, r.threads);
+  std::printf("%-34s %-10s %11llu %11llu %8.2f %9.1f %9.1f %9.1f %8.1f %8.1f %7llu %4zu %9.1f %9.1f %3d\n",
+              path.c_str(), what.c_str(), static_cast<unsigned long long>(r.fragments),
+              static_cast<unsigned long long>(r.raw_fragments),
+              static_cast<double>(r.fragments) / (r.median_ms * 1e-3) * 1e-6, r.median_ms, r.min_ms, r.max_ms,
+              r.count_ms, r.fill_ms, static_cast<unsigned long long>(r.max_list), sizeof(Fragment),
+              static_cast<double>(r.bytes) * mib, static_cast<double>(r.peak_rss) * mib, r.threads);
   std::fflush(stdout);
 }
 
 int run(const Options& o) {
-  std::printf("# bench_abuffer: median of %d runs (min, max); Mfrag/s = stored fragments / median; "
-              "peak RSS of a process doing only that build\n",
-              o.runs);
+  std::printf(
+      "# bench_abuffer: median of %d runs (min, max); Mfrag/s = stored fragments / median; "
+      "peak RSS of a process doing only that build\n",
+      o.runs);
   std::printf("%-34s %-10s %11s %11s %8s %9s %9s %9s %8s %8s %7s %4s %9s %9s %3s\n", "scene", "raster", "fragments",
               "raw", "Mfrag/s", "ms", "min", "max", "count", "fill", "maxlist", "B/fr", "MiB", "peakMiB", "thr");
   for (const std::string& path : o.scenes) {
@@ -142,7 +147,8 @@ int run(const Options& o) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  return abcube::bench_main<abcube::Options>(argc, argv, "bench_abuffer",
-                                             "CPU cube A-buffer build: median ms, fragments, Mfrag/s and peak memory per scene and N",
-                                             abcube::add_options, abcube::run);
+  return abcube::bench_main<abcube::Options>(
+      argc, argv, "bench_abuffer",
+      "CPU cube A-buffer build: median ms, fragments, Mfrag/s and peak memory per scene and N", abcube::add_options,
+      abcube::run);
 }

@@ -71,7 +71,6 @@ int run(const Options& o) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  return abcube::bench_main<abcube::Options>(argc, argv, "bench_bandwidth",
-                                             "Memory bandwidth, STREAM copy and triad", abcube::add_options,
-                                             abcube::run);
+  return abcube::bench_main<abcube::Options>(argc, argv, "bench_bandwidth", "Memory bandwidth, STREAM copy and triad",
+                                             abcube::add_options, abcube::run);
 }

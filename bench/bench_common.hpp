@@ -51,8 +51,7 @@ int guarded_main(const char* name, Fn&& fn) {
 // on a parser described by `description`, parsed (parse_command_line), then
 // run(options) under guarded_main.
 template <class Options, class AddOptions, class Run>
-int bench_main(int argc, char** argv, const char* name, const char* description, AddOptions&& add_options,
-               Run&& run) {
+int bench_main(int argc, char** argv, const char* name, const char* description, AddOptions&& add_options, Run&& run) {
   Options options;
   CLI::App app{description};
   add_options(app, options);

@@ -50,7 +50,8 @@ void add_options(CLI::App& app, Options& o) {
       ->check(CLI::IsMember({1, MASK_SAMPLES}));
   app.add_option("--width", o.width, "image width in pixels, the height scaled with it; 0 = the scene's")
       ->check(CLI::Range(0, 65536));
-  app.add_option("--isa", o.isa, "Embree's instruction set")->check(CLI::IsMember({"default", "sse4.2", "avx2", "avx512"}));
+  app.add_option("--isa", o.isa, "Embree's instruction set")
+      ->check(CLI::IsMember({"default", "sse4.2", "avx2", "avx512"}));
 }
 
 // Embree's float triangles over the soup's vertices (copied: Embree reads 16 bytes per vertex).
@@ -63,8 +64,8 @@ class FloatScene {
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, vertices_.data(), 0, sizeof(glm::vec3),
                                vertices_.size());
-    auto* index = static_cast<unsigned*>(
-        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), soup.triangle_count()));
+    auto* index = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                 3 * sizeof(unsigned), soup.triangle_count()));
     for (size_t i = 0; i < vertices_.size(); ++i) index[i] = static_cast<unsigned>(i);
     rtcCommitGeometry(g);
     rtcAttachGeometry(scene_, g);
@@ -143,7 +144,9 @@ int run(const Options& o) {
   const std::string config = o.isa == "default" ? "verbose=0" : "verbose=0,isa=" + o.isa;
   RTCDevice device = rtcNewDevice(config.c_str());
   if (!device) throw RuntimeFailure("embree: rtcNewDevice(" + config + ") failed");
-  std::printf("| scene | triangles | rays | other_rejected | other_hit | float_miss | float_extra | shadow segments | shadow |\n");
+  std::printf(
+      "| scene | triangles | rays | other_rejected | other_hit | float_miss | float_extra | shadow segments | shadow "
+      "|\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   Counts total;
   for (const std::string& path : o.scenes) {
@@ -187,8 +190,9 @@ int run(const Options& o) {
         }
       }
     }
-    std::printf("| %s | %zu | %ld | %ld | %ld | %ld | %ld | %ld | %ld |\n", path.c_str(), scene.triangles->triangle_count(),
-                c.rays, c.other_rejected, c.other_hit, c.float_miss, c.float_extra, c.segments, c.shadow);
+    std::printf("| %s | %zu | %ld | %ld | %ld | %ld | %ld | %ld | %ld |\n", path.c_str(),
+                scene.triangles->triangle_count(), c.rays, c.other_rejected, c.other_hit, c.float_miss, c.float_extra,
+                c.segments, c.shadow);
     std::fflush(stdout);
     total.rays += c.rays;
     total.other_rejected += c.other_rejected;
@@ -198,8 +202,8 @@ int run(const Options& o) {
     total.segments += c.segments;
     total.shadow += c.shadow;
   }
-  std::printf("| all | | %ld | %ld | %ld | %ld | %ld | %ld | %ld |\n", total.rays, total.other_rejected, total.other_hit,
-              total.float_miss, total.float_extra, total.segments, total.shadow);
+  std::printf("| all | | %ld | %ld | %ld | %ld | %ld | %ld | %ld |\n", total.rays, total.other_rejected,
+              total.other_hit, total.float_miss, total.float_extra, total.segments, total.shadow);
   rtcReleaseDevice(device);
   return 0;
 }

@@ -39,7 +39,9 @@ void add_options(CLI::App& app, Options& o) {
   show_defaults(app);
   app.add_option("scene", o.scene, "scene file (SCENE.json)")->required();
   app.add_option("--sizes", o.sizes, "cube resolutions N, texels per face edge (comma-separated)")
-      ->delimiter(',')->allow_extra_args(false)->check(CLI::Range(1, 65536));
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(CLI::Range(1, 65536));
   app.add_option("--runs", o.runs, "runs per N (median, min and max reported)")->check(CLI::Range(1, 1000));
   app.add_option("--gl", o.gl, "GL path")
       ->check(CLI::IsMember({"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"}));
@@ -62,8 +64,8 @@ struct PrepassError {
 };
 
 // Exact first hit along random texel-centre directions against what the prepass stored.
-PrepassError prepass_error(const SceneData& scene, const RayTracer& rt, const CubeImage& dist,
-                           const CubeIds& ids, int samples) {
+PrepassError prepass_error(const SceneData& scene, const RayTracer& rt, const CubeImage& dist, const CubeIds& ids,
+                           int samples) {
   const int n = dist.n;
   std::mt19937 rng(1234);
   std::uniform_int_distribution<int> pick(0, n - 1), pick_face(0, 5);
@@ -98,13 +100,13 @@ int run(const Options& o) {
   if (!ctx) throw RuntimeFailure("no GL context: " + log);
   const RayTracer rt(scene);
   GlScene gl(scene);
-  std::printf("scene: %s (%zu triangles)\nrenderer: %s\nruns: %d (median [min, max] ms)\n\n",
-              o.scene.c_str(), scene.triangles->triangle_count(), describe_gl(ctx.get()).c_str(),
-              o.runs);
-  std::printf("| N | prepass 6 faces ms | readback ms | camera %dx%d raster ms | prepass rel. distance error "
-              "vs exact: median / p99 / max | same object | texels checked | CPU cube A-buffer ms | fragments | "
-              "CPU/GPU |\n|---|---|---|---|---|---|---|---|---|---|\n",
-              scene.camera.width, scene.camera.height);
+  std::printf("scene: %s (%zu triangles)\nrenderer: %s\nruns: %d (median [min, max] ms)\n\n", o.scene.c_str(),
+              scene.triangles->triangle_count(), describe_gl(ctx.get()).c_str(), o.runs);
+  std::printf(
+      "| N | prepass 6 faces ms | readback ms | camera %dx%d raster ms | prepass rel. distance error "
+      "vs exact: median / p99 / max | same object | texels checked | CPU cube A-buffer ms | fragments | "
+      "CPU/GPU |\n|---|---|---|---|---|---|---|---|---|---|\n",
+      scene.camera.width, scene.camera.height);
   for (int n : o.sizes) {
     std::vector<double> prepass, readback, camera;
     CubeImage dist;
@@ -129,11 +131,12 @@ int run(const Options& o) {
     }
     const Spread p = spread(prepass), rb = spread(readback), c = spread(camera), a = spread(cpu);
     const PrepassError e = prepass_error(scene, rt, dist, ids, o.error_samples);
-    std::printf("| %d | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1e / %.1e / %.1e | %.4f | %zu "
-                "| %.1f [%.1f, %.1f] | %llu | %.1f |\n",
-                n, p.median, p.lo, p.hi, rb.median, rb.lo, rb.hi, c.median, c.lo, c.hi, e.median_rel, e.p99_rel,
-                e.max_rel, e.same_object, e.texels, a.median, a.lo, a.hi,
-                static_cast<unsigned long long>(as.fragments), a.median / p.median);
+    std::printf(
+        "| %d | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1e / %.1e / %.1e | %.4f | %zu "
+        "| %.1f [%.1f, %.1f] | %llu | %.1f |\n",
+        n, p.median, p.lo, p.hi, rb.median, rb.lo, rb.hi, c.median, c.lo, c.hi, e.median_rel, e.p99_rel, e.max_rel,
+        e.same_object, e.texels, a.median, a.lo, a.hi, static_cast<unsigned long long>(as.fragments),
+        a.median / p.median);
     std::fflush(stdout);
   }
   return 0;
@@ -143,7 +146,8 @@ int run(const Options& o) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  return abcube::bench_main<abcube::Options>(argc, argv, "bench_gl_passes",
-                                             "GL passes: the six-face distance prepass and the camera raster against N, with their error",
-                                             abcube::add_options, abcube::run);
+  return abcube::bench_main<abcube::Options>(
+      argc, argv, "bench_gl_passes",
+      "GL passes: the six-face distance prepass and the camera raster against N, with their error", abcube::add_options,
+      abcube::run);
 }

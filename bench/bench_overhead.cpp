@@ -48,7 +48,8 @@ void add_options(CLI::App& app, Options& o) {
   show_defaults(app);
   app.add_option("--renders", o.renders, "renders per method through one Renderer")->check(CLI::Range(1, 100000000));
   app.add_option("--methods", o.methods, "methods measured (comma-separated)")
-      ->delimiter(',')->allow_extra_args(false)
+      ->delimiter(',')
+      ->allow_extra_args(false)
       ->check(CLI::IsMember({"abuffer", "zbuffer", "envmap", "raytrace", "gpu"}));
   app.add_option("--gl", o.gl, "the Renderer's and the processes' GL path (gpu)")
       ->check(CLI::IsMember({"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"}));
@@ -102,10 +103,11 @@ void measure_library(const Options& o, const Scene& scene, Renderer& renderer, c
     outside.push_back(ms - r.stats.total_ms);
   }
   const double median = percentile(overhead, 0.5), p90 = percentile(overhead, 0.9);
-  std::printf("%-8s library: %d renders, wall per render median %.3f ms; overhead (wall - passes) median %.3f ms, "
-              "p90 %.3f ms, max %.3f ms; outside render()'s own total: median %.3f ms; goal under 5 ms: %s\n",
-              method.c_str(), o.renders, percentile(wall, 0.5), median, p90, percentile(overhead, 1.0),
-              percentile(outside, 0.5), p90 < 5.0 ? "met" : "NOT met");
+  std::printf(
+      "%-8s library: %d renders, wall per render median %.3f ms; overhead (wall - passes) median %.3f ms, "
+      "p90 %.3f ms, max %.3f ms; outside render()'s own total: median %.3f ms; goal under 5 ms: %s\n",
+      method.c_str(), o.renders, percentile(wall, 0.5), median, p90, percentile(overhead, 1.0),
+      percentile(outside, 0.5), p90 < 5.0 ? "met" : "NOT met");
   std::fflush(stdout);
 }
 
@@ -152,9 +154,10 @@ int run(const Options& o) {
   const std::string json = tiny_scene_json(o.size, o.size, 32);
   const Scene scene = Scene::from_json(json, "tiny");
   Renderer renderer(RendererOptions{o.gl, -1, o.threads});
-  std::printf("# bench_overhead: %dx%d tiny scene (%zu triangles), %d renders per method through one Renderer, "
-              "threads %d (0 = every core)\n",
-              o.size, o.size, scene.triangle_count(), o.renders, o.threads);
+  std::printf(
+      "# bench_overhead: %dx%d tiny scene (%zu triangles), %d renders per method through one Renderer, "
+      "threads %d (0 = every core)\n",
+      o.size, o.size, scene.triangle_count(), o.renders, o.threads);
   for (const std::string& method : o.methods) measure_library(o, scene, renderer, method);
   if (!renderer.gl_path().empty()) {
     std::printf("GL path %s (%s)\n", renderer.gl_path().c_str(), renderer.gl_renderer().c_str());
@@ -176,7 +179,8 @@ int run(const Options& o) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  return abcube::bench_main<abcube::Options>(argc, argv, "bench_overhead",
-                                             "Per-render overhead of the library (wall - passes) against `abcube render` processes",
-                                             abcube::add_options, abcube::run);
+  return abcube::bench_main<abcube::Options>(
+      argc, argv, "bench_overhead",
+      "Per-render overhead of the library (wall - passes) against `abcube render` processes", abcube::add_options,
+      abcube::run);
 }

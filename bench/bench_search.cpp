@@ -41,9 +41,9 @@ struct Options {
   std::vector<int> sizes{64, 128, 256, 512, 1024};
   std::vector<std::string> modes{"crossing", "thesis"};  // SearchMode names
   std::vector<std::string> kinds{"reflection", "shadow"};
-  std::vector<std::string> hierarchy{"off", "on"};       // SearchOptions::hierarchy
-  std::string layers = "all";                            // all | nearest (SearchLayers)
-  std::string merge = "on";                              // on: the renderer's default map
+  std::vector<std::string> hierarchy{"off", "on"};  // SearchOptions::hierarchy
+  std::string layers = "all";                       // all | nearest (SearchLayers)
+  std::string merge = "on";                         // on: the renderer's default map
   int runs = 3;
   int rays = 20000;
   unsigned seed = 1;
@@ -54,13 +54,21 @@ void add_options(CLI::App& app, Options& o) {
   show_defaults(app);
   app.add_option("scenes", o.scenes, "scene files (SCENE.json...)")->required();
   app.add_option("--sizes", o.sizes, "cube resolutions N, texels per face edge (comma-separated)")
-      ->delimiter(',')->allow_extra_args(false)->check(CLI::Range(1, 65536));
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(CLI::Range(1, 65536));
   app.add_option("--modes", o.modes, "search modes (comma-separated)")
-      ->delimiter(',')->allow_extra_args(false)->check(CLI::IsMember({"crossing", "thesis"}));
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(CLI::IsMember({"crossing", "thesis"}));
   app.add_option("--kinds", o.kinds, "searches measured (comma-separated)")
-      ->delimiter(',')->allow_extra_args(false)->check(CLI::IsMember({"reflection", "shadow"}));
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(CLI::IsMember({"reflection", "shadow"}));
   app.add_option("--hierarchy", o.hierarchy, "hierarchical skip off (the plain walk) and/or on (comma-separated)")
-      ->delimiter(',')->allow_extra_args(false)->check(CLI::IsMember({"off", "on"}));
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(CLI::IsMember({"off", "on"}));
   app.add_option("--layers", o.layers, "map layers searched")->check(CLI::IsMember({"all", "nearest"}));
   app.add_option("--merge", o.merge, "merge the cube A-buffer's fragments as the renderer does")
       ->check(CLI::IsMember({"on", "off"}));
@@ -156,9 +164,12 @@ void time_runs(int runs, size_t count, SearchAll&& search_all, Row* row) {
 
 Row measure(const SearchContext& ctx, const std::vector<ReflectionRay>& rays, const SearchOptions& so, int runs) {
   Row row;
-  time_runs(runs, rays.size(), [&](SearchKindStats* stats) {
-    for (const ReflectionRay& rr : rays) stats->add(reflection_search(ctx, rr.w, rr.r, so));
-  }, &row);
+  time_runs(
+      runs, rays.size(),
+      [&](SearchKindStats* stats) {
+        for (const ReflectionRay& rr : rays) stats->add(reflection_search(ctx, rr.w, rr.r, so));
+      },
+      &row);
   // Errors and the plain walk's answers, outside the timed loop.
   SearchOptions plain = so;
   plain.hierarchy = false;
@@ -182,9 +193,12 @@ Row measure(const SearchContext& ctx, const std::vector<ShadowRay>& rays, const 
   Row row;
   row.reflection = false;
   const std::vector<PointLight>& lights = ctx.scene().lights;
-  time_runs(runs, rays.size(), [&](SearchKindStats* stats) {
-    for (const ShadowRay& sr : rays) stats->add(shadow_search(ctx, sr.p, lights[sr.light].position, so));
-  }, &row);
+  time_runs(
+      runs, rays.size(),
+      [&](SearchKindStats* stats) {
+        for (const ShadowRay& sr : rays) stats->add(shadow_search(ctx, sr.p, lights[sr.light].position, so));
+      },
+      &row);
   SearchOptions plain = so;
   plain.hierarchy = false;
   for (const ShadowRay& sr : rays) {
@@ -196,11 +210,12 @@ Row measure(const SearchContext& ctx, const std::vector<ShadowRay>& rays, const 
 }
 
 void print_header() {
-  std::printf("%-36s %5s %-8s %-10s %4s %6s %6s %6s %6s %7s %6s %7s %6s %7s %6s %9s %9s %9s %6s %9s %9s %9s %9s %6s %6s "
-              "%6s %5s %5s\n",
-              "scene", "N", "mode", "kind", "hier", "rays", "hit%", "agree%", "same%", "texels", "nodes", "visits",
-              "max", "frags", "cands", "ns/ray", "min", "max", "x/2N", "EP mean", "EP p99", "EP max", "1/(2N^2)", ">bnd%",
-              "m:none", "m:thr", "m:0A", "m:cap");
+  std::printf(
+      "%-36s %5s %-8s %-10s %4s %6s %6s %6s %6s %7s %6s %7s %6s %7s %6s %9s %9s %9s %6s %9s %9s %9s %9s %6s %6s "
+      "%6s %5s %5s\n",
+      "scene", "N", "mode", "kind", "hier", "rays", "hit%", "agree%", "same%", "texels", "nodes", "visits", "max",
+      "frags", "cands", "ns/ray", "min", "max", "x/2N", "EP mean", "EP p99", "EP max", "1/(2N^2)", ">bnd%", "m:none",
+      "m:thr", "m:0A", "m:cap");
 }
 
 void print_row(const std::string& scene, int n, SearchMode mode, const std::string& hier, const Row& r,
@@ -215,18 +230,19 @@ void print_row(const std::string& scene, int n, SearchMode mode, const std::stri
                   r.parallax.percentile(0.99), r.parallax.max(), 1.0 / (2.0 * n * n),
                   hits > 0 ? 100.0 * static_cast<double>(r.over_bound) / hits : 0.0);
   }
-  std::printf("%-36s %5d %-8s %-10s %4s %6llu %6.1f %6.1f %6.1f %7.1f %6.1f %7.1f %6llu %7.1f %6.1f %9.0f %9.0f %9.0f %6s "
-              "%s %6llu %6llu %5llu %5llu\n",
-              scene.c_str(), n, search_mode_name(mode), r.reflection ? "reflection" : "shadow", hier.c_str(),
-              static_cast<unsigned long long>(r.stats.rays), 100.0 * static_cast<double>(r.stats.hits) / rays,
-              100.0 * static_cast<double>(r.agree) / rays, 100.0 * static_cast<double>(r.same) / rays,
-              r.stats.mean_texels(), r.stats.mean_nodes(), r.stats.mean_texels() + r.stats.mean_nodes(),
-              static_cast<unsigned long long>(r.stats.max_texels), static_cast<double>(r.stats.fragments) / rays,
-              static_cast<double>(r.stats.candidates) / rays, r.ns_median, r.ns_min, r.ns_max, ratio, errors,
-              static_cast<unsigned long long>(r.stats.misses - r.stats.threshold_rejections - r.stats.zero_area -
-                                              r.stats.aborted),
-              static_cast<unsigned long long>(r.stats.threshold_rejections),
-              static_cast<unsigned long long>(r.stats.zero_area), static_cast<unsigned long long>(r.stats.aborted));
+  std::printf(
+      "%-36s %5d %-8s %-10s %4s %6llu %6.1f %6.1f %6.1f %7.1f %6.1f %7.1f %6llu %7.1f %6.1f %9.0f %9.0f %9.0f %6s "
+      "%s %6llu %6llu %5llu %5llu\n",
+      scene.c_str(), n, search_mode_name(mode), r.reflection ? "reflection" : "shadow", hier.c_str(),
+      static_cast<unsigned long long>(r.stats.rays), 100.0 * static_cast<double>(r.stats.hits) / rays,
+      100.0 * static_cast<double>(r.agree) / rays, 100.0 * static_cast<double>(r.same) / rays, r.stats.mean_texels(),
+      r.stats.mean_nodes(), r.stats.mean_texels() + r.stats.mean_nodes(),
+      static_cast<unsigned long long>(r.stats.max_texels), static_cast<double>(r.stats.fragments) / rays,
+      static_cast<double>(r.stats.candidates) / rays, r.ns_median, r.ns_min, r.ns_max, ratio, errors,
+      static_cast<unsigned long long>(r.stats.misses - r.stats.threshold_rejections - r.stats.zero_area -
+                                      r.stats.aborted),
+      static_cast<unsigned long long>(r.stats.threshold_rejections), static_cast<unsigned long long>(r.stats.zero_area),
+      static_cast<unsigned long long>(r.stats.aborted));
   std::fflush(stdout);
 }
 
@@ -239,11 +255,12 @@ int run(const Options& o) {
     modes.push_back(m);
   }
   const SearchLayers layers = o.layers == "all" ? SearchLayers::all : SearchLayers::nearest;
-  std::printf("# bench_search: one thread; ns/ray median of %d runs (min, max); x/2N = ns/ray ratio to the previous "
-              "N (2.00 = linear in N); agree = same object as the exact tracer or both miss (shadows: same "
-              "transmittance); same = answer bit for bit the plain walk's; visits = texels + pyramid nodes stepped "
-              "over; EP = Error_Parallax of hits (thesis 9.3); layers %s, merge %s\n",
-              o.runs, o.layers.c_str(), o.merge.c_str());
+  std::printf(
+      "# bench_search: one thread; ns/ray median of %d runs (min, max); x/2N = ns/ray ratio to the previous "
+      "N (2.00 = linear in N); agree = same object as the exact tracer or both miss (shadows: same "
+      "transmittance); same = answer bit for bit the plain walk's; visits = texels + pyramid nodes stepped "
+      "over; EP = Error_Parallax of hits (thesis 9.3); layers %s, merge %s\n",
+      o.runs, o.layers.c_str(), o.merge.c_str());
   print_header();
   for (const std::string& path : o.scenes) {
     const SceneData scene = load_scene(path);
@@ -282,11 +299,12 @@ int run(const Options& o) {
           }
         }
       }
-      std::printf("# %s N=%d: cube A-buffer built in %.0f ms, %zu zero-area triangles; block bounds %.1f KiB, "
-                  "pyramid above them %.1f KiB (+%.1f%%)\n",
-                  path.c_str(), n, build_ms, ctx.zero_area_triangles().size(), static_cast<double>(ctx.block_bounds_bytes()) / 1024.0,
-                  static_cast<double>(ctx.pyramid_bytes()) / 1024.0,
-                  100.0 * static_cast<double>(ctx.pyramid_bytes()) / static_cast<double>(ctx.block_bounds_bytes()));
+      std::printf(
+          "# %s N=%d: cube A-buffer built in %.0f ms, %zu zero-area triangles; block bounds %.1f KiB, "
+          "pyramid above them %.1f KiB (+%.1f%%)\n",
+          path.c_str(), n, build_ms, ctx.zero_area_triangles().size(),
+          static_cast<double>(ctx.block_bounds_bytes()) / 1024.0, static_cast<double>(ctx.pyramid_bytes()) / 1024.0,
+          100.0 * static_cast<double>(ctx.pyramid_bytes()) / static_cast<double>(ctx.block_bounds_bytes()));
     }
   }
   return 0;

@@ -55,7 +55,8 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--gl", o.gl, "the Renderer's GL path (gpu renders)")
       ->check(CLI::IsMember({"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"}));
   app.add_option("--methods", o.methods, "methods cycled through, one per render (comma-separated)")
-      ->delimiter(',')->allow_extra_args(false)
+      ->delimiter(',')
+      ->allow_extra_args(false)
       ->check(CLI::IsMember({"abuffer", "zbuffer", "envmap", "raytrace", "gpu"}));
   app.add_option("--recreate", o.recreate, "renders of phase 2 (a new Renderer each; 0 = skip it)")
       ->check(CLI::Range(0, 100000000));
@@ -158,9 +159,10 @@ bool print_growth(const char* phase, const std::vector<Sample>& samples, int war
   const double band = middle == samples.end() ? 0.0 : highest(middle, samples.end()) - highest(from, middle);
   const int fds = b.fds - a.fds;
   const bool met = band < 2.0 && fds <= 0;
-  std::printf("%s growth after warm-up (render %d -> %d): %+.2f MB last against first, %+.2f MB highest of the second "
-              "half against the first, %+d descriptors; goal under 2 MB and 0 descriptors: %s\n",
-              phase, a.render, b.render, b.rss_mb - a.rss_mb, band, fds, met ? "met" : "NOT met");
+  std::printf(
+      "%s growth after warm-up (render %d -> %d): %+.2f MB last against first, %+.2f MB highest of the second "
+      "half against the first, %+d descriptors; goal under 2 MB and 0 descriptors: %s\n",
+      phase, a.render, b.render, b.rss_mb - a.rss_mb, band, fds, met ? "met" : "NOT met");
   return met;
 }
 
@@ -198,9 +200,11 @@ void print_timed(const TimedRenders& t, const Options& o) {
               t.finished);
   for (auto [method, v] : t.overshoot_ms) {
     std::sort(v.begin(), v.end());
-    auto at = [&](double q) { return v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())))]; };
-    std::printf("  %-9s %4zu, past the limit by %.2f ms median, %.2f p90, %.2f max\n", method.c_str(), v.size(), at(0.5),
-                at(0.9), v.back());
+    auto at = [&](double q) {
+      return v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())))];
+    };
+    std::printf("  %-9s %4zu, past the limit by %.2f ms median, %.2f p90, %.2f max\n", method.c_str(), v.size(),
+                at(0.5), at(0.9), v.back());
   }
 }
 
@@ -279,7 +283,7 @@ int run(const Options& o) {
 }  // namespace abcube
 
 int main(int argc, char** argv) {
-  return abcube::bench_main<abcube::Options>(argc, argv, "bench_soak",
-                                             "Soak: many small renders in one process; resident memory, descriptors and renders/s",
-                                             abcube::add_options, abcube::run);
+  return abcube::bench_main<abcube::Options>(
+      argc, argv, "bench_soak", "Soak: many small renders in one process; resident memory, descriptors and renders/s",
+      abcube::add_options, abcube::run);
 }

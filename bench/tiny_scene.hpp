@@ -11,7 +11,8 @@ inline std::string tiny_scene_json(int width, int height, int cube_res) {
   return R"({
   "version": 1,
   "camera": { "position": [0, 1.2, 3], "look_at": [0, 0.5, 0], "up": [0, 1, 0], "fov_y": 50,
-              "width": )" + std::to_string(width) + R"(, "height": )" + std::to_string(height) + R"( },
+              "width": )" +
+         std::to_string(width) + R"(, "height": )" + std::to_string(height) + R"( },
   "background": [0.05, 0.07, 0.1],
   "ambient": [0.1, 0.1, 0.1],
   "lights": [ { "type": "point", "position": [-2, 4, 3], "color": [1, 1, 1], "cast_shadows": true } ],
@@ -28,7 +29,8 @@ inline std::string tiny_scene_json(int width, int height, int cube_res) {
     { "type": "box", "min": [-0.3, 0, -0.3], "max": [0.3, 0.6, 0.3], "material": "red",
       "transform": { "translate": [-0.8, 0, -0.4], "rotate_deg": [0, 30, 0] } }
   ],
-  "render": { "method": "abuffer", "cube_resolution": )" + std::to_string(cube_res) + R"(, "max_depth": 3 }
+  "render": { "method": "abuffer", "cube_resolution": )" +
+         std::to_string(cube_res) + R"(, "max_depth": 3 }
 })";
 }
 

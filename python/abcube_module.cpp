@@ -18,11 +18,11 @@ std::string version_number(const std::string& full) {
 // RuntimeFailure -> RuntimeError (pybind11's std::exception default), InternalError ->
 // RuntimeError naming it a bug. The messages are the library's, location included.
 void register_exceptions(py::module_& m) {
-  py::register_exception<InputError>(m, "SceneError", PyExc_ValueError)
-      .doc() = "A bad scene or argument; the message names the place (file:line:col, or the "
-               "field path such as objects[3].radius). A subclass of ValueError.";
-  py::register_exception<RenderTimeout>(m, "RenderTimeout", PyExc_RuntimeError)
-      .doc() = "A render ran past its timeout (seconds). A subclass of RuntimeError.";
+  py::register_exception<InputError>(m, "SceneError", PyExc_ValueError).doc() =
+      "A bad scene or argument; the message names the place (file:line:col, or the "
+      "field path such as objects[3].radius). A subclass of ValueError.";
+  py::register_exception<RenderTimeout>(m, "RenderTimeout", PyExc_RuntimeError).doc() =
+      "A render ran past its timeout (seconds). A subclass of RuntimeError.";
   py::register_exception_translator([](std::exception_ptr error) {
     try {
       if (error) std::rethrow_exception(error);

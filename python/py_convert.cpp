@@ -30,29 +30,23 @@ Image array_to_image(const py::handle& array, const std::string& what) {
     throw InputError(what + ": must be a float array (H x W x C), got " + type_name(array));
   }
   if (any.dtype().kind() != 'f' && py::isinstance<py::array>(array)) {
-    throw InputError(what + ": must hold floats (linear values), got " +
-                     std::string(py::str(any.dtype())) + " pixels");
+    throw InputError(what + ": must hold floats (linear values), got " + std::string(py::str(any.dtype())) + " pixels");
   }
   using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
   const FloatArray pixels = FloatArray::ensure(any);
   const py::ssize_t ndim = pixels.ndim();
   const py::ssize_t channels = ndim == 3 ? pixels.shape(2) : 1;
-  if ((ndim != 2 && ndim != 3) || channels < 1 || channels > 4 || pixels.shape(0) < 1 ||
-      pixels.shape(1) < 1) {
+  if ((ndim != 2 && ndim != 3) || channels < 1 || channels > 4 || pixels.shape(0) < 1 || pixels.shape(1) < 1) {
     std::string shape;
     for (py::ssize_t k = 0; k < ndim; ++k) shape += (k ? " x " : "") + std::to_string(pixels.shape(k));
-    throw InputError(what + ": must have shape H x W or H x W x C with C in 1..4, got (" +
-                     shape + ")");
+    throw InputError(what + ": must have shape H x W or H x W x C with C in 1..4, got (" + shape + ")");
   }
-  Image image(static_cast<int>(pixels.shape(1)), static_cast<int>(pixels.shape(0)),
-              static_cast<int>(channels));
+  Image image(static_cast<int>(pixels.shape(1)), static_cast<int>(pixels.shape(0)), static_cast<int>(channels));
   std::copy(pixels.data(), pixels.data() + pixels.size(), image.data.begin());
   return image;
 }
 
-std::string type_name(const py::handle& value) {
-  return py::str(py::type::handle_of(value).attr("__name__"));
-}
+std::string type_name(const py::handle& value) { return py::str(py::type::handle_of(value).attr("__name__")); }
 
 std::string path_arg(const py::handle& value, const std::string& what) {
   // os.fspath accepts str and os.PathLike (pathlib.Path); bytes are refused.
@@ -110,8 +104,7 @@ uint64_t unsigned_arg(const py::handle& value, const std::string& what) {
 
 double float_arg(const py::handle& value, const std::string& what) {
   // int or float (and numpy scalars); strings are not numbers here.
-  if (py::isinstance<py::bool_>(value) || py::isinstance<py::str>(value) ||
-      !py::hasattr(value, "__float__")) {
+  if (py::isinstance<py::bool_>(value) || py::isinstance<py::str>(value) || !py::hasattr(value, "__float__")) {
     throw InputError(what + ": must be a number, got " + type_name(value));
   }
   return py::float_(py::reinterpret_borrow<py::object>(value)).cast<double>();
@@ -119,10 +112,8 @@ double float_arg(const py::handle& value, const std::string& what) {
 
 std::array<double, 3> vec3_arg(const py::handle& value, const std::string& what) {
   // Any sequence of 3 numbers: a list, a tuple, a numpy array.
-  if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value) ||
-      py::len(value) != 3) {
-    throw InputError(what + ": must be 3 numbers [x, y, z], got " +
-                     std::string(py::str(py::repr(value))));
+  if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value) || py::len(value) != 3) {
+    throw InputError(what + ": must be 3 numbers [x, y, z], got " + std::string(py::str(py::repr(value))));
   }
   const py::sequence items = py::reinterpret_borrow<py::sequence>(value);
   std::array<double, 3> v{};
@@ -133,8 +124,10 @@ std::array<double, 3> vec3_arg(const py::handle& value, const std::string& what)
 CameraOverride camera_arg(const py::handle& value) {
   // Only the keys given override the scene's camera; an unknown key is an error (a typo).
   if (!py::isinstance<py::dict>(value)) {
-    throw InputError("camera: must be a dict with any of position, look_at, up, fov_y, width, "
-                     "height, got " + type_name(value));
+    throw InputError(
+        "camera: must be a dict with any of position, look_at, up, fov_y, width, "
+        "height, got " +
+        type_name(value));
   }
   CameraOverride camera;
   for (const auto& item : py::reinterpret_borrow<py::dict>(value)) {

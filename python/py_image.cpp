@@ -13,14 +13,11 @@ namespace {
 py::dict compare(const py::handle& a, const py::handle& b) {
   const Image image_a = array_to_image(a, "compare: a");
   const Image image_b = array_to_image(b, "compare: b");
-  if (image_a.width != image_b.width || image_a.height != image_b.height ||
-      image_a.channels != image_b.channels) {
+  if (image_a.width != image_b.width || image_a.height != image_b.height || image_a.channels != image_b.channels) {
     auto shape = [](const Image& i) {
-      return std::to_string(i.height) + " x " + std::to_string(i.width) + " x " +
-             std::to_string(i.channels);
+      return std::to_string(i.height) + " x " + std::to_string(i.width) + " x " + std::to_string(i.channels);
     };
-    throw InputError("compare: the images differ in shape: a is " + shape(image_a) +
-                     ", b is " + shape(image_b));
+    throw InputError("compare: the images differ in shape: a is " + shape(image_a) + ", b is " + shape(image_b));
   }
   ImageError error;
   {

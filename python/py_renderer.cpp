@@ -142,8 +142,7 @@ volatile std::sig_atomic_t SigintStopsRender::seen_ = 0;
 // Renders with the GIL released: arguments converted before, results after.
 py::object render(Renderer& renderer, const py::handle& scene_object, const py::kwargs& kwargs) {
   if (!py::isinstance<Scene>(scene_object)) {
-    throw InputError("scene: must be an abcube.Scene (load_scene, scene_from_dict), got " +
-                     type_name(scene_object));
+    throw InputError("scene: must be an abcube.Scene (load_scene, scene_from_dict), got " + type_name(scene_object));
   }
   bool want_stats = false;
   const RenderSetup setup = setup_from_kwargs(kwargs, &want_stats);
@@ -177,9 +176,8 @@ py::object render(Renderer& renderer, const py::handle& scene_object, const py::
   PyRenderResult out;
   out.image = image_to_array(std::move(result.image));
   for (auto& [name, image] : result.aovs) out.aovs[py::str(name)] = image_to_array(std::move(image));
-  out.stats = result.stats.json.empty()
-                  ? py::object(py::none())
-                  : py::module_::import("json").attr("loads")(result.stats.json);
+  out.stats =
+      result.stats.json.empty() ? py::object(py::none()) : py::module_::import("json").attr("loads")(result.stats.json);
   return py::cast(std::move(out));
 }
 
@@ -294,7 +292,8 @@ py::dict report(const py::handle& scene_object, const py::handle& dir, const py:
 
 // The option table as Python data: a list of dicts, one an option.
 py::list option_table() {
-  static const char* const KINDS[] = {"choice", "integer", "number", "flag", "path", "text", "vec3", "names", "setting"};
+  static const char* const KINDS[] = {"choice", "integer", "number", "flag",   "path",
+                                      "text",   "vec3",    "names",  "setting"};
   static const char* const SCOPES[] = {"job", "process", "scene"};
   py::list out;
   for (const OptionSpec& s : render_option_table()) {
@@ -334,23 +333,19 @@ job key), flag (the command line's), kind, scope ("job": any render; "process": 
 Renderer's; "scene": load_scene's), choices, range, default, unit, methods (those that use
 it; empty: every method), help, aliases. The command line, abcube batch and this module
 all read their options, checks and help from this one table.)doc");
-  py::class_<PyRenderResult>(m, "RenderResult",
-                             "What Renderer.render returns when aovs or stats are asked for.")
+  py::class_<PyRenderResult>(m, "RenderResult", "What Renderer.render returns when aovs or stats are asked for.")
       .def_readonly("image", &PyRenderResult::image, "float32 H x W x 3, linear RGB.")
-      .def_readonly("aovs", &PyRenderResult::aovs,
-                    "dict name -> float32 H x W (H x W x 3 for \"normal\").")
+      .def_readonly("aovs", &PyRenderResult::aovs, "dict name -> float32 H x W (H x W x 3 for \"normal\").")
       .def_readonly("stats", &PyRenderResult::stats,
                     "dict: the CLI's --stats JSON (plan, timings_ms, counts, memory, GL path), "
                     "or None without stats=True.")
       .def("__repr__", [](const PyRenderResult& r) {
-        return "<abcube.RenderResult image " + std::string(py::str(r.image.attr("shape"))) +
-               ", aovs " + std::string(py::str(py::list(r.aovs))) + ", stats " +
-               (r.stats.is_none() ? "None" : "{...}") + ">";
+        return "<abcube.RenderResult image " + std::string(py::str(r.image.attr("shape"))) + ", aovs " +
+               std::string(py::str(py::list(r.aovs))) + ", stats " + (r.stats.is_none() ? "None" : "{...}") + ">";
       });
 
   py::class_<Renderer>(m, "Renderer", RENDERER_DOC)
-      .def(py::init(&make_renderer), py::arg("gl") = "auto", py::arg("threads") = 0,
-           py::arg("gl_device") = -1)
+      .def(py::init(&make_renderer), py::arg("gl") = "auto", py::arg("threads") = 0, py::arg("gl_device") = -1)
       .def(
           "render",
           [](Renderer& self, const py::object& scene, const py::kwargs& kwargs) { return render(self, scene, kwargs); },

@@ -42,8 +42,7 @@ Scene scene_from_dict(const py::handle& scene, const py::handle& name, const py:
   // Python's json writes the text; NaN and infinity are refused here (not JSON), the rest is
   // validated by the loader, whose messages name the field path.
   if (!py::isinstance<py::dict>(scene)) {
-    throw InputError(string_arg(name, "name") + ": the scene must be a dict, got " +
-                     type_name(scene));
+    throw InputError(string_arg(name, "name") + ": the scene must be a dict, got " + type_name(scene));
   }
   py::object text;
   try {
@@ -56,9 +55,9 @@ Scene scene_from_dict(const py::handle& scene, const py::handle& name, const py:
 }
 
 std::string scene_repr(const Scene& s) {
-  return "<abcube.Scene '" + s.name() + "' " + std::to_string(s.width()) + "x" +
-         std::to_string(s.height()) + ", " + std::to_string(s.object_count()) + " objects, " +
-         std::to_string(s.triangle_count()) + " triangles, method " + s.method() + ">";
+  return "<abcube.Scene '" + s.name() + "' " + std::to_string(s.width()) + "x" + std::to_string(s.height()) + ", " +
+         std::to_string(s.object_count()) + " objects, " + std::to_string(s.triangle_count()) + " triangles, method " +
+         s.method() + ">";
 }
 
 }  // namespace
@@ -82,8 +81,8 @@ needs it. Made by load_scene, scene_from_dict or scene_from_json.)doc")
                              "What loaded but is likely a mistake (a mesh without triangles), one line each.")
       .def("__repr__", &scene_repr);
 
-  m.def("load_scene", &load_scene, py::arg("path"), py::arg("root") = py::none(),
-        py::arg("max_triangles") = 0, py::arg("max_memory_mib") = 0, py::arg("set") = py::none(),
+  m.def("load_scene", &load_scene, py::arg("path"), py::arg("root") = py::none(), py::arg("max_triangles") = 0,
+        py::arg("max_memory_mib") = 0, py::arg("set") = py::none(),
         R"doc(Loads a scene file, or a model file (.gltf, .glb, .obj: the model alone, framed and
 lit, 640 x 480, its own camera if it has one; docs/models-and-textures.md). Untrusted scenes:
 `root` confines every file the scene references to that folder, `max_triangles` (> 0) caps
@@ -92,15 +91,14 @@ take; all are refused before anything is allocated. `set`: a dict {"camera.fov_y
 "lights[0].position": [1, 4, 2], ...} of the file's values replaced before it is read, as
 `abcube render --set`. A bad scene raises SceneError naming the place ("scene.json:12:5:
 ..." or "scene.json: objects[3].radius: ...").)doc");
-  m.def("scene_from_dict", &scene_from_dict, py::arg("scene"), py::arg("name") = "<dict>",
-        py::arg("base_dir") = ".", py::arg("root") = py::none(), py::arg("max_triangles") = 0,
-        py::arg("max_memory_mib") = 0,
+  m.def("scene_from_dict", &scene_from_dict, py::arg("scene"), py::arg("name") = "<dict>", py::arg("base_dir") = ".",
+        py::arg("root") = py::none(), py::arg("max_triangles") = 0, py::arg("max_memory_mib") = 0,
         R"doc(A scene from a dict in the scene file's format. `name` stands for the file in
 messages ("<dict>: objects[0].radius: ..."); relative mesh paths resolve against
 `base_dir`. Raises SceneError as load_scene does.)doc");
-  m.def("scene_from_json", &scene_from_json, py::arg("text"), py::arg("name") = "<json>",
-        py::arg("base_dir") = ".", py::arg("root") = py::none(), py::arg("max_triangles") = 0,
-        py::arg("max_memory_mib") = 0, "A scene from JSON text; as scene_from_dict.");
+  m.def("scene_from_json", &scene_from_json, py::arg("text"), py::arg("name") = "<json>", py::arg("base_dir") = ".",
+        py::arg("root") = py::none(), py::arg("max_triangles") = 0, py::arg("max_memory_mib") = 0,
+        "A scene from JSON text; as scene_from_dict.");
 }
 
 }  // namespace abcube

@@ -9,8 +9,14 @@ namespace abcube {
 struct Bounds {
   glm::dvec3 lo{DBL_MAX}, hi{-DBL_MAX};  // empty: lo > hi
   bool empty() const { return lo.x > hi.x; }
-  void extend(const glm::dvec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
-  void extend(const Bounds& b) { lo = glm::min(lo, b.lo); hi = glm::max(hi, b.hi); }
+  void extend(const glm::dvec3& p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  void extend(const Bounds& b) {
+    lo = glm::min(lo, b.lo);
+    hi = glm::max(hi, b.hi);
+  }
   // Surface area (the SAH's cost weight, Wald 2007); 0 when empty.
   double area() const {
     if (empty()) return 0.0;

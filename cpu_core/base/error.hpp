@@ -52,7 +52,7 @@ inline std::string join(const std::vector<std::string>& names, const char* separ
 
 }  // namespace abcube
 
-#define ABCUBE_CHECK(cond, detail)                                        \
-  do {                                                                    \
+#define ABCUBE_CHECK(cond, detail)                                            \
+  do {                                                                        \
     if (!(cond)) ::abcube::check_failed(#cond, __FILE__, __LINE__, (detail)); \
   } while (0)

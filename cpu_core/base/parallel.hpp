@@ -36,8 +36,9 @@ inline std::atomic<int>& stop_request() {
 // Throws Interrupted when a stop was requested.
 inline void check_stop_request() {
   if (const int s = stop_request().load(std::memory_order_relaxed)) {
-    throw Interrupted(s == SIGINT ? "interrupted (SIGINT)" : s == SIGTERM ? "terminated (SIGTERM)"
-                                                                          : "stopped (signal " + std::to_string(s) + ")",
+    throw Interrupted(s == SIGINT    ? "interrupted (SIGINT)"
+                      : s == SIGTERM ? "terminated (SIGTERM)"
+                                     : "stopped (signal " + std::to_string(s) + ")",
                       s);
   }
 }

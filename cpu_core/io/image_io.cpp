@@ -26,9 +26,7 @@ float srgb_encode(float x) {
   return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.f / 2.4f) - 0.055f;
 }
 
-float srgb_decode(float x) {
-  return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f);
-}
+float srgb_decode(float x) { return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f); }
 
 namespace {
 
@@ -79,12 +77,12 @@ std::vector<std::string> writable_image_extensions() {
 void write_image(const std::string& path, const Image& image) {
   auto out = OIIO::ImageOutput::create(path);
   if (!out) {
-    throw InputError(path + ": no image writer for this file extension (" + join(writable_image_extensions(), ", ") + ")");
+    throw InputError(path + ": no image writer for this file extension (" + join(writable_image_extensions(), ", ") +
+                     ")");
   }
   const bool linear = is_float_format(path);
   const int channels = image.channels;
-  OIIO::ImageSpec spec(image.width, image.height, channels,
-                       linear ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+  OIIO::ImageSpec spec(image.width, image.height, channels, linear ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
   spec.attribute("oiio:ColorSpace", linear ? "linear" : "sRGB");
   // The bytes depend on the pixels only: OpenEXR and TIFF otherwise stamp the time.
   spec.attribute("DateTime", "");

@@ -24,8 +24,8 @@ glm::dvec3 displayed(const Image& img, int x, int y) {
 
 void check_same_size(const Image& a, const Image& b) {
   if (a.width != b.width || a.height != b.height) {
-    throw InputError("images differ in size: " + std::to_string(a.width) + "x" + std::to_string(a.height) +
-                     " vs " + std::to_string(b.width) + "x" + std::to_string(b.height));
+    throw InputError("images differ in size: " + std::to_string(a.width) + "x" + std::to_string(a.height) + " vs " +
+                     std::to_string(b.width) + "x" + std::to_string(b.height));
   }
   if (a.channels < 1 || b.channels < 1) throw InputError("images must have at least one channel");
 }
@@ -125,8 +125,9 @@ Image error_heatmap(const Image& a, const Image& b) {
     for (int x = 0; x < a.width; ++x) {
       const glm::dvec3 d = glm::abs(displayed(a, x, y) - displayed(b, x, y));
       const glm::dvec3 shown = heatmap_ramp(std::max(d.x, std::max(d.y, d.z)));
-      out.set_rgb(x, y, glm::vec3(srgb_decode(static_cast<float>(shown.r)), srgb_decode(static_cast<float>(shown.g)),
-                                  srgb_decode(static_cast<float>(shown.b))));
+      out.set_rgb(x, y,
+                  glm::vec3(srgb_decode(static_cast<float>(shown.r)), srgb_decode(static_cast<float>(shown.g)),
+                            srgb_decode(static_cast<float>(shown.b))));
     }
   }
   return out;
@@ -161,9 +162,7 @@ double ErrorStats::mean() const {
   return s / static_cast<double>(values_.size());
 }
 
-double ErrorStats::max() const {
-  return values_.empty() ? 0.0 : *std::max_element(values_.begin(), values_.end());
-}
+double ErrorStats::max() const { return values_.empty() ? 0.0 : *std::max_element(values_.begin(), values_.end()); }
 
 double ErrorStats::percentile(double q) const {
   std::vector<double> v(values_);
@@ -188,9 +187,9 @@ namespace {
 // (the high bit the left column).
 int glyph_row(char c, int row) {
   static const char* const DIGITS = "0123456789/";
-  static const int GLYPHS[11][5] = {
-      {7, 5, 5, 5, 7}, {2, 6, 2, 2, 7}, {7, 1, 7, 4, 7}, {7, 1, 7, 1, 7}, {5, 5, 7, 1, 1}, {7, 4, 7, 1, 7},
-      {7, 4, 7, 5, 7}, {7, 1, 2, 2, 2}, {7, 5, 7, 5, 7}, {7, 5, 7, 1, 7}, {1, 1, 2, 4, 4}};
+  static const int GLYPHS[11][5] = {{7, 5, 5, 5, 7}, {2, 6, 2, 2, 7}, {7, 1, 7, 4, 7}, {7, 1, 7, 1, 7},
+                                    {5, 5, 7, 1, 1}, {7, 4, 7, 1, 7}, {7, 4, 7, 5, 7}, {7, 1, 2, 2, 2},
+                                    {7, 5, 7, 5, 7}, {7, 5, 7, 1, 7}, {1, 1, 2, 4, 4}};
   for (int i = 0; i < 11; ++i) {
     if (DIGITS[i] == c) return GLYPHS[i][row];
   }

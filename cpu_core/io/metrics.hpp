@@ -55,12 +55,12 @@ class ErrorStats {
   uint64_t count() const { return values_.size(); }  // found values
   uint64_t miss_count() const { return misses_; }
   uint64_t total() const { return count() + misses_; }
-  double mean() const;                 // over found values; 0 when there are none
-  double max() const;                  // 0 when there are none
+  double mean() const;  // over found values; 0 when there are none
+  double max() const;   // 0 when there are none
   // Nearest-rank percentile of the found values (base/statistics.hpp percentile), q in
   // [0, 1]; 0 when there are none.
   double percentile(double q) const;
-  double miss_share() const;           // misses / total; 0 when empty
+  double miss_share() const;  // misses / total; 0 when empty
   // Share of the found values <= bound (e.g. thesis 9.3.4's 1/(2 N^2)); 0 when none.
   double share_within(double bound) const;
 

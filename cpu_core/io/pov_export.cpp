@@ -28,9 +28,7 @@ std::string num_f(float v) {
 
 // A point or vector in POV-Ray's left-handed frame: z mirrored.
 std::string vec(const glm::dvec3& v) { return "<" + num(v.x) + ", " + num(v.y) + ", " + num(-v.z) + ">"; }
-std::string vec_f(const glm::vec3& v) {
-  return "<" + num_f(v.x) + ", " + num_f(v.y) + ", " + num_f(-v.z) + ">";
-}
+std::string vec_f(const glm::vec3& v) { return "<" + num_f(v.x) + ", " + num_f(v.y) + ", " + num_f(-v.z) + ">"; }
 std::string rgb(const glm::dvec3& c) { return "<" + num(c.r) + ", " + num(c.g) + ", " + num(c.b) + ">"; }
 
 // A comment-safe copy of a user string (no line breaks).
@@ -69,8 +67,8 @@ void write_camera(std::ostringstream& os, const Camera& c) {
 
 void write_lights(std::ostringstream& os, const SceneData& scene) {
   for (const PointLight& l : scene.lights) {
-    os << "light_source { " << vec(l.position) << " color rgb " << rgb(l.color)
-       << (l.cast_shadows ? "" : " shadowless") << " }\n";
+    os << "light_source { " << vec(l.position) << " color rgb " << rgb(l.color) << (l.cast_shadows ? "" : " shadowless")
+       << " }\n";
   }
 }
 

@@ -45,7 +45,6 @@ glm::dvec3 decode_octahedral(uint32_t code) {
   return glm::normalize(n);
 }
 
-
 namespace {
 
 constexpr int BAND_ROWS = 32;
@@ -126,9 +125,8 @@ void count_band(const TriangleSoup& soup, ViewBuild* vb, const Band& band) {
   const size_t w = static_cast<size_t>(vb->view.width);
   uint32_t* counts = vb->offsets.data() + 1;  // pixel p counts into offsets[p + 1]
   for_band_triangles(soup, *vb, band, [&](const TriangleSetup& s) {
-    rasterize_rows(s, band.y0, band.y1, [&](int x, int y, CoverageMask) {
-      ++counts[static_cast<size_t>(y) * w + static_cast<size_t>(x)];
-    });
+    rasterize_rows(s, band.y0, band.y1,
+                   [&](int x, int y, CoverageMask) { ++counts[static_cast<size_t>(y) * w + static_cast<size_t>(x)]; });
   });
 }
 
@@ -140,9 +138,8 @@ bool before(const Fragment& a, const Fragment& b) {
 // facing, z ranges overlapping, masks disjoint; and, our addition, no crease between them.
 bool mergeable(const TriangleSoup& soup, const Fragment& a, const Fragment& b) {
   const uint32_t ta = a.triangle(), tb = b.triangle();
-  return a.back_face() == b.back_face() && (a.mask & b.mask) == 0 && b.zmin <= a.zmax &&
-         a.zmin <= b.zmax && soup.object_id[ta] == soup.object_id[tb] &&
-         soup.material_id[ta] == soup.material_id[tb] &&
+  return a.back_face() == b.back_face() && (a.mask & b.mask) == 0 && b.zmin <= a.zmax && a.zmin <= b.zmax &&
+         soup.object_id[ta] == soup.object_id[tb] && soup.material_id[ta] == soup.material_id[tb] &&
          glm::dot(a.shading_normal(), b.shading_normal()) >= MERGE_MIN_NORMAL_COS;
 }
 
@@ -156,8 +153,7 @@ void merge_into(Fragment* into, const Fragment& f) {
   // one of them covers a centre sample, so centre look-ups (nearest_layer, the pixel-centre
   // shading point) use the right plane; else the one covering more samples.
   const int c1 = mask_count(into->mask & CENTRE_SAMPLES), c2 = mask_count(f.mask & CENTRE_SAMPLES);
-  const bool take = c2 != c1 ? c2 > c1
-                             : a2 > a1 || (a2 == a1 && f.triangle_and_facing < into->triangle_and_facing);
+  const bool take = c2 != c1 ? c2 > c1 : a2 > a1 || (a2 == a1 && f.triangle_and_facing < into->triangle_and_facing);
   if (take) into->triangle_and_facing = f.triangle_and_facing;
   into->mask |= f.mask;
   into->zmin = std::min(into->zmin, f.zmin);
@@ -165,8 +161,8 @@ void merge_into(Fragment* into, const Fragment& f) {
 }
 
 // Sorts one pixel's raw list, merges it, applies the cap; returns the kept count.
-uint32_t finish_list(const TriangleSoup& soup, const ABufferOptions& options, Fragment* list,
-                     uint32_t count, BandResult* r) {
+uint32_t finish_list(const TriangleSoup& soup, const ABufferOptions& options, Fragment* list, uint32_t count,
+                     BandResult* r) {
   std::sort(list, list + count, before);
   uint32_t kept = 0;
   bool merged_any = false;
@@ -192,8 +188,7 @@ uint32_t finish_list(const TriangleSoup& soup, const ABufferOptions& options, Fr
   return kept;
 }
 
-BandResult fill_band(const TriangleSoup& soup, const ABufferOptions& options, ViewBuild* vb,
-                     const Band& band) {
+BandResult fill_band(const TriangleSoup& soup, const ABufferOptions& options, ViewBuild* vb, const Band& band) {
   const size_t w = static_cast<size_t>(vb->view.width);
   const size_t p0 = static_cast<size_t>(band.y0) * w, p1 = static_cast<size_t>(band.y1) * w;
   for (size_t p = p0; p < p1; ++p) vb->cursor[p] = vb->offsets[p];
@@ -235,7 +230,8 @@ std::string mib(uint64_t bytes) { return std::to_string((bytes + MIB - 1) / MIB)
 void check_budget(const char* what, uint64_t need, const std::string& detail, const ABufferOptions& o,
                   uint64_t budget) {
   if (need <= budget && o.reserved_bytes <= budget - need) return;
-  const std::string beside = o.reserved_bytes > 0 ? " beside " + mib(o.reserved_bytes) + " MiB for the rest of the render" : "";
+  const std::string beside =
+      o.reserved_bytes > 0 ? " beside " + mib(o.reserved_bytes) + " MiB for the rest of the render" : "";
   throw InputError(std::string(what) + " needs " + mib(need) + " MiB (" + detail + ")" + beside + ", " +
                    budget_words(budget, o.max_memory_bytes > 0));
 }
@@ -250,9 +246,7 @@ void check_options(const ABufferOptions& o) {
 // Count pass over every band of every view, then prefix sums; returns the raw total.
 uint64_t count_views(const TriangleSoup& soup, std::vector<ViewBuild>* views, const std::vector<Band>& bands,
                      int threads) {
-  parallel_for(bands.size(), threads, [&](size_t i, int) {
-    count_band(soup, &(*views)[bands[i].view], bands[i]);
-  });
+  parallel_for(bands.size(), threads, [&](size_t i, int) { count_band(soup, &(*views)[bands[i].view], bands[i]); });
   uint64_t total = 0;
   for (ViewBuild& vb : *views) {
     uint64_t sum = 0;
@@ -281,8 +275,8 @@ ABufferStats summarise(const std::vector<ViewBuild>& views, const std::vector<AB
   }
   st.triangles_degenerate = views.front().degenerate;  // the same in every view of one centre
   st.triangles_edge_on = views.front().edge_on;
-  st.triangles_culled = static_cast<uint64_t>(std::count(seen.begin(), seen.end(), 0)) - st.triangles_degenerate -
-                        st.triangles_edge_on;
+  st.triangles_culled =
+      static_cast<uint64_t>(std::count(seen.begin(), seen.end(), 0)) - st.triangles_degenerate - st.triangles_edge_on;
   for (const BandResult& r : results) {
     st.dropped_by_cap += r.dropped;
     st.max_list_length = std::max(st.max_list_length, r.max_list);
@@ -305,7 +299,8 @@ std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView>
   for (size_t v = 0; v < rasters.size(); ++v) {
     views[v].view = rasters[v];
     index_bytes += (2 * rasters[v].pixel_count() + 1) * sizeof(uint32_t);
-    for (int y = 0; y < rasters[v].height; y += BAND_ROWS) bands.push_back({v, y, std::min(y + BAND_ROWS, rasters[v].height)});
+    for (int y = 0; y < rasters[v].height; y += BAND_ROWS)
+      bands.push_back({v, y, std::min(y + BAND_ROWS, rasters[v].height)});
   }
   const uint64_t budget = memory_budget_bytes(options.max_memory_bytes);
   check_budget(what, index_bytes, "its per-pixel index alone", options, budget);
@@ -326,9 +321,8 @@ std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView>
     vb.fragments.resize(vb.offsets.back());
   }
   std::vector<BandResult> results(bands.size());
-  parallel_for(bands.size(), threads, [&](size_t i, int) {
-    results[i] = fill_band(soup, options, &views[bands[i].view], bands[i]);
-  });
+  parallel_for(bands.size(), threads,
+               [&](size_t i, int) { results[i] = fill_band(soup, options, &views[bands[i].view], bands[i]); });
   parallel_for(views.size(), threads, [&](size_t v, int) { compact(&views[v]); });
 
   std::vector<ABuffer> out(views.size());
@@ -445,11 +439,13 @@ void nearest_layer_face(const CubeABuffer& cube, const TriangleSoup& triangles, 
       // A tie: another object's surface over one of the same centre samples at the same
       // distance (the rule decided; surfaces meeting at an edge cover disjoint samples).
       for (const Fragment& f : b.list(x, y)) {
-        if (best == HUGE_VAL || (f.mask & best_mask & CENTRE_SAMPLES) == 0 || triangles.object_id[f.triangle()] == best_id) {
+        if (best == HUGE_VAL || (f.mask & best_mask & CENTRE_SAMPLES) == 0 ||
+            triangles.object_id[f.triangle()] == best_id) {
           continue;
         }
         const glm::dvec3 r = point_on_triangle_plane(b.view, triangles, f.triangle(), x + 0.5, y + 0.5) - cube.centre;
-        if (glm::dot(r, d) > 0.0 && same_distance(triangles, d, {f.triangle(), glm::length(r)}, {best_triangle, best})) {
+        if (glm::dot(r, d) > 0.0 &&
+            same_distance(triangles, d, {f.triangle(), glm::length(r)}, {best_triangle, best})) {
           tied[texel] = 1;
           break;
         }

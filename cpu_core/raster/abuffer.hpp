@@ -76,34 +76,34 @@ struct CubeABuffer {
 };
 
 struct ABufferOptions {
-  int threads = 0;                // 0 = std::thread::hardware_concurrency()
-  double near_distance = 0;       // 0 = default_near_distance(farthest vertex from the centre)
-  uint32_t max_layers = 0;        // 0 = keep every layer
+  int threads = 0;           // 0 = std::thread::hardware_concurrency()
+  double near_distance = 0;  // 0 = default_near_distance(farthest vertex from the centre)
+  uint32_t max_layers = 0;   // 0 = keep every layer
   // The render's memory budget (--max-memory), 0 = the memory available
   // (memory_budget_bytes, scene_load.hpp); the A-buffer may take what `reserved_bytes`, the
   // rest of the render's estimate (estimate_render_bytes, an A-buffer built before), leaves.
   uint64_t max_memory_bytes = 0;
   uint64_t reserved_bytes = 0;
-  bool merge = true;              // false keeps one fragment per triangle and pixel (tests)
+  bool merge = true;  // false keeps one fragment per triangle and pixel (tests)
 };
 
 struct ABufferStats {
-  uint64_t fragments = 0;                  // stored, after merging and the cap
-  uint64_t raw_fragments = 0;              // triangle-pixel pairs before merging
+  uint64_t fragments = 0;                    // stored, after merging and the cap
+  uint64_t raw_fragments = 0;                // triangle-pixel pairs before merging
   std::vector<uint64_t> fragments_per_view;  // per face (or the one camera view)
   uint64_t max_list_length = 0;
   uint64_t dropped_by_cap = 0;
   uint64_t bytes_per_fragment = sizeof(Fragment);
-  uint64_t bytes_total = 0;                // fragments and offsets as stored (after merging)
+  uint64_t bytes_total = 0;  // fragments and offsets as stored (after merging)
   // The budget check's figure: the raw fragments, the per-pixel index and the triangle bins.
   // It is the peak: the fragment arrays keep the raw count's capacity after merging.
   uint64_t estimated_bytes = 0;
   uint64_t budget_bytes = 0;
-  uint64_t triangle_views = 0;             // (triangle, view) pairs rasterised
-  uint64_t triangles_clipped = 0;          // (triangle, view) pairs cut by the near plane
-  uint64_t triangles_culled = 0;           // triangles no view sees (behind near / outside)
-  uint64_t triangles_degenerate = 0;       // non-finite or zero-area
-  uint64_t triangles_edge_on = 0;          // plane through the centre
+  uint64_t triangle_views = 0;        // (triangle, view) pairs rasterised
+  uint64_t triangles_clipped = 0;     // (triangle, view) pairs cut by the near plane
+  uint64_t triangles_culled = 0;      // triangles no view sees (behind near / outside)
+  uint64_t triangles_degenerate = 0;  // non-finite or zero-area
+  uint64_t triangles_edge_on = 0;     // plane through the centre
   double near_distance = 0;
   double count_ms = 0, fill_ms = 0, total_ms = 0;
   int threads = 0;
@@ -117,13 +117,12 @@ CubeABuffer build_cube_abuffer(const SceneData& scene, const glm::dvec3& centre,
                                const ABufferOptions& options = {}, ABufferStats* stats = nullptr);
 
 // The camera view's A-buffer (scene.camera, its width x height), same rules.
-ABuffer build_camera_abuffer(const SceneData& scene, const ABufferOptions& options = {},
-                             ABufferStats* stats = nullptr);
+ABuffer build_camera_abuffer(const SceneData& scene, const ABufferOptions& options = {}, ABufferStats* stats = nullptr);
 
 // The four samples nearest the pixel centre (columns 3-4 of rows 1-2): there is no sample
 // at (0.5, 0.5), so "the texel centre is covered" means "one of these is".
-constexpr CoverageMask CENTRE_SAMPLES = (1u << sample_index(3, 1)) | (1u << sample_index(4, 1)) |
-                                        (1u << sample_index(3, 2)) | (1u << sample_index(4, 2));
+constexpr CoverageMask CENTRE_SAMPLES =
+    (1u << sample_index(3, 1)) | (1u << sample_index(4, 1)) | (1u << sample_index(3, 2)) | (1u << sample_index(4, 2));
 
 // The front-most fragment (in list order) covering a centre sample, or nullptr.
 const Fragment* centre_fragment(const ABuffer& buffer, int x, int y);
@@ -140,13 +139,12 @@ const Fragment* centre_fragment(const ABuffer& buffer, int x, int y);
 struct NearestLayer {
   CubeImage distance;  // 1 channel
   CubeIds object;
-  CubeIds tied;        // 1 where the tie rule decided between objects, else 0
+  CubeIds tied;  // 1 where the tie rule decided between objects, else 0
 };
 NearestLayer nearest_layer(const CubeABuffer& cube, const TriangleSoup& triangles);
 
 // The world point a fragment of pixel (x, y) stands for: its triangle's plane along the
 // direction through the centroid of its covered samples.
-glm::dvec3 fragment_point(const ABuffer& buffer, const TriangleSoup& triangles, const Fragment& f,
-                          int x, int y);
+glm::dvec3 fragment_point(const ABuffer& buffer, const TriangleSoup& triangles, const Fragment& f, int x, int y);
 
 }  // namespace abcube

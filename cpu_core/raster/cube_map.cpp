@@ -55,8 +55,8 @@ CubeTexel direction_to_texel(const glm::dvec3& r, int n) {
 
 namespace {
 // Rows (sx, ty, forward) of a view basis and a translation by -center; clip z = near.
-glm::mat4 reversed_infinite(const glm::dvec3& row_x, const glm::dvec3& row_y,
-                            const glm::dvec3& row_w, const glm::dvec3& center, double near) {
+glm::mat4 reversed_infinite(const glm::dvec3& row_x, const glm::dvec3& row_y, const glm::dvec3& row_w,
+                            const glm::dvec3& center, double near) {
   glm::dmat4 m(0.0);  // m[col][row]
   for (int c = 0; c < 3; ++c) {
     m[c][0] = row_x[c];
@@ -76,9 +76,8 @@ glm::mat4 face_clip_matrix(int face, const glm::dvec3& center, double near_dista
   return reversed_infinite(b.s_axis, b.t_axis, b.forward, center, near_distance);
 }
 
-glm::mat4 camera_clip_matrix(const glm::dvec3& eye, const glm::dvec3& look_at,
-                             const glm::dvec3& up, double fov_y, double aspect,
-                             double near_distance) {
+glm::mat4 camera_clip_matrix(const glm::dvec3& eye, const glm::dvec3& look_at, const glm::dvec3& up, double fov_y,
+                             double aspect, double near_distance) {
   const glm::dvec3 f = glm::normalize(look_at - eye);
   const glm::dvec3 r = glm::normalize(glm::cross(f, up));
   const glm::dvec3 u = glm::cross(r, f);
@@ -86,8 +85,6 @@ glm::mat4 camera_clip_matrix(const glm::dvec3& eye, const glm::dvec3& look_at,
   return reversed_infinite(r / (ty * aspect), u / ty, f, eye, near_distance);
 }
 
-double default_near_distance(double scene_radius) {
-  return std::max(1e-4, 1e-5 * scene_radius);
-}
+double default_near_distance(double scene_radius) { return std::max(1e-4, 1e-5 * scene_radius); }
 
 }  // namespace abcube

@@ -60,9 +60,8 @@ CubeTexel direction_to_texel(const glm::dvec3& r, int n);
 glm::mat4 face_clip_matrix(int face, const glm::dvec3& center, double near_distance);
 
 // The same infinite reversed-Z projection for a pinhole camera (fov_y in radians).
-glm::mat4 camera_clip_matrix(const glm::dvec3& eye, const glm::dvec3& look_at,
-                             const glm::dvec3& up, double fov_y, double aspect,
-                             double near_distance);
+glm::mat4 camera_clip_matrix(const glm::dvec3& eye, const glm::dvec3& look_at, const glm::dvec3& up, double fov_y,
+                             double aspect, double near_distance);
 
 // The default near distance used by every pass: small against the scene, never zero.
 double default_near_distance(double scene_radius);

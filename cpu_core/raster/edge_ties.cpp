@@ -29,7 +29,8 @@ struct EdgeTies {
     if (!(b.x != a.x)) return;  // a point (or NaN)
     if (b.x < a.x) std::swap(a, b);
     const double slope = (b.y - a.y) / (b.x - a.x);
-    const double first = std::max(std::ceil(a.x - 0.5), 0.0), last = std::min(std::floor(b.x - 0.5), double(major_n - 1));
+    const double first = std::max(std::ceil(a.x - 0.5), 0.0),
+                 last = std::min(std::floor(b.x - 0.5), double(major_n - 1));
     // From the end nearer the screen (an end cut at the near depth lies far outside it).
     const glm::dvec2 o = std::abs(a.x) <= std::abs(b.x) ? a : b;
     for (double k = first; k <= last; k += 1.0) {

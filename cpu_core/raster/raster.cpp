@@ -36,13 +36,11 @@ bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.
 bool owns_ties(const glm::dvec3& abc) { return abc.x > 0.0 || (abc.x == 0.0 && abc.y > 0.0); }
 
 glm::dvec3 raster_edge(const glm::dmat3& to_direction, const glm::dvec3& plane) {
-  return {glm::dot(to_direction[0], plane), glm::dot(to_direction[1], plane),
-          glm::dot(to_direction[2], plane)};
+  return {glm::dot(to_direction[0], plane), glm::dot(to_direction[1], plane), glm::dot(to_direction[2], plane)};
 }
 
 // Sutherland-Hodgman against one plane through the centre: keeps dot(plane, v) >= offset.
-int clip_polygon(const glm::dvec3* in, int count, const glm::dvec3& plane, double offset,
-                 glm::dvec3* out) {
+int clip_polygon(const glm::dvec3* in, int count, const glm::dvec3& plane, double offset, glm::dvec3* out) {
   int m = 0;
   for (int i = 0; i < count; ++i) {
     const glm::dvec3& a = in[i];
@@ -101,8 +99,7 @@ void setup_edges(const RasterView& view, TriangleSetup* s) {
     s->edge_3d[k] = orientation * glm::cross(s->r[k], s->r[(k + 1) % 3]);
   }
   // Near line: w(P) >= near along d  <=>  dot(|h| row_w - near * sign(h) * n, d) >= 0.
-  s->edge_3d[3] = std::fabs(s->plane_offset) * view.row_w -
-                  (view.near_distance * orientation) * s->plane_normal;
+  s->edge_3d[3] = std::fabs(s->plane_offset) * view.row_w - (view.near_distance * orientation) * s->plane_normal;
   for (size_t k = 0; k < 4; ++k) {
     s->edge[k] = raster_edge(view.to_direction, s->edge_3d[k]);
     s->owns_ties[k] = k == 3 || owns_ties(s->edge[k]);
@@ -116,8 +113,8 @@ RasterView cube_face_view(int face, const glm::dvec3& centre, int n, double near
   const double half = 0.5 * n;
   // x = N s = half (sc/ma + 1), y = N t; direction(x, y) = cube_to_direction(face, x/N, y/N).
   const glm::dmat3 to_direction(b.s_axis / half, b.t_axis / half, b.forward - b.s_axis - b.t_axis);
-  return make_view(centre, half * (b.s_axis + b.forward), half * (b.t_axis + b.forward), b.forward,
-                   to_direction, n, n, near_distance);
+  return make_view(centre, half * (b.s_axis + b.forward), half * (b.t_axis + b.forward), b.forward, to_direction, n, n,
+                   near_distance);
 }
 
 RasterView camera_view(const CameraFrame& f, double near_distance) {
@@ -129,8 +126,7 @@ RasterView camera_view(const CameraFrame& f, double near_distance) {
                    to_direction, f.width, f.height, near_distance);
 }
 
-SetupResult setup_triangle(const RasterView& view, const TriangleSoup& soup, uint32_t index,
-                           TriangleSetup* s) {
+SetupResult setup_triangle(const RasterView& view, const TriangleSoup& soup, uint32_t index, TriangleSetup* s) {
   s->triangle = index;
   const size_t base = 3 * static_cast<size_t>(index);
   double farthest = 0.0;
@@ -291,8 +287,7 @@ int pixel_polygon(const RasterView& view, const TriangleSetup& s, int x, int y, 
 
 }  // namespace
 
-FragmentGeometry fragment_geometry(const RasterView& view, const TriangleSetup& s, int x, int y,
-                                   CoverageMask mask) {
+FragmentGeometry fragment_geometry(const RasterView& view, const TriangleSetup& s, int x, int y, CoverageMask mask) {
   FragmentGeometry g;
   const glm::dvec2 c = mask_centroid(mask);
   const glm::dvec3 d = view.direction(x + c.x, y + c.y);
@@ -324,8 +319,8 @@ FragmentGeometry fragment_geometry(const RasterView& view, const TriangleSetup& 
   return g;
 }
 
-glm::dvec3 point_on_triangle_plane(const RasterView& view, const TriangleSoup& soup, uint32_t index,
-                                   double x, double y) {
+glm::dvec3 point_on_triangle_plane(const RasterView& view, const TriangleSoup& soup, uint32_t index, double x,
+                                   double y) {
   const size_t base = 3 * static_cast<size_t>(index);
   const glm::dvec3 r0 = glm::dvec3(soup.positions[base]) - view.centre;
   const glm::dvec3 n = glm::cross(glm::dvec3(soup.positions[base + 1]) - view.centre - r0,

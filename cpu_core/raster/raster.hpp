@@ -21,7 +21,7 @@ namespace abcube {
 struct RasterView {
   glm::dvec3 centre{0.0};
   glm::dvec3 row_x{1, 0, 0}, row_y{0, 1, 0}, row_w{0, 0, 1};  // row_w unit
-  glm::dmat3 to_direction{1.0};  // inverse of the rows: (x, y, 1) -> unnormalised r
+  glm::dmat3 to_direction{1.0};                               // inverse of the rows: (x, y, 1) -> unnormalised r
   int width = 1, height = 1;
   double near_distance = 1e-4;
 
@@ -46,26 +46,25 @@ enum class SetupResult { visible, culled, degenerate, edge_on };
 // its part in front of the near plane, and the pixel rows and columns it may cover.
 struct TriangleSetup {
   uint32_t triangle = 0;
-  std::array<glm::dvec3, 3> r{};          // vertices minus the view centre
-  std::array<glm::dvec3, 3> normal{};     // vertex normals
-  std::array<glm::dvec3, 4> edge{};       // (a, b, c) per edge (edge k: r_k -> r_k+1), then near
-  std::array<glm::dvec3, 4> edge_3d{};    // the same edges as inward plane normals (through the centre)
-  std::array<bool, 4> owns_ties{};        // tie rule per edge
-  int edge_count = 3;                     // 4 when the near plane cuts the triangle
-  std::array<glm::dvec3, 4> polygon{};    // the triangle clipped to w >= near (3D, minus centre)
+  std::array<glm::dvec3, 3> r{};        // vertices minus the view centre
+  std::array<glm::dvec3, 3> normal{};   // vertex normals
+  std::array<glm::dvec3, 4> edge{};     // (a, b, c) per edge (edge k: r_k -> r_k+1), then near
+  std::array<glm::dvec3, 4> edge_3d{};  // the same edges as inward plane normals (through the centre)
+  std::array<bool, 4> owns_ties{};      // tie rule per edge
+  int edge_count = 3;                   // 4 when the near plane cuts the triangle
+  std::array<glm::dvec3, 4> polygon{};  // the triangle clipped to w >= near (3D, minus centre)
   int polygon_size = 0;
-  glm::dvec3 plane_normal{0.0};           // cross(r1 - r0, r2 - r0), the geometric normal
-  double plane_offset = 0;                // dot(plane_normal, r0): < 0 front face, > 0 back face
-  double plane_distance = 0;              // |plane_offset| / |plane_normal|
-  int foot_x = -1, foot_y = -1;           // pixel holding the foot of the perpendicular, if covered
-  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;     // pixel bounds [x0, x1) x [y0, y1), clamped to the view
+  glm::dvec3 plane_normal{0.0};        // cross(r1 - r0, r2 - r0), the geometric normal
+  double plane_offset = 0;             // dot(plane_normal, r0): < 0 front face, > 0 back face
+  double plane_distance = 0;           // |plane_offset| / |plane_normal|
+  int foot_x = -1, foot_y = -1;        // pixel holding the foot of the perpendicular, if covered
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // pixel bounds [x0, x1) x [y0, y1), clamped to the view
   bool back_face() const { return plane_offset > 0; }
   bool near_clipped() const { return edge_count == 4; }
 };
 
 // Prepares triangle `index` of `soup` for `view`; `setup` is valid only for `visible`.
-SetupResult setup_triangle(const RasterView& view, const TriangleSoup& soup, uint32_t index,
-                           TriangleSetup* setup);
+SetupResult setup_triangle(const RasterView& view, const TriangleSoup& soup, uint32_t index, TriangleSetup* setup);
 
 // Columns [*x_begin, *x_end) of row y that may hold covered samples (a conservative span
 // inside the setup's bounds); empty when *x_begin >= *x_end.
@@ -100,12 +99,11 @@ struct FragmentGeometry {
 };
 
 // The geometry of the triangle's fragment in pixel (x, y) with coverage `mask` (non-empty).
-FragmentGeometry fragment_geometry(const RasterView& view, const TriangleSetup& setup, int x, int y,
-                                   CoverageMask mask);
+FragmentGeometry fragment_geometry(const RasterView& view, const TriangleSetup& setup, int x, int y, CoverageMask mask);
 
 // The point of triangle `index`'s plane seen from the view centre along pixel point (x, y)
 // (world space); the centre itself if that ray is parallel to the plane.
-glm::dvec3 point_on_triangle_plane(const RasterView& view, const TriangleSoup& soup, uint32_t index,
-                                   double x, double y);
+glm::dvec3 point_on_triangle_plane(const RasterView& view, const TriangleSoup& soup, uint32_t index, double x,
+                                   double y);
 
 }  // namespace abcube

@@ -169,7 +169,7 @@ struct Query {
   // visible_hit (bvh.hpp)
   double tie_bound_max = 0;
   double cull = INF;  // every hit with t < cull is found
-  struct Kept {  // no initialisers: not cleared for every query
+  struct Kept {       // no initialisers: not cleared for every query
     double t;
     uint32_t triangle;
   };
@@ -233,7 +233,8 @@ void visible_candidate(const RTCIntersectFunctionNArguments* args) {
   if (!args->valid[0]) return;  // rtcIntersect1: N = 1
   Query* q = reinterpret_cast<Query*>(args->context);
   TriangleHit h;
-  if (!intersect_triangle(*q->ray, *q->soup, q->triangle(chunk_first(args->geometryUserPtr) + args->primID), q->cull, &h)) {
+  if (!intersect_triangle(*q->ray, *q->soup, q->triangle(chunk_first(args->geometryUserPtr) + args->primID), q->cull,
+                          &h)) {
     return;
   }
   q->add(h);
@@ -248,7 +249,8 @@ void visit_candidate(const RTCOccludedFunctionNArguments* args) {
   Query* q = reinterpret_cast<Query*>(args->context);
   if (q->stopped) return;
   TriangleHit h;
-  if (!intersect_triangle(*q->ray, *q->soup, q->triangle(chunk_first(args->geometryUserPtr) + args->primID), q->tmax, &h)) {
+  if (!intersect_triangle(*q->ray, *q->soup, q->triangle(chunk_first(args->geometryUserPtr) + args->primID), q->tmax,
+                          &h)) {
     return;
   }
   if (q->visit(q->state, h)) return;
@@ -388,7 +390,8 @@ bool Bvh::visible_hit(const RayQuery& ray, double tmax, TriangleHit* hit) const 
   const SurfaceAt near_at{q.nearest.triangle, q.nearest.t};
   TriangleHit best = q.nearest;
   const auto consider = [&](const TriangleHit& h) {
-    if (ranks_above(soup, h.triangle, best.triangle) && same_distance(soup, ray.dir, near_at, {h.triangle, h.t})) best = h;
+    if (ranks_above(soup, h.triangle, best.triangle) && same_distance(soup, ray.dir, near_at, {h.triangle, h.t}))
+      best = h;
     return true;
   };
   if (q.incomplete) {

@@ -48,9 +48,9 @@ class Bvh {
   template <class Visit>
   void for_each_hit(const RayQuery& ray, double tmax, Visit&& visit) const {
     using V = std::remove_reference_t<Visit>;
-    visit_hits(ray, tmax,
-               [](void* state, const TriangleHit& h) { return static_cast<bool>((*static_cast<V*>(state))(h)); },
-               const_cast<void*>(static_cast<const void*>(&visit)));
+    visit_hits(
+        ray, tmax, [](void* state, const TriangleHit& h) { return static_cast<bool>((*static_cast<V*>(state))(h)); },
+        const_cast<void*>(static_cast<const void*>(&visit)));
   }
 
   // TIE_RELATIVE times the largest absolute vertex coordinate of its triangles
@@ -84,7 +84,7 @@ class Bvh {
   void build(uint32_t build_chunk);
 
   const TriangleSoup* soup_;
-  bool all_ = true;                 // every triangle of the soup, else triangles_
+  bool all_ = true;  // every triangle of the soup, else triangles_
   std::vector<uint32_t> triangles_;
   std::vector<Chunk> chunks_;
   RTCSceneTy* scene_ = nullptr;  // null when there is nothing to hit

@@ -45,8 +45,7 @@ RayTracer::RayTracer(const SceneData& scene, std::shared_ptr<const Bvh> bvh)
       bvh_(timed_build(*scene.triangles, std::move(bvh), &build_ms_)),
       scene_scale_(abcube::scene_scale(scene)),
       media_(std::make_shared<const Media>(scene)) {
-  ABCUBE_CHECK(scene.triangles->normals.size() == scene.triangles->positions.size(),
-               "one normal per triangle vertex");
+  ABCUBE_CHECK(scene.triangles->normals.size() == scene.triangles->positions.size(), "one normal per triangle vertex");
   ABCUBE_CHECK(scene.triangles->material_id.size() == scene.triangles->triangle_count(),
                "one material id per triangle");
   for (uint32_t id : scene.triangles->material_id) {
@@ -91,8 +90,7 @@ bool RayTracer::intersect(const glm::dvec3& origin, const glm::dvec3& dir, Hit* 
 }
 
 glm::dvec3 RayTracer::offset_point(const Hit& hit, const glm::dvec3& dir) const {
-  return offset_origin(hit.point, hit.geometric_normal, dir,
-                       self_intersection_offset(hit.point, scene_scale_));
+  return offset_origin(hit.point, hit.geometric_normal, dir, self_intersection_offset(hit.point, scene_scale_));
 }
 
 Ray RayTracer::reflected_ray(const Hit& hit, const glm::dvec3& dir) const {
@@ -108,9 +106,7 @@ Ray RayTracer::transmitted_ray(const Hit& hit, const glm::dvec3& dir, bool* tota
   return {offset_point(hit, t), t};
 }
 
-Ray RayTracer::continued_ray(const Hit& hit, const glm::dvec3& dir) const {
-  return {offset_point(hit, dir), dir};
-}
+Ray RayTracer::continued_ray(const Hit& hit, const glm::dvec3& dir) const { return {offset_point(hit, dir), dir}; }
 
 glm::dvec3 RayTracer::light_visibility(const Hit& hit, const PointLight& light, RayCounts* counts) const {
   if (!light.cast_shadows) return glm::dvec3(1.0);
@@ -131,15 +127,15 @@ glm::dvec3 RayTracer::light_visibility(const Hit& hit, const PointLight& light, 
       return false;
     }
     const glm::dvec3 a = vertex(soup, th.triangle, 0);
-    const bool front = glm::dot(glm::cross(vertex(soup, th.triangle, 1) - a, vertex(soup, th.triangle, 2) - a), dir) < 0.0;
+    const bool front =
+        glm::dot(glm::cross(vertex(soup, th.triangle, 1) - a, vertex(soup, th.triangle, 2) - a), dir) < 0.0;
     crossings.push_back({th.t, th.triangle, soup.object_id[th.triangle], front, tr});
     return true;
   });
   if (opaque) return glm::dvec3(0.0);
   // Product in order along the segment; a crossing through a shared edge counts once.
-  std::sort(crossings.begin(), crossings.end(), [](const Crossing& x, const Crossing& y) {
-    return x.t != y.t ? x.t < y.t : x.triangle < y.triangle;
-  });
+  std::sort(crossings.begin(), crossings.end(),
+            [](const Crossing& x, const Crossing& y) { return x.t != y.t ? x.t < y.t : x.triangle < y.triangle; });
   glm::dvec3 s(1.0);
   for (size_t i = 0; i < crossings.size(); ++i) {
     const Crossing& c = crossings[i];
@@ -287,8 +283,8 @@ std::vector<Ray> RayTracer::transmitted_path(const glm::dvec3& origin, const glm
 namespace {
 
 // One row of the image: every pixel the mean of its camera samples (box filter).
-void render_row(const RayTracer& tracer, const CameraFrame& frame, int spp, int y, Image* image,
-                RayCounts* counts, const std::vector<uint8_t>* only) {
+void render_row(const RayTracer& tracer, const CameraFrame& frame, int spp, int y, Image* image, RayCounts* counts,
+                const std::vector<uint8_t>* only) {
   for (int x = 0; x < frame.width; ++x) {
     if (only && !(*only)[static_cast<size_t>(y) * static_cast<size_t>(frame.width) + static_cast<size_t>(x)]) continue;
     glm::dvec3 sum(0.0);
@@ -310,8 +306,8 @@ Image render_raytrace(const SceneData& scene, const RaytraceOptions& options, Ra
                      std::to_string(options.samples_per_pixel));
   }
   if (options.threads < 0) throw InputError("raytrace: threads must be >= 0, got " + std::to_string(options.threads));
-  ABCUBE_CHECK(!options.only || options.only->size() == static_cast<size_t>(scene.camera.width) *
-                                                         static_cast<size_t>(scene.camera.height),
+  ABCUBE_CHECK(!options.only || options.only->size() ==
+                                    static_cast<size_t>(scene.camera.width) * static_cast<size_t>(scene.camera.height),
                "the pixel mask does not match the image");
   const RayTracer tracer(scene, options.bvh);
   const CameraFrame frame = make_camera_frame(scene.camera);

@@ -22,8 +22,8 @@
 namespace abcube {
 
 struct RaytraceOptions {
-  int threads = 0;              // 0 = std::thread::hardware_concurrency()
-  int samples_per_pixel = 32;   // 32 (the 4x8 A-buffer samples) or 1 (pixel centre)
+  int threads = 0;             // 0 = std::thread::hardware_concurrency()
+  int samples_per_pixel = 32;  // 32 (the 4x8 A-buffer samples) or 1 (pixel centre)
   // Called now and then on the calling thread with the share of rows done, in [0, 1].
   std::function<void(double)> progress;
   // The scene's BVH when already built (SceneCache); null: built for this render.
@@ -37,10 +37,10 @@ struct RaytraceStats {
   uint64_t primary_rays = 0;
   uint64_t secondary_rays = 0;  // reflected, transmitted and opacity-continued rays
   uint64_t shadow_rays = 0;
-  double build_ms = 0;          // BVH construction (Embree's, bvh.hpp)
-  double trace_ms = 0;          // all rays of the image
+  double build_ms = 0;  // BVH construction (Embree's, bvh.hpp)
+  double trace_ms = 0;  // all rays of the image
   uint64_t triangles = 0;
-  int threads = 0;              // threads actually used
+  int threads = 0;  // threads actually used
 };
 
 // Per-thread ray counters (RaytraceStats sums them).
@@ -50,15 +50,15 @@ struct RayCounts {
 
 // Everything about the first surface a ray meets.
 struct Hit {
-  double t = 0;                        // origin + t * dir (t in units of |dir|)
-  glm::dvec3 point{0.0};               // on the triangle: barycentric combination of its vertices
-  uint32_t triangle = 0;               // index into SceneData::triangles
-  glm::dvec3 barycentric{0.0};         // weights of the triangle's vertices 0, 1, 2
-  glm::dvec3 geometric_normal{0.0};    // unit, cross(b-a, c-a) direction
-  glm::dvec3 shading_normal{0.0};      // unit, interpolated vertex normal (not face-forwarded)
-  uint32_t object_id = 0;              // index into SceneData::objects
-  uint32_t material_id = 0;            // index into SceneData::materials
-  bool front_face = true;              // dot(geometric_normal, dir) < 0
+  double t = 0;                      // origin + t * dir (t in units of |dir|)
+  glm::dvec3 point{0.0};             // on the triangle: barycentric combination of its vertices
+  uint32_t triangle = 0;             // index into SceneData::triangles
+  glm::dvec3 barycentric{0.0};       // weights of the triangle's vertices 0, 1, 2
+  glm::dvec3 geometric_normal{0.0};  // unit, cross(b-a, c-a) direction
+  glm::dvec3 shading_normal{0.0};    // unit, interpolated vertex normal (not face-forwarded)
+  uint32_t object_id = 0;            // index into SceneData::objects
+  uint32_t material_id = 0;          // index into SceneData::materials
+  bool front_face = true;            // dot(geometric_normal, dir) < 0
 };
 
 // A secondary ray: origin already offset off the surface, unit direction.
@@ -79,8 +79,7 @@ class RayTracer {
 
   // The colour seen along a ray of depth `depth` (dir need not be unit). Counts rays into
   // `counts` when given (the ray itself is counted by the caller: see render_raytrace).
-  glm::dvec3 trace(const glm::dvec3& origin, const glm::dvec3& dir, int depth,
-                   RayCounts* counts = nullptr) const;
+  glm::dvec3 trace(const glm::dvec3& origin, const glm::dvec3& dir, int depth, RayCounts* counts = nullptr) const;
   // The same for a ray inside the media of `stack` (media.hpp, NESTED DIELECTRICS).
   glm::dvec3 trace(const glm::dvec3& origin, const glm::dvec3& dir, int depth, const MediumStack& stack,
                    RayCounts* counts) const;
@@ -133,7 +132,6 @@ class RayTracer {
 
 // Renders the scene's camera view with THE RULES. Throws InputError for a bad
 // option (samples_per_pixel not 1 or 32, negative threads).
-Image render_raytrace(const SceneData& scene, const RaytraceOptions& options = {},
-                      RaytraceStats* stats = nullptr);
+Image render_raytrace(const SceneData& scene, const RaytraceOptions& options = {}, RaytraceStats* stats = nullptr);
 
 }  // namespace abcube

@@ -42,8 +42,8 @@ Camera frame_camera(const Bounds& bounds, const glm::dvec3& direction, Camera ca
   for (int k = 0; k < 8; ++k) {
     const glm::dvec3 q = glm::dvec3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z) - s.centre;
     const double z = glm::dot(q, f);
-    distance = std::max({distance, std::fabs(glm::dot(q, right)) / tan_x - z, std::fabs(glm::dot(q, up)) / tan_y - z,
-                         MARGIN * -z});
+    distance = std::max(
+        {distance, std::fabs(glm::dot(q, right)) / tan_x - z, std::fabs(glm::dot(q, up)) / tan_y - z, MARGIN * -z});
   }
   camera.look_at = s.centre;
   camera.position = s.centre - distance * f;

@@ -23,8 +23,8 @@ struct PlanStep {
 // The plan of a cube-map render (methods abuffer, zbuffer, envmap). `everything` forces
 // every step (for measuring what the skips save); the image does not change.
 struct RenderPlan {
-  bool cube_map = true;                  // any reflect/transmit material or shadowing light
-  std::vector<bool> shadow_walks;        // per light: it casts shadows
+  bool cube_map = true;            // any reflect/transmit material or shadowing light
+  std::vector<bool> shadow_walks;  // per light: it casts shadows
   bool reflection_searches = true, refraction_searches = true;
   std::vector<PlanStep> steps;
 };

@@ -87,7 +87,8 @@ PlanarReflectors find_planar_reflectors(const SceneData& scene) {
       out.curved_triangles += out.reflectors[r].triangles.size();
       continue;
     }
-    for (const uint32_t t : out.reflectors[r].triangles) out.reflector_of_triangle[t] = static_cast<uint32_t>(kept.size() + 1);
+    for (const uint32_t t : out.reflectors[r].triangles)
+      out.reflector_of_triangle[t] = static_cast<uint32_t>(kept.size() + 1);
     kept.push_back(std::move(out.reflectors[r]));
   }
   out.reflectors = std::move(kept);

@@ -47,7 +47,7 @@ struct Material {
   double reflect = 0.0;   // kr, mirror weight
   double transmit = 0.0;  // kt, refractive weight
   double ior = 1.0;
-  double opacity = 1.0;   // coverage transparency, blended by the A-buffer resolve
+  double opacity = 1.0;  // coverage transparency, blended by the A-buffer resolve
   // Base colour texture: the image file, resolved (empty: none), or "#embedded/I" for
   // SceneData::embedded_images[I]. The diffuse colour at a point is color times the
   // texture at the point's uv (TriangleSoup::uvs).
@@ -55,11 +55,11 @@ struct Material {
 };
 
 struct SceneObject {
-  std::string type;              // triangle, quad, box, sphere, mesh
-  std::string path;              // "objects[3]" (for messages)
-  uint32_t material = 0;         // index into SceneData::materials (per-triangle ids may differ for meshes)
-  bool closed = false;           // has an inside (box, sphere, closed mesh)
-  uint32_t first_triangle = 0;   // range in TriangleSoup
+  std::string type;             // triangle, quad, box, sphere, mesh
+  std::string path;             // "objects[3]" (for messages)
+  uint32_t material = 0;        // index into SceneData::materials (per-triangle ids may differ for meshes)
+  bool closed = false;          // has an inside (box, sphere, closed mesh)
+  uint32_t first_triangle = 0;  // range in TriangleSoup
   uint32_t triangle_count = 0;
 };
 
@@ -107,7 +107,7 @@ struct RenderSettings {
   Method method = Method::abuffer;
   int cube_resolution = 512;
   int max_depth = 4;
-  bool fresnel = false;  // Schlick weights for kr/kt (shading.hpp secondary_weights); off = thesis
+  bool fresnel = false;     // Schlick weights for kr/kt (shading.hpp secondary_weights); off = thesis
   double error_target = 0;  // > 0: choose cube_resolution from the Error_Parallax bound (plan.hpp)
 };
 

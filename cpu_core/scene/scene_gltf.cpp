@@ -111,9 +111,8 @@ void GltfReader::precheck(const std::string& json_text) {
     fail(st_.src, path_, e.what());
   }
   const auto bad_at = [&](const std::string& at, const std::string& what) { bad(at, what); };
-  check_document(doc, bad_at, [this](const Json& element, const std::string& at, bool buffer) {
-    check_file(element, at, buffer);
-  });
+  check_document(doc, bad_at,
+                 [this](const Json& element, const std::string& at, bool buffer) { check_file(element, at, buffer); });
 }
 
 // A file a buffer or image names: inside the root, a regular file under the cap. A
@@ -140,11 +139,11 @@ void GltfReader::load(const std::string& bytes, bool binary) {
   loader.SetFsCallbacks(tg::FsCallbacks{fs_exists, fs_expand, fs_read, fs_write, &rules});
   loader.SetImageLoader(keep_image_bytes, nullptr);
   std::string err, warn;
-  const bool ok = binary ? loader.LoadBinaryFromMemory(&model_, &err, &warn,
-                                                        reinterpret_cast<const unsigned char*>(bytes.data()),
-                                                        static_cast<unsigned int>(bytes.size()), folder())
-                         : loader.LoadASCIIFromString(&model_, &err, &warn, bytes.data(),
-                                                      static_cast<unsigned int>(bytes.size()), folder());
+  const bool ok =
+      binary ? loader.LoadBinaryFromMemory(&model_, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
+                                           static_cast<unsigned int>(bytes.size()), folder())
+             : loader.LoadASCIIFromString(&model_, &err, &warn, bytes.data(), static_cast<unsigned int>(bytes.size()),
+                                          folder());
   if (!ok) {
     std::string first = err.substr(0, err.find('\n'));
     if (first.empty()) first = "tinygltf could not read it";
@@ -159,7 +158,8 @@ void GltfReader::convert() {
   if (model_.defaultScene >= 0 || !model_.scenes.empty()) {
     const int scene = std::max(model_.defaultScene, 0);
     if (static_cast<size_t>(scene) >= model_.scenes.size()) {
-      bad("scene", "index " + std::to_string(scene) + " out of range (" + std::to_string(model_.scenes.size()) + " scenes)");
+      bad("scene",
+          "index " + std::to_string(scene) + " out of range (" + std::to_string(model_.scenes.size()) + " scenes)");
     }
     roots = model_.scenes[static_cast<size_t>(scene)].nodes;
   } else {
@@ -180,8 +180,8 @@ void GltfReader::convert() {
   if (!ignored_.empty()) {
     std::string list;
     for (const std::string& s : ignored_) list += (list.empty() ? "" : "; ") + s;
-    st_.scene.warnings.push_back(one_line(st_.src.name + ": " + path_ + ": warning: glTF " + quote_path(file_) +
-                                          ": not rendered: " + list));
+    st_.scene.warnings.push_back(
+        one_line(st_.src.name + ": " + path_ + ": warning: glTF " + quote_path(file_) + ": not rendered: " + list));
   }
   if (!missing_images_.empty()) {
     st_.scene.warnings.push_back(one_line(st_.src.name + ": " + path_ + ": warning: glTF " + quote_path(file_) + ": " +

@@ -99,7 +99,8 @@ double read_component(const unsigned char* p, int c, bool normalized) {
 }
 
 const char* mode_name(int mode) {
-  static const char* names[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP", "TRIANGLES", "TRIANGLE_STRIP", "TRIANGLE_FAN"};
+  static const char* names[] = {"POINTS",    "LINES",          "LINE_LOOP",   "LINE_STRIP",
+                                "TRIANGLES", "TRIANGLE_STRIP", "TRIANGLE_FAN"};
   return mode >= 0 && mode <= 6 ? names[mode] : "unknown";
 }
 
@@ -141,20 +142,21 @@ void GltfReader::visit(int index, const glm::dmat4& parent, const std::string& f
   }
   const std::string at = index_path("nodes", static_cast<size_t>(index));
   if ((*on_path)[static_cast<size_t>(index)]) bad(at, "is its own ancestor (the node hierarchy has a cycle)");
-  if (++visits_ > MAX_NODE_VISITS) bad(at, "the node hierarchy instances more than " + std::to_string(MAX_NODE_VISITS) + " nodes");
+  if (++visits_ > MAX_NODE_VISITS)
+    bad(at, "the node hierarchy instances more than " + std::to_string(MAX_NODE_VISITS) + " nodes");
   (*on_path)[static_cast<size_t>(index)] = true;
   const tg::Node& n = model_.nodes[static_cast<size_t>(index)];
   const glm::dmat4 world = parent * local_matrix(n, at);
   if (n.skin >= 0) note("skins (meshes drawn unskinned)");
   if (n.mesh >= 0) {
     if (static_cast<size_t>(n.mesh) >= model_.meshes.size()) {
-      bad(member_path(at, "mesh"), "index " + std::to_string(n.mesh) + " out of range (" +
-                                       std::to_string(model_.meshes.size()) + " meshes)");
+      bad(member_path(at, "mesh"),
+          "index " + std::to_string(n.mesh) + " out of range (" + std::to_string(model_.meshes.size()) + " meshes)");
     }
     const tg::Mesh& mesh = model_.meshes[static_cast<size_t>(n.mesh)];
     for (size_t p = 0; p < mesh.primitives.size(); ++p) {
-      add_primitive(mesh.primitives[p], index_path(index_path("meshes", static_cast<size_t>(n.mesh)) + ".primitives", p),
-                    world);
+      add_primitive(mesh.primitives[p],
+                    index_path(index_path("meshes", static_cast<size_t>(n.mesh)) + ".primitives", p), world);
     }
   }
   if (n.camera >= 0) add_camera(n.camera, at, world);
@@ -167,7 +169,7 @@ void GltfReader::visit(int index, const glm::dmat4& parent, const std::string& f
 // The accessor's elements as doubles (normalized integers mapped), checked against the
 // types allowed and against its buffer view and buffer.
 Accessed GltfReader::read_accessor(int index, const std::string& at, std::initializer_list<int> types,
-                                 std::initializer_list<int> component_types, bool allow_normalized_only) const {
+                                   std::initializer_list<int> component_types, bool allow_normalized_only) const {
   if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size()) {
     bad(at, "accessor " + std::to_string(index) + " out of range (" + std::to_string(model_.accessors.size()) +
                 " accessors)");
@@ -232,24 +234,28 @@ Accessed GltfReader::read_accessor(int index, const std::string& at, std::initia
     const int ict = a.sparse.indices.componentType;
     if (ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
         ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
-      bad(aat + ".sparse.indices", std::string("componentType ") + component_name(ict) + ", expected an unsigned integer");
+      bad(aat + ".sparse.indices",
+          std::string("componentType ") + component_name(ict) + ", expected an unsigned integer");
     }
     size_t istride = 0, vstride = 0;
-    const unsigned char* ip = view_bytes(a.sparse.indices.bufferView, static_cast<size_t>(std::max(0, a.sparse.indices.byteOffset)),
-                                         n, component_bytes(ict), &istride, aat + ".sparse.indices");
-    const unsigned char* vp = view_bytes(a.sparse.values.bufferView, static_cast<size_t>(std::max(0, a.sparse.values.byteOffset)),
-                                         n, elem, &vstride, aat + ".sparse.values");
+    const unsigned char* ip =
+        view_bytes(a.sparse.indices.bufferView, static_cast<size_t>(std::max(0, a.sparse.indices.byteOffset)), n,
+                   component_bytes(ict), &istride, aat + ".sparse.indices");
+    const unsigned char* vp =
+        view_bytes(a.sparse.values.bufferView, static_cast<size_t>(std::max(0, a.sparse.values.byteOffset)), n, elem,
+                   &vstride, aat + ".sparse.values");
     istride = component_bytes(ict);  // sparse data is tightly packed
     vstride = elem;
     for (size_t i = 0; i < n; ++i) {
       const double target = read_component(ip + i * istride, ict, false);
       if (target >= static_cast<double>(a.count)) {
-        bad(aat + ".sparse.indices", "index " + format_number(target) + " out of range (" + std::to_string(a.count) + " elements)");
+        bad(aat + ".sparse.indices",
+            "index " + format_number(target) + " out of range (" + std::to_string(a.count) + " elements)");
       }
       for (int k = 0; k < out.n; ++k) {
         out.values[static_cast<size_t>(target) * static_cast<size_t>(out.n) + static_cast<size_t>(k)] =
-            read_component(vp + i * vstride + static_cast<size_t>(k) * component_bytes(a.componentType), a.componentType,
-                           a.normalized);
+            read_component(vp + i * vstride + static_cast<size_t>(k) * component_bytes(a.componentType),
+                           a.componentType, a.normalized);
       }
     }
   }
@@ -270,15 +276,16 @@ void GltfReader::add_primitive(const tg::Primitive& prim, const std::string& at,
     return;
   }
   if (!prim.targets.empty()) note("morph targets (the base shape is drawn)");
-  if (prim.extensions.count("KHR_draco_mesh_compression")) note("KHR_draco_mesh_compression (its uncompressed fallback is drawn)");
+  if (prim.extensions.count("KHR_draco_mesh_compression"))
+    note("KHR_draco_mesh_compression (its uncompressed fallback is drawn)");
   const auto pos = prim.attributes.find("POSITION");
   if (pos == prim.attributes.end()) {
     note("primitives without POSITION");
     return;
   }
   const std::string aat = member_path(at, "attributes");
-  const Accessed p = read_accessor(pos->second, member_path(aat, "POSITION"), {TINYGLTF_TYPE_VEC3},
-                                   {TINYGLTF_COMPONENT_TYPE_FLOAT});
+  const Accessed p =
+      read_accessor(pos->second, member_path(aat, "POSITION"), {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
   Accessed nrm;
   if (const auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
     nrm = read_accessor(it->second, member_path(aat, "NORMAL"), {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
@@ -297,7 +304,8 @@ void GltfReader::add_primitive(const tg::Primitive& prim, const std::string& at,
                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
                          true);
       if (uv.count != p.count) {
-        bad(member_path(aat, key.c_str()), std::to_string(uv.count) + " elements, POSITION has " + std::to_string(p.count));
+        bad(member_path(aat, key.c_str()),
+            std::to_string(uv.count) + " elements, POSITION has " + std::to_string(p.count));
       }
     }
   }

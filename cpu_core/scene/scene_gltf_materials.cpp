@@ -19,29 +19,33 @@ namespace abcube::detail::gltf {
 
 // ---- materials ----
 const tg::Material* GltfReader::material_at(int index) const {
-  return index >= 0 && static_cast<size_t>(index) < model_.materials.size() ? &model_.materials[static_cast<size_t>(index)]
-                                                                           : nullptr;
+  return index >= 0 && static_cast<size_t>(index) < model_.materials.size()
+             ? &model_.materials[static_cast<size_t>(index)]
+             : nullptr;
 }
 
 int GltfReader::texcoord_set(int material) const {
   const tg::Material* m = material_at(material);
-  return m && m->pbrMetallicRoughness.baseColorTexture.index >= 0 ? m->pbrMetallicRoughness.baseColorTexture.texCoord : 0;
+  return m && m->pbrMetallicRoughness.baseColorTexture.index >= 0 ? m->pbrMetallicRoughness.baseColorTexture.texCoord
+                                                                  : 0;
 }
 
 int GltfReader::material_of(int index, const std::string& at) {
   if (!use_materials_) return -1;  // the object's own
   if (index < 0) return static_cast<int>(default_material(st_));
   if (static_cast<size_t>(index) >= model_.materials.size()) {
-    bad(at, "index " + std::to_string(index) + " out of range (" + std::to_string(model_.materials.size()) + " materials)");
+    bad(at,
+        "index " + std::to_string(index) + " out of range (" + std::to_string(model_.materials.size()) + " materials)");
   }
   const std::string key = resolved_ + '\n' + std::to_string(index);
   auto it = st_.mtl_materials.find(key);
-  if (it == st_.mtl_materials.end()) it = st_.mtl_materials.emplace(key, add_material(st_, convert_material(index))).first;
+  if (it == st_.mtl_materials.end())
+    it = st_.mtl_materials.emplace(key, add_material(st_, convert_material(index))).first;
   return static_cast<int>(it->second);
 }
 
 double GltfReader::extension_number(const tg::ExtensionMap& ext, const char* name, const char* key, double fallback,
-                                         bool* present) {
+                                    bool* present) {
   const auto it = ext.find(name);
   if (it == ext.end()) return fallback;
   if (present) *present = true;
@@ -87,7 +91,8 @@ Material GltfReader::convert_material(int index) {
     m.opacity = base[3];
   } else if (mode == "MASK") {
     m.opacity = base[3] >= g.alphaCutoff ? 1.0 : 0.0;
-    if (g.pbrMetallicRoughness.baseColorTexture.index >= 0) note("MASK by the texture's alpha (the factor's alpha decides)");
+    if (g.pbrMetallicRoughness.baseColorTexture.index >= 0)
+      note("MASK by the texture's alpha (the factor's alpha decides)");
   } else if (mode != "OPAQUE") {
     bad(member_path(at, "alphaMode"), "must be OPAQUE, MASK or BLEND, got " + quote(mode));
   }
@@ -98,7 +103,7 @@ Material GltfReader::convert_material(int index) {
   for (const auto& e : g.extensions) {
     if (e.first == "KHR_materials_transmission" || e.first == "KHR_materials_ior") continue;
     note(e.first == "KHR_materials_pbrSpecularGlossiness" ? e.first + " (its metallic-roughness values are used)"
-                                                           : e.first);
+                                                          : e.first);
   }
   const tg::TextureInfo& tex = g.pbrMetallicRoughness.baseColorTexture;
   if (tex.index >= 0) {
@@ -111,7 +116,8 @@ Material GltfReader::convert_material(int index) {
 // Material::texture for textures[index]: the image file, or "#embedded/I".
 std::string GltfReader::texture_name(int index, const std::string& at) {
   if (static_cast<size_t>(index) >= model_.textures.size()) {
-    bad(at, "texture " + std::to_string(index) + " out of range (" + std::to_string(model_.textures.size()) + " textures)");
+    bad(at,
+        "texture " + std::to_string(index) + " out of range (" + std::to_string(model_.textures.size()) + " textures)");
   }
   const int source = model_.textures[static_cast<size_t>(index)].source;
   if (source < 0) return "";  // an image only an extension names (KHR_texture_basisu, EXT_texture_webp)
@@ -155,8 +161,8 @@ std::string GltfReader::embed(const std::string& at, const std::string& mime, st
 // ---- cameras and lights ----
 void GltfReader::add_camera(int index, const std::string& at, const glm::dmat4& world) {
   if (static_cast<size_t>(index) >= model_.cameras.size()) {
-    bad(member_path(at, "camera"), "index " + std::to_string(index) + " out of range (" +
-                                        std::to_string(model_.cameras.size()) + " cameras)");
+    bad(member_path(at, "camera"),
+        "index " + std::to_string(index) + " out of range (" + std::to_string(model_.cameras.size()) + " cameras)");
   }
   const tg::Camera& c = model_.cameras[static_cast<size_t>(index)];
   if (c.type != "perspective") {

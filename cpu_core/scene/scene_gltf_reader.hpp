@@ -55,7 +55,7 @@ double read_component(const unsigned char* p, int c, bool normalized);
 // What a primitive's attributes became.
 struct Accessed {
   size_t count = 0;
-  int n = 0;  // components per element
+  int n = 0;                   // components per element
   std::vector<double> values;  // count * n
 };
 

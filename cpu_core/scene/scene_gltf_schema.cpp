@@ -72,24 +72,42 @@ struct Member {
 const std::map<std::string, std::vector<Member>>& SCHEMA() {
   static const std::map<std::string, std::vector<Member>> schema = {
       {"accessors",
-       {{"bufferView", Kind::uint}, {"byteOffset", Kind::uint}, {"componentType", Kind::uint},
-        {"normalized", Kind::boolean}, {"count", Kind::uint}, {"type", Kind::string}, {"max", Kind::number_array},
-        {"min", Kind::number_array}, {"sparse", Kind::object}}},
+       {{"bufferView", Kind::uint},
+        {"byteOffset", Kind::uint},
+        {"componentType", Kind::uint},
+        {"normalized", Kind::boolean},
+        {"count", Kind::uint},
+        {"type", Kind::string},
+        {"max", Kind::number_array},
+        {"min", Kind::number_array},
+        {"sparse", Kind::object}}},
       {"animations", {}},
       {"buffers", {{"uri", Kind::string}, {"byteLength", Kind::uint}}},
       {"bufferViews",
-       {{"buffer", Kind::uint}, {"byteOffset", Kind::uint}, {"byteLength", Kind::uint}, {"byteStride", Kind::uint},
+       {{"buffer", Kind::uint},
+        {"byteOffset", Kind::uint},
+        {"byteLength", Kind::uint},
+        {"byteStride", Kind::uint},
         {"target", Kind::uint}}},
       {"cameras", {{"type", Kind::string}, {"perspective", Kind::object}, {"orthographic", Kind::object}}},
       {"images", {{"uri", Kind::string}, {"mimeType", Kind::string}, {"bufferView", Kind::uint}}},
       {"materials",
-       {{"pbrMetallicRoughness", Kind::object}, {"emissiveFactor", Kind::number_array}, {"alphaMode", Kind::string},
-        {"alphaCutoff", Kind::number}, {"doubleSided", Kind::boolean}}},
+       {{"pbrMetallicRoughness", Kind::object},
+        {"emissiveFactor", Kind::number_array},
+        {"alphaMode", Kind::string},
+        {"alphaCutoff", Kind::number},
+        {"doubleSided", Kind::boolean}}},
       {"meshes", {{"primitives", Kind::object_array}, {"weights", Kind::number_array}}},
       {"nodes",
-       {{"camera", Kind::uint}, {"children", Kind::uint_array}, {"skin", Kind::uint}, {"matrix", Kind::number_array},
-        {"mesh", Kind::uint}, {"rotation", Kind::number_array}, {"scale", Kind::number_array},
-        {"translation", Kind::number_array}, {"weights", Kind::number_array}}},
+       {{"camera", Kind::uint},
+        {"children", Kind::uint_array},
+        {"skin", Kind::uint},
+        {"matrix", Kind::number_array},
+        {"mesh", Kind::uint},
+        {"rotation", Kind::number_array},
+        {"scale", Kind::number_array},
+        {"translation", Kind::number_array},
+        {"weights", Kind::number_array}}},
       {"samplers", {}},
       {"scenes", {{"nodes", Kind::uint_array}}},
       {"skins", {}},
@@ -98,8 +116,8 @@ const std::map<std::string, std::vector<Member>>& SCHEMA() {
   return schema;
 }
 
-const std::vector<Member> PRIMITIVE = {{"attributes", Kind::object}, {"indices", Kind::uint},
-                                       {"material", Kind::uint},     {"mode", Kind::uint},
+const std::vector<Member> PRIMITIVE = {{"attributes", Kind::object},    {"indices", Kind::uint},
+                                       {"material", Kind::uint},        {"mode", Kind::uint},
                                        {"targets", Kind::object_array}, {"extensions", Kind::object}};
 
 // Refuses a member of `o` (at `at`) whose type is not its kind; `required` ones must be there.
@@ -141,19 +159,24 @@ void check_material(const std::function<void(const std::string&, const std::stri
     const auto it = o.find(key);
     if (it == o.end()) return;
     const std::string tat = member_path(at, key);
-    check_members(bad, *it, tat, {{"index", Kind::uint}, {"texCoord", Kind::uint}, {"scale", Kind::number},
-                                  {"strength", Kind::number}});
+    check_members(
+        bad, *it, tat,
+        {{"index", Kind::uint}, {"texCoord", Kind::uint}, {"scale", Kind::number}, {"strength", Kind::number}});
     if (!it->contains("index")) bad(member_path(tat, "index"), "missing required field");
   };
-  check_members(bad, m, at, {{"normalTexture", Kind::object}, {"occlusionTexture", Kind::object},
-                             {"emissiveTexture", Kind::object}});
+  check_members(
+      bad, m, at,
+      {{"normalTexture", Kind::object}, {"occlusionTexture", Kind::object}, {"emissiveTexture", Kind::object}});
   for (const char* key : {"normalTexture", "occlusionTexture", "emissiveTexture"}) texture_info(m, key);
   const auto pbr = m.find("pbrMetallicRoughness");
   if (pbr == m.end()) return;
   const std::string pat = member_path(at, "pbrMetallicRoughness");
-  check_members(bad, *pbr, pat, {{"baseColorFactor", Kind::number_array}, {"baseColorTexture", Kind::object},
-                                 {"metallicFactor", Kind::number}, {"roughnessFactor", Kind::number},
-                                 {"metallicRoughnessTexture", Kind::object}});
+  check_members(bad, *pbr, pat,
+                {{"baseColorFactor", Kind::number_array},
+                 {"baseColorTexture", Kind::object},
+                 {"metallicFactor", Kind::number},
+                 {"roughnessFactor", Kind::number},
+                 {"metallicRoughnessTexture", Kind::object}});
   for (const char* key : {"baseColorTexture", "metallicRoughnessTexture"}) {
     const auto it = pbr->find(key);
     if (it == pbr->end()) continue;
@@ -200,17 +223,22 @@ void check_document(const Json& doc, const BadAt& bad, const CheckFile& check_fi
   if (asset == doc.end() || !asset->is_object()) bad("asset", "missing (a glTF 2.0 file has asset.version \"2.0\")");
   const auto version = asset->find("version");
   if (version == asset->end() || !version->is_string() || version->get<std::string>().rfind("2.", 0) != 0) {
-    bad("asset.version", "only glTF 2.0 is read, got " + (version == asset->end() ? std::string("nothing") : describe(*version)));
+    bad("asset.version",
+        "only glTF 2.0 is read, got " + (version == asset->end() ? std::string("nothing") : describe(*version)));
   }
-  check_members(bad, doc, "", {{"scene", Kind::uint}, {"extensionsUsed", Kind::string_array},
-                                  {"extensionsRequired", Kind::string_array}, {"extensions", Kind::object}});
+  check_members(bad, doc, "",
+                {{"scene", Kind::uint},
+                 {"extensionsUsed", Kind::string_array},
+                 {"extensionsRequired", Kind::string_array},
+                 {"extensions", Kind::object}});
   if (const auto req = doc.find("extensionsRequired"); req != doc.end()) {
     for (size_t i = 0; i < req->size(); ++i) {
       const std::string name = (*req)[i].get<std::string>();
       if (!SUPPORTED_REQUIRED.count(name)) {
         bad(index_path("extensionsRequired", i),
-            quote(name) + " is not supported (supported: KHR_lights_punctual, KHR_materials_transmission, "
-                          "KHR_materials_ior)");
+            quote(name) +
+                " is not supported (supported: KHR_lights_punctual, KHR_materials_transmission, "
+                "KHR_materials_ior)");
       }
     }
   }

@@ -90,10 +90,7 @@ std::string member_path(const std::string& parent, const std::string& key) {
   return plain ? parent + "." + k : parent + k;
 }
 
-std::string index_path(const std::string& parent, size_t i) {
-  return parent + "[" + std::to_string(i) + "]";
-}
-
+std::string index_path(const std::string& parent, size_t i) { return parent + "[" + std::to_string(i) + "]"; }
 
 [[noreturn]] void fail(const Source& src, const std::string& path, const std::string& what) {
   throw InputError(one_line(path.empty() ? src.name + ": " + what : src.name + ": " + path + ": " + what));
@@ -134,9 +131,22 @@ std::string parser_message(const std::string& what) {
   // may hold anything, "'; expected " too (a fuzzed input did), so its end is found from
   // the message's end: the closing quote, or before "; expected " and one of the names
   // nlohmann gives a token type (lexer::token_type_name).
-  static const char* const names[] = {"<uninitialized>", "true literal", "false literal", "null literal",
-                                      "string literal", "number literal", "'['", "'{'", "']'", "'}'", "':'", "','",
-                                      "<parse error>", "end of input", "'[', '{', or a literal", "unknown token"};
+  static const char* const names[] = {"<uninitialized>",
+                                      "true literal",
+                                      "false literal",
+                                      "null literal",
+                                      "string literal",
+                                      "number literal",
+                                      "'['",
+                                      "'{'",
+                                      "']'",
+                                      "'}'",
+                                      "':'",
+                                      "','",
+                                      "<parse error>",
+                                      "end of input",
+                                      "'[', '{', or a literal",
+                                      "unknown token"};
   auto ends_with = [&](const std::string& tail) {
     return m.size() >= tail.size() && m.compare(m.size() - tail.size(), tail.size(), tail) == 0;
   };
@@ -316,7 +326,8 @@ int read_int(const Source& src, const Json& v, const std::string& path, int lo, 
 glm::dvec3 read_vec3(const Source& src, const Json& v, const std::string& path) {
   if (!v.is_array() || v.size() != 3) fail(src, path, "must be an array of 3 numbers, got " + describe(v));
   glm::dvec3 r;
-  for (int i = 0; i < 3; ++i) r[i] = read_number(src, v[static_cast<size_t>(i)], index_path(path, static_cast<size_t>(i)));
+  for (int i = 0; i < 3; ++i)
+    r[i] = read_number(src, v[static_cast<size_t>(i)], index_path(path, static_cast<size_t>(i)));
   return r;
 }
 

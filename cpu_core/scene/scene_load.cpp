@@ -43,14 +43,16 @@ void check_triangle_cap(const LoadState& st, const std::string& path, uint64_t a
   const uint64_t cap = st.limits.max_triangles;
   const uint64_t total = st.scene.triangles->triangle_count() + adding;
   if (cap > 0 && total > cap) {
-    fail(st.src, path, "the scene would have " + std::to_string(total) + " triangles, over the cap of " +
-                           std::to_string(cap) + " (max_triangles)");
+    fail(st.src, path,
+         "the scene would have " + std::to_string(total) + " triangles, over the cap of " + std::to_string(cap) +
+             " (max_triangles)");
   }
   if (st.memory_budget > 0 && total > st.memory_budget / SCENE_TRIANGLE_BYTES) {
     const uint64_t mib = (total * SCENE_TRIANGLE_BYTES + (uint64_t{1} << 20) - 1) >> 20;
-    fail(st.src, path, "the scene would have " + std::to_string(total) + " triangles, an estimated " +
-                           std::to_string(mib) + " MiB at " + std::to_string(SCENE_TRIANGLE_BYTES) + " bytes each, " +
-                           budget_words(st.memory_budget, st.limits.max_memory_bytes > 0));
+    fail(st.src, path,
+         "the scene would have " + std::to_string(total) + " triangles, an estimated " + std::to_string(mib) +
+             " MiB at " + std::to_string(SCENE_TRIANGLE_BYTES) + " bytes each, " +
+             budget_words(st.memory_budget, st.limits.max_memory_bytes > 0));
   }
 }
 
@@ -64,7 +66,7 @@ constexpr int MAX_IMAGE_SIDE = 32768;
 constexpr int MAX_CUBE_RESOLUTION = 16384;
 constexpr int MAX_BOUNCES = 64;
 constexpr int MIN_SEGMENTS = 3, MAX_SEGMENTS = 4096;
-constexpr double MAX_QUAD_PLANARITY_ERROR = 1e-6;   // relative to the quad's diagonal
+constexpr double MAX_QUAD_PLANARITY_ERROR = 1e-6;  // relative to the quad's diagonal
 
 // ---- Sections ----------------------------------------------------------------------
 
@@ -88,7 +90,8 @@ CameraSection read_camera(const Fields& f) {
     }
     section.frame = true;
     section.direction = f.vec3("direction", section.direction);
-    if (!(glm::length(section.direction) > 0)) fail(src, f.at("direction"), "must be nonzero, got " + describe(section.direction));
+    if (!(glm::length(section.direction) > 0))
+      fail(src, f.at("direction"), "must be nonzero, got " + describe(section.direction));
   } else {
     if (f.find("direction")) fail(src, f.at("direction"), "is read only with \"frame\": \"all\"");
     c.position = f.vec3("position");
@@ -111,8 +114,7 @@ CameraSection read_camera(const Fields& f) {
   }
   // sin of the angle between up and the view direction
   if (!(glm::length(glm::cross(glm::normalize(view), c.up / up_length)) > 1e-6)) {
-    fail(src, f.at("up"), "must not be parallel to the view direction (look_at - position), got " +
-                              describe(c.up));
+    fail(src, f.at("up"), "must not be parallel to the view direction (look_at - position), got " + describe(c.up));
   }
   return section;
 }
@@ -152,8 +154,7 @@ RenderSettings read_render(const Fields& f) {
   if (const Json* v = f.find("method")) {
     const std::string name = read_string(f.src(), *v, f.at("method"));
     if (!parse_method(name, &r.method)) {
-      fail(f.src(), f.at("method"),
-           "must be one of " + join(method_names(), ", ") + ", got " + describe(*v));
+      fail(f.src(), f.at("method"), "must be one of " + join(method_names(), ", ") + ", got " + describe(*v));
     }
   }
   r.cube_resolution = f.integer("cube_resolution", r.cube_resolution, 1, MAX_CUBE_RESOLUTION);
@@ -171,8 +172,8 @@ Transform read_transform(const Fields& f) {
   t.translate = f.vec3("translate", t.translate);
   t.rotate_deg = f.vec3("rotate_deg", t.rotate_deg);
   if (const Json* s = f.find("scale")) {
-    t.scale = s->is_number() ? glm::dvec3(read_number(f.src(), *s, f.at("scale")))
-                             : read_vec3(f.src(), *s, f.at("scale"));
+    t.scale =
+        s->is_number() ? glm::dvec3(read_number(f.src(), *s, f.at("scale"))) : read_vec3(f.src(), *s, f.at("scale"));
     for (int i = 0; i < 3; ++i) {
       if (t.scale[i] == 0) {
         fail(f.src(), s->is_number() ? f.at("scale") : index_path(f.at("scale"), static_cast<size_t>(i)),
@@ -228,8 +229,8 @@ LocalMesh read_sphere(const LoadState& st, const Fields& f) {
   if (!(radius > 0)) fail(f.src(), f.at("radius"), "must be > 0, got " + format_number(radius));
   const int segments = f.integer("segments", 32, MIN_SEGMENTS, MAX_SEGMENTS);
   if (triangles_so_far + sphere_triangle_count(segments) > MAX_TRIANGLES) {
-    fail(f.src(), f.at("segments"), "the scene would exceed " + std::to_string(MAX_TRIANGLES) +
-                                        " triangles, got " + std::to_string(segments));
+    fail(f.src(), f.at("segments"),
+         "the scene would exceed " + std::to_string(MAX_TRIANGLES) + " triangles, got " + std::to_string(segments));
   }
   check_triangle_cap(st, f.at("segments"), sphere_triangle_count(segments));
   return tessellate_sphere(center, radius, segments);
@@ -340,7 +341,7 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   obj.triangle_count = static_cast<uint32_t>(soup.triangle_count() - obj.first_triangle);
   const bool per_face_materials = !local.material.empty();
   const bool from_file = local.indexed;
-  local = LocalMesh{};  // freed before the closed-surface test: peak memory
+  local = LocalMesh{};                   // freed before the closed-surface test: peak memory
   if (from_file) release_free_memory();  // the OBJ parser's many small blocks
   if (!material && per_face_materials) {
     obj.material = obj.triangle_count > 0 ? soup.material_id[obj.first_triangle] : default_material(st);
@@ -349,12 +350,12 @@ void read_object(LoadState& st, const Json& v, size_t index) {
     // Loads and renders (nothing), but an empty export, a wrong file or a mistyped vertex
     // is the likely cause.
     const bool named_file = type == "mesh" || type == "gltf";
-    const std::string what =
-        named_file ? (type == "gltf" ? "glTF " : "mesh ") + quote_path(read_string(st.src, f.need("file"), f.at("file")))
-                  : type;
-    st.scene.warnings.push_back(one_line(
-        st.src.name + ": " + (named_file ? f.at("file") : path) + ": warning: " + what + " has no triangles" +
-        (faces > 0 ? " of nonzero area (" + std::to_string(faces) + " dropped)" : "")));
+    const std::string what = named_file ? (type == "gltf" ? "glTF " : "mesh ") +
+                                              quote_path(read_string(st.src, f.need("file"), f.at("file")))
+                                        : type;
+    st.scene.warnings.push_back(
+        one_line(st.src.name + ": " + (named_file ? f.at("file") : path) + ": warning: " + what + " has no triangles" +
+                 (faces > 0 ? " of nonzero area (" + std::to_string(faces) + " dropped)" : "")));
   }
   // A closed surface has an inside; make its geometric normals point out of it.
   obj.closed = is_closed_surface(soup, obj.first_triangle, obj.triangle_count);
@@ -369,9 +370,9 @@ void read_materials(LoadState& st, const Json& v) {
   for (const auto& entry : v.items()) {
     const std::string path = member_path("materials", entry.key());
     if (entry.key().empty()) fail(st.src, path, "a material name must not be empty");
-    const Fields f(st.src, entry.value(), path,
-                   {"color", "ambient", "diffuse", "specular", "shininess", "reflect", "transmit", "ior", "opacity",
-                    "texture"});
+    const Fields f(
+        st.src, entry.value(), path,
+        {"color", "ambient", "diffuse", "specular", "shininess", "reflect", "transmit", "ior", "opacity", "texture"});
     Material m = read_material(f, entry.key());
     if (const Json* t = f.find("texture")) {
       m.texture = texture_file(st, f.at("texture"), "", read_string(st.src, *t, f.at("texture")), st.src.base_dir);
@@ -394,9 +395,9 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
   }
   SceneData scene;
   scene.file = src.name;
-  const CameraSection camera = read_camera(Fields(src, top.need("camera"), "camera",
-                                                  {"position", "look_at", "up", "fov_y", "width", "height", "frame",
-                                                   "direction"}));
+  const CameraSection camera =
+      read_camera(Fields(src, top.need("camera"), "camera",
+                         {"position", "look_at", "up", "fov_y", "width", "height", "frame", "direction"}));
   scene.camera = camera.camera;
   scene.background = top.vec3("background", scene.background);
   check_non_negative(src, "background", scene.background);
@@ -405,8 +406,8 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
   if (const Json* lights = top.find("lights")) {
     const Json& list = read_array(src, *lights, "lights");
     for (size_t i = 0; i < list.size(); ++i) {
-      scene.lights.push_back(read_light(Fields(src, list[i], index_path("lights", i),
-                                               {"type", "position", "color", "cast_shadows"})));
+      scene.lights.push_back(
+          read_light(Fields(src, list[i], index_path("lights", i), {"type", "position", "color", "cast_shadows"})));
     }
   }
   LoadState st{src, scene, limits, root, {}, {}, -1, {}, {}, memory_budget_bytes(limits.max_memory_bytes)};
@@ -429,7 +430,8 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
     scene.camera.fov_y_deg = c.fov_y_deg;
   }
   if (const Json* render = top.find("render")) {
-    scene.render = read_render(Fields(src, *render, "render", {"method", "cube_resolution", "max_depth", "fresnel", "error_target"}));
+    scene.render = read_render(
+        Fields(src, *render, "render", {"method", "cube_resolution", "max_depth", "fresnel", "error_target"}));
   }
   load_textures(st);
   // The loaders' small blocks freed since the last object's trim (the closed-surface test's,

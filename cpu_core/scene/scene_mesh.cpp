@@ -48,8 +48,8 @@ size_t mtl_line(const std::string& file, const std::string& material, const std:
 // Ns -> shininess, d -> opacity, Ni -> ior (Ni below 1, which exporters write for
 // "unset", is taken as 1), map_Kd -> texture (relative to the MTL file `mtl_file`).
 // `where` prefixes messages.
-Material convert_mtl(LoadState& st, const std::string& path, const std::string& where,
-                     const tinyobj::material_t& in, const std::string& name, const std::string& mtl_file) {
+Material convert_mtl(LoadState& st, const std::string& path, const std::string& where, const tinyobj::material_t& in,
+                     const std::string& name, const std::string& mtl_file) {
   Material m;
   m.name = name;
   m.color = glm::dvec3(in.diffuse[0], in.diffuse[1], in.diffuse[2]);
@@ -226,14 +226,17 @@ ObjFile parse_obj(const LoadState& st, const std::string& path, const std::strin
                                    false /* triangulate: ear-clipped here, keeping the winding */, false);
   if (!mtl.escaped.empty()) {
     fail(st.src, path,
-         "mtllib " + quote_path(mtl.escaped) + " of mesh " + quote_path(resolved) + " resolves outside --root " + st.root);
+         "mtllib " + quote_path(mtl.escaped) + " of mesh " + quote_path(resolved) + " resolves outside --root " +
+             st.root);
   }
   if (!mtl.unreadable.first.empty()) {
-    fail(st.src, path, "mtllib " + quote_path(mtl.unreadable.first) + " of mesh " + quote_path(resolved) + ": " +
-                           mtl.unreadable.second);
+    fail(st.src, path,
+         "mtllib " + quote_path(mtl.unreadable.first) + " of mesh " + quote_path(resolved) + ": " +
+             mtl.unreadable.second);
   }
   obj.mtl_file_of = std::move(mtl.file_of);
-  if (!ok) fail(st.src, path, "cannot parse mesh " + quote_path(resolved) + ": " + printable(find_line(obj.error, ""), 160));
+  if (!ok)
+    fail(st.src, path, "cannot parse mesh " + quote_path(resolved) + ": " + printable(find_line(obj.error, ""), 160));
   return obj;
 }
 
@@ -313,8 +316,8 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
                                            "; the default material is used"));
     }
   }
-  const std::vector<uint32_t> mtl_ids = use_mtl ? mtl_material_ids(st, path, file, resolved, obj.materials, obj.mtl_file_of)
-                                                 : std::vector<uint32_t>{};
+  const std::vector<uint32_t> mtl_ids =
+      use_mtl ? mtl_material_ids(st, path, file, resolved, obj.materials, obj.mtl_file_of) : std::vector<uint32_t>{};
   const tinyobj::attrib_t& a = obj.attrib;
   const int vertex_count = static_cast<int>(a.vertices.size() / 3);
   const int normal_count = static_cast<int>(a.normals.size() / 3);
@@ -346,8 +349,9 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
     for (size_t face = 0; face < shape.mesh.num_face_vertices.size(); ++face) {
       const size_t n = shape.mesh.num_face_vertices[face];
       if (n < 3) {
-        fail(st.src, path, "mesh " + quote_path(resolved) + ": face " + std::to_string(face + 1) + " of shape " +
-                               quote(shape.name) + " has " + std::to_string(n) + " corners (a face needs 3 or more)");
+        fail(st.src, path,
+             "mesh " + quote_path(resolved) + ": face " + std::to_string(face + 1) + " of shape " + quote(shape.name) +
+                 " has " + std::to_string(n) + " corners (a face needs 3 or more)");
       }
       const tinyobj::index_t* corners = &shape.mesh.indices[offset];
       offset += n;
@@ -361,8 +365,9 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
       const int mtl = face < shape.mesh.material_ids.size() ? shape.mesh.material_ids[face] : -1;
       int material = -1;  // the object's own
       if (use_mtl) {
-        material = mtl >= 0 && static_cast<size_t>(mtl) < mtl_ids.size() ? static_cast<int>(mtl_ids[static_cast<size_t>(mtl)])
-                                                                         : static_cast<int>(default_material(st));
+        material = mtl >= 0 && static_cast<size_t>(mtl) < mtl_ids.size()
+                       ? static_cast<int>(mtl_ids[static_cast<size_t>(mtl)])
+                       : static_cast<int>(default_material(st));
       }
       add_obj_face(corners, n, material, &m);
       if (st.scene.triangles->triangle_count() + m.triangle_count() > MAX_TRIANGLES) {

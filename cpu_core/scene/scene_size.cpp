@@ -54,8 +54,10 @@ uint64_t estimate_render_bytes(const SceneData& scene) {
   for (const PointLight& l : scene.lights) shadow_lights += l.cast_shadows ? 1 : 0;
   const uint64_t volume_lights = std::min(shadow_lights, uint64_t{MAX_VOLUME_LIGHTS});
   const uint64_t triangles = scene.triangles->triangle_count();
-  const uint64_t volumes = volume_lights > 0 ? volume_lights * VOLUME_TRIANGLE_BYTES + VOLUME_PAIRING_TRIANGLE_BYTES : 0;
-  const uint64_t pairing = volume_lights > 0 ? std::min(VOLUME_PAIRING_EDGES_BYTES, 3 * PAIRING_EDGE_BYTES * triangles) : 0;
+  const uint64_t volumes =
+      volume_lights > 0 ? volume_lights * VOLUME_TRIANGLE_BYTES + VOLUME_PAIRING_TRIANGLE_BYTES : 0;
+  const uint64_t pairing =
+      volume_lights > 0 ? std::min(VOLUME_PAIRING_EDGES_BYTES, 3 * PAIRING_EDGE_BYTES * triangles) : 0;
   const uint64_t per_triangle = SCENE_TRIANGLE_BYTES + (gpu ? GL_TRIANGLE_BYTES + volumes : 0);
   return pixels * PIXEL_BYTES + 6 * n * n * TEXEL_BYTES + triangles * per_triangle +
          (gpu ? shadow_lights * n * n * GL_SHADOW_TEXEL_BYTES + pairing : 0);
@@ -65,10 +67,12 @@ void check_render_size(const SceneData& scene, uint64_t budget_bytes, bool cappe
   const uint64_t need = estimate_render_bytes(scene);
   if (need <= budget_bytes) return;
   throw InputError(one_line(scene.file + ": render: estimated " + mib(need) + " MiB for " +
-                            std::to_string(scene.camera.width) + "x" + std::to_string(scene.camera.height) +
-                            ", cube " + std::to_string(scene.render.cube_resolution) + " and " +
-                            std::to_string(scene.triangles->triangle_count()) + " triangles (before the A-buffers' "
-                            "fragments), " + budget_words(budget_bytes, capped)));
+                            std::to_string(scene.camera.width) + "x" + std::to_string(scene.camera.height) + ", cube " +
+                            std::to_string(scene.render.cube_resolution) + " and " +
+                            std::to_string(scene.triangles->triangle_count()) +
+                            " triangles (before the A-buffers' "
+                            "fragments), " +
+                            budget_words(budget_bytes, capped)));
 }
 
 }  // namespace abcube

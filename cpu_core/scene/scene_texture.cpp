@@ -22,7 +22,8 @@ std::string texture_file(LoadState& st, const std::string& path, const std::stri
   namespace fs = std::filesystem;
   if (file.empty()) fail(st.src, path, where + "must name an image file, got \"\"");
   const fs::path p(file);
-  const std::string resolved = (p.is_absolute() ? p : fs::path(base_dir.empty() ? "." : base_dir) / p).lexically_normal().string();
+  const std::string resolved =
+      (p.is_absolute() ? p : fs::path(base_dir.empty() ? "." : base_dir) / p).lexically_normal().string();
   if (!st.root.empty() && !inside_root(st.root, resolved)) {
     fail(st.src, path, where + quote_path(file) + " resolves outside --root " + st.root);
   }
@@ -80,7 +81,8 @@ void load_textures(LoadState& st) {
     image_of.emplace(texture, material_image[m]);
     images.push_back(std::move(image));
   }
-  if (!images.empty()) scene.textures = std::make_shared<const TextureSet>(std::move(images), std::move(material_image));
+  if (!images.empty())
+    scene.textures = std::make_shared<const TextureSet>(std::move(images), std::move(material_image));
 }
 
 }  // namespace abcube::detail

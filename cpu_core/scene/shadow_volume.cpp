@@ -164,7 +164,8 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
     for_each_edge([&](uint64_t i, const DirectedEdge& e) {
       if (buckets == 1 || bucket_of[i] == bucket) edges.push_back(e);
     });
-    std::sort(edges.begin(), edges.end(), [](const DirectedEdge& x, const DirectedEdge& y) { return x.key() < y.key(); });
+    std::sort(edges.begin(), edges.end(),
+              [](const DirectedEdge& x, const DirectedEdge& y) { return x.key() < y.key(); });
     for (size_t i = 0; i < edges.size();) {
       size_t j = i;
       long net = 0;
@@ -237,9 +238,10 @@ void clip_polygon(const std::vector<Corner>& in, const glm::dvec4& plane, std::v
 
 }  // namespace
 
-size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& soup, const glm::dmat4& clip_from_relative,
-                              const glm::dvec3& eye, double tie_step, const glm::dvec4* plane,
-                              std::vector<ShadowVolumeVertex>* out, size_t first, size_t count) {
+size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& soup,
+                              const glm::dmat4& clip_from_relative, const glm::dvec3& eye, double tie_step,
+                              const glm::dvec4* plane, std::vector<ShadowVolumeVertex>* out, size_t first,
+                              size_t count) {
   const glm::dmat4 t = glm::transpose(clip_from_relative);
   size_t written = 0;
   std::vector<Corner> a, b;
@@ -247,8 +249,8 @@ size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& so
   const auto clip_face = [&](const std::array<glm::vec4, 3>& corners, uint32_t object, uint32_t reversed) {
     const double scale = 1.0 + tie_step * (double(object) + 1.0);
     // The planes, as functionals of the relative corner: w - x, w + x, w - y, w + y, w - s z.
-    const glm::dvec4 planes[6] = {t * glm::dvec4(-1, 0, 0, 1), t * glm::dvec4(1, 0, 0, 1),
-                                  t * glm::dvec4(0, -1, 0, 1), t * glm::dvec4(0, 1, 0, 1),
+    const glm::dvec4 planes[6] = {t * glm::dvec4(-1, 0, 0, 1),     t * glm::dvec4(1, 0, 0, 1),
+                                  t * glm::dvec4(0, -1, 0, 1),     t * glm::dvec4(0, 1, 0, 1),
                                   t * glm::dvec4(0, 0, -scale, 1), plane ? *plane : glm::dvec4(0, 0, 0, 1)};
     const int count = plane ? 6 : 5;
     a.clear();

@@ -37,12 +37,12 @@ enum CapCode : uint8_t {
 
 struct ShadowVolume {
   glm::dvec3 light{0.0};
-  std::vector<uint8_t> caps;                     // CapCode per soup triangle
-  std::vector<ShadowVolumeVertex> side_vertices; // the sides: triangles, three vertices each
-  uint64_t blockers = 0;          // triangles that cast (prisms)
-  uint64_t sides = 0;             // side quads kept
-  uint64_t sides_cancelled = 0;   // side quads left out in cancelling pairs
-  uint64_t facing_away_left_out = 0;  // closed objects' triangles facing away from a light outside them
+  std::vector<uint8_t> caps;                      // CapCode per soup triangle
+  std::vector<ShadowVolumeVertex> side_vertices;  // the sides: triangles, three vertices each
+  uint64_t blockers = 0;                          // triangles that cast (prisms)
+  uint64_t sides = 0;                             // side quads kept
+  uint64_t sides_cancelled = 0;                   // side quads left out in cancelling pairs
+  uint64_t facing_away_left_out = 0;              // closed objects' triangles facing away from a light outside them
   uint64_t triangle_count() const { return 2 * blockers + 2 * sides; }
 };
 
@@ -96,9 +96,10 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
 // far cap (nothing when it casts none), the others the sides in order; the caller clips and
 // draws a run at a time, so that neither the clipped faces nor the GL's copy of them grow
 // with the whole volume.
-size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& soup, const glm::dmat4& clip_from_relative,
-                              const glm::dvec3& eye, double tie_step, const glm::dvec4* plane,
-                              std::vector<ShadowVolumeVertex>* out, size_t first = 0, size_t count = SIZE_MAX);
+size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& soup,
+                              const glm::dmat4& clip_from_relative, const glm::dvec3& eye, double tie_step,
+                              const glm::dvec4* plane, std::vector<ShadowVolumeVertex>* out, size_t first = 0,
+                              size_t count = SIZE_MAX);
 // The faces clip_faces_at_infinity numbers: the soup's triangles, then the side triangles.
 inline size_t faces_at_infinity(const ShadowVolume& volume) {
   return volume.caps.size() + volume.side_vertices.size() / 3;

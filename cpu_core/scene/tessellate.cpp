@@ -38,9 +38,7 @@ glm::dvec2 quad_uv(int corner) { return {QUAD_UV[corner][0], QUAD_UV[corner][1]}
 // normals then differ from the positions' by an ulp (tests/golden would catch it).
 [[gnu::noinline]] glm::vec3 to_float(const glm::dvec3& v) { return glm::vec3(v); }
 
-bool finite3(const glm::dvec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
+bool finite3(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // Newell's method: twice the vector area of a polygon (Sutherland et al. 1974; Tampieri,
 // "Newell's Method for Computing the Plane Equation of a Polygon", Graphics Gems III).
@@ -83,8 +81,7 @@ double cross2(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
   return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
 }
 
-bool inside_triangle(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b,
-                     const glm::dvec2& c) {
+bool inside_triangle(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
   return cross2(a, b, p) > 0 && cross2(b, c, p) > 0 && cross2(c, a, p) > 0;
 }
 
@@ -188,9 +185,7 @@ bool tessellate_quad(const std::array<glm::dvec3, 4>& v, LocalMesh* out) {
   glm::dvec3 n = newell_normal(v.data(), 4);
   // A symmetric bow tie has no net area; measure its triangles against the first one.
   if (glm::length(n) == 0.0) n = glm::cross(v[1] - v[0], v[2] - v[0]);
-  auto agrees = [&](int a, int b, int c) {
-    return glm::dot(glm::cross(v[b] - v[a], v[c] - v[a]), n) >= 0.0;
-  };
+  auto agrees = [&](int a, int b, int c) { return glm::dot(glm::cross(v[b] - v[a], v[c] - v[a]), n) >= 0.0; };
   const auto push = [&](int a, int b, int c) {
     push_triangle(out, v[a], v[b], v[c]);
     push_uvs(out, quad_uv(a), quad_uv(b), quad_uv(c));
@@ -209,9 +204,7 @@ bool tessellate_quad(const std::array<glm::dvec3, 4>& v, LocalMesh* out) {
 }
 
 LocalMesh tessellate_box(const glm::dvec3& lo, const glm::dvec3& hi) {
-  auto corner = [&](int x, int y, int z) {
-    return glm::dvec3(x ? hi.x : lo.x, y ? hi.y : lo.y, z ? hi.z : lo.z);
-  };
+  auto corner = [&](int x, int y, int z) { return glm::dvec3(x ? hi.x : lo.x, y ? hi.y : lo.y, z ? hi.z : lo.z); };
   // Each face's corners counter-clockwise seen from outside: cross(b-a, c-a) points out.
   static const int FACES[6][4][3] = {
       {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}},  // -x
@@ -324,14 +317,13 @@ AffineMap make_affine_map(const Transform& t) {
 }
 
 bool is_zero_area(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
-  const double longest2 =
-      std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
+  const double longest2 = std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
   const double twice_area = glm::length(glm::cross(b - a, c - a));
   return !(twice_area > ZERO_AREA_RELATIVE * longest2) || !std::isfinite(longest2);
 }
 
-size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t object_id,
-                        uint32_t material, TriangleSoup* soup) {
+size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t object_id, uint32_t material,
+                        TriangleSoup* soup) {
   // A mirroring transform reverses the winding; swapping b and c restores the sense of
   // the geometric normal.
   const int order[3] = {0, m.mirrors ? 2 : 1, m.mirrors ? 1 : 2};

@@ -17,11 +17,10 @@ namespace abcube {
 // triangle i. `normals` is empty (flat shading) or holds one normal per corner, where a
 // zero normal anywhere in a triangle means "flat" for that triangle. `material` is empty
 // or holds one entry per triangle, -1 meaning the object's own material.
-// Indexed (OBJ files, whose corners share vertices): when `indexed`, corner c is positions[position_index[c]] with normal normals[normal_index[c]] (a zero
-// normal for NO_NORMAL), so a shared vertex is held once.
-// Texture coordinates: `uvs` is empty (none) or, like normals, one per corner, or indexed
-// by `uv_index` (NO_UV: that corner has none, (0, 0)). u runs right and v up the image,
-// as in OBJ's vt; a loader whose format runs v down (glTF) stores 1 - v.
+// Indexed (OBJ files, whose corners share vertices): when `indexed`, corner c is positions[position_index[c]] with
+// normal normals[normal_index[c]] (a zero normal for NO_NORMAL), so a shared vertex is held once. Texture coordinates:
+// `uvs` is empty (none) or, like normals, one per corner, or indexed by `uv_index` (NO_UV: that corner has none, (0,
+// 0)). u runs right and v up the image, as in OBJ's vt; a loader whose format runs v down (glTF) stores 1 - v.
 struct LocalMesh {
   std::vector<glm::dvec3> positions;
   std::vector<glm::dvec3> normals;
@@ -95,8 +94,8 @@ bool is_zero_area(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
 // Appends `local`, moved to world space by `m`, to `soup` as object `object_id`; triangles
 // without a material entry (or with -1) get `material`. Triangles that are zero-area or
 // non-finite once stored as floats are skipped; returns how many were.
-size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t object_id,
-                        uint32_t material, TriangleSoup* soup);
+size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t object_id, uint32_t material,
+                        TriangleSoup* soup);
 
 // The half-edges of triangles [first, first + count) of the soup: half-edge 3 i + k runs
 // from corner k to corner k + 1 of triangle first + i. A vertex is an object and a float

@@ -16,9 +16,7 @@ namespace abcube {
 namespace {
 
 // The sRGB transfer function's inverse (IEC 61966-2-1): encoded value -> linear.
-float srgb_to_linear(float c) {
-  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
+float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
 
 // A file name OpenImageIO can pick a reader by, for bytes held in memory.
 std::string reader_name(const std::string& name_hint, const std::string& mime_type) {
@@ -30,8 +28,8 @@ std::string reader_name(const std::string& name_hint, const std::string& mime_ty
 
 }  // namespace
 
-bool decode_texture(const unsigned char* bytes, size_t size, const std::string& name_hint,
-                    const std::string& mime_type, TextureImage* out, std::string* why) {
+bool decode_texture(const unsigned char* bytes, size_t size, const std::string& name_hint, const std::string& mime_type,
+                    TextureImage* out, std::string* why) {
   OIIO::Filesystem::IOMemReader reader(bytes, size);
   OIIO::ImageSpec config;
   const void* proxy = &reader;  // a PTR attribute holds the pointer's value
@@ -44,7 +42,8 @@ bool decode_texture(const unsigned char* bytes, size_t size, const std::string& 
     return false;
   }
   const OIIO::ImageSpec& spec = in->spec();
-  const uint64_t texels = static_cast<uint64_t>(std::max(spec.width, 0)) * static_cast<uint64_t>(std::max(spec.height, 0));
+  const uint64_t texels =
+      static_cast<uint64_t>(std::max(spec.width, 0)) * static_cast<uint64_t>(std::max(spec.height, 0));
   if (spec.width <= 0 || spec.height <= 0 || spec.depth != 1 || spec.nchannels <= 0) {
     *why = "has no pixels (" + std::to_string(spec.width) + " x " + std::to_string(spec.height) + ")";
     return false;
@@ -114,8 +113,9 @@ std::vector<unsigned char> encode_exr(const TextureImage& image, const std::stri
   const void* proxy = &writer;
   spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
   auto out = OIIO::ImageOutput::create(name);
-  ABCUBE_CHECK(out && out->open(name, spec) && out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data()) && out->close(),
-               "encoding texture " + image.name + " for the TextureSystem: " + (out ? out->geterror() : OIIO::geterror()));
+  ABCUBE_CHECK(
+      out && out->open(name, spec) && out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data()) && out->close(),
+      "encoding texture " + image.name + " for the TextureSystem: " + (out ? out->geterror() : OIIO::geterror()));
   return bytes;
 }
 
@@ -126,8 +126,8 @@ TextureSet::TextureSet(std::vector<TextureImage> images, std::vector<int> materi
   Sampler& s = *sampler_;
   s.cache = OIIO::ImageCache::create(false);
   s.cache->attribute("max_memory_MB", 64.0f);
-  s.cache->attribute("automip", 1);        // MIP levels made in memory from the one level
-  s.cache->attribute("autotile", 64);      // and read in tiles, so the bound holds
+  s.cache->attribute("automip", 1);    // MIP levels made in memory from the one level
+  s.cache->attribute("autotile", 64);  // and read in tiles, so the bound holds
   s.cache->attribute("max_open_files", 4096);
   s.system = OIIO::TextureSystem::create(false, s.cache);
   for (size_t i = 0; i < images_.size(); ++i) {

@@ -40,8 +40,8 @@ constexpr uint64_t MAX_TEXTURE_TEXELS = uint64_t{1} << 24;
 // Decodes an encoded image (PNG, JPEG, EXR, ... whatever OpenImageIO reads; `name_hint`'s
 // extension or the mime type helps it pick) into linear RGB. Returns false with `why` (a
 // one-line reason, from OpenImageIO) when it cannot be decoded or is too large.
-bool decode_texture(const unsigned char* bytes, size_t size, const std::string& name_hint,
-                    const std::string& mime_type, TextureImage* out, std::string* why);
+bool decode_texture(const unsigned char* bytes, size_t size, const std::string& name_hint, const std::string& mime_type,
+                    TextureImage* out, std::string* why);
 
 // A scene's textures: the decoded images, which material uses which, and one OpenImageIO
 // TextureSystem over them (its own, cache bounded to 64 MiB; thread-safe, created once per
@@ -54,9 +54,7 @@ class TextureSet {
   TextureSet(const TextureSet&) = delete;
   TextureSet& operator=(const TextureSet&) = delete;
 
-  int image_of(uint32_t material) const {
-    return material < material_image_.size() ? material_image_[material] : -1;
-  }
+  int image_of(uint32_t material) const { return material < material_image_.size() ? material_image_[material] : -1; }
   const std::vector<TextureImage>& images() const { return images_; }
   const std::vector<int>& material_image() const { return material_image_; }
   // The filtered linear RGB of image `image` at (u, v) (v up), wrapped periodically.

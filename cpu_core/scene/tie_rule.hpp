@@ -61,8 +61,8 @@ inline bool same_distance(const TriangleSoup& soup, const glm::dvec3& dir, Surfa
   const double gap = std::fabs(a.t - b.t);
   const double bound = tie_bound(soup, a.triangle, b.triangle);
   if (gap * glm::length(dir) <= bound) return true;  // max |n . dir| <= |dir|
-  const double cos_max =
-      std::max(std::fabs(glm::dot(tie_normal(soup, a.triangle), dir)), std::fabs(glm::dot(tie_normal(soup, b.triangle), dir)));
+  const double cos_max = std::max(std::fabs(glm::dot(tie_normal(soup, a.triangle), dir)),
+                                  std::fabs(glm::dot(tie_normal(soup, b.triangle), dir)));
   return gap * cos_max <= bound;
 }
 

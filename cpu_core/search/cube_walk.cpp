@@ -56,8 +56,7 @@ void envelope_next(const FaceLines& f, int cur, double l, double end, double* fa
 
 CubeWalk::CubeWalk(const glm::dvec3& w, const glm::dvec3& d, int n, double l_max, double skip_radius,
                    uint32_t max_texels)
-    : w_(w), d_(d), n_(n), l_max_(l_max),
-      cap_(max_texels ? max_texels : default_cap(n)) {
+    : w_(w), d_(d), n_(n), l_max_(l_max), cap_(max_texels ? max_texels : default_cap(n)) {
   ABCUBE_CHECK(n >= 1, "n = " + std::to_string(n));
   ABCUBE_CHECK(std::fabs(glm::length(d) - 1.0) < 1e-6,
                "direction must be unit, |d| = " + std::to_string(glm::length(d)));

@@ -30,9 +30,8 @@ class CubeWalk {
   // w: ray origin relative to the cube centre; d: unit direction; n: face resolution;
   // l_max: end of the ray (+inf for a ray, |L - P| for a shadow segment);
   // skip_radius: ball around the centre to skip (rule 4); max_texels: 0 = 16 n + 64.
-  CubeWalk(const glm::dvec3& w, const glm::dvec3& d, int n,
-           double l_max = std::numeric_limits<double>::infinity(), double skip_radius = 0.0,
-           uint32_t max_texels = 0);
+  CubeWalk(const glm::dvec3& w, const glm::dvec3& d, int n, double l_max = std::numeric_limits<double>::infinity(),
+           double skip_radius = 0.0, uint32_t max_texels = 0);
 
   // The next texel in order of increasing l; false when the walk is over (or aborted).
   bool next(WalkTexel* texel);
@@ -75,9 +74,9 @@ class CubeWalk {
 
  private:
   static uint32_t default_cap(int n) { return 16u * static_cast<uint32_t>(n > 1 ? n : 1) + 64u; }
-  bool start_face();            // the next face segment of the current run; false at the end
-  bool on_face();               // a face segment started (the current or the next); false at the end
-  void start_texel_on_face();   // entry texel and first crossings of the face segment
+  bool start_face();                              // the next face segment of the current run; false at the end
+  bool on_face();                                 // a face segment started (the current or the next); false at the end
+  void start_texel_on_face();                     // entry texel and first crossings of the face segment
   double crossing(int axis, int boundary) const;  // l where the ray crosses a boundary plane
   double raw_crossing(int axis, int boundary) const;  // the same, not clamped to l_ (INF: never)
   double denominator(int axis, int boundary) const;   // of raw_crossing: its sign says if the ray gets there
@@ -102,8 +101,8 @@ class CubeWalk {
   // The DDA on the current face. A crossing's plane is N (A . X) - u (F . X) = 0, so its
   // parameter needs only A . W, A . D (A the s or t axis) and F . W, F . D, fixed per face.
   double axis_w_[2] = {0, 0}, axis_d_[2] = {0, 0}, forward_w_ = 0, forward_d_ = 0;
-  int ij_[2] = {0, 0};      // column i, row j
-  int step_[2] = {0, 0};    // +1, -1 or 0 per axis
+  int ij_[2] = {0, 0};    // column i, row j
+  int step_[2] = {0, 0};  // +1, -1 or 0 per axis
   double next_l_[2] = {0, 0};
   double l_ = 0;
   uint32_t texels_ = 0, iterations_ = 0;

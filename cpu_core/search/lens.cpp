@@ -172,8 +172,8 @@ struct LensPoints {
   std::vector<glm::dvec3> all, upper, lower;
 };
 
-LensPoints surface_points(const SceneData& scene, const SceneObject& obj, const LensFit& frame,
-                          LensSplit split, const std::vector<glm::dvec3>& all) {
+LensPoints surface_points(const SceneData& scene, const SceneObject& obj, const LensFit& frame, LensSplit split,
+                          const std::vector<glm::dvec3>& all) {
   LensPoints pts;
   if (split == LensSplit::side_of_plane) {
     for (const glm::dvec3& p : all) {
@@ -244,9 +244,7 @@ bool fit_principal_plane(const std::vector<glm::dvec3>& all, LensFit* f) {
 
 }  // namespace
 
-const char* refraction_mode_name(RefractionMode m) {
-  return enum_name(REFRACTION_MODE_NAMES, m);
-}
+const char* refraction_mode_name(RefractionMode m) { return enum_name(REFRACTION_MODE_NAMES, m); }
 
 bool parse_refraction_mode(const std::string& s, RefractionMode* out) {
   return parse_enum(REFRACTION_MODE_NAMES, s, out);
@@ -285,8 +283,8 @@ LensFit fit_lens(const SceneData& scene, uint32_t object, const LensFitOptions& 
   f.points1 = static_cast<uint32_t>(upper.size());
   f.points2 = static_cast<uint32_t>(lower.size());
   if (upper.size() < MIN_SURFACE_POINTS || lower.size() < MIN_SURFACE_POINTS) {
-    return invalid(f, obj.path + ": a surface has fewer than 3 points (" + std::to_string(upper.size()) +
-                          " above, " + std::to_string(lower.size()) + " below the principal plane)");
+    return invalid(f, obj.path + ": a surface has fewer than 3 points (" + std::to_string(upper.size()) + " above, " +
+                          std::to_string(lower.size()) + " below the principal plane)");
   }
   double top = -std::numeric_limits<double>::infinity(), bottom = std::numeric_limits<double>::infinity();
   for (const LensSurfacePoint& p : upper) top = std::max(top, p.z);
@@ -305,8 +303,8 @@ LensFit fit_lens(const SceneData& scene, uint32_t object, const LensFitOptions& 
   f.rms_residual1 = s1.rms;
   f.rms_residual2 = s2.rms;
   if (!(f.thickness > 0)) {
-    return invalid(f, obj.path + ": the fitted vertices are in the wrong order (thickness " +
-                          std::to_string(f.thickness) + ")");
+    return invalid(
+        f, obj.path + ": the fitted vertices are in the wrong order (thickness " + std::to_string(f.thickness) + ")");
   }
   f.valid = true;
   return f;
@@ -350,8 +348,8 @@ LensMatrix lens_matrix(const LensFit& lens, RefractionMode mode, bool along_axis
                                             : thin_lens_matrix(entry, exit, lens.nu);
 }
 
-bool lens_transfer(const LensFit& lens, RefractionMode mode, const glm::dvec3& origin,
-                   const glm::dvec3& dir, LensRay* out) {
+bool lens_transfer(const LensFit& lens, RefractionMode mode, const glm::dvec3& origin, const glm::dvec3& dir,
+                   LensRay* out) {
   ABCUBE_CHECK(mode != RefractionMode::search, "lens_transfer needs thick_lens or thin_lens");
   if (!lens.valid) return false;
   const glm::dvec3 d = glm::normalize(dir);

@@ -43,15 +43,15 @@ struct LensFit {
   double nu = 1;               // index of refraction (the material's ior), air outside
   double rms_residual1 = 0;    // sqrt(mean F^2) of surface 1's points (a length)
   double rms_residual2 = 0;
-  double vertex1 = 0;          // height of surface 1's vertex (its fitted z0)
-  double vertex2 = 0;          // height of surface 2's vertex
-  double radius = 0;           // largest distance of a vertex from the axis
-  glm::dvec3 spread{0.0};      // variance of the points along axis, v_axis, u_axis
-  uint32_t points1 = 0;        // points fitted for surface 1
+  double vertex1 = 0;      // height of surface 1's vertex (its fitted z0)
+  double vertex2 = 0;      // height of surface 2's vertex
+  double radius = 0;       // largest distance of a vertex from the axis
+  glm::dvec3 spread{0.0};  // variance of the points along axis, v_axis, u_axis
+  uint32_t points1 = 0;    // points fitted for surface 1
   uint32_t points2 = 0;
-  uint32_t object = 0;         // index into SceneData::objects
+  uint32_t object = 0;  // index into SceneData::objects
   bool valid = false;
-  std::string why_invalid;     // empty when valid
+  std::string why_invalid;  // empty when valid
 };
 
 // Fits object `object` of the scene (all its triangles; the index of refraction is its
@@ -92,7 +92,7 @@ struct LensRay {
 // False, and *out untouched, when the lens is invalid, the ray runs parallel to the
 // principal plane, or |S'| >= 1 (no emerging direction: the paraxial model has left its
 // domain). Allocation-free; the caller decides whether the ray hit the object at all.
-bool lens_transfer(const LensFit& lens, RefractionMode mode, const glm::dvec3& origin,
-                   const glm::dvec3& dir, LensRay* out);
+bool lens_transfer(const LensFit& lens, RefractionMode mode, const glm::dvec3& origin, const glm::dvec3& dir,
+                   LensRay* out);
 
 }  // namespace abcube

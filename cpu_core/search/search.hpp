@@ -58,13 +58,13 @@ constexpr size_t REFINE_MAX_TRIANGLES = 32;
 struct SearchOptions {
   SearchMode mode = SearchMode::crossing;
   SearchLayers layers = SearchLayers::all;
-  double theta_max = 0.034906585039886591;  // thesis mode: 2 degrees, in radians
-  double tolerance_texels = 1.0;            // crossing mode: largest accepted e
+  double theta_max = 0.034906585039886591;   // thesis mode: 2 degrees, in radians
+  double tolerance_texels = 1.0;             // crossing mode: largest accepted e
   SearchRefine refine = SearchRefine::mesh;  // MESH REFINEMENT (docs/design/search.md)
-  double self_offset_texels = 0;            // W's own surface and points closer; 0 = the mode's default
-  uint32_t max_texels = 0;                  // walk cap; 0 = CubeWalk's default
-  bool side_structure = true;               // THE SIDE STRUCTURE answers what the map cannot hold
-  bool hierarchy = true;  // HIERARCHICAL SKIP (search_scan.hpp); off: the plain walk (same answers)
+  double self_offset_texels = 0;             // W's own surface and points closer; 0 = the mode's default
+  uint32_t max_texels = 0;                   // walk cap; 0 = CubeWalk's default
+  bool side_structure = true;                // THE SIDE STRUCTURE answers what the map cannot hold
+  bool hierarchy = true;                     // HIERARCHICAL SKIP (search_scan.hpp); off: the plain walk (same answers)
 };
 
 // The self offset `options` gives, in texels at W (its own, or the mode's default).
@@ -200,7 +200,7 @@ class SearchContext {
   const CubeABuffer* cube_;
   Media media_;
   const glm::vec3* positions_;  // the soup's, 3 per triangle
-  uint64_t memo_id_;             // names this context's triangles in the threads' MEMO (search_context.cpp)
+  uint64_t memo_id_;            // names this context's triangles in the threads' MEMO (search_context.cpp)
   std::vector<uint32_t> zero_area_;
   std::shared_ptr<const Bvh> side_bvh_;  // over the side triangles (the scene's soup, not copied)
   std::vector<uint32_t> no_triangles_;
@@ -221,23 +221,24 @@ class SearchContext {
   void build_pyramid();
   void build_side_structure(std::vector<uint8_t> seen);
   glm::vec2 block_bounds(int face, int i, int j) const {
-    return block_z_[static_cast<size_t>(face)][static_cast<size_t>(j / BOUNDS_BLOCK) * static_cast<size_t>(blocks_per_row_) +
-                                               static_cast<size_t>(i / BOUNDS_BLOCK)];
+    return block_z_[static_cast<size_t>(face)]
+                   [static_cast<size_t>(j / BOUNDS_BLOCK) * static_cast<size_t>(blocks_per_row_) +
+                    static_cast<size_t>(i / BOUNDS_BLOCK)];
   }
 };
 
 struct SearchResult {
   bool hit = false;
   MissReason miss = MissReason::no_crossing;  // none when hit
-  uint32_t triangle = 0;       // the found fragment's triangle (index into SceneData::triangles)
+  uint32_t triangle = 0;                      // the found fragment's triangle (index into SceneData::triangles)
   uint32_t object_id = 0, material_id = 0;
-  bool back_face = false;      // the fragment's facing as seen from the cube centre
-  glm::dvec3 point{0.0};       // X', world space
-  double distance = 0;         // |X' - W|
-  double angle = 0;            // angle between the ray and X' - W (radians; 0 in crossing mode)
-  double outside_texels = 0;   // crossing mode: X''s distance from its triangle, in texels
-  bool side = false;           // answered by THE SIDE STRUCTURE (texel is then meaningless)
-  CubeTexel texel{0, 0, 0};    // where the fragment was found
+  bool back_face = false;         // the fragment's facing as seen from the cube centre
+  glm::dvec3 point{0.0};          // X', world space
+  double distance = 0;            // |X' - W|
+  double angle = 0;               // angle between the ray and X' - W (radians; 0 in crossing mode)
+  double outside_texels = 0;      // crossing mode: X''s distance from its triangle, in texels
+  bool side = false;              // answered by THE SIDE STRUCTURE (texel is then meaningless)
+  CubeTexel texel{0, 0, 0};       // where the fragment was found
   uint32_t texels_visited = 0;    // texels the walk stepped on
   uint32_t nodes_skipped = 0;     // pyramid nodes it stepped over (HIERARCHICAL SKIP)
   uint32_t fragments_tested = 0;  // z-interval tests
@@ -250,8 +251,8 @@ struct ShadowResult {
   uint32_t blockers = 0;          // distinct crossings counted
   uint32_t first_blocker = 0;     // triangle of the nearest counted blocker (if blockers > 0)
   bool aborted = false;
-  bool zero_area = false;         // the segment meets a zero-area surface and no side structure answered
-  uint32_t side_blockers = 0;     // blockers found by THE SIDE STRUCTURE
+  bool zero_area = false;      // the segment meets a zero-area surface and no side structure answered
+  uint32_t side_blockers = 0;  // blockers found by THE SIDE STRUCTURE
   uint32_t texels_visited = 0;
   uint32_t nodes_skipped = 0;
   uint32_t fragments_tested = 0;
@@ -267,9 +268,8 @@ SearchResult reflection_search(const SearchContext& ctx, const glm::dvec3& w, co
 // The next surface met by a ray inside object `object_id`: its first crossing, along W + l T (W
 // world space, on the entry surface; T unit, refracted inwards), of that object's surface or of
 // a surface of an object whose bounds meet its (REFRACTION, docs/design/search.md).
-SearchResult refraction_exit_search(const SearchContext& ctx, const glm::dvec3& w,
-                                    const glm::dvec3& t, uint32_t object_id,
-                                    const SearchOptions& options = {});
+SearchResult refraction_exit_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& t,
+                                    uint32_t object_id, const SearchOptions& options = {});
 
 // The exact crossing of the ray W + l D (W world space, D unit) with the mesh around
 // `triangle`: the edge-connected triangles within `radius` of the stretch
@@ -287,8 +287,8 @@ void coincident_crossings(const SearchContext& ctx, const glm::dvec3& w, const g
                           double l_hit, double tolerance, const std::function<void(uint32_t, double)>& visit);
 
 // Visibility of point light `light_position` from surface point p (world space).
-ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p,
-                           const glm::dvec3& light_position, const SearchOptions& options = {});
+ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const glm::dvec3& light_position,
+                           const SearchOptions& options = {});
 
 // Whether two searches gave the same answer bit for bit: every field but the walk's counts
 // of texels and nodes (HIERARCHICAL SKIP: on and off must agree).

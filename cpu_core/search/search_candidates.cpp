@@ -69,9 +69,9 @@ Candidate crossing_candidate(const SearchContext& ctx, const SearchRay& q, const
     c.x = q.w + l * q.d;
     c.l = l;
     c.angle = 0.0;
-    c.outside = distance_to_triangle(c.x, ctx.vertex(tri, 0), ctx.vertex(tri, 1), ctx.vertex(tri, 2), p.normal,
-                                     p.offset) /
-                texel_size_at(c.x, ctx.cube().n);
+    c.outside =
+        distance_to_triangle(c.x, ctx.vertex(tri, 0), ctx.vertex(tri, 1), ctx.vertex(tri, 2), p.normal, p.offset) /
+        texel_size_at(c.x, ctx.cube().n);
     c.exact = c.outside <= ON_TRIANGLE_TEXELS;
     c.tested = true;
   }
@@ -151,8 +151,7 @@ bool side_crossing_counts(const SearchContext& ctx, const SearchRay& q, uint32_t
 }
 
 bool side_back_face(const SearchContext& ctx, const SearchRay& q, uint32_t tri) {
-  const bool zero_area =
-      std::binary_search(ctx.zero_area_triangles().begin(), ctx.zero_area_triangles().end(), tri);
+  const bool zero_area = std::binary_search(ctx.zero_area_triangles().begin(), ctx.zero_area_triangles().end(), tri);
   const SearchContext::Plane& p = ctx.plane(tri);
   return zero_area ? glm::dot(p.normal, q.d) > 0.0 : p.offset > 0.0;
 }
@@ -163,7 +162,8 @@ SideCrossing nearest_side_crossing(const SearchContext& ctx, const SearchRay& q,
   const TriangleSoup& soup = *ctx.scene().triangles;
   ctx.for_each_side_crossing(q.w, q.d, l_end, [&](uint32_t tri, double l) {
     // The nearest; at the same distance THE TIE RULE (scene/tie_rule.hpp) picks.
-    if ((best.l == INF || seen_before(soup, q.d, {tri, l}, {best.triangle, best.l})) && side_crossing_counts(ctx, q, tri, l)) {
+    if ((best.l == INF || seen_before(soup, q.d, {tri, l}, {best.triangle, best.l})) &&
+        side_crossing_counts(ctx, q, tri, l)) {
       best = {tri, l, false};
     }
     return true;
@@ -178,8 +178,10 @@ SideCrossing nearest_side_crossing(const SearchContext& ctx, const SearchRay& q,
 SearchResult finish(const SearchContext& ctx, const SearchRay& q, const Candidate* best, MissReason miss,
                     const ScanCounts& counts) {
   SearchResult r;
-  if (best) r = make_result(ctx, q, *best);
-  else r.miss = counts.aborted ? MissReason::aborted : miss;
+  if (best)
+    r = make_result(ctx, q, *best);
+  else
+    r.miss = counts.aborted ? MissReason::aborted : miss;
   // Side crossings up to the map's answer and, for THE TIE RULE (scene/tie_rule.hpp), the
   // window past it where a side triangle may be at its distance; one there answers only if
   // the rule puts it first.
@@ -214,7 +216,7 @@ SearchResult finish(const SearchContext& ctx, const SearchRay& q, const Candidat
 }
 
 SearchRay make_query(const SearchContext& ctx, const glm::dvec3& w_world, const glm::dvec3& dir,
-                    const SearchOptions& o) {
+                     const SearchOptions& o) {
   ABCUBE_CHECK(std::fabs(glm::length(dir) - 1.0) < 1e-6, "search direction must be unit");
   SearchRay q;
   q.w = w_world - ctx.cube().centre;

@@ -78,8 +78,8 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube, co
   for (size_t f = 0; f < occupied_.size(); ++f) {
     RowBounds& rb = occupied_[f];
     const ABuffer& b = cube.faces[f];
-    const bool known = b.width() == n && b.height() == n &&
-                       b.offsets.size() == static_cast<size_t>(n) * static_cast<size_t>(n) + 1;
+    const bool known =
+        b.width() == n && b.height() == n && b.offsets.size() == static_cast<size_t>(n) * static_cast<size_t>(n) + 1;
     // A face not laid out as n x n lists is taken as full: never skipped.
     rb.min_row.assign(static_cast<size_t>(std::max(n, 0)), known ? n : 0);
     rb.max_row.assign(static_cast<size_t>(std::max(n, 0)), known ? -1 : n - 1);
@@ -236,7 +236,8 @@ SearchContext::Sphere SearchContext::compute_bounding_sphere(uint32_t triangle) 
   if (!(len > 0.0 && std::isfinite(len))) return s;
   s.centroid = (v[0] + v[1] + v[2]) / 3.0;
   double farthest2 = 0.0;  // one square root: sqrt is monotone and correctly rounded
-  for (const glm::dvec3& corner : v) farthest2 = std::max(farthest2, glm::dot(corner - s.centroid, corner - s.centroid));
+  for (const glm::dvec3& corner : v)
+    farthest2 = std::max(farthest2, glm::dot(corner - s.centroid, corner - s.centroid));
   s.radius = std::sqrt(farthest2);
   return s;
 }

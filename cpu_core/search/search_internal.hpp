@@ -19,13 +19,13 @@ constexpr double ON_TRIANGLE_TEXELS = 1e-6;
 
 // One search's ray, relative to the cube centre.
 struct SearchRay {
-  glm::dvec3 w{0.0}, d{0.0};  // origin and unit direction
-  double l_max = INF;         // end of the ray (shadow segments)
-  double self = 0;            // self offset in world units (SELF-HITS, docs/design/search.md)
-  double self_tolerance = 0;  // nearest tolerance candidate accepted, world units (SELF-HITS)
+  glm::dvec3 w{0.0}, d{0.0};     // origin and unit direction
+  double l_max = INF;            // end of the ray (shadow segments)
+  double self = 0;               // self offset in world units (SELF-HITS, docs/design/search.md)
+  double self_tolerance = 0;     // nearest tolerance candidate accepted, world units (SELF-HITS)
   bool restrict_object = false;  // refraction exit: only `object` and what may lie inside it
   uint32_t object = 0;
-  bool side = true;           // SearchOptions::side_structure
+  bool side = true;  // SearchOptions::side_structure
 };
 
 // May a surface of `object` answer this ray? Any, unless it is a refraction exit from inside

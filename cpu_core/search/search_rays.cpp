@@ -25,7 +25,8 @@ SearchResult search_crossing(const SearchContext& ctx, const SearchRay& q, const
     }
     Candidate& best = c.exact ? exact : near;
     // The first crossing; at the same distance THE TIE RULE (scene/tie_rule.hpp) picks.
-    if (!best.fragment || seen_before(*ctx.scene().triangles, q.d, {c.triangle, c.l}, {best.triangle, best.l})) best = c;
+    if (!best.fragment || seen_before(*ctx.scene().triangles, q.d, {c.triangle, c.l}, {best.triangle, best.l}))
+      best = c;
   };
   const auto after_texel = [&](const WalkTexel& t, uint32_t index) {
     const double best_l = std::min(exact.l, near.l);
@@ -102,8 +103,8 @@ bool already_counted(const std::vector<ShadowCrossing>& counted, const SearchCon
 
 // THE SIDE STRUCTURE on a shadow segment: every side triangle it crosses, nearest first, is
 // a blocker (counted once, as the map's), until an opaque one.
-void add_side_blockers(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o,
-                       const glm::dvec3& light, std::vector<ShadowCrossing>* counted, ShadowResult* res) {
+void add_side_blockers(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o, const glm::dvec3& light,
+                       std::vector<ShadowCrossing>* counted, ShadowResult* res) {
   if (!q.side || !ctx.has_side_triangles()) return;  // the common case: nothing to test
   std::vector<SideCrossing> crossings;
   ctx.for_each_side_crossing(q.w, q.d, q.l_max, [&](uint32_t tri, double l) {
@@ -178,10 +179,10 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
   if (!res.blocked) add_side_blockers(ctx, q, options, light_position, &counted, &res);
   res.blockers = static_cast<uint32_t>(counted.size());
   if (!counted.empty()) {
-    res.first_blocker = std::min_element(counted.begin(), counted.end(), [](const ShadowCrossing& a,
-                                                                            const ShadowCrossing& b) {
-                          return a.l < b.l;
-                        })->triangle;
+    res.first_blocker =
+        std::min_element(counted.begin(), counted.end(), [](const ShadowCrossing& a, const ShadowCrossing& b) {
+          return a.l < b.l;
+        })->triangle;
   }
   res.aborted = counts.aborted;
   res.zero_area = !q.side && meets_zero_area(ctx, q, len);

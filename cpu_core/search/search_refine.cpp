@@ -79,7 +79,8 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
       break;
     }
     const uint32_t nb = ctx.neighbour(walker, c.outside_edge);
-    if (nb == SearchContext::NO_NEIGHBOUR || (start_near && !near_ray(ctx.bounding_sphere(nb), q, l_lo, l_hi, radius))) break;
+    if (nb == SearchContext::NO_NEIGHBOUR || (start_near && !near_ray(ctx.bounding_sphere(nb), q, l_lo, l_hi, radius)))
+      break;
     walker = nb;
   }
   if (!start_near) return a;
@@ -108,8 +109,10 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
       seen[count++] = nb;
     }
   }
-  if (a.l < INF) a.result = Refined::hit;
-  else a.result = overflow ? Refined::unknown : Refined::miss;
+  if (a.l < INF)
+    a.result = Refined::hit;
+  else
+    a.result = overflow ? Refined::unknown : Refined::miss;
   return a;
 }
 

@@ -161,7 +161,7 @@ ScanCounts scan(const SearchContext& ctx, const SearchRay& q, const SearchOption
     if (!walk.next(&t)) break;
     ++counts.texels;
     const ABuffer& b = cube.faces[static_cast<size_t>(t.face)];
-    glm::dvec2 range2(0.0);  // squared distances from the centre
+    glm::dvec2 range2(0.0);                         // squared distances from the centre
     bool skip = ctx.block_empty(t.face, t.i, t.j);  // BLOCK BOUNDS
     if (!skip) {
       range2 = distances2(t.l0, t.l1);

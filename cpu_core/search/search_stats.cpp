@@ -91,8 +91,10 @@ void SearchKindStats::add(const SearchResult& r) {
 
 void SearchKindStats::add(const ShadowResult& r) {
   add_walk(this, r);
-  if (r.blockers > 0) ++hits;
-  else ++misses;
+  if (r.blockers > 0)
+    ++hits;
+  else
+    ++misses;
   threshold_rejections += r.blockers == 0 && r.threshold_rejections > 0;
   zero_area += r.zero_area;
   side_hits += r.side_blockers > 0;

@@ -58,8 +58,8 @@ SurfacePoint surface_point(const SceneData& scene, uint32_t triangle, const glm:
   const double area2 = glm::dot(ng, ng);
   sp.geometric_normal = area2 > 0.0 ? ng / std::sqrt(area2) : glm::dvec3(0, 0, 1);
   const glm::dvec3 w = barycentric_weights(t, triangle, point);
-  const glm::dvec3 n = w.x * glm::dvec3(t.normals[base]) + w.y * glm::dvec3(t.normals[base + 1]) +
-                       w.z * glm::dvec3(t.normals[base + 2]);
+  const glm::dvec3 n =
+      w.x * glm::dvec3(t.normals[base]) + w.y * glm::dvec3(t.normals[base + 1]) + w.z * glm::dvec3(t.normals[base + 2]);
   const double len = glm::length(n);
   sp.shading_normal = len > 0.0 && std::isfinite(len) ? n / len : sp.geometric_normal;
   return sp;
@@ -81,7 +81,8 @@ MapShader::MapShader(const SceneData& scene, const CubeABuffer& cube, const MapS
   }
   if (options_.method == Method::envmap) {
     env_colour_ = CubeImage(cube.n, 3);
-    texel_state_ = std::make_unique<std::atomic<uint8_t>[]>(6 * static_cast<size_t>(cube.n) * static_cast<size_t>(cube.n));
+    texel_state_ =
+        std::make_unique<std::atomic<uint8_t>[]>(6 * static_cast<size_t>(cube.n) * static_cast<size_t>(cube.n));
   }
 }
 
@@ -108,10 +109,10 @@ glm::dvec3 MapShader::shade(const Crossed& cr, const glm::dvec3& dir, int depth,
   const glm::dvec3 n = face_forward(sp.shading_normal, v);
   const glm::dvec3 od = diffuse_color_at(scene_, sp.triangle, sp.point);
   glm::dvec3 c = phong_ambient(m, scene_.ambient, od) + lights(sp, v, n, od, stats);
-  const SecondaryWeights w = secondary_weights(
-      m, scene_.render.fresnel, dir,
-      transmission_between(dir, sp.geometric_normal, sp.shading_normal, cr.itf.n_from, cr.itf.n_to),
-      sp.geometric_normal);
+  const SecondaryWeights w =
+      secondary_weights(m, scene_.render.fresnel, dir,
+                        transmission_between(dir, sp.geometric_normal, sp.shading_normal, cr.itf.n_from, cr.itf.n_to),
+                        sp.geometric_normal);
   if (depth < scene_.render.max_depth && w.reflect > 0.0) {
     c += w.reflect * reflected(sp, dir, depth, primary, cr.itf.before, stats);
   }
@@ -167,15 +168,17 @@ MapShader::Crossed MapShader::crossing_set(const glm::dvec3& w, const glm::dvec3
   const auto leaving = [&](uint32_t tri) { return !(glm::dot(ctx_->plane(tri).normal, dir) < 0.0); };
   std::vector<MediumCrossing> set{{r.triangle, leaving(r.triangle), r.distance}};
   if (media.is_medium(r.triangle)) {
-    coincident_crossings(*ctx_, w, dir, r.triangle, r.distance, media.tolerance(r.point),
-                         [&](uint32_t tri, double l) { set.push_back({tri, leaving(tri), l}); });
+    coincident_crossings(*ctx_, w, dir, r.triangle, r.distance, media.tolerance(r.point), [&](uint32_t tri, double l) {
+      set.push_back({tri, leaving(tri), l});
+    });
   }
   c.itf = media.resolve(stack, set.data(), set.size());
   if (set.size() == 1) return c;
   double far_l = r.distance;
   for (const MediumCrossing& k : set) {
     if (k.t > far_l) far_l = k.t;
-    if (k.triangle == c.itf.triangle && k.triangle != r.triangle) c.sp = surface_point(scene_, k.triangle, w + k.t * dir);
+    if (k.triangle == c.itf.triangle && k.triangle != r.triangle)
+      c.sp = surface_point(scene_, k.triangle, w + k.t * dir);
   }
   c.far = far_l > r.distance ? w + far_l * dir : r.point;
   return c;
@@ -219,8 +222,7 @@ Ray MapShader::transmitted_ray(const Crossed& c, const Transmission& tr, MediumS
 
 glm::dvec3 MapShader::transmitted(const Crossed& c, const glm::dvec3& dir, int depth, MapShadingStats* stats) const {
   const SurfacePoint& sp = c.sp;
-  const Transmission tr =
-      transmission_between(dir, sp.geometric_normal, sp.shading_normal, c.itf.n_from, c.itf.n_to);
+  const Transmission tr = transmission_between(dir, sp.geometric_normal, sp.shading_normal, c.itf.n_from, c.itf.n_to);
   if (options_.method == Method::envmap) {
     if (stats) ++stats->envmap_lookups;
     return envmap_at(envmap_direction(sp.point, glm::normalize(tr.dir)));
@@ -269,14 +271,12 @@ glm::dvec3 MapShader::envmap_direction(const glm::dvec3& w, const glm::dvec3& r)
   const double len = glm::length(wc);
   const glm::dvec3 wu = len > 0.0 ? wc / len : r;
   switch (options_.lookup) {
-    case EnvmapLookup::reflected:
-      return r;
+    case EnvmapLookup::reflected: return r;
     case EnvmapLookup::bisector: {
       const glm::dvec3 b = r + wu;
       return glm::dot(b, b) > 1e-24 ? glm::normalize(b) : r;  // R = -[[W]]: no bisector
     }
-    case EnvmapLookup::position:
-      return wu;
+    case EnvmapLookup::position: return wu;
   }
   return r;
 }
@@ -289,8 +289,9 @@ glm::dvec3 MapShader::envmap_direction(const glm::dvec3& w, const glm::dvec3& r)
 glm::dvec3 MapShader::envmap_at(const glm::dvec3& direction) const {
   const int n = cube_.n;
   const CubeTexel t = direction_to_texel(direction, n);
-  const size_t index = (static_cast<size_t>(t.face) * static_cast<size_t>(n) + static_cast<size_t>(t.j)) *
-                           static_cast<size_t>(n) + static_cast<size_t>(t.i);
+  const size_t index =
+      (static_cast<size_t>(t.face) * static_cast<size_t>(n) + static_cast<size_t>(t.j)) * static_cast<size_t>(n) +
+      static_cast<size_t>(t.i);
   std::atomic<uint8_t>& state = texel_state_[index];
   uint8_t expected = 0;
   if (state.compare_exchange_strong(expected, 1, std::memory_order_acq_rel)) {
@@ -319,8 +320,8 @@ glm::dvec3 MapShader::envmap_texel(int face, int i, int j) const {
 }
 
 // Error_CP and Error_Parallax of one reflection ray against the exact tracer (thesis 9).
-void MapShader::measure(const glm::dvec3& w, const glm::dvec3& r, const SearchResult* found,
-                        const glm::dvec3* lookup, MapShadingStats* stats) const {
+void MapShader::measure(const glm::dvec3& w, const glm::dvec3& r, const SearchResult* found, const glm::dvec3* lookup,
+                        MapShadingStats* stats) const {
   RayErrors& e = stats->errors;
   const glm::dvec3 origin = w + r * (1e-9 * reference_->scene_scale());
   Hit exact;
@@ -379,9 +380,10 @@ static bool differ(const glm::dvec3& a, const glm::dvec3& b) {
 // Secondary searches and those of them that found nothing (the "fallback" AOV, header).
 static std::pair<uint64_t, uint64_t> searches_and_failures(const MapShadingStats& s) {
   const SearchStats& q = s.searches;
-  const uint64_t rays = q.reflection.rays + q.refraction_exit.rays + q.shadow.rays + s.lens_transfers + s.lens_fallbacks;
-  const uint64_t failed = q.reflection.misses + q.refraction_exit.misses + q.shadow.zero_area + q.shadow.aborted +
-                          s.lens_fallbacks;
+  const uint64_t rays =
+      q.reflection.rays + q.refraction_exit.rays + q.shadow.rays + s.lens_transfers + s.lens_fallbacks;
+  const uint64_t failed =
+      q.reflection.misses + q.refraction_exit.misses + q.shadow.zero_area + q.shadow.aborted + s.lens_fallbacks;
   return {rays, failed};
 }
 
@@ -389,7 +391,8 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
                       MapShadingStats* stats, Image* fallback, const std::vector<uint8_t>* only) {
   // Per pixel: secondary searches and failures (one resolve worker owns a row at a time).
   std::vector<std::pair<uint64_t, uint64_t>> pixel_searches;
-  if (fallback) pixel_searches.assign(static_cast<size_t>(camera.width()) * static_cast<size_t>(camera.height()), {0, 0});
+  if (fallback)
+    pixel_searches.assign(static_cast<size_t>(camera.width()) * static_cast<size_t>(camera.height()), {0, 0});
   ResolveOptions ro;
   ro.threads = threads;
   ro.exact_priority = shader.exact_priority();
@@ -411,7 +414,8 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
       glm::dvec3 on = p;
       double l = 0;
       const double dist = glm::length(p - eye);
-      if (shader.refines_on_mesh() && mesh_crossing(shader.context(), eye, dir, f.triangle(), dist, dist * pixel, &tri, &l)) {
+      if (shader.refines_on_mesh() &&
+          mesh_crossing(shader.context(), eye, dir, f.triangle(), dist, dist * pixel, &tri, &l)) {
         on = eye + l * dir;
       }
       return shader.shade(surface_point(scene, tri, on), dir, 0, true, s);

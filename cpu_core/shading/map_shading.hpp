@@ -131,8 +131,8 @@ class MapShader {
   glm::dvec3 lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n, const glm::dvec3& od,
                     MapShadingStats* stats) const;
   glm::dvec3 visibility(const glm::dvec3& p, const PointLight& light, MapShadingStats* stats) const;
-  glm::dvec3 reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
-                       const MediumStack& stack, MapShadingStats* stats) const;
+  glm::dvec3 reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary, const MediumStack& stack,
+                       MapShadingStats* stats) const;
   glm::dvec3 transmitted(const Crossed& c, const glm::dvec3& dir, int depth, MapShadingStats* stats) const;
   glm::dvec3 envmap_direction(const glm::dvec3& w, const glm::dvec3& r) const;
   glm::dvec3 envmap_at(const glm::dvec3& direction) const;

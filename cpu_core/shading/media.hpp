@@ -56,8 +56,8 @@ struct MediumCrossing {
 
 // What a crossing set is (INTERFACES, docs/design/media.md).
 struct Interface {
-  uint32_t triangle = 0;     // the surface shaded
-  bool pass = false;         // no interface: go on straight, unshaded, same depth
+  uint32_t triangle = 0;  // the surface shaded
+  bool pass = false;      // no interface: go on straight, unshaded, same depth
   double n_from = 1.0, n_to = 1.0;
   MediumStack before, after;
 };

@@ -64,8 +64,8 @@ glm::dvec3 pack(FragmentList list, CoverageMask search, Shade&& shade, const Tri
     const ShadedFragment& sf = shaded(i);
     double alpha = sf.opacity;  // thesis 5.2.1.1: C_in = Op_f C_f + (1 - Op_f) C_behind
     const size_t j = first_overlapping(list, i + 1, in);
-    const bool intersecting = j < n && list[j].zmin <= f.zmax &&
-                              triangles.object_id[list[j].triangle()] != triangles.object_id[f.triangle()];
+    const bool intersecting =
+        j < n && list[j].zmin <= f.zmax && triangles.object_id[list[j].triangle()] != triangles.object_id[f.triangle()];
     if (intersecting && depth) {
       // EXACT PRIORITY MASKS (thesis 11.2.4; docs/design/resolve.md): next is in front where
       // its plane is nearer.
@@ -126,8 +126,7 @@ glm::dvec3 pack_under_mask(FragmentList list, CoverageMask search, const Fragmen
   return pack(list, search, shade, triangles, background, scratch ? scratch : &local, depth);
 }
 
-void visible_triangles(const ABuffer& camera, const TriangleSoup& triangles, int x, int y,
-                       uint32_t out[MASK_SAMPLES]) {
+void visible_triangles(const ABuffer& camera, const TriangleSoup& triangles, int x, int y, uint32_t out[MASK_SAMPLES]) {
   const FragmentList list = camera.list(x, y);
   const SampleDepth depth{&camera.view, &triangles, x, y};
   for (int k = 0; k < MASK_SAMPLES; ++k) {
@@ -167,7 +166,8 @@ Image resolve_image_per_worker(const ABuffer& camera, const TriangleSoup& triang
   parallel_for(static_cast<size_t>(camera.height()), threads, [&](size_t row, int worker) {
     const int y = static_cast<int>(row);
     for (int x = 0; x < camera.width(); ++x) {
-      if (options.only && !(*options.only)[static_cast<size_t>(y) * static_cast<size_t>(camera.width()) + static_cast<size_t>(x)]) {
+      if (options.only &&
+          !(*options.only)[static_cast<size_t>(y) * static_cast<size_t>(camera.width()) + static_cast<size_t>(x)]) {
         continue;
       }
       const auto shade_here = [&](const Fragment& f) { return shade(f, x, y, worker); };

@@ -57,8 +57,8 @@ struct SampleDepth {
 // `triangles` gives each fragment's object id (the intersection test); `depth` (optional)
 // the pixel's geometry for exact priority masks (else the thesis' Vis_front estimate).
 glm::dvec3 pack_under_mask(FragmentList list, CoverageMask search, const FragmentShader& shade,
-                           const TriangleSoup& triangles, const glm::dvec3& background,
-                           PackScratch* scratch = nullptr, const SampleDepth* depth = nullptr);
+                           const TriangleSoup& triangles, const glm::dvec3& background, PackScratch* scratch = nullptr,
+                           const SampleDepth* depth = nullptr);
 
 // Shades fragment f of pixel (x, y) of the camera A-buffer.
 using PixelShader = std::function<ShadedFragment(const Fragment& f, int x, int y)>;
@@ -93,7 +93,6 @@ Image resolve_image_per_worker(const ABuffer& camera, const TriangleSoup& triang
 // sees the same surfaces (`abcube crosscheck`, sample by sample). Opacity is not applied:
 // this is visibility.
 constexpr uint32_t NO_SAMPLE_TRIANGLE = 0xffffffffu;
-void visible_triangles(const ABuffer& camera, const TriangleSoup& triangles, int x, int y,
-                       uint32_t out[MASK_SAMPLES]);
+void visible_triangles(const ABuffer& camera, const TriangleSoup& triangles, int x, int y, uint32_t out[MASK_SAMPLES]);
 
 }  // namespace abcube

@@ -40,7 +40,8 @@ std::shared_ptr<const Bvh> SceneCache::bvh() const {
 SceneCache::Builds SceneCache::builds() const {
   // A piece's figures are read only once its flag says its call_once has finished.
   Builds b;
-  if (neighbours_done_.load(std::memory_order_acquire)) b.neighbours = builds_.neighbours, b.neighbours_ms = builds_.neighbours_ms;
+  if (neighbours_done_.load(std::memory_order_acquire))
+    b.neighbours = builds_.neighbours, b.neighbours_ms = builds_.neighbours_ms;
   if (lenses_done_.load(std::memory_order_acquire)) b.lenses = builds_.lenses, b.lenses_ms = builds_.lenses_ms;
   if (bvh_done_.load(std::memory_order_acquire)) b.bvh = builds_.bvh, b.bvh_ms = builds_.bvh_ms;
   return b;

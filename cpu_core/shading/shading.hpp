@@ -25,9 +25,7 @@
 namespace abcube {
 
 // The normal turned to the viewer's side: N if N.V >= 0, else -N.
-inline glm::dvec3 face_forward(const glm::dvec3& n, const glm::dvec3& v) {
-  return glm::dot(n, v) >= 0.0 ? n : -n;
-}
+inline glm::dvec3 face_forward(const glm::dvec3& n, const glm::dvec3& v) { return glm::dot(n, v) >= 0.0 ? n : -n; }
 
 // Ambient term alone: ka * Ia * Od.
 inline glm::dvec3 phong_ambient(const Material& m, const glm::dvec3& ambient, const glm::dvec3& od) {
@@ -39,8 +37,8 @@ inline glm::dvec3 phong_ambient(const Material& m, const glm::dvec3& ambient) {
 
 // One light's diffuse + specular contribution before visibility (S_l = 1).
 // n must already face the viewer (face_forward), all vectors unit.
-inline glm::dvec3 phong_light(const Material& m, const glm::dvec3& n, const glm::dvec3& v,
-                              const glm::dvec3& to_light, const glm::dvec3& light_color, const glm::dvec3& od) {
+inline glm::dvec3 phong_light(const Material& m, const glm::dvec3& n, const glm::dvec3& v, const glm::dvec3& to_light,
+                              const glm::dvec3& light_color, const glm::dvec3& od) {
   const double ndotl = glm::dot(n, to_light);
   if (ndotl <= 0.0) return glm::dvec3(0.0);
   glm::dvec3 c = m.diffuse * ndotl * od;
@@ -51,16 +49,15 @@ inline glm::dvec3 phong_light(const Material& m, const glm::dvec3& n, const glm:
   }
   return light_color * c;
 }
-inline glm::dvec3 phong_light(const Material& m, const glm::dvec3& n, const glm::dvec3& v,
-                              const glm::dvec3& to_light, const glm::dvec3& light_color) {
+inline glm::dvec3 phong_light(const Material& m, const glm::dvec3& n, const glm::dvec3& v, const glm::dvec3& to_light,
+                              const glm::dvec3& light_color) {
   return phong_light(m, n, v, to_light, light_color, m.color);
 }
 
 // The local Phong colour at p with geometric/shading normal n seen from `eye`,
 // every light fully visible (no shadows): what the GPU Z-buffer pass computes.
-inline glm::dvec3 phong_local(const Material& m, const glm::dvec3& p, const glm::dvec3& n_in,
-                              const glm::dvec3& eye, const glm::dvec3& ambient,
-                              const std::vector<PointLight>& lights, const glm::dvec3& od) {
+inline glm::dvec3 phong_local(const Material& m, const glm::dvec3& p, const glm::dvec3& n_in, const glm::dvec3& eye,
+                              const glm::dvec3& ambient, const std::vector<PointLight>& lights, const glm::dvec3& od) {
   const glm::dvec3 v = glm::normalize(eye - p);
   const glm::dvec3 n = face_forward(glm::normalize(n_in), v);
   glm::dvec3 c = phong_ambient(m, ambient, od);
@@ -69,16 +66,13 @@ inline glm::dvec3 phong_local(const Material& m, const glm::dvec3& p, const glm:
   }
   return c;
 }
-inline glm::dvec3 phong_local(const Material& m, const glm::dvec3& p, const glm::dvec3& n_in,
-                              const glm::dvec3& eye, const glm::dvec3& ambient,
-                              const std::vector<PointLight>& lights) {
+inline glm::dvec3 phong_local(const Material& m, const glm::dvec3& p, const glm::dvec3& n_in, const glm::dvec3& eye,
+                              const glm::dvec3& ambient, const std::vector<PointLight>& lights) {
   return phong_local(m, p, n_in, eye, ambient, lights, m.color);
 }
 
 // Mirror direction of incident direction i about unit normal n: i - 2 (n.i) n.
-inline glm::dvec3 reflect_dir(const glm::dvec3& i, const glm::dvec3& n) {
-  return i - 2.0 * glm::dot(n, i) * n;
-}
+inline glm::dvec3 reflect_dir(const glm::dvec3& i, const glm::dvec3& n) { return i - 2.0 * glm::dot(n, i) * n; }
 
 // Snell refraction of unit incident i through unit normal n (n against i) with
 // eta = n1/n2: T = eta I + (eta c1 - c2) N, c1 = -N.I, c2 = sqrt(1 - eta^2 (1 - c1^2)).
@@ -111,10 +105,9 @@ inline double self_intersection_offset(const glm::dvec3& p, double scene_scale) 
   return SELF_INTERSECTION_REL * (m + scene_scale);
 }
 
-inline glm::dvec3 offset_origin(const glm::dvec3& p, const glm::dvec3& geometric_normal,
-                                const glm::dvec3& dir, double eps) {
-  return glm::dot(geometric_normal, dir) >= 0.0 ? p + eps * geometric_normal
-                                                : p - eps * geometric_normal;
+inline glm::dvec3 offset_origin(const glm::dvec3& p, const glm::dvec3& geometric_normal, const glm::dvec3& dir,
+                                double eps) {
+  return glm::dot(geometric_normal, dir) >= 0.0 ? p + eps * geometric_normal : p - eps * geometric_normal;
 }
 
 // Refraction at an interface (rule "refraction", Whitted 1980 with Snell's law):
@@ -168,8 +161,8 @@ inline Transmission transmission(const glm::dvec3& d, const glm::dvec3& geometri
 struct SecondaryWeights {
   double reflect = 0, transmit = 0;
 };
-inline SecondaryWeights secondary_weights(const Material& m, bool fresnel, const glm::dvec3& d,
-                                          const Transmission& tr, const glm::dvec3& geometric_normal) {
+inline SecondaryWeights secondary_weights(const Material& m, bool fresnel, const glm::dvec3& d, const Transmission& tr,
+                                          const glm::dvec3& geometric_normal) {
   SecondaryWeights w{m.reflect, m.transmit};
   if (!fresnel || m.transmit <= 0.0 || tr.total_internal_reflection) return w;
   const double cos_d = std::abs(glm::dot(d, geometric_normal));
@@ -213,8 +206,7 @@ inline bool plane_holds_light(const TriangleSoup& soup, uint32_t triangle, const
 
 // Coverage transparency (rule "opacity"; thesis 5.2.1, Pack_Under_Mask blend):
 // C = op * C_surface + (1 - op) * C_behind, C_behind from the ray continued straight on.
-inline glm::dvec3 blend_coverage(double opacity, const glm::dvec3& c_surface,
-                                 const glm::dvec3& c_behind) {
+inline glm::dvec3 blend_coverage(double opacity, const glm::dvec3& c_surface, const glm::dvec3& c_behind) {
   return opacity * c_surface + (1.0 - opacity) * c_behind;
 }
 

@@ -93,14 +93,17 @@ class JobReader {
   }
 
   void read_key(Job& job, const std::string& key, const json& v) const {
-    if (key == "scene") job.scene = path(v, job.line, "scene");
-    else if (key == "out") job.out = path(v, job.line, "out");
-    else if (key == "stats") job.stats = path(v, job.line, "stats");
-    else if (key == "camera") read_camera(job, v);
+    if (key == "scene")
+      job.scene = path(v, job.line, "scene");
+    else if (key == "out")
+      job.out = path(v, job.line, "out");
+    else if (key == "stats")
+      job.stats = path(v, job.line, "stats");
+    else if (key == "camera")
+      read_camera(job, v);
     else if (key == "reference_image" && v.is_string() && !v.get<std::string>().empty()) {
       add_option(job, key, key, json(path(v, job.line, "reference_image")));  // relative to the jobs file
-    }
-    else {
+    } else {
       const OptionSpec* spec = find_render_option(key);
       if (!spec || spec->key != key) {  // flags ("--cube-res") and aliases are the command line's and Python's
         std::vector<std::string> known = {"scene", "out", "stats", "camera"};

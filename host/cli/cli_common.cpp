@@ -50,7 +50,8 @@ void RenderFlags::add_to(CLI::App* cmd) {
   for (const OptionSpec& s : render_option_table()) {
     std::vector<std::string>& texts = texts_[s.key];
     if (s.kind == OptionKind::flag) {
-      cmd->add_flag_function(s.flag, [&texts](int64_t) { texts.assign(1, "true"); }, help_line(s));
+      cmd->add_flag_function(
+          s.flag, [&texts](int64_t) { texts.assign(1, "true"); }, help_line(s));
     } else if (s.kind == OptionKind::setting) {
       cmd->add_option(s.flag, texts, help_line(s))->type_name(value_name(s.kind))->allow_extra_args(false);
     } else {
@@ -104,7 +105,8 @@ namespace {
 std::string folder_problem(const std::filesystem::path& folder) {
   const std::string f = folder.empty() ? "." : folder.string();
   if (!std::filesystem::is_directory(folder.empty() ? "." : folder)) return "folder " + quote_path(f) + " is no folder";
-  if (access(f.c_str(), W_OK | X_OK) != 0) return "folder " + quote_path(f) + " is not writable (" + std::strerror(errno) + ")";
+  if (access(f.c_str(), W_OK | X_OK) != 0)
+    return "folder " + quote_path(f) + " is not writable (" + std::strerror(errno) + ")";
   return "";
 }
 
@@ -113,7 +115,8 @@ std::string folder_problem(const std::filesystem::path& folder) {
 void check_output_path(const std::string& path, bool image) {
   if (path.empty()) return;
   if (image && !image_format_supported(path)) {
-    throw InputError(path + ": no image writer for this file extension (" + join(writable_image_extensions(), ", ") + ")");
+    throw InputError(path + ": no image writer for this file extension (" + join(writable_image_extensions(), ", ") +
+                     ")");
   }
   std::filesystem::path dir = std::filesystem::path(path).parent_path();
   std::error_code ec;

@@ -92,7 +92,6 @@ struct BatchCommand {
     return abcube::read_jobs(in, jobs_path, shard_i, shard_n);
   }
 
-
   int run() const {
     const Clock::time_point start = Clock::now();
     const auto [shard_i, shard_n] = parse_shard();
@@ -100,7 +99,8 @@ struct BatchCommand {
     if (job_timeout_s > 0) base.render.timeout_s = job_timeout_s;
     const std::vector<Job> jobs = read_jobs(shard_i, shard_n);
     for (const Job& job : jobs) {  // before anything renders, as a malformed line
-      for (const auto& [key, out] : {std::pair<const char*, const std::string*>{"out", &job.out}, {"stats", &job.stats}}) {
+      for (const auto& [key, out] :
+           {std::pair<const char*, const std::string*>{"out", &job.out}, {"stats", &job.stats}}) {
         try {
           check_output_path(*out, out == &job.out);
         } catch (const InputError& e) {
@@ -163,10 +163,11 @@ struct BatchCommand {
     const double total_ms = ms_since(start);
     std::vector<double> sorted = render_ms;
     const double median = sorted.empty() ? 0.0 : percentile(sorted, 0.5);
-    std::printf("batch %s shard %zu/%zu: %zu jobs, %zu rendered, %zu failed, %zu skipped; %zu scenes loaded; "
-                "%.1f ms per render (median, with load and write), %.1f s in all\n",
-                jobs_path.c_str(), shard_i, shard_n, jobs.size(), render_ms.size(), failed, skipped, scenes.loads(),
-                median, total_ms / 1000.0);
+    std::printf(
+        "batch %s shard %zu/%zu: %zu jobs, %zu rendered, %zu failed, %zu skipped; %zu scenes loaded; "
+        "%.1f ms per render (median, with load and write), %.1f s in all\n",
+        jobs_path.c_str(), shard_i, shard_n, jobs.size(), render_ms.size(), failed, skipped, scenes.loads(), median,
+        total_ms / 1000.0);
     return failed ? 1 : 0;
   }
 };
@@ -184,9 +185,11 @@ CommandRun add_batch_command(CLI::App& app) {
   cmd->add_option("--shard", c->shard, "render the jobs whose 0-based index modulo N is I")->capture_default_str();
   cmd->add_flag("--skip-existing", c->skip_existing, "skip jobs whose output exists (resume an interrupted batch)");
   cmd->add_option("--job-timeout", c->job_timeout_s, "stop one job past this many seconds, 0 = no limit")
-      ->capture_default_str()->check(CLI::Range(0.0, 1e9));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e9));
   cmd->add_option("--scene-cache", c->scene_cache, "distinct scenes kept loaded at once (least recently used dropped)")
-      ->capture_default_str()->check(CLI::Range(1, 1 << 20));
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1 << 20));
   c->flags.add_to(cmd);
   return [c] { return c->run(); };
 }

@@ -84,9 +84,11 @@ CommandRun add_compare_command(CLI::App& app) {
   cmd->add_option("--diff", c->diff_path,
                   "write a per-pixel error heat map here, its legend beneath (black 0 ... red 128/255)");
   cmd->add_option("--fail", c->fail, "a pixel fails above this difference, displayed values in [0, 1]")
-      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--failpercent", c->fail_percent, "the comparison fails above this share of failing pixels, %")
-      ->capture_default_str()->check(CLI::Range(0.0, 100.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
   cmd->add_flag("--exact", c->exact, "pass only when every float is the same (bit for bit, before encoding)");
   cmd->add_flag("--json", c->json_output, "print every figure as one JSON object instead of the text");
   return [c] { return c->run(); };

@@ -48,22 +48,22 @@ struct CrosscheckCommand {
     std::printf("crosscheck %s, cube %d, %s\n", scene_path.c_str(), scene.render.cube_resolution,
                 describe_gl(ctx.get()).c_str());
     std::printf("%s\n", CROSSCHECK_COVERS);
-    std::printf("cube texels: %zu, covered on both %zu, GPU only %zu, CPU only %zu; differing within 1/128 of a "
-                "texel of an edge (edge_ties.hpp, apart) %zu\n",
-                r.texels, r.both_covered, r.gpu_only, r.cpu_only, r.texels_edge_ties);
-    std::printf("distance |gpu-cpu|/cpu: median %.2e (<= %.0e), p99 %.2e (<= %.0e), max %.2e\n",
-                r.distance_median_rel, tol.distance_median_rel, r.distance_p99_rel, tol.distance_p99_rel,
-                r.distance_max_rel);
+    std::printf(
+        "cube texels: %zu, covered on both %zu, GPU only %zu, CPU only %zu; differing within 1/128 of a "
+        "texel of an edge (edge_ties.hpp, apart) %zu\n",
+        r.texels, r.both_covered, r.gpu_only, r.cpu_only, r.texels_edge_ties);
+    std::printf("distance |gpu-cpu|/cpu: median %.2e (<= %.0e), p99 %.2e (<= %.0e), max %.2e\n", r.distance_median_rel,
+                tol.distance_median_rel, r.distance_p99_rel, tol.distance_p99_rel, r.distance_max_rel);
     std::printf("same object id: %.5f (>= %.3f)\n", r.same_object, tol.same_object_min);
-    std::printf("exact ties (two objects at the same distance, tie_rule.hpp): %zu texels, resolved alike %zu\n",
-                r.tied, r.tied_agree);
-    std::printf("camera interior pixels: %zu of %zu, RMSE %.2e (<= %.0e), max abs %.2e (<= %.2e)\n",
-                r.interior_pixels, r.pixels, r.interior_rmse, tol.interior_rmse, r.interior_max_abs,
-                tol.interior_max_abs);
-    std::printf("camera samples: %zu, same object %zu (agreement %.6f >= %.4f), GPU only %zu, CPU only %zu, "
-                "other object %zu; differing within 1/128 of a sample of an edge (edge_ties.hpp, apart) %zu\n",
-                r.samples, r.samples_same, r.sample_agreement, tol.sample_agreement_min, r.samples_gpu_only,
-                r.samples_cpu_only, r.samples_other_object, r.samples_edge_ties);
+    std::printf("exact ties (two objects at the same distance, tie_rule.hpp): %zu texels, resolved alike %zu\n", r.tied,
+                r.tied_agree);
+    std::printf("camera interior pixels: %zu of %zu, RMSE %.2e (<= %.0e), max abs %.2e (<= %.2e)\n", r.interior_pixels,
+                r.pixels, r.interior_rmse, tol.interior_rmse, r.interior_max_abs, tol.interior_max_abs);
+    std::printf(
+        "camera samples: %zu, same object %zu (agreement %.6f >= %.4f), GPU only %zu, CPU only %zu, "
+        "other object %zu; differing within 1/128 of a sample of an edge (edge_ties.hpp, apart) %zu\n",
+        r.samples, r.samples_same, r.sample_agreement, tol.sample_agreement_min, r.samples_gpu_only, r.samples_cpu_only,
+        r.samples_other_object, r.samples_edge_ties);
     if (r.shadow_lights > 0) {
       auto line = [](const char* what, const ShadowAgreement& a) {
         std::printf("  %-22s %.5f of %zu, away from edges %.5f of %zu (false shadow %zu, false light %zu)\n", what,
@@ -108,7 +108,8 @@ CommandRun add_crosscheck_command(CLI::App& app) {
   cmd->add_option("--cube-res", c->cube_res, "face edge N, texels (default: the scene's)")->check(CLI::Range(1, 16384));
   cmd->add_option("--gl", c->gl, "GL path: auto | egl | egl-device | egl-surfaceless | osmesa")->capture_default_str();
   cmd->add_option("--gl-device", c->device, "EGL device index")->check(CLI::Range(0, 1024));
-  cmd->add_option("--threads", c->threads, "worker threads, 0 = every core")->capture_default_str()
+  cmd->add_option("--threads", c->threads, "worker threads, 0 = every core")
+      ->capture_default_str()
       ->check(CLI::Range(0, 4096));
   cmd->add_option("--stats", c->stats_path, "figures and tolerances as JSON");
   cmd->add_option("--samples-image", c->samples_image,

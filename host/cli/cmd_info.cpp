@@ -39,8 +39,8 @@ int run_info() {
   std::printf("EGL devices: %zu%s%s\n", devices.size(), devices.empty() ? " (" : "",
               devices.empty() ? (why + ")").c_str() : "");
   for (const EglDeviceInfo& d : devices) {
-    std::printf("  device %d: %s%s%s\n", d.index, d.software ? "software" : "hardware",
-                d.drm_node.empty() ? "" : ", ", d.drm_node.c_str());
+    std::printf("  device %d: %s%s%s\n", d.index, d.software ? "software" : "hardware", d.drm_node.empty() ? "" : ", ",
+                d.drm_node.c_str());
   }
 
   std::printf("GL paths (auto tries them in this order):\n");

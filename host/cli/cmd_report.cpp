@@ -61,8 +61,8 @@ struct ReportCommand {
         continue;
       }
       const nlohmann::json& db = x["error"]["psnr_db"];
-      std::printf("  %-9s %s dB, %.0f ms\n", m.c_str(), db.is_number() ? std::to_string(db.get<double>()).c_str() : "inf",
-                  x["total_ms"].get<double>());
+      std::printf("  %-9s %s dB, %.0f ms\n", m.c_str(),
+                  db.is_number() ? std::to_string(db.get<double>()).c_str() : "inf", x["total_ms"].get<double>());
     }
     if (j["crosscheck"].contains("pass")) {
       std::printf("  crosscheck %s\n", j["crosscheck"]["pass"].get<bool>() ? "PASS" : "FAIL");
@@ -83,8 +83,10 @@ CommandRun add_report_command(CLI::App& app) {
       "in DIR/index.html (self-contained, offline)");
   cmd->add_option("SCENE", c->scene, "scene file, or a model file (.gltf, .glb, .obj)")->required();
   cmd->add_option("-o,--output", c->dir, "output folder: index.html, report.json, images/, stats/ (made if missing)");
-  cmd->add_option("--methods", c->methods, "the methods compared with raytrace, comma-separated")->capture_default_str();
-  cmd->add_option("--sweep", c->sweep, "abuffer again at these cube resolutions, comma-separated (e.g. 64,128,256,512)");
+  cmd->add_option("--methods", c->methods, "the methods compared with raytrace, comma-separated")
+      ->capture_default_str();
+  cmd->add_option("--sweep", c->sweep,
+                  "abuffer again at these cube resolutions, comma-separated (e.g. 64,128,256,512)");
   cmd->add_flag("--no-crosscheck", c->no_crosscheck, "leave out the GPU-against-CPU crosscheck");
   c->flags.add_to(cmd);
   return [c] { return c->run(); };

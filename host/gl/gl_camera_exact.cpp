@@ -39,21 +39,24 @@ glm::dmat4 reflection_matrix(const glm::dvec3& n, double d) {
 }
 
 // The pixels of the tile (width x height) that triangles `r` of the soup cover when drawn
-// through `clip_model` relative to `eye` (scene.vert), within `parent` (x, y, width, height); the parent itself when one
-// of their corners is behind the eye. Empty (zero size) when they fall outside.
-glm::ivec4 projected_bounds(const TriangleSoup& soup, const std::vector<uint32_t>& triangles, const glm::dmat4& clip_model,
-                            const glm::dvec3& eye, const glm::ivec4& parent, int width, int height) {
+// through `clip_model` relative to `eye` (scene.vert), within `parent` (x, y, width, height); the parent itself when
+// one of their corners is behind the eye. Empty (zero size) when they fall outside.
+glm::ivec4 projected_bounds(const TriangleSoup& soup, const std::vector<uint32_t>& triangles,
+                            const glm::dmat4& clip_model, const glm::dvec3& eye, const glm::ivec4& parent, int width,
+                            int height) {
   double lo_x = 1e300, lo_y = 1e300, hi_x = -1e300, hi_y = -1e300;
   for (const uint32_t t : triangles) {
     for (size_t k = 0; k < 3; ++k) {
-      const glm::dvec4 c = clip_model * glm::dvec4(glm::dvec3(soup.positions[3 * static_cast<size_t>(t) + k]) - eye, 1.0);
+      const glm::dvec4 c =
+          clip_model * glm::dvec4(glm::dvec3(soup.positions[3 * static_cast<size_t>(t) + k]) - eye, 1.0);
       if (!(c.w > 0.0)) return parent;
       const double x = (c.x / c.w * 0.5 + 0.5) * width, y = (c.y / c.w * 0.5 + 0.5) * height;
       lo_x = std::min(lo_x, x), lo_y = std::min(lo_y, y), hi_x = std::max(hi_x, x), hi_y = std::max(hi_y, y);
     }
   }
   // One pixel of margin each way: the rasteriser's own rounding.
-  const double x0 = std::max(std::floor(lo_x) - 1.0, double(parent.x)), y0 = std::max(std::floor(lo_y) - 1.0, double(parent.y));
+  const double x0 = std::max(std::floor(lo_x) - 1.0, double(parent.x)),
+               y0 = std::max(std::floor(lo_y) - 1.0, double(parent.y));
   const double x1 = std::min(std::ceil(hi_x) + 1.0, double(parent.x + parent.z));
   const double y1 = std::min(std::ceil(hi_y) + 1.0, double(parent.y + parent.w));
   if (!(x1 > x0) || !(y1 > y0)) return glm::ivec4(0);
@@ -128,7 +131,10 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
   auto bind_target = [&] {
     glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
     glDrawBuffers(1, colour);
-    if (view.level > 0) glEnable(GL_CLIP_DISTANCE0); else glDisable(GL_CLIP_DISTANCE0);
+    if (view.level > 0)
+      glEnable(GL_CLIP_DISTANCE0);
+    else
+      glDisable(GL_CLIP_DISTANCE0);
     glEnable(GL_SCISSOR_TEST);
     glScissor(view.scissor.x, view.scissor.y, view.scissor.z, view.scissor.w);
   };
@@ -157,8 +163,8 @@ void GlScene::render_view(const glm::mat4& clip, const MirrorView& view, int* vi
       if (static_cast<uint32_t>(r + 1) == view.skip || side == 0.0) continue;  // seen through; edge-on covers nothing
       glm::dmat4 linear = view.model;
       linear[3] = glm::dvec4(0.0, 0.0, 0.0, 1.0);
-      const glm::ivec4 bounds = projected_bounds(*scene_.triangles, mirror.triangles, glm::dmat4(clip) * linear, view.eye,
-                                                 view.scissor, t.width, t.height);
+      const glm::ivec4 bounds = projected_bounds(*scene_.triangles, mirror.triangles, glm::dmat4(clip) * linear,
+                                                 view.eye, view.scissor, t.width, t.height);
       if (bounds.z <= 0 || bounds.w <= 0) {
         ++exact_stats_.mirror_views_empty;
         continue;
@@ -271,9 +277,11 @@ void GlScene::make_exact_programs() {
   if (exact_program_) return;
   const std::vector<const char*> scene_vert = scene_vertex_stage(), fill_vert{"fill.vert"};
   exact_program_ = std::make_unique<GlProgram>(
-      scene_vert, std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "camera_surface.glsl", "camera_exact.frag"});
-  groups_program_ = std::make_unique<GlProgram>(
-      fill_vert, std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "camera_surface.glsl", "camera_groups.frag"});
+      scene_vert,
+      std::vector<const char*>{"common_scene.glsl", "common_shading.glsl", "camera_surface.glsl", "camera_exact.frag"});
+  groups_program_ =
+      std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"common_scene.glsl", "common_shading.glsl",
+                                                                      "camera_surface.glsl", "camera_groups.frag"});
   ids_program_ = std::make_unique<GlProgram>(scene_vert, std::vector<const char*>{"camera_ids.frag"});
   depth_program_ = std::make_unique<GlProgram>(scene_vert, std::vector<const char*>{"camera_depth.frag"});
   probe_program_ = std::make_unique<GlProgram>(
@@ -285,8 +293,8 @@ void GlScene::make_exact_programs() {
   groups_program_->use();
   glUniform1i(groups_program_->uniform("u_keys"), 0);
   fill_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"fill.frag"});
-  volume_program_ =
-      std::make_unique<GlProgram>(scene_vertex_stage("volume_caps.glsl"), std::vector<const char*>{"shadow_volume.frag"});
+  volume_program_ = std::make_unique<GlProgram>(scene_vertex_stage("volume_caps.glsl"),
+                                                std::vector<const char*>{"shadow_volume.frag"});
   resolve_program_ = std::make_unique<GlProgram>(fill_vert, std::vector<const char*>{"resolve_samples.frag"});
   glGenBuffers(1, &recursed_);
 }
@@ -303,7 +311,7 @@ Image GlScene::camera_color_exact(const Camera& camera) {
       shadows_approximate_ = shadows_approximate_ || (scene_.lights[i].cast_shadows && volume_bit_[i] < 0);
     }
     if (!exact_buffers_ || exact_buffers_->width != t.width || exact_buffers_->height != t.height ||
-      exact_buffers_->layers != static_cast<int>(volume_lights_.size())) {
+        exact_buffers_->layers != static_cast<int>(volume_lights_.size())) {
       exact_buffers_.reset();
       exact_buffers_ = std::make_unique<ExactBuffers>(t, static_cast<int>(volume_lights_.size()));
     }
@@ -327,7 +335,8 @@ Image GlScene::camera_color_exact(const Camera& camera) {
       check_deadline();
       Clock::time_point t0 = Clock::now();
       t.clear(scene_.background);
-      const float background[4] = {float(scene_.background.x), float(scene_.background.y), float(scene_.background.z), 0.f};
+      const float background[4] = {float(scene_.background.x), float(scene_.background.y), float(scene_.background.z),
+                                   0.f};
       glClearBufferfv(GL_COLOR, 0, background);  // alpha: no approximated surface yet
       MirrorView camera_view;
       camera_view.eye = camera.position;
@@ -391,7 +400,8 @@ Image GlScene::camera_color_exact(const Camera& camera) {
         for (int64_t px = 0; px < pw && x0 + MASK_COLUMNS * px < full_w; ++px) {
           const size_t k = static_cast<size_t>(py * pw + px);
           const size_t pixel = row * static_cast<size_t>(camera.width) + static_cast<size_t>(x0 / MASK_COLUMNS + px);
-          for (int c = 0; c < 3; ++c) out.data[pixel * 3 + static_cast<size_t>(c)] = rgba[4 * k + static_cast<size_t>(c)];
+          for (int c = 0; c < 3; ++c)
+            out.data[pixel * 3 + static_cast<size_t>(c)] = rgba[4 * k + static_cast<size_t>(c)];
           exact_stats_.samples_approximate += static_cast<uint64_t>(rgba[4 * k + 3]);
           if (rgba[4 * k + 3] != 0.f) exact_pixels_[pixel] = 0;
         }

@@ -57,8 +57,7 @@ std::unique_ptr<GlContext> open_gl_context(GlChoice choice, int device_index, st
     if (log) *log += std::string(api) + ": " + why + "\n";
   };
   switch (choice) {
-    case GlChoice::none:
-      return nullptr;
+    case GlChoice::none: return nullptr;
     case GlChoice::egl_device:
       if ((ctx = create_egl_device_context(device_index, &why))) return ctx;
       throw RuntimeFailure("--gl egl-device failed: " + why);

@@ -20,7 +20,7 @@ struct GlInfo {
   std::string egl_vendor;   // empty for OSMesa
   std::string egl_version;  // or the OSMesa library name
   std::string gl_version, gl_renderer, gl_vendor;
-  int device_index = -1;    // EGL device used, -1 if none
+  int device_index = -1;  // EGL device used, -1 if none
 };
 
 class GlContext {

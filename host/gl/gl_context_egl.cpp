@@ -88,9 +88,9 @@ class EglContext : public GlContext {
         return false;
       }
     }
-    const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                                  EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                                  EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    const EGLint ctx_attribs[] = {
+        EGL_CONTEXT_MAJOR_VERSION,           4,       EGL_CONTEXT_MINOR_VERSION, 5, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+        EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
     context_ = eglCreateContext(display, config, EGL_NO_CONTEXT, ctx_attribs);
     if (context_ == EGL_NO_CONTEXT) {
       *why = "no OpenGL 4.5 core context (" + egl_error_name(eglGetError()) + ")";
@@ -123,8 +123,8 @@ std::vector<EGLDeviceEXT> query_devices(std::string* why) {
   if (!load_egl_client(why)) return {};
   const char* cext = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
   // EGL_EXT_device_base is the older name of enumeration + query together.
-  const bool enumeration = has_extension(cext, "EGL_EXT_device_enumeration") ||
-                           has_extension(cext, "EGL_EXT_device_base");
+  const bool enumeration =
+      has_extension(cext, "EGL_EXT_device_enumeration") || has_extension(cext, "EGL_EXT_device_base");
   if (!enumeration || !has_extension(cext, "EGL_EXT_platform_device") || !eglQueryDevicesEXT) {
     *why = "EGL_EXT_device_enumeration / EGL_EXT_platform_device not offered";
     return {};
@@ -189,8 +189,7 @@ std::unique_ptr<GlContext> create_egl_device_context(int device_index, std::stri
   const std::vector<EGLDeviceEXT> devices = query_devices(why);
   if (devices.empty()) return nullptr;
   if (device_index >= static_cast<int>(devices.size())) {
-    *why = "EGL device " + std::to_string(device_index) + " requested, " + std::to_string(devices.size()) +
-           " found";
+    *why = "EGL device " + std::to_string(device_index) + " requested, " + std::to_string(devices.size()) + " found";
     return nullptr;
   }
   if (device_index >= 0) {
@@ -206,9 +205,8 @@ std::unique_ptr<GlContext> create_egl_device_context(int device_index, std::stri
     }
     auto ctx = start_device(devices[i], index, why);
     if (ctx && !software_renderer(ctx->info().gl_renderer)) return ctx;
-    tried += (tried.empty() ? "" : ", ") + (ctx ? "device " + std::to_string(index) + ": software renderer " +
-                                                      ctx->info().gl_renderer
-                                                : *why);
+    tried += (tried.empty() ? "" : ", ") +
+             (ctx ? "device " + std::to_string(index) + ": software renderer " + ctx->info().gl_renderer : *why);
   }
   *why = "no hardware EGL device (" + tried + "; choose one with --gl-device K)";
   return nullptr;

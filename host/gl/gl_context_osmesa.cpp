@@ -26,9 +26,7 @@ using DestroyContext = void (*)(OSMesaContextHandle);
 using GetProcAddress = GLADapiproc (*)(const char*);
 
 // glad's loader callback with OSMesaGetProcAddress as its user pointer.
-GLADapiproc osmesa_load(void* get_proc, const char* name) {
-  return reinterpret_cast<GetProcAddress>(get_proc)(name);
-}
+GLADapiproc osmesa_load(void* get_proc, const char* name) { return reinterpret_cast<GetProcAddress>(get_proc)(name); }
 
 class OsmesaContext : public GlContext {
  public:
@@ -57,9 +55,17 @@ class OsmesaContext : public GlContext {
       *why = "libOSMesa lacks OSMesaCreateContextAttribs";
       return false;
     }
-    const int attribs[] = {OSMESA_FORMAT, GL_RGBA, OSMESA_DEPTH_BITS, 24,
-                           OSMESA_PROFILE, OSMESA_CORE_PROFILE,
-                           OSMESA_CONTEXT_MAJOR_VERSION, 4, OSMESA_CONTEXT_MINOR_VERSION, 5, 0};
+    const int attribs[] = {OSMESA_FORMAT,
+                           GL_RGBA,
+                           OSMESA_DEPTH_BITS,
+                           24,
+                           OSMESA_PROFILE,
+                           OSMESA_CORE_PROFILE,
+                           OSMESA_CONTEXT_MAJOR_VERSION,
+                           4,
+                           OSMESA_CONTEXT_MINOR_VERSION,
+                           5,
+                           0};
     context_ = create(attribs, nullptr);
     if (!context_) {
       *why = "OSMesa could not create an OpenGL 4.5 core context";

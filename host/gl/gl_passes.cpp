@@ -222,8 +222,8 @@ std::vector<float> GlScene::upload_textures() {
   for (size_t a = 0; a < sizes.size(); ++a) {
     const int w = sizes[a].first, h = sizes[a].second;
     if (w > max_size_ || h > max_size_) {
-      throw RuntimeFailure("texture of " + std::to_string(w) + "x" + std::to_string(h) + " exceeds GL_MAX_TEXTURE_SIZE " +
-                           std::to_string(max_size_));
+      throw RuntimeFailure("texture of " + std::to_string(w) + "x" + std::to_string(h) +
+                           " exceeds GL_MAX_TEXTURE_SIZE " + std::to_string(max_size_));
     }
     int levels = 1;
     while ((std::max(w, h) >> levels) > 0) ++levels;
@@ -286,8 +286,7 @@ GlScene::Target& GlScene::target(int width, int height, bool distance_pass) {
     throw RuntimeFailure("GL target " + std::to_string(width) + "x" + std::to_string(height) +
                          " exceeds GL_MAX_TEXTURE_SIZE " + std::to_string(max_size_));
   }
-  if (!target_ || target_->width != width || target_->height != height ||
-      target_->distance_pass != distance_pass) {
+  if (!target_ || target_->width != width || target_->height != height || target_->distance_pass != distance_pass) {
     target_.reset();
     target_ = std::make_unique<Target>(width, height, distance_pass);
   }
@@ -309,8 +308,8 @@ void GlScene::upload_lights(const glm::dvec3& center) {
   }
   if (lights.empty()) lights.push_back({});
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, lights_);
-  glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(lights.size() * sizeof(LightGpu)),
-               lights.data(), GL_DYNAMIC_DRAW);
+  glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(lights.size() * sizeof(LightGpu)), lights.data(),
+               GL_DYNAMIC_DRAW);
 }
 
 void GlScene::draw(const GlProgram& program, const glm::mat4& clip, const glm::dvec3& center) {
@@ -365,8 +364,7 @@ void GlScene::set_view(const GlProgram& program, const glm::mat4& clip, const Mi
   // peels order equal depths by triangle (shadow_caster.frag), GL_GREATER's draw order.
   const bool ties = &program != shadow_program_.get();
   glUniform1f(program.uniform("u_tie_step"), ties ? float(gl_tie_step(scene_.objects.size())) : 0.f);
-  glUniform3f(program.uniform("u_ambient"), float(scene_.ambient.r), float(scene_.ambient.g),
-              float(scene_.ambient.b));
+  glUniform3f(program.uniform("u_ambient"), float(scene_.ambient.r), float(scene_.ambient.g), float(scene_.ambient.b));
   glUniform1i(program.uniform("u_light_count"), static_cast<GLint>(scene_.lights.size()));
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, materials_);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, lights_);
@@ -387,19 +385,23 @@ void GlScene::bind_lookups(const GlProgram& program, bool with_environment) {
   for (int k = 0; k < MAX_SHADOW_PEELS; ++k) {
     units[k] = static_cast<GLint>(PEEL_UNIT) + k;
     glActiveTexture(GL_TEXTURE0 + PEEL_UNIT + static_cast<GLenum>(k));
-    glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY, static_cast<size_t>(k) < shadow_peels_.size() ? shadow_peels_[static_cast<size_t>(k)] : 0);
+    glBindTexture(GL_TEXTURE_CUBE_MAP_ARRAY,
+                  static_cast<size_t>(k) < shadow_peels_.size() ? shadow_peels_[static_cast<size_t>(k)] : 0);
   }
   glUniform1iv(program.uniform("u_shadow_peel_maps"), MAX_SHADOW_PEELS, units);
   const bool environment = with_environment && environment_ != 0;
   glUniform1i(program.uniform("u_environment"), environment);
-  glUniform1i(program.uniform("u_lookup"), lookup_ == EnvmapLookup::bisector ? 1 : lookup_ == EnvmapLookup::position ? 2 : 0);
+  glUniform1i(program.uniform("u_lookup"), lookup_ == EnvmapLookup::bisector   ? 1
+                                           : lookup_ == EnvmapLookup::position ? 2
+                                                                               : 0);
   glUniform1i(program.uniform("u_fresnel"), fresnel_);
   glUniform1i(program.uniform("u_environment_map"), 2);
   GLint texture_units[MAX_TEXTURE_ARRAYS];
   for (int k = 0; k < MAX_TEXTURE_ARRAYS; ++k) {
     texture_units[k] = static_cast<GLint>(TEXTURE_UNIT) + k;
     glActiveTexture(GL_TEXTURE0 + TEXTURE_UNIT + static_cast<GLenum>(k));
-    glBindTexture(GL_TEXTURE_2D_ARRAY, static_cast<size_t>(k) < texture_arrays_.size() ? texture_arrays_[static_cast<size_t>(k)] : 0);
+    glBindTexture(GL_TEXTURE_2D_ARRAY,
+                  static_cast<size_t>(k) < texture_arrays_.size() ? texture_arrays_[static_cast<size_t>(k)] : 0);
   }
   glUniform1iv(program.uniform("u_textures"), MAX_TEXTURE_ARRAYS, texture_units);
   glUniform1i(program.uniform("u_texture_level0"), texture_level0_);
@@ -499,7 +501,8 @@ Image GlScene::camera_color(const Camera& camera, CameraSamples samples) {
   // Coverage transparency (rule "opacity"): the view is peeled front to back, each layer
   // blended under the ones before it, C += T op c, T *= 1 - op, the background last.
   bool transparent = false;
-  for (const uint32_t id : scene_.triangles->material_id) transparent = transparent || scene_.materials[id].opacity < 1.0;
+  for (const uint32_t id : scene_.triangles->material_id)
+    transparent = transparent || scene_.materials[id].opacity < 1.0;
   const size_t tile_samples = static_cast<size_t>(tiles.target_w()) * static_cast<size_t>(tiles.target_h());
   std::vector<float> rgba(tile_samples * 4);
   std::vector<double> colour(tile_samples * 3), through(tile_samples);
@@ -555,7 +558,8 @@ Image GlScene::camera_color(const Camera& camera, CameraSamples samples) {
         t.read(0, GL_RGBA, GL_FLOAT, rgba.data());
         for (size_t k = 0; k < tile_samples; ++k) {
           const double a = transparent ? rgba[4 * k + 3] : 1.0;
-          for (int c = 0; c < 3; ++c) colour[3 * k + static_cast<size_t>(c)] += through[k] * a * rgba[4 * k + static_cast<size_t>(c)];
+          for (int c = 0; c < 3; ++c)
+            colour[3 * k + static_cast<size_t>(c)] += through[k] * a * rgba[4 * k + static_cast<size_t>(c)];
           through[k] *= 1.0 - a;
         }
         timings_.readback_ms += ms_since(t0);

@@ -86,12 +86,12 @@ struct ExactCameraStats {
   uint64_t mirror_views_empty = 0;        // mirrors drawn but covering no sample
   uint64_t mirror_views_over_budget = 0;  // mirrors shown through the environment map instead
   int deepest_level = 0;
-  uint64_t samples_approximate = 0;       // camera samples whose path meets an approximated surface
-  uint64_t pixels_exact = 0;              // pixels with none
+  uint64_t samples_approximate = 0;  // camera samples whose path meets an approximated surface
+  uint64_t pixels_exact = 0;         // pixels with none
   int volume_lights = 0;
-  uint64_t volume_triangles = 0;          // over every volume light
-  bool shading_pixels = false;            // the colour shaded once a pixel and surface (else once a sample)
-  std::string shading_why;                // why per sample, when pixels were asked
+  uint64_t volume_triangles = 0;  // over every volume light
+  bool shading_pixels = false;    // the colour shaded once a pixel and surface (else once a sample)
+  std::string shading_why;        // why per sample, when pixels were asked
   double volume_build_ms = 0;
 };
 
@@ -243,7 +243,7 @@ class GlScene {
   // A GL buffer holding `bytes` at `data`: that memory itself when pin_soup_ and the GL
   // can (the soup must then outlive the buffer), else a copy.
   GLuint soup_buffer(const void* data, size_t bytes);
-  std::vector<GLuint> texture_arrays_;  // by size class; the material's code names array and layer
+  std::vector<GLuint> texture_arrays_;   // by size class; the material's code names array and layer
   std::vector<float> upload_textures();  // per material: -1, or array + MAX_TEXTURE_ARRAYS * layer
   GLuint shadow_maps_ = 0, environment_ = 0, lookup_fbo_ = 0, lookup_depth_ = 0;
   std::vector<GLuint> shadow_peels_;  // one cube-map array (a layer per light and face) per peel
@@ -277,9 +277,9 @@ class GlScene {
   GLuint portal_vbo_ = 0, portal_ebo_ = 0;
   std::vector<std::pair<size_t, size_t>> portal_ranges_;  // first index, count
   bool volumes_built_ = false;
-  std::vector<int> volume_lights_;        // light index per count (its layer)
-  std::vector<int> volume_bit_;           // per light: its opaque blockers' count, or -1
-  std::vector<int> translucent_bit_;      // per light: its translucent blockers' count, or -1
+  std::vector<int> volume_lights_;    // light index per count (its layer)
+  std::vector<int> volume_bit_;       // per light: its opaque blockers' count, or -1
+  std::vector<int> translucent_bit_;  // per light: its translucent blockers' count, or -1
   // Each volume light's volume (shadow_volume.hpp): its caps' codes, also in a storage
   // buffer each (volume_caps_, read by scene.vert's VOLUME_CAPS when the scene's own vertex
   // buffer draws the near caps), and its sides; its faces at infinity are clipped per view
@@ -296,7 +296,8 @@ class GlScene {
   void draw_faces_at_infinity(int layer, const glm::mat4& clip, const MirrorView& view);
   std::string volume_caps_why_not() const;
   std::unique_ptr<GlProgram> exact_program_, fill_program_, volume_program_, probe_program_, resolve_program_;
-  std::unique_ptr<GlProgram> ids_program_, groups_program_, depth_program_;  // per-group shading (camera_ids, camera_groups)
+  std::unique_ptr<GlProgram> ids_program_, groups_program_,
+      depth_program_;  // per-group shading (camera_ids, camera_groups)
   struct VisibilityBuffers;
   std::unique_ptr<VisibilityBuffers> visibility_;
   void shade_groups(const glm::mat4& clip, const MirrorView& view, bool volumes);

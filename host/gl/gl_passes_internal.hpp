@@ -109,8 +109,8 @@ struct SampleTiles {
 // The camera's clip matrix with the eye at the origin (scene.vert subtracts the eye).
 inline glm::mat4 relative_camera_clip(const Camera& camera, double near_distance) {
   const double aspect = static_cast<double>(camera.width) / camera.height;
-  return camera_clip_matrix(glm::dvec3(0.0), camera.look_at - camera.position, camera.up, glm::radians(camera.fov_y_deg),
-                            aspect, near_distance);
+  return camera_clip_matrix(glm::dvec3(0.0), camera.look_at - camera.position, camera.up,
+                            glm::radians(camera.fov_y_deg), aspect, near_distance);
 }
 
 inline glm::mat4 tile_matrix(int64_t full_w, int64_t full_h, int64_t x0, int64_t y0, int tile_w, int tile_h) {
@@ -151,8 +151,8 @@ struct GlScene::Target {
     glDrawBuffers(2, buffers);
     const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE) {
-      throw RuntimeFailure("framebuffer " + std::to_string(w) + "x" + std::to_string(h) +
-                           " incomplete (status " + std::to_string(status) + ")");
+      throw RuntimeFailure("framebuffer " + std::to_string(w) + "x" + std::to_string(h) + " incomplete (status " +
+                           std::to_string(status) + ")");
     }
   }
   ~Target() {

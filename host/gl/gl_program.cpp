@@ -40,8 +40,7 @@ GLuint compile(GLenum stage, const std::vector<const char*>& files) {
 
 }  // namespace
 
-GlProgram::GlProgram(const std::vector<const char*>& vertex_files,
-                     const std::vector<const char*>& fragment_files) {
+GlProgram::GlProgram(const std::vector<const char*>& vertex_files, const std::vector<const char*>& fragment_files) {
   const GLuint vs = compile(GL_VERTEX_SHADER, vertex_files);
   GLuint fs = 0;
   try {

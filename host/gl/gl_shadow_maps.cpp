@@ -25,9 +25,12 @@ void check_gl_limits(const SceneData& scene) {
   for (const PointLight& l : scene.lights) casting += l.cast_shadows ? 1 : 0;
   const int limit = gl_shadow_light_limit();
   if (casting > static_cast<size_t>(limit)) {
-    throw InputError(scene.file + ": lights: " + std::to_string(casting) + " cast shadows; --method gpu holds the shadow maps "
-                     "of at most " + std::to_string(limit) + " here (GL_MAX_ARRAY_TEXTURE_LAYERS " +
-                     std::to_string(limit * CUBE_FACES) + " / 6 faces): set \"cast_shadows\": false on some, or use a CPU method");
+    throw InputError(scene.file + ": lights: " + std::to_string(casting) +
+                     " cast shadows; --method gpu holds the shadow maps "
+                     "of at most " +
+                     std::to_string(limit) + " here (GL_MAX_ARRAY_TEXTURE_LAYERS " +
+                     std::to_string(limit * CUBE_FACES) +
+                     " / 6 faces): set \"cast_shadows\": false on some, or use a CPU method");
   }
 }
 

@@ -38,9 +38,12 @@ namespace {
 // The bound vertex buffer holds ShadowVolumeVertex: scene.vert's position, object, reversed.
 void volume_attributes() {
   const auto offset = [](size_t bytes) { return reinterpret_cast<const void*>(bytes); };
-  glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, sizeof(ShadowVolumeVertex), offset(offsetof(ShadowVolumeVertex, position)));
-  glVertexAttribIPointer(2, 1, GL_UNSIGNED_INT, sizeof(ShadowVolumeVertex), offset(offsetof(ShadowVolumeVertex, object)));
-  glVertexAttribIPointer(6, 1, GL_UNSIGNED_INT, sizeof(ShadowVolumeVertex), offset(offsetof(ShadowVolumeVertex, reversed)));
+  glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, sizeof(ShadowVolumeVertex),
+                        offset(offsetof(ShadowVolumeVertex, position)));
+  glVertexAttribIPointer(2, 1, GL_UNSIGNED_INT, sizeof(ShadowVolumeVertex),
+                         offset(offsetof(ShadowVolumeVertex, object)));
+  glVertexAttribIPointer(6, 1, GL_UNSIGNED_INT, sizeof(ShadowVolumeVertex),
+                         offset(offsetof(ShadowVolumeVertex, reversed)));
   for (const GLuint a : {0u, 2u, 6u}) glEnableVertexAttribArray(a);
 }
 }  // namespace
@@ -59,39 +62,40 @@ void GlScene::build_volumes() {
   const size_t per_light = translucent ? 2 : 1;
   for (size_t i = 0; i < scene_.lights.size() && volume_lights_.size() + per_light <= size_t{MAX_VOLUME_LIGHTS}; ++i) {
     if (!scene_.lights[i].cast_shadows) continue;
-   for (const Blockers kind : {Blockers::opaque, Blockers::translucent}) {
-    if (kind == Blockers::translucent && !translucent) continue;
-    (kind == Blockers::opaque ? volume_bit_ : translucent_bit_)[i] = static_cast<int>(volume_lights_.size());
-    volume_lights_.push_back(static_cast<int>(i));
-    volumes_.push_back(build_shadow_volume(scene_, scene_.lights[i].position, kind));
-    const ShadowVolume& v = volumes_.back();
-    const size_t volume_triangles = v.triangle_count();
-    // The caps' codes, four to a word of the storage buffer (byte k of word i is triangle
-    // 4 i + k: a little-endian host, as every GL host this runs on).
-    GLuint caps = 0;
-    glGenBuffers(1, &caps);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, caps);
-    const size_t bytes = (v.caps.size() + 3) / 4 * 4;
-    glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(std::max<size_t>(bytes, 4)), nullptr, GL_STATIC_DRAW);
-    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, static_cast<GLsizeiptr>(v.caps.size()), v.caps.data());
-    volume_caps_.push_back(caps);
-    // The runs of consecutive casting triangles, drawn alone (a light's translucent volume
-    // has a few glass blockers among every triangle of the scene).
-    CapRuns runs;
-    for (size_t t = 0; t < v.caps.size();) {
-      if (v.caps[t] == NO_CAP) {
-        ++t;
-        continue;
+    for (const Blockers kind : {Blockers::opaque, Blockers::translucent}) {
+      if (kind == Blockers::translucent && !translucent) continue;
+      (kind == Blockers::opaque ? volume_bit_ : translucent_bit_)[i] = static_cast<int>(volume_lights_.size());
+      volume_lights_.push_back(static_cast<int>(i));
+      volumes_.push_back(build_shadow_volume(scene_, scene_.lights[i].position, kind));
+      const ShadowVolume& v = volumes_.back();
+      const size_t volume_triangles = v.triangle_count();
+      // The caps' codes, four to a word of the storage buffer (byte k of word i is triangle
+      // 4 i + k: a little-endian host, as every GL host this runs on).
+      GLuint caps = 0;
+      glGenBuffers(1, &caps);
+      glBindBuffer(GL_SHADER_STORAGE_BUFFER, caps);
+      const size_t bytes = (v.caps.size() + 3) / 4 * 4;
+      glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(std::max<size_t>(bytes, 4)), nullptr,
+                   GL_STATIC_DRAW);
+      glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, static_cast<GLsizeiptr>(v.caps.size()), v.caps.data());
+      volume_caps_.push_back(caps);
+      // The runs of consecutive casting triangles, drawn alone (a light's translucent volume
+      // has a few glass blockers among every triangle of the scene).
+      CapRuns runs;
+      for (size_t t = 0; t < v.caps.size();) {
+        if (v.caps[t] == NO_CAP) {
+          ++t;
+          continue;
+        }
+        size_t end = t;
+        while (end < v.caps.size() && v.caps[end] != NO_CAP) ++end;
+        runs.first.push_back(static_cast<GLint>(3 * t));
+        runs.count.push_back(static_cast<GLsizei>(3 * (end - t)));
+        t = end;
       }
-      size_t end = t;
-      while (end < v.caps.size() && v.caps[end] != NO_CAP) ++end;
-      runs.first.push_back(static_cast<GLint>(3 * t));
-      runs.count.push_back(static_cast<GLsizei>(3 * (end - t)));
-      t = end;
+      cap_runs_.push_back(std::move(runs));
+      exact_stats_.volume_triangles += volume_triangles;
     }
-    cap_runs_.push_back(std::move(runs));
-    exact_stats_.volume_triangles += volume_triangles;
-   }
   }
   glGenVertexArrays(1, &clipped_vao_);
   glBindVertexArray(clipped_vao_);

@@ -36,7 +36,8 @@ std::map<std::string, Image> render_aovs(MethodContext& mc, const std::vector<st
     if (name == "distance") out[name] = distance;
     if (name == "normal") out[name] = normal;
     if (name == "object_id") out[name] = object;
-    if (name == "fallback") out[name] = mc.fallback && mc.fallback->width > 0 ? *mc.fallback : Image(frame.width, frame.height, 1, 0.f);
+    if (name == "fallback")
+      out[name] = mc.fallback && mc.fallback->width > 0 ? *mc.fallback : Image(frame.width, frame.height, 1, 0.f);
   }
   return out;
 }

@@ -173,11 +173,15 @@ void compare_camera(const SceneData& scene, int threads, GlScene& gl, Crosscheck
           continue;
         }
         ++differ;
-        if (c == NO_OBJECT) ++r->samples_gpu_only;
-        else if (g == NO_OBJECT) ++r->samples_cpu_only;
-        else ++r->samples_other_object;
+        if (c == NO_OBJECT)
+          ++r->samples_gpu_only;
+        else if (g == NO_OBJECT)
+          ++r->samples_cpu_only;
+        else
+          ++r->samples_other_object;
       }
-      r->sample_disagreement.data[static_cast<size_t>(y) * static_cast<size_t>(camera.width()) + static_cast<size_t>(x)] =
+      r->sample_disagreement
+          .data[static_cast<size_t>(y) * static_cast<size_t>(camera.width()) + static_cast<size_t>(x)] =
           float(differ) / float(MASK_SAMPLES);
     }
   }
@@ -199,7 +203,8 @@ constexpr double GRAZING_COSINE = 1e-3;
 void compare_shadows(const SceneData& scene, int n, int threads, GlScene& gl, CrosscheckResult* r) {
   Camera camera = scene.camera;
   if (camera.width > SHADOW_CHECK_MAX_WIDTH) {
-    camera.height = std::max(1, static_cast<int>(std::lround(double(camera.height) * SHADOW_CHECK_MAX_WIDTH / camera.width)));
+    camera.height =
+        std::max(1, static_cast<int>(std::lround(double(camera.height) * SHADOW_CHECK_MAX_WIDTH / camera.width)));
     camera.width = SHADOW_CHECK_MAX_WIDTH;
   }
   r->shadow_width = camera.width;
@@ -304,8 +309,7 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   compare_cube(scene, n, threads, gl, &r);
   compare_camera(scene, threads, gl, &r);
   compare_shadows(scene, n, threads, gl, &r);
-  const double mismatch =
-      r.texels ? static_cast<double>(r.gpu_only + r.cpu_only) / static_cast<double>(r.texels) : 0.0;
+  const double mismatch = r.texels ? static_cast<double>(r.gpu_only + r.cpu_only) / static_cast<double>(r.texels) : 0.0;
   auto fail = [&r](bool bad, const std::string& what) {
     if (bad) r.failures += (r.failures.empty() ? "" : "; ") + what;
   };
@@ -322,35 +326,61 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
 }
 
 nlohmann::json shadow_json(const ShadowAgreement& a) {
-  return {{"pairs", a.pairs}, {"agreement", a.share()}, {"false_shadow", a.false_shadow},
-          {"false_light", a.false_light}, {"interior_pairs", a.interior}, {"interior_agreement", a.interior_share()}};
+  return {{"pairs", a.pairs},
+          {"agreement", a.share()},
+          {"false_shadow", a.false_shadow},
+          {"false_light", a.false_light},
+          {"interior_pairs", a.interior},
+          {"interior_agreement", a.interior_share()}};
 }
 
 nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolerances& tol) {
   using nlohmann::json;
-  return json{
-      {"cube", {{"texels", r.texels}, {"both_covered", r.both_covered}, {"gpu_only", r.gpu_only},
-                {"cpu_only", r.cpu_only}, {"distance_rel_median", r.distance_median_rel},
-                {"distance_rel_p99", r.distance_p99_rel}, {"distance_rel_max", r.distance_max_rel},
-                {"same_object", r.same_object}, {"tied", r.tied}, {"tied_agree", r.tied_agree}, {"texels_edge_ties", r.texels_edge_ties},
-                {"gpu_prepass_ms", r.gpu_ms}, {"cpu_abuffer_ms", r.cpu_ms},
+  return json{{"cube",
+               {{"texels", r.texels},
+                {"both_covered", r.both_covered},
+                {"gpu_only", r.gpu_only},
+                {"cpu_only", r.cpu_only},
+                {"distance_rel_median", r.distance_median_rel},
+                {"distance_rel_p99", r.distance_p99_rel},
+                {"distance_rel_max", r.distance_max_rel},
+                {"same_object", r.same_object},
+                {"tied", r.tied},
+                {"tied_agree", r.tied_agree},
+                {"texels_edge_ties", r.texels_edge_ties},
+                {"gpu_prepass_ms", r.gpu_ms},
+                {"cpu_abuffer_ms", r.cpu_ms},
                 {"fragments", r.fragments}}},
-      {"camera", {{"pixels", r.pixels}, {"interior_pixels", r.interior_pixels}, {"interior_rmse", r.interior_rmse},
-                  {"interior_max_abs", r.interior_max_abs}}},
-      {"shadows", {{"camera", {r.shadow_width, r.shadow_height}}, {"lights", r.shadow_lights},
-                   {"volumes", shadow_json(r.volumes)}, {"maps", shadow_json(r.maps)},
-                   {"cpu_search", shadow_json(r.search)}}},
-      {"camera_samples", {{"samples", r.samples}, {"same_object", r.samples_same},
-                          {"gpu_only", r.samples_gpu_only}, {"cpu_only", r.samples_cpu_only},
-                          {"other_object", r.samples_other_object}, {"edge_ties_differing", r.samples_edge_ties},
-                          {"agreement", r.sample_agreement}}},
-      {"tolerances", {{"distance_rel_median", tol.distance_median_rel}, {"distance_rel_p99", tol.distance_p99_rel},
-                      {"same_object_min", tol.same_object_min}, {"coverage_mismatch_max", tol.coverage_mismatch_max},
-                      {"interior_rmse", tol.interior_rmse}, {"interior_max_abs", tol.interior_max_abs},
-                      {"sample_agreement_min", tol.sample_agreement_min},
-                      {"volumes_agreement_min", tol.volumes_agreement_min}}},
-      {"pass", r.pass},
-      {"failures", r.failures}};
+              {"camera",
+               {{"pixels", r.pixels},
+                {"interior_pixels", r.interior_pixels},
+                {"interior_rmse", r.interior_rmse},
+                {"interior_max_abs", r.interior_max_abs}}},
+              {"shadows",
+               {{"camera", {r.shadow_width, r.shadow_height}},
+                {"lights", r.shadow_lights},
+                {"volumes", shadow_json(r.volumes)},
+                {"maps", shadow_json(r.maps)},
+                {"cpu_search", shadow_json(r.search)}}},
+              {"camera_samples",
+               {{"samples", r.samples},
+                {"same_object", r.samples_same},
+                {"gpu_only", r.samples_gpu_only},
+                {"cpu_only", r.samples_cpu_only},
+                {"other_object", r.samples_other_object},
+                {"edge_ties_differing", r.samples_edge_ties},
+                {"agreement", r.sample_agreement}}},
+              {"tolerances",
+               {{"distance_rel_median", tol.distance_median_rel},
+                {"distance_rel_p99", tol.distance_p99_rel},
+                {"same_object_min", tol.same_object_min},
+                {"coverage_mismatch_max", tol.coverage_mismatch_max},
+                {"interior_rmse", tol.interior_rmse},
+                {"interior_max_abs", tol.interior_max_abs},
+                {"sample_agreement_min", tol.sample_agreement_min},
+                {"volumes_agreement_min", tol.volumes_agreement_min}}},
+              {"pass", r.pass},
+              {"failures", r.failures}};
 }
 
 Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options, nlohmann::json* stats,
@@ -367,11 +397,15 @@ Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options
   Image image = resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera), scene.background, ro);
   (*stats)["timings_ms"]["camera_abuffer"] = build_ms;
   (*stats)["timings_ms"]["resolve"] = ms_since(t0);
-  (*stats)["abuffer"] = {{"fragments", s.fragments}, {"raw_fragments", s.raw_fragments},
-                         {"max_list_length", s.max_list_length}, {"bytes_per_fragment", s.bytes_per_fragment},
-                         {"bytes_total", s.bytes_total}, {"dropped_by_cap", s.dropped_by_cap},
+  (*stats)["abuffer"] = {{"fragments", s.fragments},
+                         {"raw_fragments", s.raw_fragments},
+                         {"max_list_length", s.max_list_length},
+                         {"bytes_per_fragment", s.bytes_per_fragment},
+                         {"bytes_total", s.bytes_total},
+                         {"dropped_by_cap", s.dropped_by_cap},
                          {"triangles_degenerate", s.triangles_degenerate},
-                         {"triangles_clipped", s.triangles_clipped}, {"triangles_culled", s.triangles_culled}};
+                         {"triangles_clipped", s.triangles_clipped},
+                         {"triangles_culled", s.triangles_culled}};
   return image;
 }
 

@@ -22,15 +22,15 @@ namespace abcube {
 // double and the fragment's 32-bit normal. On a large bench mesh at coarse N, merged
 // fragments span many triangles and the p99 may exceed its tolerance below N = 512.
 struct CrosscheckTolerances {
-  double distance_median_rel = 1e-6;      // |gpu - cpu| / cpu over texels covered on both
+  double distance_median_rel = 1e-6;  // |gpu - cpu| / cpu over texels covered on both
   double distance_p99_rel = 1e-4;
-  double same_object_min = 0.995;         // share of those texels with the same object id
-  double coverage_mismatch_max = 0.01;    // share of texels covered on one path only
+  double same_object_min = 0.995;       // share of those texels with the same object id
+  double coverage_mismatch_max = 0.01;  // share of texels covered on one path only
   // Camera view, displayed values, interior pixels (one triangle over the whole pixel and
   // its centre: both sides shade the same point, so only float rounding remains).
   double interior_rmse = 1e-4;
   double interior_max_abs = 1.0 / 255.0;
-  double sample_agreement_min = 0.9999;   // camera samples where GPU and CPU see the same object (or none)
+  double sample_agreement_min = 0.9999;  // camera samples where GPU and CPU see the same object (or none)
   // Shadows sample by sample, away from shadow edges: the GPU's shadow volumes against the
   // exact tracer.
   double volumes_agreement_min = 0.999;
@@ -56,7 +56,7 @@ struct CrosscheckResult {
   // Cube map: GL prepass vs CPU A-buffer nearest layer (NearestLayer in abuffer.hpp).
   size_t texels = 0, both_covered = 0, gpu_only = 0, cpu_only = 0;
   double distance_median_rel = 0, distance_p99_rel = 0, distance_max_rel = 0;
-  double same_object = 0;            // over every texel covered on both, exact ties included
+  double same_object = 0;  // over every texel covered on both, exact ties included
   // Texels where the two differ (in object, or covered on one side only) and whose centre
   // lies within EDGE_TIE_EPS texels of a triangle's edge (edge_ties.hpp): GL's snapped
   // vertices may put the centre on either side. Counted apart, in none of the figures here.

@@ -60,9 +60,9 @@ void check_value(const OptionSpec& s, const json& v) {
       throw OptionError(s.key, "must be one of " + join(s.choices, ", ") + ", got " + got(v) +
                                    did_you_mean(v.get<std::string>(), s.choices));
     case OptionKind::integer: {
-      const bool whole = v.is_number_integer() || (v.is_number_float() && std::isfinite(v.get<double>()) &&
-                                                   v.get<double>() == std::floor(v.get<double>()) &&
-                                                   std::fabs(v.get<double>()) < 9.0e15);
+      const bool whole = v.is_number_integer() ||
+                         (v.is_number_float() && std::isfinite(v.get<double>()) &&
+                          v.get<double>() == std::floor(v.get<double>()) && std::fabs(v.get<double>()) < 9.0e15);
       if (!whole || v.get<double>() < s.min || v.get<double>() > s.max) bad(s, "an integer in " + range_text(s), v);
       return;
     }
@@ -125,6 +125,8 @@ json unless(const T& value, const T& fallback) {
   return value == fallback ? json() : json(value);
 }
 
+// The table reads as a table: one option an entry, its spec on a line or two.
+// clang-format off
 std::vector<Entry> make_table() {
   const RenderOptions d;  // the defaults
   const RendererOptions rd;
@@ -329,6 +331,7 @@ std::vector<Entry> make_table() {
       [rd](const RenderSetup& s) { return unless(s.renderer.gl_device, rd.gl_device); });
   return t;
 }
+// clang-format on
 
 const std::vector<Entry>& entries() {
   static const std::vector<Entry> table = make_table();
@@ -369,8 +372,7 @@ json value_from_text(const OptionSpec& s, const std::string& text) {
   json v;
   switch (s.kind) {
     case OptionKind::integer:
-    case OptionKind::number:
-      return number(text, &v) ? v : json(text);
+    case OptionKind::number: return number(text, &v) ? v : json(text);
     case OptionKind::flag:
       if (text == "true" || text.empty()) return true;
       if (text == "false") return false;
@@ -384,8 +386,7 @@ json value_from_text(const OptionSpec& s, const std::string& text) {
       }
       return a;
     }
-    case OptionKind::names:
-      return split(text);
+    case OptionKind::names: return split(text);
     case OptionKind::setting: {
       const size_t eq = text.find('=');
       if (eq == std::string::npos || eq == 0) {
@@ -397,8 +398,7 @@ json value_from_text(const OptionSpec& s, const std::string& text) {
     }
     case OptionKind::choice:
     case OptionKind::path:
-    case OptionKind::text:
-      return text;
+    case OptionKind::text: return text;
   }
   return text;
 }
@@ -463,10 +463,12 @@ void refuse_options_unused_by(const std::string& scene_method, const RenderOptio
   for (const Entry& e : entries()) {
     const std::vector<std::string>& m = e.spec.methods;
     if (m.empty() || std::find(m.begin(), m.end(), method) != m.end()) continue;
-    if (!e.read(setup).is_null()) throw OptionError(e.spec.key, "not used by method " + method + " (" + e.spec.why + ")");
+    if (!e.read(setup).is_null())
+      throw OptionError(e.spec.key, "not used by method " + method + " (" + e.spec.why + ")");
   }
 }
 
+// clang-format off
 RenderOptions without_unused_options(const RenderOptions& options, const std::string& method) {
   const RenderOptions d;
   // Each option some methods do not use, set back to its default (the table's "methods").
@@ -487,6 +489,7 @@ RenderOptions without_unused_options(const RenderOptions& options, const std::st
       {"gpu_max_views", [](RenderOptions& o, const RenderOptions& x) { o.gpu_max_views = x.gpu_max_views; }},
       {"gpu_shading", [](RenderOptions& o, const RenderOptions& x) { o.gpu_shading = x.gpu_shading; }},
   };
+  // clang-format on
   RenderOptions out = options;
   out.method = method;
   for (const Entry& e : entries()) {

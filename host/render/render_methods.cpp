@@ -23,8 +23,7 @@ using nlohmann::json;
 json gl_json(const GlContext* ctx) {
   if (!ctx) return {{"path", "none"}, {"renderer", describe_gl(nullptr)}};
   const GlInfo& i = ctx->info();
-  json j = {{"path", i.api}, {"renderer", i.gl_renderer}, {"gl_version", i.gl_version},
-            {"gl_vendor", i.gl_vendor}};
+  json j = {{"path", i.api}, {"renderer", i.gl_renderer}, {"gl_version", i.gl_version}, {"gl_vendor", i.gl_vendor}};
   if (!i.egl_vendor.empty()) j["egl_vendor"] = i.egl_vendor;
   if (i.device_index >= 0) j["egl_device"] = i.device_index;
   return j;
@@ -35,27 +34,37 @@ json gl_json(const GlContext* ctx) {
 json gpu_paths_json(const GlScene& gl, const RenderRequest& request, const std::string& curved, bool maps) {
   const ExactCameraStats& ex = gl.exact_camera_stats();
   return {
-      {"planar_mirrors", {{"technique", ex.mirrors ? "stencil" : curved},
-                          {"why", ex.mirrors ? "exact: virtual views through the stencil test, to max_depth"
-                                             : request.gpu.planar_mirrors ? ex.mirrors_why : "asked: --gpu-mirrors envmap"},
-                          {"reflectors", ex.reflectors}, {"views", ex.mirror_views}, {"views_empty", ex.mirror_views_empty},
-                          {"views_over_budget", ex.mirror_views_over_budget}, {"max_views_per_tile", request.gpu.max_views},
-                          {"deepest_level", ex.deepest_level}}},
-      {"curved_mirrors_and_refraction", {{"technique", curved},
-                                         {"curved_reflective_triangles", ex.curved_reflective_triangles},
-                                         {"why", curved == "environment_map"
-                                                     ? "approximate: Blinn-Newell lookups in the cube texture around the eye"
-                                                     : curved == "none" ? "none in the view's reach (or max_depth 0)"
-                                                                        : "the CPU's A-buffer searches, for the pixels they reach"}}},
-      {"shadows", {{"technique", ex.volumes ? "shadow_volumes" : maps ? "shadow_maps" : "none"},
-                   {"why", ex.volumes ? "exact: depth-fail counting of every opaque blocker's prism"
-                                      : request.gpu.shadow_volumes ? ex.volumes_why : "asked: --gpu-shadows maps"},
-                   {"volume_lights", ex.volumes ? ex.volume_lights : 0},
-                   {"volume_triangles", ex.volumes ? ex.volume_triangles : 0},
-                   {"translucent_casters", maps && gl.shadow_peels() > 0 ? "shadow maps' peeled layers" : "none"}}},
-      {"shading", {{"technique", ex.shading_pixels ? "pixels" : "samples"},
-                   {"why", ex.shading_pixels ? "once a pixel and surface: its samples grouped by triangle and shadow-volume set"
-                                             : ex.shading_why}}},
+      {"planar_mirrors",
+       {{"technique", ex.mirrors ? "stencil" : curved},
+        {"why", ex.mirrors                   ? "exact: virtual views through the stencil test, to max_depth"
+                : request.gpu.planar_mirrors ? ex.mirrors_why
+                                             : "asked: --gpu-mirrors envmap"},
+        {"reflectors", ex.reflectors},
+        {"views", ex.mirror_views},
+        {"views_empty", ex.mirror_views_empty},
+        {"views_over_budget", ex.mirror_views_over_budget},
+        {"max_views_per_tile", request.gpu.max_views},
+        {"deepest_level", ex.deepest_level}}},
+      {"curved_mirrors_and_refraction",
+       {{"technique", curved},
+        {"curved_reflective_triangles", ex.curved_reflective_triangles},
+        {"why", curved == "environment_map" ? "approximate: Blinn-Newell lookups in the cube texture around the eye"
+                : curved == "none"          ? "none in the view's reach (or max_depth 0)"
+                                            : "the CPU's A-buffer searches, for the pixels they reach"}}},
+      {"shadows",
+       {{"technique", ex.volumes ? "shadow_volumes"
+                      : maps     ? "shadow_maps"
+                                 : "none"},
+        {"why", ex.volumes                   ? "exact: depth-fail counting of every opaque blocker's prism"
+                : request.gpu.shadow_volumes ? ex.volumes_why
+                                             : "asked: --gpu-shadows maps"},
+        {"volume_lights", ex.volumes ? ex.volume_lights : 0},
+        {"volume_triangles", ex.volumes ? ex.volume_triangles : 0},
+        {"translucent_casters", maps && gl.shadow_peels() > 0 ? "shadow maps' peeled layers" : "none"}}},
+      {"shading",
+       {{"technique", ex.shading_pixels ? "pixels" : "samples"},
+        {"why", ex.shading_pixels ? "once a pixel and surface: its samples grouped by triangle and shadow-volume set"
+                                  : ex.shading_why}}},
       {"camera_samples_approximate", ex.samples_approximate},
       {"pixels_exact", ex.pixels_exact}};
 }
@@ -85,8 +94,9 @@ Image render_gpu(MethodContext& mc) {
   if (!needed) {
     gl.drop_environment();
     if (!mc.request.plan_everything) {
-      skipped.push_back({{"pass", "environment_map"},
-                         {"why", mirrors ? "max_depth 0: no reflected or refracted ray" : "no material reflects or transmits"}});
+      skipped.push_back(
+          {{"pass", "environment_map"},
+           {"why", mirrors ? "max_depth 0: no reflected or refracted ray" : "no material reflects or transmits"}});
     }
   }
   stats["plan"]["mode"] = mc.request.plan_everything ? "everything" : "needed";
@@ -101,7 +111,8 @@ Image render_gpu(MethodContext& mc) {
   const GpuTimings& t = gl.timings();
   stats["timings_ms"]["upload"] = t.upload_ms - before.upload_ms;
   if (maps > 0) stats["timings_ms"]["shadow_maps"] = t.shadow_maps_ms - before.shadow_maps_ms;
-  if (needed || mc.request.plan_everything) stats["timings_ms"]["environment_map"] = t.environment_ms - before.environment_ms;
+  if (needed || mc.request.plan_everything)
+    stats["timings_ms"]["environment_map"] = t.environment_ms - before.environment_ms;
   stats["timings_ms"]["camera_raster"] = t.camera_ms - before.camera_ms;
   stats["timings_ms"]["readback"] = t.readback_ms - before.readback_ms;
   stats["counts"]["shadow_maps"] = maps;
@@ -252,13 +263,15 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   if (!plan.cube_map) return render_abuffer_local(scene, r.abuffer, &stats, r.map.exact_priority, only);
   Clock::time_point t0 = Clock::now();
   ABufferStats cs;
-  const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, scene.render.cube_resolution, r.abuffer, &cs);
+  const CubeABuffer cube =
+      build_cube_abuffer(scene, scene.camera.position, scene.render.cube_resolution, r.abuffer, &cs);
   stats["timings_ms"]["cube_abuffer"] = ms_since(t0);
   stats["cube_abuffer"] = cube_abuffer_json(cs);
   std::unique_ptr<RayTracer> reference;
   if (r.reference) reference = std::make_unique<RayTracer>(scene, mc.cache.bvh());
   MapShadingOptions options = r.map;
-  options.method = scene.render.method == Method::hybrid ? Method::abuffer : scene.render.method;  // hybrid: abuffer's searches
+  options.method =
+      scene.render.method == Method::hybrid ? Method::abuffer : scene.render.method;  // hybrid: abuffer's searches
   options.walk_all_shadows = r.plan_everything;
   t0 = Clock::now();
   const MapShader shader(scene, cube, options, reference.get(), &mc.cache);
@@ -277,14 +290,13 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   stats["searches"] = map_shading_json(ms);
   if (reference) {
     const double bound = parallax_bound(scene.render.cube_resolution);
-    stats["reference"]["ray_error"] = {
-        {"rays", "reflection rays of camera-visible surfaces"},
-        {"error_cp", error_stats_json(ms.errors.error_cp)},
-        {"error_parallax", error_stats_json(ms.errors.error_parallax)},
-        {"false_hits", ms.errors.false_hits},
-        {"wrong_object", ms.errors.wrong_object},
-        {"bound_1_over_2n2", bound},
-        {"error_parallax_within_bound", ms.errors.error_parallax.share_within(bound)}};
+    stats["reference"]["ray_error"] = {{"rays", "reflection rays of camera-visible surfaces"},
+                                       {"error_cp", error_stats_json(ms.errors.error_cp)},
+                                       {"error_parallax", error_stats_json(ms.errors.error_parallax)},
+                                       {"false_hits", ms.errors.false_hits},
+                                       {"wrong_object", ms.errors.wrong_object},
+                                       {"bound_1_over_2n2", bound},
+                                       {"error_parallax_within_bound", ms.errors.error_parallax.share_within(bound)}};
   }
   return image;
 }

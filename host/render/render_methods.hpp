@@ -24,21 +24,21 @@ struct RenderRequest {
   bool reference = false;
   std::string reference_image;  // the exact image, rendered before
   bool plan_everything = false;
-  ABufferOptions abuffer;       // threads, layer cap, memory budget
-  MapShadingOptions map;        // search mode, refinement, theta_max, refraction, envmap lookup
+  ABufferOptions abuffer;  // threads, layer cap, memory budget
+  MapShadingOptions map;   // search mode, refinement, theta_max, refraction, envmap lookup
   std::vector<std::string> aovs;
-  ExactCameraOptions gpu;       // the gpu method's exact camera pass (gl_passes.hpp)
+  ExactCameraOptions gpu;  // the gpu method's exact camera pass (gl_passes.hpp)
 };
 
 // What every method's passes read and write.
 struct MethodContext {
-  const SceneData& scene;       // with this render's camera and settings
+  const SceneData& scene;  // with this render's camera and settings
   const SceneCache& cache;
   const RenderRequest& request;
   nlohmann::json& stats;
   const std::function<void(const std::string&, double)>& progress;
-  GlScene* gl_scene;            // the scene on the GPU (gpu method only)
-  GpuTimings gl_before;         // its timings before this render (zero when it uploaded now)
+  GlScene* gl_scene;     // the scene on the GPU (gpu method only)
+  GpuTimings gl_before;  // its timings before this render (zero when it uploaded now)
   // Filled by the map methods for the "fallback" AOV: per pixel, the share of secondary
   // searches that found nothing.
   Image* fallback;

@@ -25,7 +25,6 @@
 #include "scene/scene_load.hpp"
 #include "shading/scene_cache.hpp"
 
-
 namespace abcube {
 
 using nlohmann::json;
@@ -122,7 +121,8 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   r.gpu.planar_mirrors = o.gpu_mirrors == "stencil";
   r.gpu.shadow_volumes = o.gpu_shadows == "volumes";
   r.gpu.max_views = o.gpu_max_views;
-  r.gpu.shading = o.gpu_shading == "pixels" ? ExactCameraOptions::Shading::pixels : ExactCameraOptions::Shading::samples;
+  r.gpu.shading =
+      o.gpu_shading == "pixels" ? ExactCameraOptions::Shading::pixels : ExactCameraOptions::Shading::samples;
   r.gpu.max_depth = view->render.max_depth;
   r.abuffer.max_layers = o.max_layers;
   r.abuffer.max_memory_bytes = o.max_memory_mib << 20;  // the whole render's budget
@@ -148,8 +148,10 @@ json request_stats(const SceneData& view, const RenderRequest& request) {
                              {"cube_resolution", view.render.cube_resolution},
                              {"bound_at_that_n", parallax_bound(view.render.cube_resolution)}};
   }
-  stats["size"] = {{"width", view.camera.width}, {"height", view.camera.height},
-                   {"cube_resolution", view.render.cube_resolution}, {"max_depth", view.render.max_depth}};
+  stats["size"] = {{"width", view.camera.width},
+                   {"height", view.camera.height},
+                   {"cube_resolution", view.render.cube_resolution},
+                   {"max_depth", view.render.max_depth}};
   stats["threads"] = thread_count(request.threads, SIZE_MAX);
   stats["method_options"] = {{"search", search_mode_name(request.map.search.mode)},
                              {"refine", search_refine_name(request.map.search.refine)},
@@ -169,7 +171,8 @@ RenderStats render_stats(const json& stats, int built, std::optional<double> psn
   for (const auto& [k, v] : stats["timings_ms"].items()) rs.timings_ms[k] = v.get<double>();
   for (const char* tracer : {"raytrace", "reference"}) {  // the exact tracer's passes, by name
     if (stats.contains(tracer) && stats[tracer].contains("timings_ms")) {
-      for (const auto& [k, v] : stats[tracer]["timings_ms"].items()) rs.timings_ms[std::string(tracer) + "." + k] = v.get<double>();
+      for (const auto& [k, v] : stats[tracer]["timings_ms"].items())
+        rs.timings_ms[std::string(tracer) + "." + k] = v.get<double>();
     }
   }
   rs.gl_path = stats["gl"]["path"].get<std::string>();
@@ -203,8 +206,9 @@ struct Renderer::Impl {
       gl_thread = std::this_thread::get_id();
     }
     if (gl && std::this_thread::get_id() != gl_thread) {
-      throw RuntimeFailure("this Renderer opened GL on another thread; GL contexts are current per thread: "
-                           "use one Renderer per thread");
+      throw RuntimeFailure(
+          "this Renderer opened GL on another thread; GL contexts are current per thread: "
+          "use one Renderer per thread");
     }
     return gl.get();
   }
@@ -223,7 +227,8 @@ struct Renderer::Impl {
 Renderer::Renderer(const RendererOptions& options) : impl_(std::make_unique<Impl>()) {
   impl_->options = options;
   if (!parse_gl_choice(options.gl, &impl_->gl_choice)) {
-    throw InputError("gl: unknown path " + quote(options.gl) + " (auto, egl, egl-device, egl-surfaceless, osmesa, none)");
+    throw InputError("gl: unknown path " + quote(options.gl) +
+                     " (auto, egl, egl-device, egl-surfaceless, osmesa, none)");
   }
   if (options.threads < 0) throw InputError("threads: must be >= 0, got " + std::to_string(options.threads));
   if (options.gl_device < -1) throw InputError("gl-device: must be >= 0, got " + std::to_string(options.gl_device));
@@ -269,8 +274,8 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   json stats = request_stats(view, request);
   Image fallback;  // the map methods' "fallback" AOV, when asked
   const bool wants_fallback = std::find(request.aovs.begin(), request.aovs.end(), "fallback") != request.aovs.end();
-  MethodContext mc{view, scene.cache(), request, stats, options.progress, nullptr, {},
-                   wants_fallback ? &fallback : nullptr};
+  MethodContext mc{
+      view, scene.cache(), request, stats, options.progress, nullptr, {}, wants_fallback ? &fallback : nullptr};
   Image image;
   switch (view.render.method) {
     case Method::gpu:
@@ -323,11 +328,12 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   // What this render built of the per-scene data (0 when an earlier render did).
   const SceneCache::Builds after = scene.cache().builds();
   const int built = (after.neighbours - before.neighbours) + (after.lenses - before.lenses) + (after.bvh - before.bvh);
-  stats["scene_data"] = {{"built_by_this_render", built},
-                         {"scene_load_ms", scene.load_ms()},
-                         {"mesh_neighbours", {{"built", after.neighbours - before.neighbours}, {"ms", after.neighbours_ms}}},
-                         {"lens_fits", {{"built", after.lenses - before.lenses}, {"ms", after.lenses_ms}}},
-                         {"bvh", {{"built", after.bvh - before.bvh}, {"ms", after.bvh_ms}}}};
+  stats["scene_data"] = {
+      {"built_by_this_render", built},
+      {"scene_load_ms", scene.load_ms()},
+      {"mesh_neighbours", {{"built", after.neighbours - before.neighbours}, {"ms", after.neighbours_ms}}},
+      {"lens_fits", {{"built", after.lenses - before.lenses}, {"ms", after.lenses_ms}}},
+      {"bvh", {{"built", after.bvh - before.bvh}, {"ms", after.bvh_ms}}}};
   ++impl_->renders;
   stats["renderer"] = {{"renders", impl_->renders}};
   stats["timings_ms"]["total"] = ms_since(start);

@@ -167,7 +167,8 @@ class Report {
     for (const std::string& m : o_.methods) {
       const std::vector<std::string>& known = method_names();
       if (std::find(known.begin(), known.end(), m) == known.end()) {
-        throw InputError("methods: unknown method " + quote(m) + " (" + join(known, ", ") + ")" + did_you_mean(m, known));
+        throw InputError("methods: unknown method " + quote(m) + " (" + join(known, ", ") + ")" +
+                         did_you_mean(m, known));
       }
       if (m == "raytrace") throw InputError("methods: raytrace is the reference, always rendered");
       if (!seen.insert(m).second) throw InputError("methods: " + m + " given twice");
@@ -201,8 +202,11 @@ class Report {
     write_image(path("images/raytrace.exr"), reference_);
     write_image(path("images/raytrace.png"), reference_);
     j_["size"] = {{"width", reference_.width}, {"height", reference_.height}};
-    j_["reference"] = {{"method", "raytrace"}, {"image", "images/raytrace.png"}, {"stats", "stats/raytrace.json"},
-                       {"total_ms", r.stats.total_ms}, {"timings_ms", timings(r.stats.timings_ms)}};
+    j_["reference"] = {{"method", "raytrace"},
+                       {"image", "images/raytrace.png"},
+                       {"stats", "stats/raytrace.json"},
+                       {"total_ms", r.stats.total_ms},
+                       {"timings_ms", timings(r.stats.timings_ms)}};
   }
 
   void render_method(Renderer& renderer, const std::string& method) {
@@ -247,7 +251,9 @@ class Report {
       options.aovs.clear();
       const RenderResult r = render(renderer, options, "sweep_" + std::to_string(n));
       const json stats = json::parse(r.stats.json);
-      json p = {{"n", n}, {"total_ms", r.stats.total_ms}, {"error", image_error_json(image_error(r.image, reference_))},
+      json p = {{"n", n},
+                {"total_ms", r.stats.total_ms},
+                {"error", image_error_json(image_error(r.image, reference_))},
                 {"bound_1_over_2n2", parallax_bound(n)}};
       const json& ray = stats["reference"]["ray_error"];
       if (ray.is_object()) {
@@ -262,10 +268,12 @@ class Report {
 
   void run_crosscheck() {
     json& c = j_["crosscheck"];
-    c["covers"] = "visibility (the cube map's nearest layer texel by texel, which object each camera sample sees), "
-                  "direct shading of interior pixels, hard shadows sample by sample against the exact tracer";
-    c["does_not_cover"] = "reflections, refractions and antialiased edges, where the methods differ by design: the "
-                          "sections above compare every method with the exact tracer there";
+    c["covers"] =
+        "visibility (the cube map's nearest layer texel by texel, which object each camera sample sees), "
+        "direct shading of interior pixels, hard shadows sample by sample against the exact tracer";
+    c["does_not_cover"] =
+        "reflections, refractions and antialiased edges, where the methods differ by design: the "
+        "sections above compare every method with the exact tracer there";
     if (!o_.crosscheck) {
       c["skipped"] = "not asked for";
       return;
@@ -312,10 +320,13 @@ class Report {
     char host[256] = {};
     c["host"] = gethostname(host, sizeof host - 1) == 0 ? std::string(host) : std::string();
     const SceneData& s = scene_.data();
-    c["scene"] = {{"triangles", s.triangles->triangle_count()}, {"objects", s.objects.size()},
-                  {"lights", s.lights.size()}, {"materials", s.materials.size()},
-                  {"cube_resolution", o_.render.cube_resolution > 0 ? o_.render.cube_resolution : s.render.cube_resolution},
-                  {"max_depth", o_.render.max_depth >= 0 ? o_.render.max_depth : s.render.max_depth}};
+    c["scene"] = {
+        {"triangles", s.triangles->triangle_count()},
+        {"objects", s.objects.size()},
+        {"lights", s.lights.size()},
+        {"materials", s.materials.size()},
+        {"cube_resolution", o_.render.cube_resolution > 0 ? o_.render.cube_resolution : s.render.cube_resolution},
+        {"max_depth", o_.render.max_depth >= 0 ? o_.render.max_depth : s.render.max_depth}};
   }
 
   const Scene& scene_;

@@ -43,7 +43,8 @@ std::string figure(const json& report, const std::string& key, int decimals, dou
   const std::string none = std::string("<") + tag + ">-</" + tag + ">";
   for (std::string part; std::getline(path, part, '.');) {
     if (v->is_array()) {  // an index: sweep.points.0.total_ms
-      const size_t i = part.find_first_not_of("0123456789") == std::string::npos && !part.empty() ? std::stoul(part) : SIZE_MAX;
+      const size_t i =
+          part.find_first_not_of("0123456789") == std::string::npos && !part.empty() ? std::stoul(part) : SIZE_MAX;
       if (i >= v->size()) return none;
       v = &(*v)[i];
       continue;
@@ -96,7 +97,8 @@ std::string svg(const Plot& p) {
   std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + fixed(W, 0) + "\" height=\"" + fixed(H, 0) +
                   "\" viewBox=\"0 0 " + fixed(W, 0) + " " + fixed(H, 0) + "\" role=\"img\"><title>" + escape(p.title) +
                   "</title><rect width=\"100%\" height=\"100%\" fill=\"#fff\"/>";
-  s += "<text x=\"" + fixed(W / 2, 0) + "\" y=\"18\" text-anchor=\"middle\" font-size=\"13\">" + escape(p.title) + "</text>";
+  s += "<text x=\"" + fixed(W / 2, 0) + "\" y=\"18\" text-anchor=\"middle\" font-size=\"13\">" + escape(p.title) +
+       "</text>";
   s += "<line x1=\"" + fixed(L, 0) + "\" y1=\"" + fixed(H - B, 0) + "\" x2=\"" + fixed(W - R, 0) + "\" y2=\"" +
        fixed(H - B, 0) + "\" stroke=\"#333\"/><line x1=\"" + fixed(L, 0) + "\" y1=\"" + fixed(T, 0) + "\" x2=\"" +
        fixed(L, 0) + "\" y2=\"" + fixed(H - B, 0) + "\" stroke=\"#333\"/>";
@@ -106,22 +108,23 @@ std::string svg(const Plot& p) {
     const double lx = p.log_x ? std::pow(10, vx) : vx, ly = p.log_y ? std::pow(10, vy) : vy;
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.3g", lx);
-    s += "<text x=\"" + fixed(px, 1) + "\" y=\"" + fixed(H - B + 16, 0) + "\" text-anchor=\"middle\" font-size=\"11\">" +
-         buf + "</text>";
+    s += "<text x=\"" + fixed(px, 1) + "\" y=\"" + fixed(H - B + 16, 0) +
+         "\" text-anchor=\"middle\" font-size=\"11\">" + buf + "</text>";
     std::snprintf(buf, sizeof buf, "%.3g", ly);
-    s += "<text x=\"" + fixed(L - 6, 0) + "\" y=\"" + fixed(py + 4, 1) + "\" text-anchor=\"end\" font-size=\"11\">" + buf +
-         "</text>";
+    s += "<text x=\"" + fixed(L - 6, 0) + "\" y=\"" + fixed(py + 4, 1) + "\" text-anchor=\"end\" font-size=\"11\">" +
+         buf + "</text>";
   }
-  s += "<text x=\"" + fixed((L + W - R) / 2, 0) + "\" y=\"" + fixed(H - 8, 0) + "\" text-anchor=\"middle\" font-size=\"12\">" +
-       escape(p.x_name) + "</text>";
-  s += "<text x=\"14\" y=\"" + fixed((T + H - B) / 2, 0) + "\" text-anchor=\"middle\" font-size=\"12\" transform=\"rotate(-90 14 " +
-       fixed((T + H - B) / 2, 0) + ")\">" + escape(p.y_name) + "</text>";
+  s += "<text x=\"" + fixed((L + W - R) / 2, 0) + "\" y=\"" + fixed(H - 8, 0) +
+       "\" text-anchor=\"middle\" font-size=\"12\">" + escape(p.x_name) + "</text>";
+  s += "<text x=\"14\" y=\"" + fixed((T + H - B) / 2, 0) +
+       "\" text-anchor=\"middle\" font-size=\"12\" transform=\"rotate(-90 14 " + fixed((T + H - B) / 2, 0) + ")\">" +
+       escape(p.y_name) + "</text>";
   if (!p.curve.empty()) {
     std::string d;
     for (const auto& [x, y] : p.curve) d += (d.empty() ? "M" : " L") + fixed(sx(x), 1) + " " + fixed(sy(y), 1);
     s += "<path d=\"" + d + "\" fill=\"none\" stroke=\"#c33\" stroke-dasharray=\"5 3\"/>";
-    s += "<text x=\"" + fixed(W - R - 4, 0) + "\" y=\"" + fixed(T + 14, 0) + "\" text-anchor=\"end\" font-size=\"11\" fill=\"#c33\">" +
-         escape(p.curve_name) + "</text>";
+    s += "<text x=\"" + fixed(W - R - 4, 0) + "\" y=\"" + fixed(T + 14, 0) +
+         "\" text-anchor=\"end\" font-size=\"11\" fill=\"#c33\">" + escape(p.curve_name) + "</text>";
   }
   for (size_t i = 0; i < p.points.size(); ++i) {
     const auto& [x, y] = p.points[i];
@@ -194,13 +197,15 @@ void summary(std::string& h, const json& r) {
        "<th>at pixel</th><th>&gt; 1/255 %</th><th>&gt; 2/255 %</th><th>&gt; 8/255 %</th><th>time ms</th>"
        "<th>time / raytrace</th></tr>";
   const double ref_ms = r["reference"].value("total_ms", 0.0);
-  h += "<tr><td>raytrace (reference)</td><td colspan=\"8\"></td>" + figure(r, "reference.total_ms", 0) + "<td>1</td></tr>";
+  h += "<tr><td>raytrace (reference)</td><td colspan=\"8\"></td>" + figure(r, "reference.total_ms", 0) +
+       "<td>1</td></tr>";
   for (const std::string& m : method_order(r)) {
     const json& x = r["methods"][m];
     const std::string k = "methods." + m;
     if (x.contains("failed")) {
-      h += "<tr><td>" + escape(m) + "</td><td colspan=\"10\" class=\"fail\">not rendered: " +
-           escape(x["failed"].get<std::string>()) + "</td></tr>";
+      h += "<tr><td>" + escape(m) +
+           "</td><td colspan=\"10\" class=\"fail\">not rendered: " + escape(x["failed"].get<std::string>()) +
+           "</td></tr>";
       continue;
     }
     const json& w = x["error"]["worst_pixel"];
@@ -225,26 +230,29 @@ void viewer(std::string& h, const json& r) {
   if (r["crosscheck"].contains("samples_image")) {
     options += "<option value=\"images/crosscheck_samples.png\">crosscheck: samples that differ</option>";
   }
-  h += "<h2 id=\"viewer\">Side by side</h2><div class=\"controls\"><label>left <select id=\"pick-a\">" + options +
-       "</select></label><label>right <select id=\"pick-b\">" + options +
-       "</select></label><button id=\"flip\" type=\"button\">flip</button><label>wipe <input id=\"wipe\" type=\"range\" "
-       "min=\"0\" max=\"100\" value=\"50\"></label><label>zoom <select id=\"zoom\"><option>1</option><option>2</option>"
-       "<option>4</option><option>8</option></select></label></div><div id=\"view-label\" class=\"note\"></div>"
-       "<div class=\"viewer\"><img id=\"view-b\" class=\"px base\" alt=\"right image\" src=\"images/raytrace.png\">"
-       "<img id=\"view-a\" class=\"px layer\" alt=\"left image\" src=\"images/raytrace.png\"></div>"
-       "<p class=\"note\">The left image covers the right one up to the wipe's line; zoom enlarges pixels as they are "
-       "(scroll to move over the image).</p>";
+  h +=
+      "<h2 id=\"viewer\">Side by side</h2><div class=\"controls\"><label>left <select id=\"pick-a\">" + options +
+      "</select></label><label>right <select id=\"pick-b\">" + options +
+      "</select></label><button id=\"flip\" type=\"button\">flip</button><label>wipe <input id=\"wipe\" type=\"range\" "
+      "min=\"0\" max=\"100\" value=\"50\"></label><label>zoom <select id=\"zoom\"><option>1</option><option>2</option>"
+      "<option>4</option><option>8</option></select></label></div><div id=\"view-label\" class=\"note\"></div>"
+      "<div class=\"viewer\"><img id=\"view-b\" class=\"px base\" alt=\"right image\" src=\"images/raytrace.png\">"
+      "<img id=\"view-a\" class=\"px layer\" alt=\"left image\" src=\"images/raytrace.png\"></div>"
+      "<p class=\"note\">The left image covers the right one up to the wipe's line; zoom enlarges pixels as they are "
+      "(scroll to move over the image).</p>";
   // Defaults: abuffer's heat map against gpu's, or whatever two there are.
-  h += "<script>document.getElementById('pick-b').selectedIndex = Math.min(1, document.getElementById('pick-b').options.length - 1);</script>";
+  h += "<script>document.getElementById('pick-b').selectedIndex = Math.min(1, "
+       "document.getElementById('pick-b').options.length - 1);</script>";
   h += "<h2 id=\"images\">Images and heat maps</h2><div class=\"gallery\"><figure><img class=\"px\" "
        "src=\"images/raytrace.png\" alt=\"raytrace\"><figcaption>raytrace: the reference</figcaption></figure>";
   for (const std::string& m : method_order(r)) {
     const json& x = r["methods"][m];
     if (x.contains("failed")) continue;
     h += "<figure><img class=\"px\" src=\"images/" + escape(m) + ".png\" alt=\"" + escape(m) + "\"><figcaption>" +
-         escape(m) + "</figcaption></figure><figure><img class=\"px\" src=\"images/" + escape(m) + ".heat.png\" alt=\"" +
-         escape(m) + " heat map\" data-pick=\"images/" + escape(m) + ".heat.png\" style=\"cursor:pointer\"><figcaption>" +
-         escape(m) + " against raytrace: black 0, blue 1-2/255, green 8, yellow 32, red 128/255 and above"
+         escape(m) + "</figcaption></figure><figure><img class=\"px\" src=\"images/" + escape(m) +
+         ".heat.png\" alt=\"" + escape(m) + " heat map\" data-pick=\"images/" + escape(m) +
+         ".heat.png\" style=\"cursor:pointer\"><figcaption>" + escape(m) +
+         " against raytrace: black 0, blue 1-2/255, green 8, yellow 32, red 128/255 and above"
          "</figcaption></figure>";
   }
   h += "</div>";
@@ -256,7 +264,8 @@ void regions(std::string& h, const json& r) {
   for (const std::string& m : method_order(r)) {
     const json& x = r["methods"][m];
     if (x.contains("failed")) continue;
-    h += "<h3>" + escape(m) + "</h3><table><tr><th>surface</th><th>pixels</th><th>PSNR dB</th><th>&gt; 2/255 %</th></tr>";
+    h += "<h3>" + escape(m) +
+         "</h3><table><tr><th>surface</th><th>pixels</th><th>PSNR dB</th><th>&gt; 2/255 %</th></tr>";
     for (const auto& [kind, f] : x["regions"]["kinds"].items()) {
       const std::string k = "methods." + m + ".regions.kinds." + kind;
       h += "<tr><td>" + escape(kind) + "</td>" + figure(r, k + ".pixels", 0) + figure(r, k + ".psnr_db", 2) +
@@ -264,10 +273,10 @@ void regions(std::string& h, const json& r) {
     }
     h += "</table><table><tr><th>object</th><th>material</th><th>pixels</th><th>RMSE</th><th>&gt; 2/255 %</th></tr>";
     for (const json& o : x["regions"]["objects"]) {
-      h += "<tr><td>" + escape(o.value("name", std::string())) + "</td><td>" + escape(o.value("material", std::string())) +
-           "</td><td class=\"num\">" + std::to_string(o.value("pixels", 0)) + "</td><td class=\"num\">" +
-           fixed(o.value("rmse", 0.0), 5) + "</td><td class=\"num\">" + fixed(100 * o.value("share_over_2_255", 0.0), 2) +
-           "</td></tr>";
+      h += "<tr><td>" + escape(o.value("name", std::string())) + "</td><td>" +
+           escape(o.value("material", std::string())) + "</td><td class=\"num\">" +
+           std::to_string(o.value("pixels", 0)) + "</td><td class=\"num\">" + fixed(o.value("rmse", 0.0), 5) +
+           "</td><td class=\"num\">" + fixed(100 * o.value("share_over_2_255", 0.0), 2) + "</td></tr>";
     }
     h += "</table>";
   }
@@ -297,10 +306,24 @@ void timing(std::string& h, const json& r) {
   h += "</table>";
   const json& points = r["sweep"]["points"];
   if (!points.empty()) {
-    Plot speed{"abuffer: error against time, one point a cube resolution N", "time, ms", "PSNR against raytrace, dB",
-               {}, {}, {}, "", false, false};
-    Plot bound{"abuffer: Error_Parallax of reflection rays against N", "N (texels a face edge)", "Error_Parallax",
-               {}, {}, {}, "the thesis's bound 1/(2 N^2)", true, true};
+    Plot speed{"abuffer: error against time, one point a cube resolution N",
+               "time, ms",
+               "PSNR against raytrace, dB",
+               {},
+               {},
+               {},
+               "",
+               false,
+               false};
+    Plot bound{"abuffer: Error_Parallax of reflection rays against N",
+               "N (texels a face edge)",
+               "Error_Parallax",
+               {},
+               {},
+               {},
+               "the thesis's bound 1/(2 N^2)",
+               true,
+               true};
     for (const json& p : points) {
       const json& db = p["error"]["psnr_db"];
       speed.points.push_back({p.value("total_ms", 0.0), db.is_number() ? db.get<double>() : 200.0});
@@ -378,10 +401,13 @@ void context(std::string& h, const json& r) {
   const json& c = r["context"];
   h += "<h3>Machine</h3><table>";
   for (const char* k : {"version", "gl_path", "gl_renderer", "cpu", "cores", "memory", "host"}) {
-    if (c.contains(k)) h += std::string("<tr><td>") + k + "</td><td>" + escape(c[k].is_string() ? c[k].get<std::string>() : c[k].dump()) + "</td></tr>";
+    if (c.contains(k))
+      h += std::string("<tr><td>") + k + "</td><td>" +
+           escape(c[k].is_string() ? c[k].get<std::string>() : c[k].dump()) + "</td></tr>";
   }
   h += "</table><h3>Scene</h3><table>";
-  for (const auto& [k, v] : c["scene"].items()) h += "<tr><td>" + escape(k) + "</td>" + figure(r, "context.scene." + k, 0) + "</tr>";
+  for (const auto& [k, v] : c["scene"].items())
+    h += "<tr><td>" + escape(k) + "</td>" + figure(r, "context.scene." + k, 0) + "</tr>";
   h += "</table><p class=\"note\">Renders took " + fixed(r.value("render_ms", 0.0), 0) + " ms; the report's own work " +
        fixed(r.value("report_ms", 0.0), 0) + " ms.</p>";
 }

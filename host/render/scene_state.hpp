@@ -12,15 +12,14 @@ namespace abcube {
 // Where a scene came from, so that it can be loaded again with values replaced
 // (Scene::with_overrides): a file, or JSON text with its name and folder.
 struct SceneSource {
-  std::string path;       // the file; empty for text
+  std::string path;  // the file; empty for text
   std::string text, name, base_dir;
   SceneLimits limits;
-  SceneOverrides set;     // the overrides it was loaded with
+  SceneOverrides set;  // the overrides it was loaded with
 };
 
 struct Scene::State {
-  State(SceneData d, double ms, SceneSource s)
-      : data(std::move(d)), cache(data), load_ms(ms), source(std::move(s)) {}
+  State(SceneData d, double ms, SceneSource s) : data(std::move(d)), cache(data), load_ms(ms), source(std::move(s)) {}
   State(const State&) = delete;
   State& operator=(const State&) = delete;
 

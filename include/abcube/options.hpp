@@ -48,8 +48,8 @@ enum class OptionScope {
 };
 
 struct OptionSpec {
-  std::string key;    // batch job key and Python keyword: "cube_res"
-  std::string flag;   // command line: "--cube-res"
+  std::string key;   // batch job key and Python keyword: "cube_res"
+  std::string flag;  // command line: "--cube-res"
   OptionKind kind;
   OptionScope scope;
   std::vector<std::string> choices;  // choice and names: the values taken

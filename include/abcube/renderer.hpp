@@ -50,36 +50,37 @@ bool stop_requested();
 // scene file's camera is (fov_y in (0, 180) degrees, sizes >= 1, up not along the view).
 struct CameraOverride {
   std::optional<std::array<double, 3>> position, look_at, up;
-  std::optional<double> fov_y;   // degrees
+  std::optional<double> fov_y;       // degrees
   std::optional<int> width, height;  // pixels
 };
 
 // The names the string options accept (the CLI's --help and the messages list them too).
 // Empty strings and negative numbers mean "the scene's own value".
 struct RenderOptions {
-  std::string method;            // abuffer | zbuffer | envmap | raytrace | gpu | hybrid ("" = render.method)
-  int cube_resolution = 0;       // N texels per face edge (0 = render.cube_resolution, or error_target's)
-  int max_depth = -1;            // bounces (< 0 = render.max_depth)
-  double error_target = -1;      // > 0: N from the Error_Parallax bound 1/(2 N^2) (< 0 = the scene's)
-  std::optional<bool> fresnel;   // Schlick weights for kr and kt (unset = the scene's)
-  int threads = 0;               // 0 = the Renderer's (RendererOptions::threads)
-  bool reference = false;        // also trace the exact reference: error figures in the stats
-  std::string reference_image;   // the exact image rendered before (implies reference)
-  bool plan_everything = false;  // run the steps the plan would skip, to time them
-  std::string search = "crossing";   // crossing | thesis (map searches, thesis 7.4)
-  std::string refine = "mesh";       // mesh | plane (crossing refinement)
-  double theta_max_deg = 2.0;        // thesis mode's acceptance angle, degrees
-  std::string refraction = "search"; // search | thick_lens | thin_lens
-  std::string envmap_lookup = "R";   // R | bisector | position (envmap method)
-  std::string resolve = "exact";     // intersecting fragments: exact (priority masks) | thesis (Vis_front)
-  bool side_structure = true;        // searches also test the triangles the map cannot hold (false: --map-only)
-  std::string gpu_mirrors = "stencil";  // gpu: planar mirrors by the stencil test | envmap (every mirror from the cube texture)
+  std::string method;                 // abuffer | zbuffer | envmap | raytrace | gpu | hybrid ("" = render.method)
+  int cube_resolution = 0;            // N texels per face edge (0 = render.cube_resolution, or error_target's)
+  int max_depth = -1;                 // bounces (< 0 = render.max_depth)
+  double error_target = -1;           // > 0: N from the Error_Parallax bound 1/(2 N^2) (< 0 = the scene's)
+  std::optional<bool> fresnel;        // Schlick weights for kr and kt (unset = the scene's)
+  int threads = 0;                    // 0 = the Renderer's (RendererOptions::threads)
+  bool reference = false;             // also trace the exact reference: error figures in the stats
+  std::string reference_image;        // the exact image rendered before (implies reference)
+  bool plan_everything = false;       // run the steps the plan would skip, to time them
+  std::string search = "crossing";    // crossing | thesis (map searches, thesis 7.4)
+  std::string refine = "mesh";        // mesh | plane (crossing refinement)
+  double theta_max_deg = 2.0;         // thesis mode's acceptance angle, degrees
+  std::string refraction = "search";  // search | thick_lens | thin_lens
+  std::string envmap_lookup = "R";    // R | bisector | position (envmap method)
+  std::string resolve = "exact";      // intersecting fragments: exact (priority masks) | thesis (Vis_front)
+  bool side_structure = true;         // searches also test the triangles the map cannot hold (false: --map-only)
+  std::string gpu_mirrors =
+      "stencil";  // gpu: planar mirrors by the stencil test | envmap (every mirror from the cube texture)
   std::string gpu_shadows = "volumes";  // gpu: shadow volumes | maps (cube shadow maps)
   int gpu_max_views = 256;              // gpu: mirror views drawn per camera tile, at most
   std::string gpu_shading = "pixels";   // gpu: shade once a pixel and surface | once a sample
-  uint32_t max_layers = 0;       // A-buffer layers kept per list (0 = all)
-  uint64_t max_memory_mib = 0;   // the whole render's memory budget, MiB (0 = the memory available)
-  uint64_t max_pixels = 0;       // refuse a camera image larger than this (0 = no cap)
+  uint32_t max_layers = 0;              // A-buffer layers kept per list (0 = all)
+  uint64_t max_memory_mib = 0;          // the whole render's memory budget, MiB (0 = the memory available)
+  uint64_t max_pixels = 0;              // refuse a camera image larger than this (0 = no cap)
   CameraOverride camera;
   // Extra per-pixel outputs, each an Image in RenderResult::aovs, from the eye ray through
   // the pixel centre (the exact tracer on the same triangles, whatever the method):
@@ -91,8 +92,8 @@ struct RenderOptions {
   // refraction-exit miss, a shadow walk on a zero-area surface or aborted, a lens transfer
   // that fell back to a search; 0 where none was made and for the other methods).
   std::vector<std::string> aovs;
-  bool stats = true;             // fill RenderResult::stats (cheap; off saves its JSON)
-  double timeout_s = 0;          // > 0: stop with RenderTimeout past this many seconds
+  bool stats = true;     // fill RenderResult::stats (cheap; off saves its JSON)
+  double timeout_s = 0;  // > 0: stop with RenderTimeout past this many seconds
   // Called on the rendering thread with a stage name and the share done, in [0, 1].
   std::function<void(const std::string& stage, double done)> progress;
 };
@@ -104,18 +105,18 @@ struct RenderStats {
   // Per pass; the exact tracer's as "raytrace.trace", "reference.bvh_build", ...; no
   // scene loading (Scene::load_ms; the CLI adds it as "load").
   std::map<std::string, double> timings_ms;
-  std::string gl_path;                       // "egl-surfaceless", "osmesa", ... or "none"
+  std::string gl_path;  // "egl-surfaceless", "osmesa", ... or "none"
   std::string gl_renderer;
   // Per-scene data built by THIS render (0 when an earlier render of the scene built it):
   // the searches' mesh neighbours, the lens fits, the tracer's BVH.
   int scene_data_built = 0;
-  std::optional<double> psnr_db;             // with reference: the image against the exact one
-  std::string json;                          // everything, as a JSON object (2-space indent)
+  std::optional<double> psnr_db;  // with reference: the image against the exact one
+  std::string json;               // everything, as a JSON object (2-space indent)
 };
 
 struct RenderResult {
-  Image image;                          // linear RGB, height x width
-  std::map<std::string, Image> aovs;    // as asked in RenderOptions::aovs
+  Image image;                        // linear RGB, height x width
+  std::map<std::string, Image> aovs;  // as asked in RenderOptions::aovs
   RenderStats stats;
 };
 

@@ -8,8 +8,8 @@
 
 namespace abcube {
 
-struct SceneData;   // the loaded scene (cpu_core/scene/scene_data.hpp)
-class SceneCache;   // its per-scene search and tracer data (cpu_core/shading/scene_cache.hpp)
+struct SceneData;  // the loaded scene (cpu_core/scene/scene_data.hpp)
+class SceneCache;  // its per-scene search and tracer data (cpu_core/shading/scene_cache.hpp)
 
 // Limits for scenes from untrusted sources. Refused with an InputError before anything
 // is allocated for them.
@@ -56,15 +56,15 @@ class Scene {
   // values replaced; the scene itself when `set` is empty.
   Scene with_overrides(const SceneOverrides& set) const;
 
-  const std::string& name() const;   // the file as given, for messages
-  int width() const;                 // camera image size in pixels
+  const std::string& name() const;  // the file as given, for messages
+  int width() const;                // camera image size in pixels
   int height() const;
   size_t triangle_count() const;
   size_t object_count() const;
-  std::string method() const;        // render.method of the file
-  int cube_resolution() const;       // render.cube_resolution (N)
-  int max_depth() const;             // render.max_depth
-  double load_ms() const;            // what loading took (parse, validate, tessellate)
+  std::string method() const;   // render.method of the file
+  int cube_resolution() const;  // render.cube_resolution (N)
+  int max_depth() const;        // render.max_depth
+  double load_ms() const;       // what loading took (parse, validate, tessellate)
   // What loaded but is likely a mistake, one line each naming the place (a mesh without
   // triangles: "scene.json: objects[2].file: warning: mesh \"empty.obj\" has no triangles").
   // The CLI prints them on stderr; nothing else does.

@@ -159,10 +159,14 @@ TEST(ErrorsQuote, EscapesControlBytesAndQuotes) {
   EXPECT_EQ(quote(std::string("a\nb\rc\td\0e\x7f", 10)), "\"a\\nb\\rc\\td\\x00e\\x7F\"");
   // UTF-8 passes; the C1 control U+009B (CSI) and bytes that are not UTF-8 are escaped.
   EXPECT_EQ(quote("verre \xC3\xA9 \xE2\x82\xAC"), "\"verre \xC3\xA9 \xE2\x82\xAC\"");
-  EXPECT_EQ(quote("\xC2\x9B" "31m"), "\"\\xC2\\x9B31m\"");
-  EXPECT_EQ(quote("\x9B" "31m \xFF \xC3"), "\"\\x9B31m \\xFF \\xC3\"");
+  EXPECT_EQ(quote("\xC2\x9B"
+                  "31m"),
+            "\"\\xC2\\x9B31m\"");
+  EXPECT_EQ(quote("\x9B"
+                  "31m \xFF \xC3"),
+            "\"\\x9B31m \\xFF \\xC3\"");
   EXPECT_EQ(quote("\xED\xA0\x80"), "\"\\xED\\xA0\\x80\"");  // a surrogate
-  EXPECT_EQ(printable("a\x1b[2Jb\"\\"), "a\\e[2Jb\"\\");     // unquoted: " and \ stay
+  EXPECT_EQ(printable("a\x1b[2Jb\"\\"), "a\\e[2Jb\"\\");    // unquoted: " and \ stay
 }
 
 TEST(ErrorsQuote, LongTextIsCutWithItsLength) {

@@ -83,7 +83,7 @@ TEST(HardCases, QuadsMeetingAtOneDegreeSplitEachPixelAsTheirPlanes) {
       int green_samples = 0;
       for (int k = 0; k < MASK_SAMPLES; ++k) {
         const glm::dvec3 d = frame.direction(x + sample_dx(k), y + sample_dy(k));
-        const double t_red = -frame.eye.y / d.y;                                       // y = 0
+        const double t_red = -frame.eye.y / d.y;                                           // y = 0
         const double t_green = (slope * frame.eye.z - frame.eye.y) / (d.y - slope * d.z);  // y = slope z
         green_samples += t_green < t_red;
       }
@@ -162,8 +162,8 @@ Scene glass_scene(const std::string& objects, const std::string& name) {
     "objects": [)";
   for (int i = -6; i < 6; ++i) {  // stripes along z
     const double x = (i + 0.5) * 0.5;
-    s << R"({"type": "quad", "material": ")" << (i % 2 ? "a" : "b") << R"(", "vertices": [[)" << x - 0.25
-      << ",0,-4],[" << x - 0.25 << ",0,4],[" << x + 0.25 << ",0,4],[" << x + 0.25 << ",0,-4]]},";
+    s << R"({"type": "quad", "material": ")" << (i % 2 ? "a" : "b") << R"(", "vertices": [[)" << x - 0.25 << ",0,-4],["
+      << x - 0.25 << ",0,4],[" << x + 0.25 << ",0,4],[" << x + 0.25 << ",0,-4]]},";
   }
   s << objects << R"(], "render": {"cube_resolution": 256, "max_depth": 6}})";
   return Scene::from_json(s.str(), name);
@@ -208,8 +208,10 @@ TEST(HardCases, TouchingBoxesOfOneGlassLookLikeOneBox) {
 // map finds the inner sphere and the second box (the exit search is no longer restricted to
 // the entered object) and agrees with the tracer.
 TEST(HardCases, NestedAndTouchingGlassAgreeWithTheTracer) {
-  const std::string glass = R"({"type": "sphere", "center": [-0.6, 0.65, 0], "radius": 0.6, "segments": 48, "material": "glass"})";
-  const std::string water = R"({"type": "sphere", "center": [-0.55, 0.7, 0], "radius": 0.35, "segments": 40, "material": "water"})";
+  const std::string glass =
+      R"({"type": "sphere", "center": [-0.6, 0.65, 0], "radius": 0.6, "segments": 48, "material": "glass"})";
+  const std::string water =
+      R"({"type": "sphere", "center": [-0.55, 0.7, 0], "radius": 0.35, "segments": 40, "material": "water"})";
   const std::string boxes = R"({"type": "box", "min": [0.5, 0, -0.3], "max": [1.1, 0.6, 0.3], "material": "glass"},
       {"type": "box", "min": [1.1, 0, -0.3], "max": [1.7, 0.7, 0.3], "material": "water"})";
   const Scene nested = glass_scene(glass + "," + water + "," + boxes, "nested.json");

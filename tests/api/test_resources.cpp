@@ -69,8 +69,8 @@ constexpr double RISE_MB = 48;
 // 2.8 GB of scene data).
 std::string with_sphere(int segments) {
   std::string json = tiny_scene_json(32, 24, 32);
-  const std::string sphere = R"({ "type": "sphere", "center": [0, 3, 0], "radius": 0.2, "segments": )" +
-                             std::to_string(segments) + R"( },
+  const std::string sphere =
+      R"({ "type": "sphere", "center": [0, 3, 0], "radius": 0.2, "segments": )" + std::to_string(segments) + R"( },
     )";
   json.insert(json.find("{ \"type\": \"quad\""), sphere);
   return json;
@@ -102,7 +102,7 @@ TEST(ResourcesApi, CapsRefuseBeforeAllocating) {
   SceneLimits by_count;
   by_count.max_triangles = 100000;
   rises.emplace_back("max_triangles", refused_rise_mb([&] { Scene::from_json(big, "big", ".", by_count); },
-                                                       {"objects[0].segments", "16769024 triangles", "100000"}));
+                                                      {"objects[0].segments", "16769024 triangles", "100000"}));
   SceneLimits by_memory;
   by_memory.max_memory_mib = 64;
   rises.emplace_back("max_memory at load", refused_rise_mb([&] { Scene::from_json(big, "big", ".", by_memory); },
@@ -126,8 +126,10 @@ TEST(ResourcesApi, CapsRefuseBeforeAllocating) {
   RenderOptions cube;
   cube.cube_resolution = 1024;  // 6 x 1024^2 texels: 384 MiB estimated beside the fragments
   cube.max_memory_mib = 440;
-  rises.emplace_back("max_memory, A-buffer", refused_rise_mb([&] { renderer.render(tiny, cube); },
-                                                             {"cube A-buffer needs", "beside", "fragments at 20 bytes) beside", "above --max-memory 440 MiB"}));
+  rises.emplace_back("max_memory, A-buffer",
+                     refused_rise_mb([&] { renderer.render(tiny, cube); },
+                                     {"cube A-buffer needs", "beside", "fragments at 20 bytes) beside",
+                                      "above --max-memory 440 MiB"}));
   for (const auto& [what, rise] : rises) {
     std::printf("%s: peak resident +%.1f MB\n", what.c_str(), rise);
     EXPECT_GE(rise, 0.0) << what;

@@ -68,7 +68,8 @@ struct CoplanarPair {
 std::string scene_json(const std::string& camera, const std::string& objects) {
   std::ostringstream s;
   s << R"({"version": 1, "camera": )" << camera << R"(, "background": [0, 0, 1], "ambient": [1, 1, 1],
-    "lights": [], )" << MATERIALS << R"(, "objects": [)" << objects
+    "lights": [], )"
+    << MATERIALS << R"(, "objects": [)" << objects
     << R"(], "render": {"method": "abuffer", "cube_resolution": 128, "max_depth": 2}})";
   return s.str();
 }
@@ -99,14 +100,16 @@ int wrong_pixels(const Image& image, const CameraFrame& frame, Seen&& seen, int*
   for (int y = 0; y < frame.height; ++y) {
     for (int x = 0; x < frame.width; ++x) {
       glm::dvec3 expected(0.0);
-      for (int k = 0; k < MASK_SAMPLES; ++k) expected += seen(frame.eye, frame.direction(x + sample_dx(k), y + sample_dy(k)));
+      for (int k = 0; k < MASK_SAMPLES; ++k)
+        expected += seen(frame.eye, frame.direction(x + sample_dx(k), y + sample_dy(k)));
       expected /= double(MASK_SAMPLES);
       *green_pixels += expected == glm::dvec3(0, 1, 0);
       const glm::dvec3 got(image.rgb(x, y));
       const glm::dvec3 e = glm::abs(got - expected);
       if (std::max(e.x, std::max(e.y, e.z)) > 1e-5 + samples_off / double(MASK_SAMPLES)) {
-        if (wrong < 5) ADD_FAILURE() << "pixel " << x << ", " << y << ": " << got.x << " " << got.y << " " << got.z
-                                     << ", expected " << expected.x << " " << expected.y << " " << expected.z;
+        if (wrong < 5)
+          ADD_FAILURE() << "pixel " << x << ", " << y << ": " << got.x << " " << got.y << " " << got.z << ", expected "
+                        << expected.x << " " << expected.y << " " << expected.z;
         ++wrong;
       }
     }
@@ -148,17 +151,17 @@ TEST_P(CoplanarQuads, TheLaterObjectWinsOnEveryPath) {
       R"({"position": [0.4, 1.9, 2.1], "look_at": [0.1, 0.1, 0.05], "fov_y": 45, "width": 64, "height": 48})";
   for (const bool tilted : {false, true}) {
     const CoplanarPair pair = tilted ? tilted_pair() : flat_pair();
-    const Scene scene = Scene::from_json(scene_json(camera, pair.red.json("red") + ", " + pair.green.json("green")),
-                                         "coplanar.json");
+    const Scene scene =
+        Scene::from_json(scene_json(camera, pair.red.json("red") + ", " + pair.green.json("green")), "coplanar.json");
     Renderer renderer(RendererOptions{GetParam() == "gpu" ? "auto" : "none", -1, 0});
     RenderOptions o;
     o.method = GetParam();
     const Image image = renderer.render(scene, o).image;
     const CameraFrame frame = make_camera_frame(scene.data().camera);
     int green = 0;
-    const int wrong = wrong_pixels(image, frame,
-                                   [&](const glm::dvec3& eye, const glm::dvec3& d) { return pair.seen(eye, d); }, &green,
-                                   GetParam() == "gpu" ? 1 : 0);
+    const int wrong = wrong_pixels(
+        image, frame, [&](const glm::dvec3& eye, const glm::dvec3& d) { return pair.seen(eye, d); }, &green,
+        GetParam() == "gpu" ? 1 : 0);
     EXPECT_EQ(wrong, 0) << GetParam() << (tilted ? ", tilted plane" : ", plane y = 0");
     EXPECT_GE(green, 200) << "the overlap fills many pixels";
   }

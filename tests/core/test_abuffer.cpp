@@ -179,7 +179,8 @@ TEST(ABuffer, EachDirectionLandsInItsCubeTexel) {
     EXPECT_EQ(face.list(t.i, t.j).size(), 1u) << cube_face_name(t.face);
     int near_texel = 0;
     for (int j = std::max(t.j - 1, 0); j <= std::min(t.j + 1, n - 1); ++j) {
-      for (int i = std::max(t.i - 1, 0); i <= std::min(t.i + 1, n - 1); ++i) near_texel += static_cast<int>(face.list(i, j).size());
+      for (int i = std::max(t.i - 1, 0); i <= std::min(t.i + 1, n - 1); ++i)
+        near_texel += static_cast<int>(face.list(i, j).size());
     }
     size_t everywhere = 0;
     for (const ABuffer* b : rasters(cube)) everywhere += b->fragments.size();
@@ -292,7 +293,8 @@ TEST(ABuffer, RefusesAboveTheMemoryBudgetWithTheEstimate) {
   } catch (const InputError& e) {
     const std::string msg = e.what();
     EXPECT_TRUE(std::regex_search(msg, std::regex(" fragments at 20 bytes\\) beside 1 MiB for the rest of the render, "
-                                                  "above --max-memory [0-9]+ MiB$"))) << msg;
+                                                  "above --max-memory [0-9]+ MiB$")))
+        << msg;
   }
   o.reserved_bytes = 0;
   o.max_memory_bytes = 1024;  // not even the per-pixel index fits
@@ -414,7 +416,7 @@ TEST(ABuffer, NearestLayerMatchesTheExactTracer) {
     }
   }
   EXPECT_GT(hits, 1000);
-  EXPECT_GE(same, hits * 95 / 100) << same << " of " << hits;  // 1235 of 1266 when written
+  EXPECT_GE(same, hits * 95 / 100) << same << " of " << hits;                    // 1235 of 1266 when written
   EXPECT_GE(with_fragment, hits * 95 / 100) << with_fragment << " of " << hits;  // 1252
 }
 

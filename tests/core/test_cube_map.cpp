@@ -113,8 +113,8 @@ TEST(Camera, ClipMatrixMatchesRayDirections) {
   c.height = 200;
   c.fov_y_deg = 50;
   const CameraFrame f = make_camera_frame(c);
-  const glm::dmat4 m(camera_clip_matrix(c.position, c.look_at, c.up, glm::radians(c.fov_y_deg),
-                                        double(c.width) / c.height, 0.01));
+  const glm::dmat4 m(
+      camera_clip_matrix(c.position, c.look_at, c.up, glm::radians(c.fov_y_deg), double(c.width) / c.height, 0.01));
   for (double x : {0.5, 100.25, 319.5}) {
     for (double y : {0.5, 77.0, 199.5}) {
       const glm::dvec4 clip = m * glm::dvec4(f.eye + 4.0 * f.direction(x, y), 1.0);

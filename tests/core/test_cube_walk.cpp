@@ -27,8 +27,8 @@ struct Ray {
 std::string describe(const Ray& r, int n) {
   std::ostringstream s;
   s.precision(17);
-  s << "n=" << n << " W=(" << r.w.x << "," << r.w.y << "," << r.w.z << ") D=(" << r.d.x << "," << r.d.y << ","
-    << r.d.z << ") l_max=" << r.l_max << " skip=" << r.skip;
+  s << "n=" << n << " W=(" << r.w.x << "," << r.w.y << "," << r.w.z << ") D=(" << r.d.x << "," << r.d.y << "," << r.d.z
+    << ") l_max=" << r.l_max << " skip=" << r.skip;
   return s.str();
 }
 
@@ -179,7 +179,8 @@ TEST(CubeWalk, CostIsLinearInN) {
   std::uniform_real_distribution<double> u(-3, 3);
   for (const int n : {8, 64, 512}) {
     size_t most = 0;
-    for (int k = 0; k < 200; ++k) most = std::max(most, walk_all({glm::dvec3(u(rng), u(rng), u(rng)), random_unit(rng)}, n).size());
+    for (int k = 0; k < 200; ++k)
+      most = std::max(most, walk_all({glm::dvec3(u(rng), u(rng), u(rng)), random_unit(rng)}, n).size());
     EXPECT_LE(most, static_cast<size_t>(8 * n + 8)) << n;
     EXPECT_GE(most, static_cast<size_t>(n)) << n;  // some arc of 200 crosses a whole face
   }
@@ -194,8 +195,9 @@ TEST(CubeWalk, RaysAlongSeamsEdgesAndCorners) {
     // Arcs through a cube corner (1,1,1) and (-1,1,-1): X(2) is exactly that direction.
     check_walk({glm::dvec3(3, 3, 1), glm::dvec3(0, 0, 1)}, n);
     check_walk({glm::dvec3(-3, 1, -3), glm::dvec3(0, 1, 0)}, n);
-    check_walk({glm::dvec3(3, 3, 3) - 2.0 * glm::normalize(glm::dvec3(0.6, 0.8, 0)),
-                glm::normalize(glm::dvec3(0.6, 0.8, 0))}, n);
+    check_walk(
+        {glm::dvec3(3, 3, 3) - 2.0 * glm::normalize(glm::dvec3(0.6, 0.8, 0)), glm::normalize(glm::dvec3(0.6, 0.8, 0))},
+        n);
     // Starting exactly on a seam, on a corner, and heading into another face.
     check_walk({glm::dvec3(1, 1, 0.2), glm::normalize(glm::dvec3(-1, 0.5, 0.3))}, n);
     check_walk({glm::dvec3(1, 1, 1), glm::normalize(glm::dvec3(0.3, -1, 0.2))}, n);

@@ -34,7 +34,7 @@ TEST(EdgeTies, AnEdgeAlongASampleRowMarksEveryPixelItCrosses) {
   add_ledge(s, 0.3125);
   const std::vector<uint8_t> m = edge_tie_pixels(s);
   for (int x = 5; x <= 10; ++x) EXPECT_TRUE(marked(m, x, 4)) << "pixel " << x;
-  EXPECT_FALSE(marked(m, 4, 4));   // beyond the edge's ends
+  EXPECT_FALSE(marked(m, 4, 4));  // beyond the edge's ends
   EXPECT_FALSE(marked(m, 11, 4));
   for (int y : {3, 5}) {
     for (int x = 5; x <= 10; ++x) EXPECT_FALSE(marked(m, x, y)) << "pixel " << x << ", " << y;

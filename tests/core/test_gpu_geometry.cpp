@@ -19,8 +19,10 @@ namespace abcube {
 namespace {
 
 SceneData scene_of(const std::string& materials, const std::string& objects, const std::string& lights = "[]") {
-  const std::string text = R"({"version": 1, "camera": {"position": [0, 1, 6], "look_at": [0, 0, 0], "width": 8, "height": 8},
-    "lights": )" + lights + R"(, "materials": )" + materials + R"(, "objects": )" + objects + "}";
+  const std::string text =
+      R"({"version": 1, "camera": {"position": [0, 1, 6], "look_at": [0, 0, 0], "width": 8, "height": 8},
+    "lights": )" +
+      lights + R"(, "materials": )" + materials + R"(, "objects": )" + objects + "}";
   return load_scene_text(text, "scene.json", ".");
 }
 
@@ -63,8 +65,9 @@ TEST(PlanarReflectors, FacetedObjectsAndTheSmallestPastTheCapAreCurved) {
   const size_t many = MAX_REFLECTORS + 6;
   for (size_t k = 0; k < many; ++k) {
     const double e = 0.1 + 0.01 * static_cast<double>(k), y = static_cast<double>(k);
-    objects += (k ? "," : "") + std::string(R"({"type": "triangle", "material": "mirror", "vertices": [[0, )") + std::to_string(y) +
-               ", 0], [0, " + std::to_string(y) + ", " + std::to_string(e) + "], [" + std::to_string(e) + ", " + std::to_string(y) + ", 0]]}";
+    objects += (k ? "," : "") + std::string(R"({"type": "triangle", "material": "mirror", "vertices": [[0, )") +
+               std::to_string(y) + ", 0], [0, " + std::to_string(y) + ", " + std::to_string(e) + "], [" +
+               std::to_string(e) + ", " + std::to_string(y) + ", 0]]}";
   }
   objects += "]";
   const SceneData s = scene_of(MATERIALS, objects);
@@ -95,8 +98,10 @@ TEST(PlanarReflectors, FacetedObjectsAndTheSmallestPastTheCapAreCurved) {
     }
     for (size_t k = 0; k < facets; ++k) std::fprintf(f, "f 1 %zu %zu\n", 2 + (k + 1) % facets, 2 + k);
     std::fclose(f);
-    const std::string text = std::string(R"({"version": 1, "camera": {"position": [0, 1, 6], "look_at": [0, 0, 0], "width": 8, "height": 8},
-      "lights": [], "materials": )") + MATERIALS + R"(, "objects": [{"type": "mesh", "file": ")" + obj + R"(", "material": "mirror"}]})";
+    const std::string text =
+        std::string(R"({"version": 1, "camera": {"position": [0, 1, 6], "look_at": [0, 0, 0], "width": 8, "height": 8},
+      "lights": [], "materials": )") +
+        MATERIALS + R"(, "objects": [{"type": "mesh", "file": ")" + obj + R"(", "material": "mirror"}]})";
     const PlanarReflectors c = find_planar_reflectors(load_scene_text(text, "scene.json", dir));
     if (facets <= MAX_PLANES_PER_OBJECT) {
       EXPECT_EQ(c.reflectors.size(), facets);
@@ -136,11 +141,13 @@ bool closed_and_oriented(const SceneData& s, const ShadowVolume& volume, std::st
 }
 
 TEST(ShadowVolume, AQuadIsTwoPrismsWithTheirCommonSideLeftOut) {
-  const SceneData s = scene_of(MATERIALS, R"([{"type": "quad", "vertices": [[-1, 0, -1], [-1, 0, 1], [1, 0, 1], [1, 0, -1]], "material": "matte"}])");
+  const SceneData s = scene_of(
+      MATERIALS,
+      R"([{"type": "quad", "vertices": [[-1, 0, -1], [-1, 0, 1], [1, 0, 1], [1, 0, -1]], "material": "matte"}])");
   const ShadowVolume v = build_shadow_volume(s, glm::dvec3(0.2, 3, 0.1));
   EXPECT_EQ(v.blockers, 2u);
-  EXPECT_EQ(v.sides, 4u);             // the quad's outline
-  EXPECT_EQ(v.sides_cancelled, 2u);   // the diagonal, once from each triangle
+  EXPECT_EQ(v.sides, 4u);            // the quad's outline
+  EXPECT_EQ(v.sides_cancelled, 2u);  // the diagonal, once from each triangle
   EXPECT_EQ(volume_triangles(v, *s.triangles).size(), 2u * 6 + 4u * 6);
   EXPECT_EQ(v.triangle_count(), 2u * 2 + 4u * 2);
   EXPECT_EQ(v.caps, (std::vector<uint8_t>{CAP, CAP}));
@@ -177,7 +184,8 @@ TEST(ShadowVolume, BlockersByKindAndLightsOnSurfacesLeftOut) {
 // behind the box. (Leaving them out for every closed object was tried: the light on a mirror
 // of tests/cli/flat_mirrors.sh lost its shadows, 18.5 dB.)
 TEST(ShadowVolume, AClosedBoxCastsFromEveryFaceUnlessTheLightIsOutside) {
-  const SceneData s = scene_of(MATERIALS, R"([{"type": "box", "min": [-1, 0, -1], "max": [1, 1, 1], "material": "matte"}])");
+  const SceneData s =
+      scene_of(MATERIALS, R"([{"type": "box", "min": [-1, 0, -1], "max": [1, 1, 1], "material": "matte"}])");
   ASSERT_TRUE(s.objects[0].closed);
   std::string why;
   const ShadowVolume inside = build_shadow_volume(s, glm::dvec3(0.1, 0.5, 0.2));
@@ -211,12 +219,14 @@ TEST(ShadowVolume, ALightInAConcavityIsOutside) {
   {
     std::FILE* f = std::fopen((dir + "/l_prism.obj").c_str(), "w");
     ASSERT_NE(f, nullptr);
-    std::fputs("v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\n"
-               "v 0 0 1\nv 2 0 1\nv 2 1 1\nv 1 1 1\nv 1 2 1\nv 0 2 1\n"
-               "f 1 3 2\nf 1 4 3\nf 1 6 4\nf 4 6 5\n"        // z = 0, outward -z
-               "f 7 8 9\nf 7 9 10\nf 7 10 12\nf 10 11 12\n"  // z = 1, outward +z
-               "f 1 2 8\nf 1 8 7\nf 2 3 9\nf 2 9 8\nf 3 4 10\nf 3 10 9\n"
-               "f 4 5 11\nf 4 11 10\nf 5 6 12\nf 5 12 11\nf 6 1 7\nf 6 7 12\n", f);
+    std::fputs(
+        "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\n"
+        "v 0 0 1\nv 2 0 1\nv 2 1 1\nv 1 1 1\nv 1 2 1\nv 0 2 1\n"
+        "f 1 3 2\nf 1 4 3\nf 1 6 4\nf 4 6 5\n"        // z = 0, outward -z
+        "f 7 8 9\nf 7 9 10\nf 7 10 12\nf 10 11 12\n"  // z = 1, outward +z
+        "f 1 2 8\nf 1 8 7\nf 2 3 9\nf 2 9 8\nf 3 4 10\nf 3 10 9\n"
+        "f 4 5 11\nf 4 11 10\nf 5 6 12\nf 5 12 11\nf 6 1 7\nf 6 7 12\n",
+        f);
     std::fclose(f);
   }
   const std::string text = R"({"version": 1, "camera": {"position": [0, 1, 6], "look_at": [0, 0, 0], "width": 8,
@@ -254,11 +264,12 @@ TEST(ShadowVolume, FacesAtInfinityClippedCountTheShadowEverywhere) {
   const std::vector<ShadowVolumeVertex> all = volume_triangles(v, *s.triangles);
   for (size_t i = 0; i < all.size(); i += 3) {
     if (all[i].position.w == 1.f && all[i + 1].position.w == 1.f && all[i + 2].position.w == 1.f) {
-      finite.insert(finite.end(), all.begin() + static_cast<std::ptrdiff_t>(i), all.begin() + static_cast<std::ptrdiff_t>(i + 3));
+      finite.insert(finite.end(), all.begin() + static_cast<std::ptrdiff_t>(i),
+                    all.begin() + static_cast<std::ptrdiff_t>(i + 3));
     }
   }
-  EXPECT_EQ(finite.size(), 6u);                // the two near caps
-  EXPECT_EQ(all.size(), 6u + 3u * (2 + 8));    // two far caps, four sides of two triangles
+  EXPECT_EQ(finite.size(), 6u);              // the two near caps
+  EXPECT_EQ(all.size(), 6u + 3u * (2 + 8));  // two far caps, four sides of two triangles
   const glm::dmat4 m(camera_clip_matrix(glm::dvec3(0.0), look_at - eye, glm::dvec3(0, 1, 0), glm::radians(49.419),
                                         640.0 / 480.0, 1e-4));
   const size_t triangles = clip_faces_at_infinity(v, *s.triangles, m, eye, 0.0, nullptr, &clipped);
@@ -279,7 +290,8 @@ TEST(ShadowVolume, FacesAtInfinityClippedCountTheShadowEverywhere) {
   // near caps through the same matrix.
   std::vector<std::array<glm::dvec3, 3>> faces;
   for (size_t i = 0; i < clipped.size(); i += 3) {
-    faces.push_back({glm::dvec3(clipped[i].position), glm::dvec3(clipped[i + 1].position), glm::dvec3(clipped[i + 2].position)});
+    faces.push_back(
+        {glm::dvec3(clipped[i].position), glm::dvec3(clipped[i + 1].position), glm::dvec3(clipped[i + 2].position)});
   }
   for (size_t i = 0; i < finite.size(); i += 3) {
     std::array<glm::dvec3, 3> f;
@@ -296,41 +308,41 @@ TEST(ShadowVolume, FacesAtInfinityClippedCountTheShadowEverywhere) {
   int shadowed = 0, lit = 0, skipped = 0;
   constexpr int NX = 160, NY = 120;
   for (const double height : {0.0, 1.0}) {  // the floor (in the quad's wide shadow), a plane above the light (lit)
-  for (int j = 0; j < NY; ++j) {
-    for (int i = 0; i < NX; ++i) {
-      const double x = -1.0 + 2.0 * (i + 0.5) / NX, y = -1.0 + 2.0 * (j + 0.5) / NY;
-      // The plane y = height on this point's ray, and its window depth.
-      const glm::dvec4 far = unproject * glm::dvec4(x, y, 0.5, 1.0);
-      const glm::dvec3 dir = glm::normalize(glm::dvec3(far) / far.w);
-      if (!(dir.y < 0.0)) continue;
-      const glm::dvec3 p = eye + dir * ((height - eye.y) / dir.y);
-      const glm::dvec4 hp = m * glm::dvec4(p - eye, 1.0);
-      const double depth = hp.z / hp.w;
-      // Shadowed: the segment from p to the light meets the quad (its plane between them).
-      const double t = (0.57461057 - p.y) / (light.y - p.y);
-      const glm::dvec3 q = p + t * (light - p);
-      const bool in_shadow = t > 0.0 && t < 1.0 && std::abs(q.x) < 0.964029168 && std::abs(q.z) < 0.328310396;
-      bool near_edge = std::abs(std::abs(q.x) - 0.964029168) < 1e-9 || std::abs(std::abs(q.z) - 0.328310396) < 1e-9;
-      int count = 0;
-      for (const auto& f : faces) {
-        const double e0 = edge(f[0], f[1], x, y), e1 = edge(f[1], f[2], x, y), e2 = edge(f[2], f[0], x, y);
-        const double area = edge(f[0], f[1], f[2].x, f[2].y);
-        if (area == 0.0) continue;
-        const double scale = std::abs(area);
-        if (std::min({std::abs(e0), std::abs(e1), std::abs(e2)}) < 1e-9 * scale) near_edge = true;
-        const bool inside = area > 0 ? (e0 > 0 && e1 > 0 && e2 > 0) : (e0 < 0 && e1 < 0 && e2 < 0);
-        if (!inside) continue;
-        const double z = (e1 * f[0].z + e2 * f[1].z + e0 * f[2].z) / area;
-        if (z <= depth) count += area > 0 ? -1 : 1;  // depth-fail: at or behind; front (CCW) -1
+    for (int j = 0; j < NY; ++j) {
+      for (int i = 0; i < NX; ++i) {
+        const double x = -1.0 + 2.0 * (i + 0.5) / NX, y = -1.0 + 2.0 * (j + 0.5) / NY;
+        // The plane y = height on this point's ray, and its window depth.
+        const glm::dvec4 far = unproject * glm::dvec4(x, y, 0.5, 1.0);
+        const glm::dvec3 dir = glm::normalize(glm::dvec3(far) / far.w);
+        if (!(dir.y < 0.0)) continue;
+        const glm::dvec3 p = eye + dir * ((height - eye.y) / dir.y);
+        const glm::dvec4 hp = m * glm::dvec4(p - eye, 1.0);
+        const double depth = hp.z / hp.w;
+        // Shadowed: the segment from p to the light meets the quad (its plane between them).
+        const double t = (0.57461057 - p.y) / (light.y - p.y);
+        const glm::dvec3 q = p + t * (light - p);
+        const bool in_shadow = t > 0.0 && t < 1.0 && std::abs(q.x) < 0.964029168 && std::abs(q.z) < 0.328310396;
+        bool near_edge = std::abs(std::abs(q.x) - 0.964029168) < 1e-9 || std::abs(std::abs(q.z) - 0.328310396) < 1e-9;
+        int count = 0;
+        for (const auto& f : faces) {
+          const double e0 = edge(f[0], f[1], x, y), e1 = edge(f[1], f[2], x, y), e2 = edge(f[2], f[0], x, y);
+          const double area = edge(f[0], f[1], f[2].x, f[2].y);
+          if (area == 0.0) continue;
+          const double scale = std::abs(area);
+          if (std::min({std::abs(e0), std::abs(e1), std::abs(e2)}) < 1e-9 * scale) near_edge = true;
+          const bool inside = area > 0 ? (e0 > 0 && e1 > 0 && e2 > 0) : (e0 < 0 && e1 < 0 && e2 < 0);
+          if (!inside) continue;
+          const double z = (e1 * f[0].z + e2 * f[1].z + e0 * f[2].z) / area;
+          if (z <= depth) count += area > 0 ? -1 : 1;  // depth-fail: at or behind; front (CCW) -1
+        }
+        if (near_edge) {
+          ++skipped;
+          continue;
+        }
+        EXPECT_EQ(count, in_shadow ? 1 : 0) << "at (" << x << ", " << y << ") on y = " << height;
+        ++(in_shadow ? shadowed : lit);
       }
-      if (near_edge) {
-        ++skipped;
-        continue;
-      }
-      EXPECT_EQ(count, in_shadow ? 1 : 0) << "at (" << x << ", " << y << ") on y = " << height;
-      ++(in_shadow ? shadowed : lit);
     }
-  }
   }
   EXPECT_GT(shadowed, 10000);  // the floor
   EXPECT_GT(lit, 10000);       // the plane above
@@ -338,7 +350,8 @@ TEST(ShadowVolume, FacesAtInfinityClippedCountTheShadowEverywhere) {
 }
 
 TEST(ShadowVolume, SmoothMeshesStayClosed) {
-  const SceneData s = scene_of(MATERIALS, R"([{"type": "sphere", "center": [0, 1, 0], "radius": 0.7, "segments": 24, "material": "matte"}])");
+  const SceneData s = scene_of(
+      MATERIALS, R"([{"type": "sphere", "center": [0, 1, 0], "radius": 0.7, "segments": 24, "material": "matte"}])");
   const ShadowVolume v = build_shadow_volume(s, glm::dvec3(1, 5, 2));
   EXPECT_GT(v.facing_away_left_out, 0u);  // the light outside: its far half casts nothing
   EXPECT_EQ(v.blockers + v.facing_away_left_out, s.triangles->triangle_count());

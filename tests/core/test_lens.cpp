@@ -150,8 +150,7 @@ double axis_crossing(const LensRay& ray, const dvec3& on_axis, const dvec3& trav
 struct Incident {
   dvec3 origin, dir;
 };
-Incident incident(const LensPlacement& pl, const LensShape& shape, bool from_top, double h, double phi,
-                  double tilt) {
+Incident incident(const LensPlacement& pl, const LensShape& shape, bool from_top, double h, double phi, double tilt) {
   const double z = from_top ? shape.sag1() + 1.0 : -shape.sag2() - 1.0;
   const dvec3 across = std::cos(phi) * pl.e1 + std::sin(phi) * pl.e2;
   const dvec3 travel = from_top ? -pl.axis : pl.axis;
@@ -205,8 +204,8 @@ TEST(LensFit, BiconvexRecoversCurvaturesAndThickness) {
   add_lens(s, shape, pl, 64, 128, glass(s, 1.5));
   const LensFit f = fit_lens(s, 0);
   ASSERT_TRUE(f.valid) << f.why_invalid;
-  std::printf("biconvex R1=2 R2=3: rho1 - 1/R1 %.1e, rho2 + 1/R2 %.1e, d error %.1e, rms %.1e %.1e\n",
-              f.rho1 - 0.5, f.rho2 + 1.0 / 3.0, f.thickness - shape.thickness(), f.rms_residual1, f.rms_residual2);
+  std::printf("biconvex R1=2 R2=3: rho1 - 1/R1 %.1e, rho2 + 1/R2 %.1e, d error %.1e, rms %.1e %.1e\n", f.rho1 - 0.5,
+              f.rho2 + 1.0 / 3.0, f.thickness - shape.thickness(), f.rms_residual1, f.rms_residual2);
   EXPECT_GT(glm::dot(f.axis, pl.axis), 1.0 - 1e-12);
   // Vertices are stored as floats (rounding 6e-8 relative): the fit is exact to ~1e-9.
   EXPECT_NEAR(f.rho1, 0.5, 1e-6);
@@ -235,10 +234,11 @@ TEST(LensFit, PlanoConvexHasFlatBack) {
   LensFitOptions literal;
   literal.split = LensSplit::side_of_plane;
   const LensFit g = fit_lens(s, 0, literal);
-  std::printf("plano-convex R1=2: facing rho1 %.6f rho2 %.1e d %.6f (%.6f) rms %.1e %.1e | side_of_plane rho1 %.6f "
-              "rho2 %.4f d %.6f rms %.1e %.1e\n",
-              f.rho1, f.rho2, f.thickness, shape.thickness(), f.rms_residual1, f.rms_residual2, g.rho1, g.rho2,
-              g.thickness, g.rms_residual1, g.rms_residual2);
+  std::printf(
+      "plano-convex R1=2: facing rho1 %.6f rho2 %.1e d %.6f (%.6f) rms %.1e %.1e | side_of_plane rho1 %.6f "
+      "rho2 %.4f d %.6f rms %.1e %.1e\n",
+      f.rho1, f.rho2, f.thickness, shape.thickness(), f.rms_residual1, f.rms_residual2, g.rho1, g.rho2, g.thickness,
+      g.rms_residual1, g.rms_residual2);
   EXPECT_NEAR(f.rho1, 0.5, 1e-6);
   EXPECT_NEAR(f.rho2, 0.0, 1e-6);
   EXPECT_NEAR(f.thickness, shape.thickness(), 1e-6);
@@ -382,9 +382,9 @@ dvec3 plane_crossing(const LensRay& ray, const dvec3& on_plane, const dvec3& nor
 // Errors of both modes against the exact tracer for rays at height h (fraction of the
 // aperture) and slope `tilt`, worst over four azimuths.
 struct ModeErrors {
-  double deviation = 0;  // exact: angle between incident and emerging directions
+  double deviation = 0;                    // exact: angle between incident and emerging directions
   double thick_angle = 0, thin_angle = 0;  // angle between model and exact emerging directions
-  double thick_offset = 0;  // distance between the emerging lines in the exit vertex plane
+  double thick_offset = 0;                 // distance between the emerging lines in the exit vertex plane
   bool ok = true;
 };
 ModeErrors mode_errors(const RayTracer& tracer, const LensFit& f, const LensPlacement& pl, const LensShape& shape,

@@ -132,9 +132,10 @@ TEST_P(MethodsAgainstReference, AbufferIsClosestToTheExactImage) {
   const double p_pl = image_error(pl.image, ref).psnr;
   const double p_ab = image_error(ab.image, ref).psnr, p_th = image_error(th.image, ref).psnr;
   const double p_zb = image_error(zb.image, ref).psnr, p_em = image_error(em.image, ref).psnr;
-  std::printf("[ methods  ] %s %dpx N=256: abuffer %.1f dB (plane refinement only %.1f), thesis %.1f, "
-              "zbuffer %.1f, envmap %.1f\n",
-              c.scene, c.width, p_ab, p_pl, p_th, p_zb, p_em);
+  std::printf(
+      "[ methods  ] %s %dpx N=256: abuffer %.1f dB (plane refinement only %.1f), thesis %.1f, "
+      "zbuffer %.1f, envmap %.1f\n",
+      c.scene, c.width, p_ab, p_pl, p_th, p_zb, p_em);
   std::printf("[ parallax ] abuffer crossing p99 %.2e, thesis p99 %.2e max %.2e, zbuffer misses %.3f\n",
               ab.stats.errors.error_parallax.percentile(0.99), th.stats.errors.error_parallax.percentile(0.99),
               th.stats.errors.error_parallax.max(), zb.stats.errors.error_parallax.miss_share());

@@ -113,10 +113,10 @@ TEST(Metrics, HeatmapShowsTheRamp) {
   b.set_rgb(2, 0, glm::vec3(1.0f));
   const Image h = error_heatmap(a, b);
   ASSERT_EQ(h.width, 3);
-  EXPECT_EQ(h.rgb(0, 0), glm::vec3(0.0f));                       // equal: black
-  EXPECT_NEAR(srgb_encode(h.rgb(1, 0).g), 1.0, 1e-4);            // 8/255: green
+  EXPECT_EQ(h.rgb(0, 0), glm::vec3(0.0f));             // equal: black
+  EXPECT_NEAR(srgb_encode(h.rgb(1, 0).g), 1.0, 1e-4);  // 8/255: green
   EXPECT_NEAR(srgb_encode(h.rgb(1, 0).r), 0.0, 1e-4);
-  EXPECT_NEAR(srgb_encode(h.rgb(2, 0).r), 1.0, 1e-6);            // full scale: red
+  EXPECT_NEAR(srgb_encode(h.rgb(2, 0).r), 1.0, 1e-6);               // full scale: red
   EXPECT_NEAR(heatmap_ramp(1.5 / 255).b, 0.35 + 0.5 * 0.65, 1e-9);  // linear between stops
 }
 

@@ -138,8 +138,8 @@ Image render_pov(const SceneData& scene, const std::string& name, int threads, d
   }
   std::ostringstream cmd;
   cmd << "cd '" << dir << "' && povray +I" << name << ".pov +O" << name << ".ppm +FP16 File_Gamma=1.0"
-      << " +W" << scene.camera.width * MASK_COLUMNS << " +H" << scene.camera.height * MASK_ROWS
-      << " -A -D -P +WT" << threads << " > " << name << ".log 2>&1";
+      << " +W" << scene.camera.width * MASK_COLUMNS << " +H" << scene.camera.height * MASK_ROWS << " -A -D -P +WT"
+      << threads << " > " << name << ".log 2>&1";
   const Clock::time_point start = Clock::now();
   const int rc = std::system(cmd.str().c_str());
   *seconds = std::chrono::duration<double>(Clock::now() - start).count();
@@ -187,7 +187,7 @@ TEST(Pov, ExportWritesTheSceneAsMesh2) {
   EXPECT_EQ(pov.find("#version 3.7;"), pov.find("#version"));
   EXPECT_NE(pov.find("max_trace_level 4"), std::string::npos);
   EXPECT_NE(pov.find("assumed_gamma 1.0"), std::string::npos);
-  EXPECT_NE(pov.find("right x*2"), std::string::npos);  // aspect 64/32
+  EXPECT_NE(pov.find("right x*2"), std::string::npos);            // aspect 64/32
   EXPECT_NE(pov.find("location <0, 1, -5>"), std::string::npos);  // z mirrored
   EXPECT_NE(pov.find("<1, 0, 7.25>"), std::string::npos);
   EXPECT_NE(pov.find("shadowless"), std::string::npos);
@@ -229,7 +229,8 @@ TEST(Pov, ImageIsNotMirrored) {
   auto centroid = [](const Image& img, int channel) {
     glm::dvec3 acc(0.0);
     for (int y = 0; y < img.height; ++y) {
-      for (int x = 0; x < img.width; ++x) acc += static_cast<double>(img.at(x, y)[channel]) * glm::dvec3(x + 0.5, y + 0.5, 1.0);
+      for (int x = 0; x < img.width; ++x)
+        acc += static_cast<double>(img.at(x, y)[channel]) * glm::dvec3(x + 0.5, y + 0.5, 1.0);
     }
     return glm::dvec2(acc.x / acc.z, acc.y / acc.z);
   };
@@ -289,11 +290,12 @@ TEST(Pov, MatchesOurTracerOnTheSharedModel) {
   const double t_pov_trace = pov_trace_seconds(work_dir() + "/shared_model.log");
   const ImageError e = image_error(ours, pov);
   std::printf("[ povray   ] %dx%d, 32 samples/pixel, %d threads: %s\n", w, h, threads, describe(e).c_str());
-  std::printf("[ timing   ] povray %.3f s whole process (%dx%d, no AA), %.3f s its trace time; abcube %.3f s "
-              "(BVH %.1f ms + trace %.1f ms; %llu primary, %llu secondary, %llu shadow rays, %llu triangles)\n",
-              t_pov, w * MASK_COLUMNS, h * MASK_ROWS, t_pov_trace, t_ours, st.build_ms, st.trace_ms,
-              static_cast<unsigned long long>(st.primary_rays), static_cast<unsigned long long>(st.secondary_rays),
-              static_cast<unsigned long long>(st.shadow_rays), static_cast<unsigned long long>(st.triangles));
+  std::printf(
+      "[ timing   ] povray %.3f s whole process (%dx%d, no AA), %.3f s its trace time; abcube %.3f s "
+      "(BVH %.1f ms + trace %.1f ms; %llu primary, %llu secondary, %llu shadow rays, %llu triangles)\n",
+      t_pov, w * MASK_COLUMNS, h * MASK_ROWS, t_pov_trace, t_ours, st.build_ms, st.trace_ms,
+      static_cast<unsigned long long>(st.primary_rays), static_cast<unsigned long long>(st.secondary_rays),
+      static_cast<unsigned long long>(st.shadow_rays), static_cast<unsigned long long>(st.triangles));
   std::printf("[ timing   ] povray / abcube: %.2f whole process, %.2f trace only (printed, never asserted)\n",
               t_pov / t_ours, t_pov_trace / t_ours);
   EXPECT_GE(e.psnr, POV_MIN_PSNR) << describe(e);
@@ -328,15 +330,16 @@ TEST(Pov, RepositoryScenesMatchOnTheSharedModel) {
     SceneData s = load_scene(file.string());
     restrict_to_shared_model(&s);
     const int w = POV_SCENE_WIDTH;
-    s.camera.height = std::max(1, static_cast<int>(std::lround(static_cast<double>(w) * s.camera.height / s.camera.width)));
+    s.camera.height =
+        std::max(1, static_cast<int>(std::lround(static_cast<double>(w) * s.camera.height / s.camera.width)));
     s.camera.width = w;
     const std::string name = "repo_" + file.stem().string();
     double t_pov = 0, t_ours = 0;
     const Image pov = render_pov(s, name, 2, &t_pov);
     const Image ours = render_ours(s, 2, &t_ours);
     const ImageError e = image_error(ours, pov);
-    std::printf("[ povray   ] %s %dx%d: %s; povray %.2f s, abcube %.2f s\n", file.filename().c_str(),
-                s.camera.width, s.camera.height, describe(e).c_str(), t_pov, t_ours);
+    std::printf("[ povray   ] %s %dx%d: %s; povray %.2f s, abcube %.2f s\n", file.filename().c_str(), s.camera.width,
+                s.camera.height, describe(e).c_str(), t_pov, t_ours);
     EXPECT_GE(e.psnr, POV_MIN_PSNR) << name << ": " << describe(e);
     EXPECT_LE(e.share_over_2, POV_MAX_SHARE_OVER_2) << name << ": " << describe(e);
     if (HasFailure()) save_artifacts("pov_" + name, ours, pov);

@@ -176,7 +176,8 @@ TEST(Raster, PixelMasksFollowThePerSampleRuleExactly) {
   SceneData s = empty_scene({0, 0, 0}, {0, 0, -1}, 60, 8, 8);
   add_material(s, Material{});
   begin_object(s, "random", 0, false);
-  for (int t = 0; t < 60; ++t) add_flat_triangle(s, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
+  for (int t = 0; t < 60; ++t)
+    add_flat_triangle(s, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
   int partial = 0, full = 0;
   for (int face = 0; face < CUBE_FACES; ++face) {
     const RasterView v = cube_face_view(face, dvec3(0.05, -0.1, 0.02), 20, 0.3);
@@ -198,7 +199,8 @@ TEST(Raster, PixelMasksFollowThePerSampleRuleExactly) {
             expect |= CoverageMask(in) << k;
           }
           const bool in_span = y >= st.y0 && y < st.y1 && x >= xb && x < xe;
-          ASSERT_EQ(in_span ? pixel_mask(st, x, y) : 0u, expect) << "face " << face << " triangle " << t << " pixel " << x << ", " << y;
+          ASSERT_EQ(in_span ? pixel_mask(st, x, y) : 0u, expect)
+              << "face " << face << " triangle " << t << " pixel " << x << ", " << y;
           partial += expect != 0 && expect != FULL_MASK;
           full += expect == FULL_MASK;
         }
@@ -281,7 +283,8 @@ TEST(Raster, DistanceRangeIsTheClippedPolygonsRange) {
   SceneData r = empty_scene({0, 0, 0}, {0, 0, 1}, 60, 8, 8);
   add_material(r, Material{});
   begin_object(r, "random", 0, false);
-  for (int t = 0; t < 40; ++t) add_flat_triangle(r, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
+  for (int t = 0; t < 40; ++t)
+    add_flat_triangle(r, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
   const CubeABuffer rc = build_cube_abuffer(r, dvec3(0.1, 0.0, -0.1), 24, test_options());
   int checked = 0;
   for (const ABuffer* b : rasters(rc)) {
@@ -360,7 +363,8 @@ TEST(Raster, NormalIsPerspectiveCorrectAtTheCoveredCentroid) {
   add_material(s, Material{});
   begin_object(s, "tilted", 0, false);
   const dvec3 a(-2, -2, -2), b(3, -2, -8), c(-2, 3, -3);
-  const dvec3 na = glm::normalize(dvec3(1, 0, 1)), nb = glm::normalize(dvec3(0, 1, 1)), nc = glm::normalize(dvec3(-1, -1, 2));
+  const dvec3 na = glm::normalize(dvec3(1, 0, 1)), nb = glm::normalize(dvec3(0, 1, 1)),
+              nc = glm::normalize(dvec3(-1, -1, 2));
   add_triangle(s, a, b, c, na, nb, nc);
   const ABuffer buf = build_camera_abuffer(s, test_options());
   int checked = 0;
@@ -400,14 +404,14 @@ TEST(Raster, DegenerateTrianglesAreCountedNotRasterised) {
   add_material(s, Material{});
   begin_object(s, "junk", 0, false);
   const double nan = std::nan("");
-  add_flat_triangle(s, {0, 0, -1}, {1, 0, -1}, {0, 1, -1});                   // fine
+  add_flat_triangle(s, {0, 0, -1}, {1, 0, -1}, {0, 1, -1});                                // fine
   add_triangle(s, {nan, 0, -1}, {1, 0, -1}, {0, 1, -1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1});  // NaN
   add_triangle(s, {0, 0, -1}, {1, 1, -1}, {2, 2, -1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1});    // collinear
   add_triangle(s, {1, 1, -1}, {1, 1, -1}, {1, 1, -1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1});    // a point
-  add_flat_triangle(s, {0, -1, -1}, {0, 1, -1}, {0, 0, -5});                  // plane x = 0: edge-on
-  add_flat_triangle(s, {-3e37, -3e37, -1e37}, {3e37, -3e37, -1e37}, {0, 3e37, -1e37});  // enormous
-  add_flat_triangle(s, {-1e-6, 0, 1e-6}, {1e-6, 0, 1e-6}, {0, 1e-6, 1e-6});   // inside the near distance
-  add_flat_triangle(s, {-1e4, -1e4, 5}, {1e4, -1e4, 5}, {0, 1e4, 5});        // behind the camera
+  add_flat_triangle(s, {0, -1, -1}, {0, 1, -1}, {0, 0, -5});                               // plane x = 0: edge-on
+  add_flat_triangle(s, {-3e37, -3e37, -1e37}, {3e37, -3e37, -1e37}, {0, 3e37, -1e37});     // enormous
+  add_flat_triangle(s, {-1e-6, 0, 1e-6}, {1e-6, 0, 1e-6}, {0, 1e-6, 1e-6});                // inside the near distance
+  add_flat_triangle(s, {-1e4, -1e4, 5}, {1e4, -1e4, 5}, {0, 1e4, 5});                      // behind the camera
   ABufferOptions o = test_options();
   o.near_distance = 1e-3;
   ABufferStats st;

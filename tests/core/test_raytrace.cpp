@@ -171,9 +171,7 @@ glm::dvec2 project(const CameraFrame& f, const dvec3& p) {
   return {(nx + 1.0) * 0.5 * f.width, (1.0 - ny) * 0.5 * f.height};
 }
 
-dvec3 pixel_center_dir(const CameraFrame& f, int x, int y) {
-  return glm::normalize(f.direction(x + 0.5, y + 0.5));
-}
+dvec3 pixel_center_dir(const CameraFrame& f, int x, int y) { return glm::normalize(f.direction(x + 0.5, y + 0.5)); }
 
 dvec3 pixel(const Image& img, int x, int y) { return dvec3(img.rgb(x, y)); }
 
@@ -512,8 +510,8 @@ TEST(Raytrace, MirrorAt45SendsMarkerToComputedPixel) {
   const double plane_d = glm::dot(n, mc);
   const CameraFrame f = make_camera_frame(s.camera);
   const glm::dvec2 expect = project(f, m - 2.0 * (glm::dot(n, m) - plane_d) * n);
-  const double side_px = 0.4 / (glm::dot(m - 2.0 * (glm::dot(n, m) - plane_d) * n, f.forward) * f.tan_half_fov_y) *
-                         0.5 * f.height;
+  const double side_px =
+      0.4 / (glm::dot(m - 2.0 * (glm::dot(n, m) - plane_d) * n, f.forward) * f.tan_half_fov_y) * 0.5 * f.height;
   double area = 0, cx = 0, cy = 0, stray = 0;
   for (int y = 0; y < img.height; ++y) {
     for (int x = 0; x < img.width; ++x) {
@@ -742,7 +740,7 @@ TEST(Raytrace, GrazingHitsDoNotSelfShadowOrSelfReflect) {
   floor.reflect = 0.5;
   begin_object(s, "triangle", add_material(s, floor), false);
   add_flat_triangle(s, {-300, 0, 200}, {300, 0, 200}, {0, 0, -400});  // one plane, no crease
-  const CameraFrame f = make_camera_frame(s.camera);  // expectations in the unmoved frame
+  const CameraFrame f = make_camera_frame(s.camera);                  // expectations in the unmoved frame
   move_scene(s, rotation({1, 2, 3}, 0.7), {3.3, 1.7, -2.9});
   const Image img = render_raytrace(s, centre_samples());
   Image expected = img;
@@ -878,10 +876,11 @@ TEST(Raytrace, NestedGlassAndGrazingRaysStayFinite) {
   auto check = [&](const dvec3& o, const dvec3& d) {
     const dvec3 c = tracer.trace(o, d, 0);
     ++rays;
-    bad += !(std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b) && glm::all(glm::greaterThanEqual(c, dvec3(0))));
+    bad += !(std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b) &&
+             glm::all(glm::greaterThanEqual(c, dvec3(0))));
   };
   for (const glm::vec3& v : s.triangles->positions) check(eye, dvec3(v) - eye);
-  check({-5, 1, 0}, {1, 0, 0});    // in the plane of the glass box's top face
+  check({-5, 1, 0}, {1, 0, 0});     // in the plane of the glass box's top face
   check({-5, -1, 0.3}, {1, 0, 0});  // in the floor's plane
   check({0, 0.9, 0}, {std::sin(std::asin(1 / 1.5)), std::cos(std::asin(1 / 1.5)), 0});  // inside, critical
   EXPECT_EQ(bad, 0) << "of " << rays << " rays";

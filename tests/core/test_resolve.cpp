@@ -56,13 +56,13 @@ TEST(Resolve, NothingUnderTheMaskIsTheBackground) {
 
 TEST(Resolve, CoverageIsWeightedByMaskArea) {
   HandList h;
-  h.add(1, 2, 0x000000ffu, 0, RED);             // 8 samples
-  h.add(3, 4, 0x0000ffffu, 1, GREEN);           // 8 more visible behind it
-  h.add(5, 6, FULL_MASK, 2, BLUE);              // the remaining 16
+  h.add(1, 2, 0x000000ffu, 0, RED);    // 8 samples
+  h.add(3, 4, 0x0000ffffu, 1, GREEN);  // 8 more visible behind it
+  h.add(5, 6, FULL_MASK, 2, BLUE);     // the remaining 16
   expect_colour(h.pack(), 0.25 * RED + 0.25 * GREEN + 0.5 * BLUE);
-  expect_colour(h.pack(0x0000ff00u), GREEN);    // a search mask restricts the area
+  expect_colour(h.pack(0x0000ff00u), GREEN);  // a search mask restricts the area
   HandList partial;
-  partial.add(1, 2, 0x0f0f0f0fu, 0, RED);       // half of the pixel
+  partial.add(1, 2, 0x0f0f0f0fu, 0, RED);  // half of the pixel
   expect_colour(partial.pack(), 0.5 * RED + 0.5 * GREY);
 }
 
@@ -77,7 +77,7 @@ TEST(Resolve, TransparentVeilBlendsWithWhatIsBehind) {
   half.add(3, 4, FULL_MASK, 1, BLUE);
   EXPECT_EQ(half.pack(), 0.5 * (0.25 * RED + 0.75 * BLUE) + 0.5 * BLUE);
   HandList alone;
-  alone.add(1, 1.5f, FULL_MASK, 0, RED, 0.25);   // nothing behind: the background shows
+  alone.add(1, 1.5f, FULL_MASK, 0, RED, 0.25);  // nothing behind: the background shows
   EXPECT_EQ(alone.pack(), 0.25 * RED + 0.75 * GREY);
 }
 

@@ -112,8 +112,8 @@ struct SceneText {
 
   std::string str() const {
     return "{\n\"version\": " + version + ",\n\"camera\": " + camera + ",\n\"lights\": " + lights +
-           ",\n\"materials\": " + materials + ",\n\"objects\": " + objects + ",\n\"render\": " + render +
-           extra + "\n}\n";
+           ",\n\"materials\": " + materials + ",\n\"objects\": " + objects + ",\n\"render\": " + render + extra +
+           "\n}\n";
   }
 };
 
@@ -146,10 +146,10 @@ std::string load_error(const std::string& text, const std::string& dir = ".") {
   return input_error([&] { load_text(text, dir); }, text);
 }
 
-#define EXPECT_ERROR(text, place)                                     \
-  do {                                                                \
-    const std::string message_ = load_error(text);                    \
-    EXPECT_NE(message_.find(place), std::string::npos) << message_;   \
+#define EXPECT_ERROR(text, place)                                   \
+  do {                                                              \
+    const std::string message_ = load_error(text);                  \
+    EXPECT_NE(message_.find(place), std::string::npos) << message_; \
   } while (0)
 
 glm::dvec3 corner(const SceneData& s, size_t triangle, int k) {
@@ -310,13 +310,15 @@ TEST(SceneLoadErrors, UnknownFieldsAnywhere) {
   s.render = R"({"samples": 4})";
   EXPECT_ERROR(s.str(), "scene.json: render.samples: unknown field");
   EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1]},
-                                {"type": "sphere", "center": [0,0,0], "radus": 1}])").str(),
+                                {"type": "sphere", "center": [0,0,0], "radus": 1}])")
+                   .str(),
                "scene.json: objects[1].radus: unknown field");
   // A field of another object type is unknown here too.
   EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1], "radius": 1}])").str(),
                "objects[0].radius: unknown field");
-  EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1], "transform": {"rotate": [0,1,0]}}])").str(),
-               "objects[0].transform.rotate: unknown field");
+  EXPECT_ERROR(
+      with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1], "transform": {"rotate": [0,1,0]}}])").str(),
+      "objects[0].transform.rotate: unknown field");
   EXPECT_ERROR(with_objects(R"([{"type": "cone"}])").str(), "objects[0].type: must be one of");
 }
 
@@ -325,7 +327,8 @@ TEST(SceneLoadErrors, RepeatedFieldsAreNotSilentlyReplaced) {
   s.camera = R"({"position": [0, 1, 5], "look_at": [0, 0, 0], "fov_y": 60, "fov_y": 30})";
   EXPECT_ERROR(s.str(), "scene.json: camera.fov_y: field appears twice");
   EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1]},
-                                {"type": "sphere", "center": [0,0,0], "radius": 1, "radius": 2}])").str(),
+                                {"type": "sphere", "center": [0,0,0], "radius": 1, "radius": 2}])")
+                   .str(),
                "scene.json: objects[1].radius: field appears twice");
 }
 
@@ -368,7 +371,8 @@ TEST(SceneLoadErrors, MissingMeshFileNamesFieldAndResolvedPath) {
 
 TEST(SceneLoadErrors, UnknownMaterialNamesTheObject) {
   EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1], "material": "white"},
-                                {"type": "box", "min": [0,0,0], "max": [1,1,1], "material": "nope"}])").str(),
+                                {"type": "box", "min": [0,0,0], "max": [1,1,1], "material": "nope"}])")
+                   .str(),
                "scene.json: objects[1].material: no material of that name");
 }
 
@@ -427,7 +431,8 @@ TEST(SceneLoadErrors, QuadMustBeCoplanarAndSimple) {
   EXPECT_ERROR(with_objects(R"([{"type": "quad", "vertices": [[0,0,0],[1,1,0],[1,0,0],[0,1,0]]}])").str(),
                "objects[0].vertices: the quad crosses itself");
   // Within the relative tolerance: a large quad with a tiny wobble is fine.
-  EXPECT_NO_THROW(load_text(with_objects(R"([{"type": "quad", "vertices": [[0,0,0],[1000,0,0],[1000,1000,0],[0,1000,1e-7]]}])").str()));
+  EXPECT_NO_THROW(load_text(
+      with_objects(R"([{"type": "quad", "vertices": [[0,0,0],[1000,0,0],[1000,1000,0],[0,1000,1e-7]]}])").str()));
 }
 
 TEST(SceneLoadErrors, BoxMinBelowMax) {
@@ -453,8 +458,9 @@ TEST(SceneLoadErrors, SphereRadiusAndSegments) {
 TEST(SceneLoadErrors, TransformScaleNonzero) {
   EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1], "transform": {"scale": 0}}])").str(),
                "objects[0].transform.scale: must be nonzero, got 0");
-  EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1], "transform": {"scale": [1,0,1]}}])").str(),
-               "objects[0].transform.scale[1]: must be nonzero");
+  EXPECT_ERROR(
+      with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1], "transform": {"scale": [1,0,1]}}])").str(),
+      "objects[0].transform.scale[1]: must be nonzero");
 }
 
 TEST(SceneLoadErrors, LightsAndRender) {
@@ -465,7 +471,9 @@ TEST(SceneLoadErrors, LightsAndRender) {
   EXPECT_ERROR(s.str(), "lights[0].color[1]: must be >= 0, got -1");
   s = SceneText();
   s.render = R"({"method": "photon"})";
-  EXPECT_ERROR(s.str(), "scene.json: render.method: must be one of abuffer, zbuffer, envmap, raytrace, gpu, hybrid, got \"photon\"");
+  EXPECT_ERROR(
+      s.str(),
+      "scene.json: render.method: must be one of abuffer, zbuffer, envmap, raytrace, gpu, hybrid, got \"photon\"");
   s.render = R"({"cube_resolution": 0})";
   EXPECT_ERROR(s.str(), "render.cube_resolution: must be >= 1, got 0");
   s.render = R"({"cube_resolution": 20000})";
@@ -549,7 +557,8 @@ TEST(SceneLoadGeometry, ZeroAreaTrianglesAreDroppedAndCounted) {
       {"type": "quad", "vertices": [[0,0,0],[1,0,0],[2,0,0],[0,1,0]]},
       {"type": "triangle", "vertices": [[1e30,0,0],[0,1e30,0],[0,0,1e30]], "transform": {"scale": 1e30}},
       {"type": "triangle", "vertices": [[0,0,0],[1e-6,0,0],[0,1e-6,0]]},
-      {"type": "triangle", "vertices": [[0,0,0],[1e6,0,0],[0,1e6,0]]}])").str());
+      {"type": "triangle", "vertices": [[0,0,0],[1e6,0,0],[0,1e6,0]]}])")
+                                    .str());
   ASSERT_EQ(s.objects.size(), 6u);
   EXPECT_EQ(s.dropped_triangles, 4u);  // collinear, repeated vertex, half the quad, overflow
   const uint32_t expected[6] = {0, 0, 1, 0, 1, 1};
@@ -569,8 +578,8 @@ TEST(SceneLoadGeometry, BoxIsClosedWithOutwardFlatNormals) {
   for (size_t t = 0; t < 12; ++t) {
     const glm::dvec3 n = geometric_normal(s, t);
     const glm::dvec3 mid = (corner(s, t, 0) + corner(s, t, 1) + corner(s, t, 2)) / 3.0;
-    EXPECT_GT(glm::dot(n, mid - center), 0.0) << t;                               // outward
-    EXPECT_NEAR(std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z), 1.0, 1e-12);    // axis-aligned
+    EXPECT_GT(glm::dot(n, mid - center), 0.0) << t;                             // outward
+    EXPECT_NEAR(std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z), 1.0, 1e-12);  // axis-aligned
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(glm::length(glm::dvec3(s.triangles->normals[3 * t + static_cast<size_t>(k)]) - n), 0.0, 1e-6);
     }
@@ -579,8 +588,8 @@ TEST(SceneLoadGeometry, BoxIsClosedWithOutwardFlatNormals) {
 
 TEST(SceneLoadGeometry, SphereIsClosedWithOutwardSmoothNormals) {
   for (int segments : {3, 7, 32, 65}) {
-    const std::string objects = R"([{"type": "sphere", "center": [1,2,3], "radius": 2, "segments": )" +
-                                std::to_string(segments) + "}]";
+    const std::string objects =
+        R"([{"type": "sphere", "center": [1,2,3], "radius": 2, "segments": )" + std::to_string(segments) + "}]";
     const SceneData s = load_text(with_objects(objects).str());
     const SceneObject& o = s.objects[0];
     const int rings = std::max(2, segments / 2);
@@ -611,7 +620,8 @@ TEST(SceneLoadGeometry, TransformScalesThenRotatesXYZThenTranslates) {
   // (1,2,3) scaled by (2,3,4) is (2,6,12); 90 degrees about x: (2,-12,6); about y: (6,-12,-2);
   // about z: (12,6,-2); translated by (10,20,30): (22,26,28).
   const SceneData s = load_text(with_objects(R"([{"type": "triangle", "vertices": [[1,2,3],[2,2,3],[1,3,3]],
-      "transform": {"scale": [2,3,4], "rotate_deg": [90,90,90], "translate": [10,20,30]}}])").str());
+      "transform": {"scale": [2,3,4], "rotate_deg": [90,90,90], "translate": [10,20,30]}}])")
+                                    .str());
   ASSERT_EQ(s.triangles->triangle_count(), 1u);
   const glm::dvec3 p = corner(s, 0, 0);
   EXPECT_NEAR(p.x, 22, 1e-5);
@@ -627,7 +637,8 @@ TEST(SceneLoadGeometry, MirroringTransformKeepsNormalsOutward) {
   const SceneData s = load_text(with_objects(R"([
       {"type": "box", "min": [0,0,0], "max": [1,2,3], "transform": {"scale": [-1,1,1]}},
       {"type": "triangle", "vertices": [[0,0,0],[1,0,0],[0,1,0]], "transform": {"scale": [1,1,-2]}},
-      {"type": "sphere", "center": [0,0,0], "radius": 1, "transform": {"scale": [2,-1,1]}}])").str());
+      {"type": "sphere", "center": [0,0,0], "radius": 1, "transform": {"scale": [2,-1,1]}}])")
+                                    .str());
   EXPECT_TRUE(s.objects[0].closed);
   EXPECT_NEAR(object_volume(s, s.objects[0]), 6.0, 1e-9);
   // The triangle faced +z; mirrored in z, the surface it becomes still faces the side its
@@ -648,7 +659,8 @@ TEST(SceneLoadGeometry, MirroringTransformKeepsNormalsOutward) {
 
 TEST(SceneLoadGeometry, QuarterTurnsKeepBoxesAxisAligned) {
   const SceneData s = load_text(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,2,3],
-      "transform": {"rotate_deg": [0,90,0]}}])").str());
+      "transform": {"rotate_deg": [0,90,0]}}])")
+                                    .str());
   const Bounds b = s.bounds();
   EXPECT_EQ(b.lo, glm::dvec3(0, 0, -1));
   EXPECT_EQ(b.hi, glm::dvec3(3, 2, 0));
@@ -683,8 +695,8 @@ TEST(SceneLoadMesh, MtlMaterialsAreUsedWithoutObjectMaterial) {
               mid.y > 0 ? "meshes/octahedron.obj:red" : "meshes/octahedron.obj:blue");
   }
   // An object material overrides the MTL, which then adds no materials.
-  const SceneData named = load_text(
-      with_objects(R"([{"type": "mesh", "file": "meshes/octahedron.obj", "material": "m"}])").str(), dir);
+  const SceneData named =
+      load_text(with_objects(R"([{"type": "mesh", "file": "meshes/octahedron.obj", "material": "m"}])").str(), dir);
   EXPECT_EQ(named.materials.size(), 2u);
   for (uint32_t id : named.triangles->material_id) EXPECT_EQ(named.materials[id].name, "m");
 }
@@ -719,7 +731,9 @@ f 4//1 1//1 5//1
   // An L-shaped hexagon (concave): ear clipping must cover exactly its area, 3 units.
   dir.write("ell.obj", "v 0 0 0\nv 2 0 0\nv 2 0 1\nv 1 0 1\nv 1 0 2\nv 0 0 2\nf 6 5 4 3 2 1\n");
   const SceneData s = load_text(with_objects(R"([{"type": "mesh", "file": "pyramid.obj"},
-      {"type": "mesh", "file": "ell.obj", "transform": {"translate": [5, 0, 0]}}])").str(), dir.path().string());
+      {"type": "mesh", "file": "ell.obj", "transform": {"translate": [5, 0, 0]}}])")
+                                    .str(),
+                                dir.path().string());
   const SceneObject& pyramid = s.objects[0];
   EXPECT_EQ(pyramid.triangle_count, 6u);
   EXPECT_TRUE(pyramid.closed);
@@ -752,15 +766,22 @@ TEST(SceneLoadMesh, MissingMtlOrMaterialIsAWarningAndTheDefault) {
   TempDir dir;
   dir.write("lost.obj", "mtllib lost.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl paint\nf 1 2 3\n");
   dir.write("m.mtl", "newmtl red\nKd 1 0 0\n");
-  dir.write("some.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nusemtl red\nf 1 2 3\n"
-                        "usemtl blue\nf 2 4 3\nusemtl green\nf 2 4 3\nusemtl blue\nf 2 4 3\n");
+  dir.write("some.obj",
+            "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nusemtl red\nf 1 2 3\n"
+            "usemtl blue\nf 2 4 3\nusemtl green\nf 2 4 3\nusemtl blue\nf 2 4 3\n");
   const SceneData s = load_text(with_objects(R"([{"type": "mesh", "file": "lost.obj"},
-      {"type": "mesh", "file": "some.obj"}])").str(), dir.path().string());
+      {"type": "mesh", "file": "some.obj"}])")
+                                    .str(),
+                                dir.path().string());
   ASSERT_EQ(s.warnings.size(), 2u);
-  EXPECT_EQ(s.warnings[0], "scene.json: objects[0].file: warning: mesh \"lost.obj\": mtllib: material file \"lost.mtl\" "
-                           "not found (and 1 more); the default material is used") << s.warnings[0];
-  EXPECT_EQ(s.warnings[1], "scene.json: objects[1].file: warning: mesh \"some.obj\": usemtl: material \"blue\" "
-                           "not found (and 1 more); the default material is used") << s.warnings[1];
+  EXPECT_EQ(s.warnings[0],
+            "scene.json: objects[0].file: warning: mesh \"lost.obj\": mtllib: material file \"lost.mtl\" "
+            "not found (and 1 more); the default material is used")
+      << s.warnings[0];
+  EXPECT_EQ(s.warnings[1],
+            "scene.json: objects[1].file: warning: mesh \"some.obj\": usemtl: material \"blue\" "
+            "not found (and 1 more); the default material is used")
+      << s.warnings[1];
   ASSERT_EQ(s.triangles->triangle_count(), 5u);
   for (size_t t = 0; t < 5; ++t) {
     const Material& m = s.materials[s.triangles->material_id[t]];
@@ -814,8 +835,8 @@ TEST(SceneLoadMessages, MtlMaterialNameAndMeshPathAreEscaped) {
   TempDir dir;
   dir.write("m.mtl", "newmtl \x1b[2Jpaint\nKd -1 0 0\n");
   dir.write("m\x1b[1m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl \x1b[2Jpaint\nf 1 2 3\n");
-  const std::string m = load_error(with_objects(R"([{"type": "mesh", "file": "m\u001b[1m.obj"}])").str(),
-                                   dir.path().string());
+  const std::string m =
+      load_error(with_objects(R"([{"type": "mesh", "file": "m\u001b[1m.obj"}])").str(), dir.path().string());
   EXPECT_TRUE(no_control_bytes(m)) << m;
   EXPECT_NE(m.find("m\\e[1m.obj\": material \"\\e[2Jpaint\": Kd must be finite and >= 0"), std::string::npos) << m;
 }
@@ -825,8 +846,9 @@ TEST(SceneLoadMessages, HugeKeysAndValuesAreCut) {
   SceneText s;
   s.extra = ",\n\"" + big + "\": 1";
   std::string m = load_error(s.str());
-  EXPECT_EQ(m, "scene.json: [\"" + std::string(QUOTE_MAX_CHARS, 'k') + "\"... (5242880 bytes)]: unknown field "
-               "(known here: version, camera, background, ambient, lights, materials, objects, render)");
+  EXPECT_EQ(m, "scene.json: [\"" + std::string(QUOTE_MAX_CHARS, 'k') +
+                   "\"... (5242880 bytes)]: unknown field "
+                   "(known here: version, camera, background, ambient, lights, materials, objects, render)");
   // A value of megabytes after "got".
   m = load_error(with_objects(R"([{"type": ")" + big + R"("}])").str());
   EXPECT_LT(m.size(), 300u) << m.substr(0, 300);
@@ -850,7 +872,9 @@ TEST(SceneLoadMesh, MeshWithoutTrianglesLoadsWithAWarning) {
   dir.write("cube.obj", CUBE_OBJ);
   const SceneData s = load_text(with_objects(R"([{"type": "mesh", "file": "cube.obj"},
       {"type": "mesh", "file": "empty.obj", "material": "white"}, {"type": "mesh", "file": "points.obj"},
-      {"type": "mesh", "file": "flat.obj"}])").str(), dir.path().string());
+      {"type": "mesh", "file": "flat.obj"}])")
+                                    .str(),
+                                dir.path().string());
   ASSERT_EQ(s.objects.size(), 4u);
   EXPECT_EQ(s.objects[1].triangle_count, 0u);
   EXPECT_EQ(s.triangles->triangle_count(), 12u);
@@ -866,7 +890,8 @@ TEST(SceneLoadMesh, MeshWithoutTrianglesLoadsWithAWarning) {
 // with nothing to draw and no word).
 TEST(SceneLoadMesh, FlatPrimitiveLoadsWithAWarning) {
   const SceneData s = load_text(with_objects(R"([{"type": "sphere", "center": [0, 0, 0], "radius": 1},
-      {"type": "quad", "vertices": [[0, 0, 0], [1, 0, 0], [1, 0, 0], [0, 0, 0]]}])").str());
+      {"type": "quad", "vertices": [[0, 0, 0], [1, 0, 0], [1, 0, 0], [0, 0, 0]]}])")
+                                    .str());
   ASSERT_EQ(s.objects.size(), 2u);
   EXPECT_EQ(s.objects[1].triangle_count, 0u);
   const std::vector<std::string> expected = {
@@ -879,7 +904,7 @@ TEST(SceneLoadMesh, FlatPrimitiveLoadsWithAWarning) {
 TEST(Tessellate, ClosedSurfaceNeedsConsistentOrientation) {
   SceneData s = load_text(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1]}])").str());
   EXPECT_TRUE(is_closed_surface(*s.triangles, 0, 12));
-  EXPECT_FALSE(is_closed_surface(*s.triangles, 0, 11));  // a hole
+  EXPECT_FALSE(is_closed_surface(*s.triangles, 0, 11));                         // a hole
   std::swap(s.triangles.edit().positions[1], s.triangles.edit().positions[2]);  // one face turned over
   EXPECT_FALSE(is_closed_surface(*s.triangles, 0, 12));
 }
@@ -978,7 +1003,8 @@ TEST(RepositoryScenes, HiddenPointSeenOnlyInTheMirror) {
   for (int i = 0; i <= n; ++i) {
     for (int j = 0; i + j <= n; ++j) {
       // A point on the mirror, and the camera ray reflected there.
-      const glm::dvec3 m = tri(0, 0) + (tri(0, 1) - tri(0, 0)) * (i / double(n)) + (tri(0, 2) - tri(0, 0)) * (j / double(n));
+      const glm::dvec3 m =
+          tri(0, 0) + (tri(0, 1) - tri(0, 0)) * (i / double(n)) + (tri(0, 2) - tri(0, 0)) * (j / double(n));
       const glm::dvec3 d = glm::normalize(m - eye);
       const glm::dvec3 normal = geometric_normal(s, 0);
       const glm::dvec3 r = d - 2.0 * glm::dot(d, normal) * normal;
@@ -1050,8 +1076,8 @@ TEST(SceneLoadLimits, MtllibOutsideTheRootIsRefusedBeforeItIsRead) {
   dir.write("outside/secret.mtl", "newmtl red\nKd 1 0 0\n");
   dir.write("root/meshes/cube.obj", "mtllib ../../outside/secret.mtl\nusemtl red\n" + std::string(CUBE_OBJ));
   // No "material": the OBJ's own MTL materials are used.
-  const std::string scene = dir.write("root/scenes/scene.json",
-                                      with_objects(R"([{"type": "mesh", "file": "../meshes/cube.obj"}])").str());
+  const std::string scene =
+      dir.write("root/scenes/scene.json", with_objects(R"([{"type": "mesh", "file": "../meshes/cube.obj"}])").str());
   LoadLimits limits;
   limits.root = (dir.path() / "root").string();
   const std::string m = limited_load_error(scene, limits);
@@ -1091,8 +1117,8 @@ TEST(SceneLoadLimits, MtlMapKdOutsideTheRootIsRefusedWithItsLine) {
   dir.write("outside/secret.png", "SECRET CONTENT");
   const std::string mtl = dir.write("root/meshes/cube.mtl", "newmtl red\nKd 1 0 0\nmap_Kd ../../outside/secret.png\n");
   dir.write("root/meshes/cube.obj", "mtllib cube.mtl\nusemtl red\n" + std::string(CUBE_OBJ));
-  const std::string scene = dir.write("root/scenes/scene.json",
-                                      with_objects(R"([{"type": "mesh", "file": "../meshes/cube.obj"}])").str());
+  const std::string scene =
+      dir.write("root/scenes/scene.json", with_objects(R"([{"type": "mesh", "file": "../meshes/cube.obj"}])").str());
   LoadLimits limits;
   limits.root = (dir.path() / "root").string();
   const std::string m = limited_load_error(scene, limits);
@@ -1110,7 +1136,8 @@ TEST(SceneLoadLimits, TextureSymlinkEscapingTheRootIsRefused) {
   LoadLimits limits;
   limits.root = (dir.path() / "root").string();
   const std::string m = limited_load_error(scene, limits);
-  EXPECT_NE(m.find("materials.white.texture: \"../textures/link.png\" resolves outside --root"), std::string::npos) << m;
+  EXPECT_NE(m.find("materials.white.texture: \"../textures/link.png\" resolves outside --root"), std::string::npos)
+      << m;
   EXPECT_EQ(m.find("SECRET"), std::string::npos) << m;
 }
 
@@ -1127,7 +1154,8 @@ TEST(SceneLoadLimits, TriangleCapNamesTheCountAndTheCap) {
   // Two spheres of 32 segments (sphere_triangle_count each) against a cap between one and two.
   const size_t one = sphere_triangle_count(32);
   const std::string text = with_objects(R"([{"type": "sphere", "center": [0,0,0], "radius": 1},
-      {"type": "sphere", "center": [3,0,0], "radius": 1}])").str();
+      {"type": "sphere", "center": [3,0,0], "radius": 1}])")
+                               .str();
   LoadLimits limits;
   limits.max_triangles = one + 1;
   EXPECT_EQ(input_error([&] { load_scene_text(text, "scene.json", ".", limits); }, text),
@@ -1143,7 +1171,6 @@ TEST(SceneLoadLimits, TriangleCapNamesTheCountAndTheCap) {
   EXPECT_EQ(input_error([&] { load_scene_text(mesh, "scene.json", dir.path().string(), limits); }, mesh),
             "scene.json: objects[0].file: the scene would have 12 triangles, over the cap of 11 (max_triangles)");
 }
-
 
 // ---- glTF 2.0 (issue 15 part 1) ---------------------------------------------------------
 
@@ -1166,18 +1193,20 @@ struct QuadGltf {
   std::string buffer_uri = "quad.bin";
   std::vector<uint16_t> indices = {0, 1, 2, 0, 2, 3};
   std::string str() const {
-    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": )" + scene_nodes + R"(}], "nodes": [)" + node +
-           R"(], "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 2}, "indices": 1)" +
+    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": )" + scene_nodes + R"(}], "nodes": [)" +
+           node + R"(], "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 2}, "indices": 1)" +
            primitive_extra + R"(}]}], "materials": )" + materials + R"(,
       "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"},
-                    {"bufferView": 1, "componentType": 5123, "count": )" + std::to_string(indices.size()) +
+                    {"bufferView": 1, "componentType": 5123, "count": )" +
+           std::to_string(indices.size()) +
            R"(, "type": "SCALAR"},
                     {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"}],
       "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": )" +
            std::to_string(2 * indices.size()) + R"(},
-                      {"buffer": 0, "byteOffset": )" + std::to_string(48 + 2 * indices.size()) + R"(, "byteLength": 32}],
-      "buffers": [{"uri": ")" + buffer_uri + R"(", "byteLength": )" + std::to_string(48 + 2 * indices.size() + 32) +
-           "}]" + extra + "}";
+                      {"buffer": 0, "byteOffset": )" +
+           std::to_string(48 + 2 * indices.size()) + R"(, "byteLength": 32}],
+      "buffers": [{"uri": ")" +
+           buffer_uri + R"(", "byteLength": )" + std::to_string(48 + 2 * indices.size() + 32) + "}]" + extra + "}";
   }
   std::string bin() const {
     return bytes_of(std::vector<float>{0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}) + bytes_of(indices) +
@@ -1197,13 +1226,14 @@ TEST(SceneLoadGltf, NodeTransformsAndTexcoordsReachTheSoup) {
   TempDir dir;
   QuadGltf g;
   // Scale 2, then a quarter turn about z, then a shift: (1, 0, 0) -> (0, 2, 0) + (5, 0, 0).
-  g.node = R"({"children": [1], "translation": [5, 0, 0]}, {"mesh": 0, "rotation": [0, 0, 0.7071067811865476, 0.7071067811865476], "scale": [2, 2, 2]})";
+  g.node =
+      R"({"children": [1], "translation": [5, 0, 0]}, {"mesh": 0, "rotation": [0, 0, 0.7071067811865476, 0.7071067811865476], "scale": [2, 2, 2]})";
   g.write(dir);
   const SceneData s = load_text(gltf_scene(), dir.path().string());
   ASSERT_EQ(s.triangles->triangle_count(), 2u);
   EXPECT_NEAR(glm::distance(corner(s, 0, 1), glm::dvec3(5, 2, 0)), 0.0, 1e-6);
   EXPECT_NEAR(glm::distance(corner(s, 0, 2), glm::dvec3(3, 2, 0)), 0.0, 1e-6);
-  EXPECT_TRUE(s.triangles->uvs.empty());  // untextured: uvs are not kept
+  EXPECT_TRUE(s.triangles->uvs.empty());             // untextured: uvs are not kept
   EXPECT_NEAR(geometric_normal(s, 0).z, 1.0, 1e-9);  // counter-clockwise seen from +z
   EXPECT_EQ(s.materials[s.triangles->material_id[0]].name, "(default)");
   EXPECT_TRUE(s.warnings.empty());
@@ -1222,8 +1252,8 @@ TEST(SceneLoadGltf, MaterialsAreMapped) {
   EXPECT_EQ(m.name, "quad.gltf:glass");
   EXPECT_EQ(m.color, glm::dvec3(0.2, 0.4, 0.6));
   EXPECT_DOUBLE_EQ(m.opacity, 0.5);
-  EXPECT_DOUBLE_EQ(m.transmit, 0.8 * 0.5);             // transmission x (1 - metallic)
-  EXPECT_DOUBLE_EQ(m.reflect, 0.5 * (1 - 0.2));        // metallic x (1 - roughness)
+  EXPECT_DOUBLE_EQ(m.transmit, 0.8 * 0.5);       // transmission x (1 - metallic)
+  EXPECT_DOUBLE_EQ(m.reflect, 0.5 * (1 - 0.2));  // metallic x (1 - roughness)
   EXPECT_DOUBLE_EQ(m.diffuse, 1 - m.reflect - m.transmit);
   EXPECT_DOUBLE_EQ(m.ior, 1.33);
   // The object's own material replaces the file's.
@@ -1237,7 +1267,8 @@ TEST(SceneLoadGltf, BadIndicesAndTypesNameTheirPlace) {
   g.indices = {0, 1, 2, 0, 2, 99};
   g.write(dir);
   EXPECT_EQ(load_error(gltf_scene(), dir.path().string()),
-            "scene.json: objects[0].file: \"quad.gltf\": meshes[0].primitives[0].indices: index 99 out of range (4 vertices)");
+            "scene.json: objects[0].file: \"quad.gltf\": meshes[0].primitives[0].indices: index 99 out of range (4 "
+            "vertices)");
   QuadGltf t;
   t.node = R"({"mesh": "zero"})";
   t.write(dir);
@@ -1248,7 +1279,8 @@ TEST(SceneLoadGltf, BadIndicesAndTypesNameTheirPlace) {
   cycle.write(dir);
   EXPECT_NE(load_error(gltf_scene(), dir.path().string()).find("nodes[0]: is its own ancestor"), std::string::npos);
   QuadGltf draco;
-  draco.extra = R"(, "extensionsRequired": ["KHR_draco_mesh_compression"], "extensionsUsed": ["KHR_draco_mesh_compression"])";
+  draco.extra =
+      R"(, "extensionsRequired": ["KHR_draco_mesh_compression"], "extensionsUsed": ["KHR_draco_mesh_compression"])";
   draco.write(dir);
   EXPECT_NE(load_error(gltf_scene(), dir.path().string())
                 .find("extensionsRequired[0]: \"KHR_draco_mesh_compression\" is not supported"),
@@ -1267,8 +1299,9 @@ TEST(SceneLoadGltf, UnsupportedPartsWarnOnce) {
   g.write(dir);
   const SceneData s = load_text(gltf_scene(), dir.path().string());
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_EQ(s.warnings[0], "scene.json: objects[0].file: warning: glTF \"quad.gltf\": not rendered: "
-                           "KHR_lights_punctual spot lights; skins (meshes drawn unskinned)");
+  EXPECT_EQ(s.warnings[0],
+            "scene.json: objects[0].file: warning: glTF \"quad.gltf\": not rendered: "
+            "KHR_lights_punctual spot lights; skins (meshes drawn unskinned)");
   EXPECT_EQ(s.lights.size(), 1u);  // the scene's own only
 }
 
@@ -1279,7 +1312,8 @@ TEST(SceneLoadGltf, PointLightsAndCameraFromTheFile) {
   // looking down -z (a node without rotation), yfov 0.5 rad.
   g.node = R"({"mesh": 0}, {"translation": [0.5, 0.5, 2], "extensions": {"KHR_lights_punctual": {"light": 0}}},
              {"translation": [0.5, 0.5, 3], "camera": 0})";
-  g.extra = R"(, "extensionsUsed": ["KHR_lights_punctual"], "cameras": [{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}],
+  g.extra =
+      R"(, "extensionsUsed": ["KHR_lights_punctual"], "cameras": [{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}],
       "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "color": [1, 0.5, 0.25], "intensity": 8}]}})";
   g.scene_nodes = "[0, 1, 2]";
   g.write(dir);
@@ -1313,14 +1347,16 @@ TEST(SceneLoadGltf, GlbImagesAreKeptEncoded) {
   const std::string bin = g.bin() + png + std::string((4 - png.size() % 4) % 4, '\0');
   json.replace(json.find("\"uri\": \"\", "), 11, "");
   json.replace(json.find("\"byteLength\": 92}]"), 18, "\"byteLength\": " + std::to_string(bin.size()) + "}]");
-  json.replace(json.rfind('}'), 1, R"(, "textures": [{"source": 0}], "images": [{"bufferView": 3, "mimeType": "image/png"}]})");
-  json.replace(json.find("\"byteLength\": 32}]"), 18,
-               "\"byteLength\": 32}, {\"buffer\": 0, \"byteOffset\": 92, \"byteLength\": " + std::to_string(png.size()) + "}]");
+  json.replace(json.rfind('}'), 1,
+               R"(, "textures": [{"source": 0}], "images": [{"bufferView": 3, "mimeType": "image/png"}]})");
+  json.replace(
+      json.find("\"byteLength\": 32}]"), 18,
+      "\"byteLength\": 32}, {\"buffer\": 0, \"byteOffset\": 92, \"byteLength\": " + std::to_string(png.size()) + "}]");
   json += std::string((4 - json.size() % 4) % 4, ' ');
   const auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
   const std::string glb = "glTF" + u32(2) + u32(static_cast<uint32_t>(12 + 8 + json.size() + 8 + bin.size())) +
-                          u32(static_cast<uint32_t>(json.size())) + "JSON" + json + u32(static_cast<uint32_t>(bin.size())) +
-                          std::string("BIN\0", 4) + bin;
+                          u32(static_cast<uint32_t>(json.size())) + "JSON" + json +
+                          u32(static_cast<uint32_t>(bin.size())) + std::string("BIN\0", 4) + bin;
   dir.write("quad.glb", glb);
   const SceneData s = load_text(with_objects(R"([{"type": "gltf", "file": "quad.glb"}])").str(), dir.path().string());
   ASSERT_EQ(s.embedded_images.size(), 1u);
@@ -1345,18 +1381,22 @@ TEST(SceneLoadLimits, GltfBuffersAndImagesOutsideTheRootAreRefused) {
   LoadLimits limits;
   limits.root = (dir.path() / "root").string();
   const std::string root = fs::canonical(limits.root).string();
-  EXPECT_EQ(limited_load_error(scene, limits), scene + ": objects[0].file: \"../models/quad.gltf\": buffers[0].uri "
-                                                       "\"../../outside/quad.bin\" resolves outside --root " + root);
+  EXPECT_EQ(limited_load_error(scene, limits), scene +
+                                                   ": objects[0].file: \"../models/quad.gltf\": buffers[0].uri "
+                                                   "\"../../outside/quad.bin\" resolves outside --root " +
+                                                   root);
   // The same through a symbolic link inside the root.
   g.buffer_uri = "link.bin";
   dir.write("root/models/quad.gltf", g.str());
   fs::create_symlink(dir.path() / "outside" / "quad.bin", dir.path() / "root" / "models" / "link.bin");
-  EXPECT_NE(limited_load_error(scene, limits).find("buffers[0].uri \"link.bin\" resolves outside --root"), std::string::npos);
+  EXPECT_NE(limited_load_error(scene, limits).find("buffers[0].uri \"link.bin\" resolves outside --root"),
+            std::string::npos);
   // An image: refused the same way; a data: URI image is fine.
   g.buffer_uri = "quad.bin";
   dir.write("root/models/quad.bin", g.bin());
   dir.write("outside/x.png", "secret");
-  for (const std::string& uri : {std::string("../../outside/x.png"), std::string("data:image/png;base64,iVBORw0KGgo=")}) {
+  for (const std::string& uri :
+       {std::string("../../outside/x.png"), std::string("data:image/png;base64,iVBORw0KGgo=")}) {
     std::string json = g.str();
     json.replace(json.rfind('}'), 1, R"(, "images": [{"uri": "x.png"}, {"uri": ")" + uri + R"("}]})");
     dir.write("root/models/quad.gltf", json);
@@ -1364,7 +1404,8 @@ TEST(SceneLoadLimits, GltfBuffersAndImagesOutsideTheRootAreRefused) {
       EXPECT_EQ(load_scene(scene, limits).triangles->triangle_count(), 2u);
     } else {
       const std::string m = limited_load_error(scene, limits);
-      EXPECT_NE(m.find(": images[1].uri \"../../outside/x.png\" resolves outside --root " + root), std::string::npos) << m;
+      EXPECT_NE(m.find(": images[1].uri \"../../outside/x.png\" resolves outside --root " + root), std::string::npos)
+          << m;
       EXPECT_EQ(m.find("secret"), std::string::npos) << m;
     }
   }
@@ -1402,7 +1443,8 @@ TEST(Framing, TheBoundsFitTheImageFromTheGivenDirection) {
   Bounds b;
   b.extend(glm::dvec3(-1, 0, -3));
   b.extend(glm::dvec3(3, 2, 1));
-  for (const glm::dvec3& dir : {glm::dvec3(0, -0.35, -1), glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0), glm::dvec3(-1, -2, 3)}) {
+  for (const glm::dvec3& dir :
+       {glm::dvec3(0, -0.35, -1), glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0), glm::dvec3(-1, -2, 3)}) {
     Camera c;
     c.width = 320;
     c.height = 200;
@@ -1488,8 +1530,9 @@ TEST(SceneLoadGltf, AModelFileIsAFramedLitScene) {
     EXPECT_NEAR(glm::distance(s.camera.look_at, centre), 0.0, 1e-12) << name;
     if (name == "cube.OBJ") {
       ASSERT_EQ(s.warnings.size(), 1u);
-      EXPECT_EQ(s.warnings[0], (dir.path() / name).string() + ": warning: mesh \"cube.OBJ\": mtllib: material file "
-                               "\"gone.mtl\" not found; the default material is used");
+      EXPECT_EQ(s.warnings[0], (dir.path() / name).string() +
+                                   ": warning: mesh \"cube.OBJ\": mtllib: material file "
+                                   "\"gone.mtl\" not found; the default material is used");
     }
   }
 }

@@ -143,10 +143,11 @@ TEST(Search, ReflectionCrossingMatchesExactTracer) {
       EXPECT_LT(glm::length(r.point - h.point), 1e-7 * world->tracer->scene_scale());
     }
   }
-  std::printf("crossing: %zu rays, %d away from silhouettes, same triangle %d, both miss %d; hits %d; "
-              "max Error_Parallax %.3g; texels mean %.1f max %llu\n",
-              rays.size(), interior, same, both_miss, hits, worst_parallax, stats.mean_texels(),
-              static_cast<unsigned long long>(stats.max_texels));
+  std::printf(
+      "crossing: %zu rays, %d away from silhouettes, same triangle %d, both miss %d; hits %d; "
+      "max Error_Parallax %.3g; texels mean %.1f max %llu\n",
+      rays.size(), interior, same, both_miss, hits, worst_parallax, stats.mean_texels(),
+      static_cast<unsigned long long>(stats.max_texels));
   EXPECT_GE(same + both_miss, 0.99 * interior);
   EXPECT_LT(worst_parallax, 1e-12);  // a refined point is on the ray
   EXPECT_EQ(stats.aborted, 0u);
@@ -167,8 +168,7 @@ TEST(Search, MergedMapStillFindsTheSameObject) {
     same_object += !exact || h.object_id == r.object_id;
     same_triangle += !exact || h.triangle == r.triangle;
   }
-  std::printf("merged map: %d interior rays, same object %d, same triangle %d\n", interior, same_object,
-              same_triangle);
+  std::printf("merged map: %d interior rays, same object %d, same triangle %d\n", interior, same_object, same_triangle);
   EXPECT_GE(same_object, 0.99 * interior);
 }
 
@@ -184,7 +184,9 @@ IdealCandidate ideal_candidate(const World& world, const SurfaceRay& s, const Hi
   const CubeTexel t = direction_to_texel(sc, world.n);
   const dvec3 v = texel_center_direction(t.face, t.i, t.j, world.n);
   const dvec3 p = world.cube.centre + (glm::dot(h.geometric_normal, sc) / glm::dot(h.geometric_normal, v)) * v;
-  const auto angle = [](const dvec3& a, const dvec3& b) { return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)); };
+  const auto angle = [](const dvec3& a, const dvec3& b) {
+    return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+  };
   return {angle(v, sc), angle(s.r, p - s.w)};
 }
 
@@ -226,12 +228,13 @@ TEST(Search, ReflectionThesisModeErrorBounds) {
         ++amplified;
       }
     }
-    std::printf("thesis N=%d: hits %llu, misses %llu (ideal texel over theta_max: %d); Error_Parallax mean %.3g "
-                "p99 %.3g max %.3g vs 1/(2N^2) = %.3g; amplified (theta_0 > theta_c) %d, not amplified %llu with max "
-                "%.3g; found worse than the ideal texel %d\n",
-                n, static_cast<unsigned long long>(all.count()), static_cast<unsigned long long>(all.miss_count()),
-                misses_explained, all.mean(), all.percentile(0.99), all.max(), 1.0 / (2.0 * n * n), amplified,
-                static_cast<unsigned long long>(plain.count()), plain.max(), worse_than_ideal);
+    std::printf(
+        "thesis N=%d: hits %llu, misses %llu (ideal texel over theta_max: %d); Error_Parallax mean %.3g "
+        "p99 %.3g max %.3g vs 1/(2N^2) = %.3g; amplified (theta_0 > theta_c) %d, not amplified %llu with max "
+        "%.3g; found worse than the ideal texel %d\n",
+        n, static_cast<unsigned long long>(all.count()), static_cast<unsigned long long>(all.miss_count()),
+        misses_explained, all.mean(), all.percentile(0.99), all.max(), 1.0 / (2.0 * n * n), amplified,
+        static_cast<unsigned long long>(plain.count()), plain.max(), worse_than_ideal);
     EXPECT_EQ(misses_explained, static_cast<int>(all.miss_count()));
     EXPECT_GT(plain.count(), 20u);  // the mirror wall sees the box behind the camera
   }
@@ -252,9 +255,10 @@ TEST(Search, HiddenPointFoundOnlyWithAllLayers) {
     // (the one-layer map's red silhouette is exact to a texel only).
     const double delta = 2.0 * texel_size_at(h.point - c, world->n);
     bool hidden_here = true;
-    for (const dvec3& e : {dvec3(0), dvec3(delta, 0, 0), dvec3(-delta, 0, 0), dvec3(0, delta, 0), dvec3(0, -delta, 0)}) {
-      hidden_here = hidden_here && world->tracer->intersect(c, h.point + e - c, 1.0 - 1e-9, &from_c) &&
-                    from_c.object_id == red;
+    for (const dvec3& e :
+         {dvec3(0), dvec3(delta, 0, 0), dvec3(-delta, 0, 0), dvec3(0, delta, 0), dvec3(0, -delta, 0)}) {
+      hidden_here =
+          hidden_here && world->tracer->intersect(c, h.point + e - c, 1.0 - 1e-9, &from_c) && from_c.object_id == red;
     }
     if (!hidden_here) continue;
     if (!away_from_silhouettes(*world, s)) continue;
@@ -265,8 +269,8 @@ TEST(Search, HiddenPointFoundOnlyWithAllLayers) {
     nearest_green += z.hit && z.object_id == green;
     nearest_red_or_miss += !z.hit || z.object_id == red;
   }
-  std::printf("hidden point: %d rays; all layers green %d; nearest layer green %d, red or miss %d\n", hidden,
-              all_green, nearest_green, nearest_red_or_miss);
+  std::printf("hidden point: %d rays; all layers green %d; nearest layer green %d, red or miss %d\n", hidden, all_green,
+              nearest_green, nearest_red_or_miss);
   ASSERT_GT(hidden, 50);
   EXPECT_GE(all_green, 0.99 * hidden);
   EXPECT_EQ(nearest_green, 0);
@@ -378,12 +382,15 @@ TEST(Search, ShadowsMatchExactVisibility) {
       const double delta = 3.0 * texel_size_at(p - world->cube.centre, world->n);
       dvec3 ref(0.0);
       bool edge = false;
-      for (const dvec3& q : {p, p + dvec3(delta, 0, 0), p - dvec3(delta, 0, 0), p + dvec3(0, 0, delta), p - dvec3(0, 0, delta)}) {
+      for (const dvec3& q :
+           {p, p + dvec3(delta, 0, 0), p - dvec3(delta, 0, 0), p + dvec3(0, 0, delta), p - dvec3(0, 0, delta)}) {
         Hit h;
         ASSERT_TRUE(world->tracer->intersect(q + dvec3(0, 1e-4, 0), {0, -1, 0}, &h));
         const dvec3 v = world->tracer->light_visibility(h, light, nullptr);
-        if (q == p) ref = v;
-        else edge = edge || glm::length(v - ref) > 1e-9;
+        if (q == p)
+          ref = v;
+        else
+          edge = edge || glm::length(v - ref) > 1e-9;
       }
       if (edge) continue;
       ++points;
@@ -402,8 +409,8 @@ TEST(Search, ShadowsMatchExactVisibility) {
       }
     }
   }
-  std::printf("shadows: %d points off edges, agree %d, opaque %d, glass %d; texels mean %.1f\n", points, agree,
-              blocked, glass, stats.mean_texels());
+  std::printf("shadows: %d points off edges, agree %d, opaque %d, glass %d; texels mean %.1f\n", points, agree, blocked,
+              glass, stats.mean_texels());
   EXPECT_GT(blocked, 20);
   EXPECT_GT(glass, 20);
   EXPECT_EQ(agree, points);
@@ -433,10 +440,10 @@ SceneData room_scene() {
   const uint32_t m = add_mirror(s);
   const uint32_t a = add_material(s, emissive({1, 0.5, 0}));
   const uint32_t b = add_material(s, emissive({0, 0.5, 1}));
-  add_box(s, {-1.5, -1.5, -4.0}, {1.5, -1.0, -3.0}, a);             // 0: behind the mirror
+  add_box(s, {-1.5, -1.5, -4.0}, {1.5, -1.0, -3.0}, a);                    // 0: behind the mirror
   add_quad(s, {-1, -0.5, -2}, {1, -0.5, -2}, {1, 1, -2}, {-1, 1, -2}, m);  // 1: mirror facing +z
-  add_box(s, {-1.0, -1.0, 3.0}, {1.0, 1.0, 4.0}, b);               // 2: behind the camera
-  add_quad(s, {1.5, 0, -1}, {1.5, 0, 1}, {2.5, 0, 1}, {2.5, 0, -1}, a);  // 3: plane y = 0 through C
+  add_box(s, {-1.0, -1.0, 3.0}, {1.0, 1.0, 4.0}, b);                       // 2: behind the camera
+  add_quad(s, {1.5, 0, -1}, {1.5, 0, 1}, {2.5, 0, 1}, {2.5, 0, -1}, a);    // 3: plane y = 0 through C
   // 4..9: the room's walls, inward facing.
   const double r = 6;
   add_quad(s, {-r, -r, -r}, {r, -r, -r}, {r, -r, r}, {-r, -r, r}, b);
@@ -475,7 +482,8 @@ TEST(Search, TessellatedMirrorSphereDoesNotFindItself) {
   int interior = 0, agree = 0, self = 0;
   for (const SurfaceRay& r : mirror_rays(*world, 160, 160)) {
     Hit at;
-    if (!world->tracer->intersect(world->cube.centre, r.w - world->cube.centre, &at) || at.object_id != sphere) continue;
+    if (!world->tracer->intersect(world->cube.centre, r.w - world->cube.centre, &at) || at.object_id != sphere)
+      continue;
     if (!away_from_silhouettes(*world, r)) continue;
     ++interior;
     agree += static_cast<bool>(matches_tracer(*world, r));
@@ -529,9 +537,9 @@ TEST(SearchDegenerate, ArcsAlongSeamsEdgesAndCorners) {
     ++checked;
     if (!matches_tracer(*world, s) && ++failed <= 5) {
       const SearchResult r = reflection_search(*world->ctx, s.w, s.r);
-      ADD_FAILURE() << matches_tracer(*world, s).message() << " W " << s.w.x << " " << s.w.y << " " << s.w.z
-                    << " R " << s.r.x << " " << s.r.y << " " << s.r.z << " X' " << r.point.x << " " << r.point.y
-                    << " " << r.point.z << " outside " << r.outside_texels;
+      ADD_FAILURE() << matches_tracer(*world, s).message() << " W " << s.w.x << " " << s.w.y << " " << s.w.z << " R "
+                    << s.r.x << " " << s.r.y << " " << s.r.z << " X' " << r.point.x << " " << r.point.y << " "
+                    << r.point.z << " outside " << r.outside_texels;
     }
   };
   for (int k = 0; k < 200; ++k) {
@@ -720,8 +728,8 @@ TEST(MeshRefine, RaysGrazingASilhouetteMeetWhatTheExactRayMeets) {
       plane_right += right(reflection_search(*w->ctx, origin, dir, with_refine(SearchRefine::plane, false)));
     }
   }
-  std::printf("silhouette rays %d: right with mesh refinement %d (map only %d), with plane only (map only) %d\n",
-              rays, mesh_right, mesh_map_right, plane_right);
+  std::printf("silhouette rays %d: right with mesh refinement %d (map only %d), with plane only (map only) %d\n", rays,
+              mesh_right, mesh_map_right, plane_right);
   ASSERT_GT(rays, 1000);
   EXPECT_GE(mesh_right, 0.998 * rays);
   EXPECT_GE(mesh_map_right, 0.998 * rays);
@@ -754,8 +762,8 @@ TEST(MeshRefine, ACreaseDoesNotShadowItsOwnFace) {
       plane_false += shadow_search(*w->ctx, p, light, with_refine(SearchRefine::plane)).blockers > 0;
     }
   }
-  std::printf("crease: %d lit points, false shadows with mesh refinement %d, with plane only %d\n", points,
-              mesh_false, plane_false);
+  std::printf("crease: %d lit points, false shadows with mesh refinement %d, with plane only %d\n", points, mesh_false,
+              plane_false);
   ASSERT_GT(points, 300);
   EXPECT_EQ(mesh_false, 0);
   EXPECT_GT(plane_false, points / 10);  // the scenario shows the plane tolerance's error

@@ -38,8 +38,8 @@ struct WalkRay {
 
 std::string describe(const WalkRay& r, int n) {
   char s[400];
-  std::snprintf(s, sizeof s, "n=%d W=(%.17g,%.17g,%.17g) D=(%.17g,%.17g,%.17g) l_max=%.17g skip=%.17g", n, r.w.x,
-                r.w.y, r.w.z, r.d.x, r.d.y, r.d.z, r.l_max, r.skip);
+  std::snprintf(s, sizeof s, "n=%d W=(%.17g,%.17g,%.17g) D=(%.17g,%.17g,%.17g) l_max=%.17g skip=%.17g", n, r.w.x, r.w.y,
+                r.w.z, r.d.x, r.d.y, r.d.z, r.l_max, r.skip);
   return s;
 }
 
@@ -197,7 +197,8 @@ TEST(SearchHierarchy, PyramidNodesBoundTheirFragments) {
                 ASSERT_EQ(z, ctx.node_bounds(face, k, i0, j0));  // one node for the square
               }
             }
-            EXPECT_EQ(ctx.node_bounds(face, k, i0, j0), glm::vec2(lo, hi)) << face << " " << k << " " << i0 << " " << j0;
+            EXPECT_EQ(ctx.node_bounds(face, k, i0, j0), glm::vec2(lo, hi))
+                << face << " " << k << " " << i0 << " " << j0;
           }
         }
       }
@@ -275,7 +276,8 @@ void compare_searches(const SceneData& scene, const SearchContext& ctx, const Ra
     }
     // A random ray and segment near the centre's scene.
     const glm::dvec3 w = c + unit() * reach * pos(rng), d = unit();
-    tally->add(reflection_search(ctx, w, d, off), reflection_search(ctx, w, d, o), name + " " + ray_text("random", w, d));
+    tally->add(reflection_search(ctx, w, d, off), reflection_search(ctx, w, d, o),
+               name + " " + ray_text("random", w, d));
     const glm::dvec3 to = c + unit() * reach * pos(rng);
     tally->add(shadow_search(ctx, w, to, off), shadow_search(ctx, w, to, o), name + " " + ray_text("segment", w, to));
   }
@@ -357,7 +359,8 @@ TEST(SearchHierarchy, SearchesGiveThePlainWalksAnswers) {
   }
   std::printf("searches: %ld compared, %ld differ; texels per search %.1f plain, %.1f + %.1f nodes hierarchical\n",
               tally.searches, tally.differ, static_cast<double>(tally.texels_plain) / tally.searches,
-              static_cast<double>(tally.texels_hier) / tally.searches, static_cast<double>(tally.nodes) / tally.searches);
+              static_cast<double>(tally.texels_hier) / tally.searches,
+              static_cast<double>(tally.nodes) / tally.searches);
   EXPECT_GT(tally.searches, 10000);
   EXPECT_EQ(tally.differ, 0);
   EXPECT_GT(tally.nodes, 0u);

@@ -28,7 +28,8 @@ TEST(Shading, PhongLocalMatchesHandComputation) {
   const glm::dvec3 c = phong_local(m, p, n, eye, glm::dvec3(0.2), {l});
   // ka Ia Od + I (kd Od N.L + ks (R.V)^n); R = reflect(-L, N) = (-1, 0, 1)/sqrt 2, V = z.
   const double ndotl = 1.0 / std::sqrt(2.0), rdotv = 1.0 / std::sqrt(2.0);
-  const glm::dvec3 expect = 0.5 * 0.2 * m.color + l.color * (0.8 * ndotl * m.color + glm::dvec3(0.3 * std::pow(rdotv, 4)));
+  const glm::dvec3 expect =
+      0.5 * 0.2 * m.color + l.color * (0.8 * ndotl * m.color + glm::dvec3(0.3 * std::pow(rdotv, 4)));
   EXPECT_NEAR(c.r, expect.r, 1e-12);
   EXPECT_NEAR(c.g, expect.g, 1e-12);
   EXPECT_NEAR(c.b, expect.b, 1e-12);
@@ -68,9 +69,7 @@ TEST(Shading, TotalInternalReflectionExactlyBeyondCriticalAngle) {
   for (double ior : {1.33, 1.5, 2.4}) {
     const double critical = std::asin(1.0 / ior);
     // Leaving through the plane from below (inside): direction upwards at angle theta from +z.
-    auto leave = [&](double theta) {
-      return transmission({std::sin(theta), 0.0, std::cos(theta)}, n, n, ior);
-    };
+    auto leave = [&](double theta) { return transmission({std::sin(theta), 0.0, std::cos(theta)}, n, n, ior); };
     const Transmission below = leave(critical * (1.0 - 1e-9));
     EXPECT_FALSE(below.total_internal_reflection) << "ior " << ior;
     EXPECT_GT(below.dir.z, 0.0);

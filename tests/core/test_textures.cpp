@@ -42,7 +42,8 @@ std::vector<unsigned char> png(int w, int h, const std::vector<unsigned char>& r
 std::vector<unsigned char> test_texels() {
   std::vector<unsigned char> rgb;
   for (int j = 0; j < 2; ++j) {
-    for (int i = 0; i < 4; ++i) rgb.insert(rgb.end(), {static_cast<unsigned char>(40 * i + 10), static_cast<unsigned char>(100 * j + 30), 200});
+    for (int i = 0; i < 4; ++i)
+      rgb.insert(rgb.end(), {static_cast<unsigned char>(40 * i + 10), static_cast<unsigned char>(100 * j + 30), 200});
   }
   return rgb;
 }
@@ -84,7 +85,8 @@ std::string load_error(const std::string& path) {
 std::string quad_scene(const std::string& texture) {
   return R"({"version": 1, "camera": {"position": [0, 0, 3], "look_at": [0, 0, 0], "fov_y": 40, "width": 48, "height": 32},
     "ambient": [1, 1, 1], "lights": [{"type": "point", "position": [0.5, 1, 4]}],
-    "materials": {"t": {"color": [1, 0.5, 1], "ambient": 0.3, "texture": ")" + texture + R"("}},
+    "materials": {"t": {"color": [1, 0.5, 1], "ambient": 0.3, "texture": ")" +
+         texture + R"("}},
     "objects": [{"type": "quad", "vertices": [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], "material": "t"}],
     "render": {"cube_resolution": 64, "max_depth": 1}})";
 }
@@ -114,7 +116,8 @@ TEST(Textures, CorruptBytesAreRefusedWithAReason) {
   EXPECT_FALSE(decode_texture(bytes.data(), bytes.size(), "t.png", "", &image, &why));
   EXPECT_FALSE(why.empty());
   const std::string text = "not an image at all";
-  EXPECT_FALSE(decode_texture(reinterpret_cast<const unsigned char*>(text.data()), text.size(), "t.png", "", &image, &why));
+  EXPECT_FALSE(
+      decode_texture(reinterpret_cast<const unsigned char*>(text.data()), text.size(), "t.png", "", &image, &why));
 }
 
 // Texel centres give the texel (bilinear weights 1), v runs up (row 0 is the top), and
@@ -199,8 +202,8 @@ TEST(Textures, EmbeddedImageIsDecodedFromMemory) {
   const TextureImage from_file = scene.textures->images()[0];
   scene.textures = nullptr;
   scene.materials[0].texture = "#embedded/0";
-  scene.embedded_images.push_back({"box.glb: images[0]", "image/png",
-                                   std::make_shared<const std::vector<unsigned char>>(bytes)});
+  scene.embedded_images.push_back(
+      {"box.glb: images[0]", "image/png", std::make_shared<const std::vector<unsigned char>>(bytes)});
   LoadLimits limits;
   detail::LoadState st{src, scene, limits, "", {}, {}, -1, {}};
   detail::load_textures(st);
@@ -213,7 +216,8 @@ TEST(Textures, EmbeddedImageIsDecodedFromMemory) {
     detail::load_textures(st);
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("cannot decode texture \"box.glb: images[0]\""), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cannot decode texture \"box.glb: images[0]\""), std::string::npos)
+        << e.what();
   }
 }
 
@@ -236,9 +240,11 @@ TEST(Textures, MissingAndCorruptFilesNameTheField) {
   EXPECT_NE(load_error(text).find("materials.t.texture: cannot decode texture"), std::string::npos) << load_error(text);
   // An MTL map_Kd that is missing names the MTL file and line.
   dir.write("tile.mtl", "newmtl a\nKd 1 1 1\n\nmap_Kd gone.png\n");
-  dir.write("tile.obj", "mtllib tile.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\n");
+  dir.write("tile.obj",
+            "mtllib tile.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\n");
   const std::string mesh = dir.write(
-      "o.json", R"({"version": 1, "camera": {"position": [0, 0, 3], "look_at": [0, 0, 0]}, "objects": [{"type": "mesh", "file": "tile.obj"}]})");
+      "o.json",
+      R"({"version": 1, "camera": {"position": [0, 0, 3], "look_at": [0, 0, 0]}, "objects": [{"type": "mesh", "file": "tile.obj"}]})");
   EXPECT_NE(load_error(mesh).find(mesh + ": objects[0].file: \"" + (dir.path() / "tile.mtl").string() +
                                   "\":4: map_Kd cannot read texture"),
             std::string::npos)

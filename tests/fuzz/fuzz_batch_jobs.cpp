@@ -31,10 +31,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       const std::string message = e.what();
       fz::check_message(message, file);
       size_t line = 0;  // "FILE:LINE: ..."
-      for (size_t i = file.size() + 1; i < message.size() && message[i] >= '0' && message[i] <= '9' && line < lines + 1; ++i) {
+      for (size_t i = file.size() + 1; i < message.size() && message[i] >= '0' && message[i] <= '9' && line < lines + 1;
+           ++i) {
         line = 10 * line + static_cast<size_t>(message[i] - '0');
       }
-      if (line == 0 || line > lines) fz::broken("error names line " + std::to_string(line) + " of " + std::to_string(lines));
+      if (line == 0 || line > lines)
+        fz::broken("error names line " + std::to_string(line) + " of " + std::to_string(lines));
     } catch (const std::exception& e) {
       fz::broken(std::string("not an InputError: ") + e.what());
     }

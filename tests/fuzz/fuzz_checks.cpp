@@ -33,7 +33,8 @@ bool finite(const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y
 
 void check_scene(const SceneData& scene) {
   const Camera& c = scene.camera;
-  if (!finite(c.position) || !finite(c.look_at) || !finite(c.up) || !std::isfinite(c.fov_y_deg)) broken("camera not finite");
+  if (!finite(c.position) || !finite(c.look_at) || !finite(c.up) || !std::isfinite(c.fov_y_deg))
+    broken("camera not finite");
   if (c.width <= 0 || c.height <= 0) broken("camera size not positive");
   if (!finite(scene.background) || !finite(scene.ambient)) broken("background or ambient not finite");
   for (const PointLight& l : scene.lights) {
@@ -58,7 +59,8 @@ void check_scene(const SceneData& scene) {
     if (!soup.uvs.empty() && !finite(soup.uvs[i])) broken("uv " + std::to_string(i) + " not finite");
   }
   for (size_t t = 0; t < n; ++t) {
-    if (soup.material_id[t] >= scene.materials.size()) broken("triangle " + std::to_string(t) + ": material id out of range");
+    if (soup.material_id[t] >= scene.materials.size())
+      broken("triangle " + std::to_string(t) + ": material id out of range");
     if (soup.object_id[t] >= scene.objects.size()) broken("triangle " + std::to_string(t) + ": object id out of range");
   }
   for (size_t o = 0; o < scene.objects.size(); ++o) {

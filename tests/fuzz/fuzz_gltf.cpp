@@ -33,8 +33,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     fz::write_file(limits.root + "/in.gltf", data, json_size);
     fz::write_file(limits.root + "/in.bin", data + bin_start, size - bin_start);
   }
-  const std::string scene = R"({"version": 1, "camera": {"position": [0, 1, -4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 60, "width": 8, "height": 8},
-"objects": [{"type": "gltf", "file": ")" + model + R"("}]})";
+  const std::string scene =
+      R"({"version": 1, "camera": {"position": [0, 1, -4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 60, "width": 8, "height": 8},
+"objects": [{"type": "gltf", "file": ")" +
+      model + R"("}]})";
   fz::expect_input_error_or_success(
       [&] { fz::check_scene(abcube::load_scene_text(scene, "scene.json", limits.root, limits)); }, "scene.json");
   return 0;

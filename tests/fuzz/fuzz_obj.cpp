@@ -25,7 +25,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const size_t mtl_start = split == std::string::npos ? size : split + separator.size();
   fz::write_file(limits.root + "/in.obj", data, obj_size);
   fz::write_file(limits.root + "/in.mtl", data + mtl_start, size - mtl_start);
-  const std::string scene = R"({"version": 1, "camera": {"position": [0, 1, -4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 60, "width": 8, "height": 8},
+  const std::string scene =
+      R"({"version": 1, "camera": {"position": [0, 1, -4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 60, "width": 8, "height": 8},
 "objects": [{"type": "mesh", "file": "in.obj"}]})";
   fz::expect_input_error_or_success(
       [&] { fz::check_scene(abcube::load_scene_text(scene, "scene.json", limits.root, limits)); }, "scene.json");

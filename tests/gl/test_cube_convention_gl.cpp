@@ -51,8 +51,8 @@ TEST(CubeConventionGl, EveryTexelCentreLandsOnItsTexel) {
         const uint32_t expected = static_cast<uint32_t>((face * n + j) * n + i);
         const uint32_t got = ids.faces[face][static_cast<size_t>(j) * n + i];
         if (got != expected && ++wrong < 10) {
-          ADD_FAILURE() << "face " << cube_face_name(face) << " texel (" << i << "," << j << "): GL object "
-                        << got << ", CPU mapping expects " << expected;
+          ADD_FAILURE() << "face " << cube_face_name(face) << " texel (" << i << "," << j << "): GL object " << got
+                        << ", CPU mapping expects " << expected;
         }
       }
     }

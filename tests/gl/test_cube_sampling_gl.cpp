@@ -65,8 +65,8 @@ TEST(CubeConventionGl, GlCubeSamplingPicksCpuTexel) {
   glBindTexture(GL_TEXTURE_CUBE_MAP, tex);
   for (int face = 0; face < CUBE_FACES; ++face) {
     std::vector<float> v(ids.faces[face].begin(), ids.faces[face].end());
-    glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + static_cast<GLenum>(face), 0, GL_R32F, n, n, 0, GL_RED,
-                 GL_FLOAT, v.data());
+    glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + static_cast<GLenum>(face), 0, GL_R32F, n, n, 0, GL_RED, GL_FLOAT,
+                 v.data());
   }
   glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
   glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_NEAREST);

@@ -126,16 +126,19 @@ TEST(GpuLookupsGl, ShadowMapsMultiplyTransmittances) {
           uniform = glm::length(visibility[static_cast<size_t>((y + dy) * s.camera.width + x + dx)] - st) < 1e-9;
       if (!uniform) continue;
       const glm::dvec3 glass_twice = 0.81 * s.materials[glass].color * s.materials[glass].color;
-      const char* kind = st == glm::dvec3(1.0) ? "lit" : st == glm::dvec3(0.0) ? "opaque"
-                         : glm::length(st - glass_twice) < 1e-9 ? "glass"
-                         : glm::length(st - 0.5 * glass_twice) < 1e-9 ? "glass and veil" : "other";
+      const char* kind = st == glm::dvec3(1.0)                        ? "lit"
+                         : st == glm::dvec3(0.0)                      ? "opaque"
+                         : glm::length(st - glass_twice) < 1e-9       ? "glass"
+                         : glm::length(st - 0.5 * glass_twice) < 1e-9 ? "glass and veil"
+                                                                      : "other";
       ++kinds[kind];
       const glm::vec3 got = img.rgb(x, y);
       const glm::dvec3 want = expected[static_cast<size_t>(y * s.camera.width + x)];
       for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(double(got[c]) - want[c]));
     }
   }
-  for (const char* kind : {"lit", "opaque", "glass", "glass and veil"}) EXPECT_GT(kinds[kind], 40) << kind << ": " << kinds["other"] << " other";
+  for (const char* kind : {"lit", "opaque", "glass", "glass and veil"})
+    EXPECT_GT(kinds[kind], 40) << kind << ": " << kinds["other"] << " other";
   EXPECT_LT(worst, 2e-3);
 }
 

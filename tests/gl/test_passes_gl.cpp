@@ -99,8 +99,8 @@ TEST(ZbufferGl, QuadCoversKnownRectangle) {
       const bool inside = px > x0 && px < x1 && py > y0 && py < y1;
       // Within one pixel of an edge either answer is allowed.
       const double pix = 2.0 * f.tan_half_fov_y / s.camera.height;
-      const bool near_edge = std::min({std::abs(px - x0), std::abs(px - x1), std::abs(py - y0),
-                                       std::abs(py - y1)}) < pix;
+      const bool near_edge =
+          std::min({std::abs(px - x0), std::abs(px - x1), std::abs(py - y0), std::abs(py - y1)}) < pix;
       const glm::vec3 c = img.rgb(x, y);
       const bool red_here = c.r > 0.99f && c.b < 0.01f;
       const bool bg_here = c.b > 0.99f && c.r < 0.01f;
@@ -143,8 +143,7 @@ TEST(ZbufferGl, PhongMatchesCpuShading) {
       const double t = -f.eye.y / d.y;
       const glm::dvec3 p = f.eye + t * d;
       if (std::abs(p.x) > 2.9 || std::abs(p.z) > 2.9) continue;
-      const glm::dvec3 expected =
-          phong_local(s.materials[m], p, glm::dvec3(0, 1, 0), f.eye, s.ambient, s.lights);
+      const glm::dvec3 expected = phong_local(s.materials[m], p, glm::dvec3(0, 1, 0), f.eye, s.ambient, s.lights);
       const glm::vec3 got = img.rgb(x, y);
       for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(got[c] - expected[c]));
       ++checked;
