@@ -214,7 +214,7 @@ std::vector<Entry> make_table() {
       });
 
   // ---- outputs and the reference
-  add({"aovs", "--aovs", OptionKind::names, OptionScope::job, {"distance", "normal", "object_id", "fallback"}, 0, 0,
+  add({"aovs", "--aovs", OptionKind::names, OptionScope::job, {"distance", "normal", "object_id", "shadowed", "fallback"}, 0, 0,
        "none", "", {}, "", "extra outputs beside the image, comma-separated (OUT_STEM.NAME.exr)", {}},
       [](RenderSetup& s, const json& v) { s.render.aovs = v.get<std::vector<std::string>>(); },
       [](const RenderSetup& s) { return s.render.aovs.empty() ? json() : json(s.render.aovs); });

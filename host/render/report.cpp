@@ -45,8 +45,11 @@ std::string surface_kind(const Material& m) {
 }
 
 // The error of `image` against `reference` per object and per kind of surface, over the
-// pixels whose centre sees that object in the reference (`object_id`, -1 for none).
-json error_by_region(const Image& image, const Image& reference, const Image& object_id, const SceneData& scene) {
+// pixels whose centre sees that object in the reference (`object_id`, -1 for none); and
+// over the pixels whose centre surface is in some light's shadow (`shadowed` > 0), whatever
+// its kind ("in shadow": those pixels are in their kind's figures too).
+json error_by_region(const Image& image, const Image& reference, const Image& object_id, const Image& shadowed,
+                     const SceneData& scene) {
   struct Sum {
     double sq = 0;
     size_t pixels = 0, over_2 = 0;
@@ -65,11 +68,14 @@ json error_by_region(const Image& image, const Image& reference, const Image& ob
       const std::string kind = id < 0 || static_cast<size_t>(id) >= scene.objects.size()
                                    ? "background"
                                    : surface_kind(scene.materials[scene.objects[static_cast<size_t>(id)].material]);
-      for (Sum* s : {&by_object[id], &by_kind[kind]}) {
+      const auto add = [&](Sum* s) {
         s->sq += glm::dot(d, d);
         ++s->pixels;
         s->over_2 += m > 2.0 / 255.0 + 1e-6;
-      }
+      };
+      add(&by_object[id]);
+      add(&by_kind[kind]);
+      if (shadowed.at(x, y)[0] > 0) add(&by_kind["in shadow"]);
     }
   }
   const auto figures = [](const Sum& s) {
@@ -193,12 +199,13 @@ class Report {
   void render_reference(Renderer& renderer) {
     say("rendering the reference (raytrace)");
     RenderOptions options = without_unused_options(o_.render, "raytrace");
-    options.aovs = {"object_id"};
+    options.aovs = {"object_id", "shadowed"};
     options.reference = false;
     options.reference_image.clear();
     RenderResult r = render(renderer, options, "raytrace");
     reference_ = std::move(r.image);
     object_id_ = std::move(r.aovs.at("object_id"));
+    shadowed_ = std::move(r.aovs.at("shadowed"));
     write_image(path("images/raytrace.exr"), reference_);
     write_image(path("images/raytrace.png"), reference_);
     j_["size"] = {{"width", reference_.width}, {"height", reference_.height}};
@@ -233,7 +240,7 @@ class Report {
     m["error"] = image_error_json(e);
     m["total_ms"] = r.stats.total_ms;
     m["timings_ms"] = timings(r.stats.timings_ms);
-    m["regions"] = error_by_region(r.image, reference_, object_id_, scene_.data());
+    m["regions"] = error_by_region(r.image, reference_, object_id_, shadowed_, scene_.data());
     if (stats.contains("plan")) m["plan"] = stats["plan"];
     if (stats.contains("reference") && stats["reference"].contains("ray_error")) {
       m["ray_error"] = stats["reference"]["ray_error"];
@@ -333,7 +340,7 @@ class Report {
   std::string dir_;
   const ReportOptions& o_;
   json j_;
-  Image reference_, object_id_;
+  Image reference_, object_id_, shadowed_;
   double render_ms_ = 0;
   int failed_ = 0;
 };

@@ -260,7 +260,8 @@ void viewer(std::string& h, const json& r) {
 
 void regions(std::string& h, const json& r) {
   h += "<h2 id=\"regions\">Where the error lies</h2><p class=\"note\">Pixels grouped by what the reference sees at "
-       "their centre: the kind of surface (by its material) and the object.</p>";
+       "their centre: the kind of surface (by its material) and the object; \"in shadow\": the pixels whose surface "
+       "some light does not reach whole, whatever their kind.</p>";
   for (const std::string& m : method_order(r)) {
     const json& x = r["methods"][m];
     if (x.contains("failed")) continue;

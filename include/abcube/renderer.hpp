@@ -87,10 +87,12 @@ struct RenderOptions {
   // "distance" (1 channel, world units from the camera to the first surface, +inf where
   // none), "normal" (3 channels, unit shading normal facing the camera, 0 where none),
   // "object_id" (1 channel, the object's index in the file, -1 where none; exact in float
-  // up to 2^24 objects); and from the render itself, "fallback" (1 channel, map methods:
-  // the share of the pixel's secondary searches that found nothing: a reflection or
-  // refraction-exit miss, a shadow walk on a zero-area surface or aborted, a lens transfer
-  // that fell back to a search; 0 where none was made and for the other methods).
+  // up to 2^24 objects), "shadowed" (1 channel, the share of the scene's lights whose light
+  // that surface does not get whole, 0 where none); and from the render itself,
+  // "fallback" (1 channel, map methods: the share of the pixel's secondary searches that
+  // found nothing: a reflection or refraction-exit miss, a shadow walk on a zero-area
+  // surface or aborted, a lens transfer that fell back to a search; 0 where none was made
+  // and for the other methods).
   std::vector<std::string> aovs;
   bool stats = true;     // fill RenderResult::stats (cheap; off saves its JSON)
   double timeout_s = 0;  // > 0: stop with RenderTimeout past this many seconds
