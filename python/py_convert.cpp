@@ -102,56 +102,6 @@ uint64_t unsigned_arg(const py::handle& value, const std::string& what) {
   return integer_arg<uint64_t>(value, what, "an integer >= 0", "must be an integer >= 0");
 }
 
-double float_arg(const py::handle& value, const std::string& what) {
-  // int or float (and numpy scalars); strings are not numbers here.
-  if (py::isinstance<py::bool_>(value) || py::isinstance<py::str>(value) || !py::hasattr(value, "__float__")) {
-    throw InputError(what + ": must be a number, got " + type_name(value));
-  }
-  return py::float_(py::reinterpret_borrow<py::object>(value)).cast<double>();
-}
-
-std::array<double, 3> vec3_arg(const py::handle& value, const std::string& what) {
-  // Any sequence of 3 numbers: a list, a tuple, a numpy array.
-  if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value) || py::len(value) != 3) {
-    throw InputError(what + ": must be 3 numbers [x, y, z], got " + std::string(py::str(py::repr(value))));
-  }
-  const py::sequence items = py::reinterpret_borrow<py::sequence>(value);
-  std::array<double, 3> v{};
-  for (size_t k = 0; k < 3; ++k) v[k] = float_arg(items[k], what + "[" + std::to_string(k) + "]");
-  return v;
-}
-
-CameraOverride camera_arg(const py::handle& value) {
-  // Only the keys given override the scene's camera; an unknown key is an error (a typo).
-  if (!py::isinstance<py::dict>(value)) {
-    throw InputError(
-        "camera: must be a dict with any of position, look_at, up, fov_y, width, "
-        "height, got " +
-        type_name(value));
-  }
-  CameraOverride camera;
-  for (const auto& item : py::reinterpret_borrow<py::dict>(value)) {
-    const std::string key = string_arg(item.first, "camera key");
-    const std::string what = "camera." + key;
-    if (key == "position") {
-      camera.position = vec3_arg(item.second, what);
-    } else if (key == "look_at") {
-      camera.look_at = vec3_arg(item.second, what);
-    } else if (key == "up") {
-      camera.up = vec3_arg(item.second, what);
-    } else if (key == "fov_y") {
-      camera.fov_y = float_arg(item.second, what);
-    } else if (key == "width") {
-      camera.width = int_arg(item.second, what);
-    } else if (key == "height") {
-      camera.height = int_arg(item.second, what);
-    } else {
-      throw InputError(what + ": unknown key (position, look_at, up, fov_y, width, height)");
-    }
-  }
-  return camera;
-}
-
 // A Python value as JSON text, for the option table: bool, int, float, str, os.PathLike,
 // sequences (lists, tuples, numpy arrays) and dicts; numpy scalars by their .item().
 std::string json_text(const py::handle& v, const std::string& what) {

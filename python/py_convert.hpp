@@ -33,11 +33,7 @@ std::string string_arg(const py::handle& value, const std::string& what);
 bool bool_arg(const py::handle& value, const std::string& what);
 int int_arg(const py::handle& value, const std::string& what);
 uint64_t unsigned_arg(const py::handle& value, const std::string& what);
-double float_arg(const py::handle& value, const std::string& what);
-std::array<double, 3> vec3_arg(const py::handle& value, const std::string& what);
 
-// A camera dict with any of position, look_at, up, fov_y, width, height.
-CameraOverride camera_arg(const py::handle& value);
 
 // A Python value as JSON text (bool, int, float, str, os.PathLike, sequences, numpy
 // arrays and scalars, dicts); InputError naming `what` for a NaN or another type.
