@@ -74,13 +74,13 @@ bool keep_image_bytes(tg::Image* image, const int, std::string*, std::string*, i
 LocalMesh GltfReader::read() {
   const std::string bytes = read_whole();
   const bool binary = bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0;
-  if (binary && bytes.size() >= 8) {
-    uint32_t version = 0;
-    std::memcpy(&version, bytes.data() + 4, 4);
-    if (version != 2) bad("", "binary glTF version " + std::to_string(version) + ": only glTF 2.0 is read");
+  std::string json_text = bytes;
+  if (binary) {
+    GlbChunks glb = read_glb(bytes);
+    if (!glb.problem.empty()) bad("", glb.problem);
+    json_text = std::move(glb.json);
   }
-  const std::string json_text = binary ? glb_json(bytes) : bytes;
-  if (!binary || !json_text.empty()) precheck(json_text);
+  precheck(json_text);
   load(bytes, binary);
   convert();
   return std::move(out_);

@@ -39,9 +39,14 @@ using CheckFile = std::function<void(const Json& element, const std::string& at,
 // buffer and image element through `check_file`.
 void check_document(const Json& doc, const BadAt& bad, const CheckFile& check_file);
 
-// The JSON chunk of a .glb (binary glTF, version 2), or "" when the container is not one
-// (tinygltf then names what is wrong).
-std::string glb_json(const std::string& bytes);
+// A .glb (binary glTF 2.0) container read: its JSON chunk, or what is wrong with its
+// layout. Every chunk lies wholly inside the header's length, so what tinygltf later takes
+// from the BIN chunk is inside the file.
+struct GlbChunks {
+  std::string json;
+  std::string problem;  // empty when the layout holds
+};
+GlbChunks read_glb(const std::string& bytes);
 
 // ---- Accessors (scene_gltf_geometry.cpp) ----
 

@@ -204,16 +204,42 @@ std::string url_decode(const std::string& s) {
 
 bool is_data_uri(const std::string& uri) { return uri.rfind("data:", 0) == 0; }
 
-std::string glb_json(const std::string& bytes) {
+GlbChunks read_glb(const std::string& bytes) {
   const auto u32 = [&](size_t at) {
     uint32_t v = 0;
     std::memcpy(&v, bytes.data() + at, 4);
     return v;
   };
-  if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0 || u32(4) != 2) return "";
-  const uint32_t length = u32(12);
-  if (u32(16) != 0x4E4F534Au /* JSON */ || length > bytes.size() - 20) return "";
-  return bytes.substr(20, length);
+  GlbChunks out;
+  const auto refuse = [&](const std::string& why) {
+    out.problem = "not a valid binary glTF: " + why;
+    return out;
+  };
+  if (bytes.size() < 12) return refuse("shorter than its 12-byte header");
+  if (u32(4) != 2) return refuse("version " + std::to_string(u32(4)) + " (only glTF 2.0 is read)");
+  // The header's length bounds every chunk; bytes after it are not part of the container.
+  const uint64_t length = u32(8);
+  if (length > bytes.size()) {
+    return refuse("the header says " + std::to_string(length) + " bytes, the file has " +
+                  std::to_string(bytes.size()));
+  }
+  // Chunks: an 8-byte header (length, type), then the data, each wholly inside `length`.
+  // The first is JSON; a BIN chunk may follow it.
+  uint64_t at = 12;
+  for (int index = 0; at < length; ++index) {
+    if (at + 8 > length) return refuse("chunk " + std::to_string(index) + " has no room for its 8-byte header");
+    const uint64_t size = u32(static_cast<size_t>(at));
+    const uint32_t type = u32(static_cast<size_t>(at) + 4);
+    if (at + 8 + size > length) {
+      return refuse("chunk " + std::to_string(index) + " claims " + std::to_string(size) + " bytes, " +
+                    std::to_string(length - at - 8) + " remain");
+    }
+    if (index == 0 && type != 0x4E4F534Au /* JSON */) return refuse("the first chunk is not JSON");
+    if (index == 0) out.json = bytes.substr(static_cast<size_t>(at) + 8, static_cast<size_t>(size));
+    at += 8 + size;
+  }
+  if (at == 12) return refuse("no JSON chunk");
+  return out;
 }
 
 void check_document(const Json& doc, const BadAt& bad, const CheckFile& check_file) {

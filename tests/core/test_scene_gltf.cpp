@@ -54,6 +54,17 @@ struct QuadGltf {
   }
 };
 
+std::string u32_bytes(uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); }
+
+// A binary glTF container: the header, a JSON chunk (padded with spaces to 4 bytes) and,
+// when `bin` is not empty, a BIN chunk, each chunk's length as the layout requires.
+std::string glb(std::string json, const std::string& bin) {
+  json += std::string((4 - json.size() % 4) % 4, ' ');
+  std::string chunks = u32_bytes(static_cast<uint32_t>(json.size())) + "JSON" + json;
+  if (!bin.empty()) chunks += u32_bytes(static_cast<uint32_t>(bin.size())) + std::string("BIN\0", 4) + bin;
+  return "glTF" + u32_bytes(2) + u32_bytes(static_cast<uint32_t>(12 + chunks.size())) + chunks;
+}
+
 std::string gltf_scene(const std::string& object_extra = "") {
   return with_objects(R"([{"type": "gltf", "file": "quad.gltf")" + object_extra + "}]").str();
 }
@@ -188,12 +199,7 @@ TEST(SceneLoadGltf, GlbImagesAreKeptEncoded) {
   json.replace(
       json.find("\"byteLength\": 32}]"), 18,
       "\"byteLength\": 32}, {\"buffer\": 0, \"byteOffset\": 92, \"byteLength\": " + std::to_string(png.size()) + "}]");
-  json += std::string((4 - json.size() % 4) % 4, ' ');
-  const auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
-  const std::string glb = "glTF" + u32(2) + u32(static_cast<uint32_t>(12 + 8 + json.size() + 8 + bin.size())) +
-                          u32(static_cast<uint32_t>(json.size())) + "JSON" + json +
-                          u32(static_cast<uint32_t>(bin.size())) + std::string("BIN\0", 4) + bin;
-  dir.write("quad.glb", glb);
+  dir.write("quad.glb", glb(json, bin));
   const SceneData s = load_text(with_objects(R"([{"type": "gltf", "file": "quad.glb"}])").str(), dir.path().string());
   ASSERT_EQ(s.embedded_images.size(), 1u);
   EXPECT_EQ(s.embedded_images[0].mime_type, "image/png");
@@ -202,6 +208,48 @@ TEST(SceneLoadGltf, GlbImagesAreKeptEncoded) {
   ASSERT_EQ(s.triangles->uvs.size(), 6u);
   EXPECT_EQ(s.triangles->uvs[1], glm::vec2(1, 1));  // glTF (1, 0): v runs down, stored 1 - v
   EXPECT_EQ(s.triangles->uvs[2], glm::vec2(1, 0));
+}
+
+// A .glb's chunks must lie inside its header's length before tinygltf reads them: a BIN
+// chunk whose length runs past the file would have it copy bytes from beyond the end.
+TEST(SceneLoadGltf, GlbContainerLayoutIsChecked) {
+  TempDir dir;
+  QuadGltf g;
+  g.buffer_uri = "";
+  std::string json = g.str();
+  json.replace(json.find("\"uri\": \"\", "), 11, "");
+  const std::string good = glb(json, g.bin());
+  const std::string scene = with_objects(R"([{"type": "gltf", "file": "quad.glb"}])").str();
+  dir.write("quad.glb", good);
+  EXPECT_EQ(load_text(scene, dir.path().string()).triangles->triangle_count(), 2u);
+
+  const auto error_for = [&](const std::string& bytes) {
+    dir.write("quad.glb", bytes);
+    return load_error(scene, dir.path().string());
+  };
+  const std::string prefix = "scene.json: objects[0].file: \"quad.glb\": not a valid binary glTF: ";
+  const size_t bin_header = 12 + 8 + (json.size() + 3) / 4 * 4;
+  std::string overlong = good;  // the BIN chunk claims its own 8-byte header as data too
+  overlong.replace(bin_header, 4, u32_bytes(static_cast<uint32_t>(good.size() - bin_header)));
+  EXPECT_EQ(error_for(overlong), prefix + "chunk 1 claims " + std::to_string(good.size() - bin_header) + " bytes, " +
+                                     std::to_string(good.size() - bin_header - 8) + " remain");
+  std::string long_header = good;
+  long_header.replace(8, 4, u32_bytes(static_cast<uint32_t>(good.size() + 4)));
+  EXPECT_EQ(error_for(long_header), prefix + "the header says " + std::to_string(good.size() + 4) +
+                                        " bytes, the file has " + std::to_string(good.size()));
+  std::string not_json = good;
+  not_json.replace(16, 4, "JSOX");
+  EXPECT_EQ(error_for(not_json), prefix + "the first chunk is not JSON");
+  EXPECT_EQ(error_for(good.substr(0, 10)), prefix + "shorter than its 12-byte header");
+  std::string torn = good.substr(0, bin_header + 4);  // the header's length cut to match
+  torn.replace(8, 4, u32_bytes(static_cast<uint32_t>(torn.size())));
+  EXPECT_EQ(error_for(torn), prefix + "chunk 1 has no room for its 8-byte header");
+  std::string empty = good.substr(0, 12);
+  empty.replace(8, 4, u32_bytes(12));
+  EXPECT_EQ(error_for(empty), prefix + "no JSON chunk");
+  std::string version_one = good;
+  version_one.replace(4, 4, u32_bytes(1));
+  EXPECT_EQ(error_for(version_one), prefix + "version 1 (only glTF 2.0 is read)");
 }
 
 // Issue 18: what a glTF names must resolve inside --root (symbolic links followed); the
