@@ -32,6 +32,38 @@ void check_same_size(const Image& a, const Image& b) {
 
 }  // namespace
 
+double psnr_of_mse(double mse) {
+  return mse > 0.0 ? 10.0 * std::log10(1.0 / mse) : std::numeric_limits<double>::infinity();
+}
+
+SampledError sampled_error(const Image& a, const Image& b, const std::vector<uint8_t>& only) {
+  check_same_size(a, b);
+  const size_t pixels = static_cast<size_t>(a.width) * static_cast<size_t>(a.height);
+  ABCUBE_CHECK(only.size() == pixels, "sampled_error: the mask is not width x height");
+  double sum = 0, sum_sq = 0;
+  SampledError s;
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < a.width; ++x) {
+      if (!only[static_cast<size_t>(y) * static_cast<size_t>(a.width) + static_cast<size_t>(x)]) continue;
+      const glm::dvec3 d = displayed(a, x, y) - displayed(b, x, y);
+      const double e = glm::dot(d, d) / 3.0;
+      sum += e;
+      sum_sq += e * e;
+      ++s.pixels;
+    }
+  }
+  if (s.pixels == 0) return s;
+  const double k = static_cast<double>(s.pixels), n = static_cast<double>(pixels);
+  s.mse = sum / k;
+  // The sample variance of the per-pixel errors, and the finite-population correction:
+  // every pixel counted leaves no sampling error.
+  const double variance = k > 1 ? std::max(0.0, (sum_sq - k * s.mse * s.mse) / (k - 1)) : s.mse * s.mse;
+  s.mse_standard_error = std::sqrt(variance / k * std::max(0.0, 1.0 - k / n));
+  s.psnr = psnr_of_mse(s.mse);
+  s.psnr_low = psnr_of_mse(s.mse + 1.645 * s.mse_standard_error);
+  return s;
+}
+
 ImageError image_error(const Image& a, const Image& b) {
   check_same_size(a, b);
   ImageError e;
@@ -66,7 +98,7 @@ ImageError image_error(const Image& a, const Image& b) {
   }
   const double n = static_cast<double>(pixels);
   e.rmse = std::sqrt(sum_sq / (3.0 * n));
-  e.psnr = e.rmse > 0.0 ? 20.0 * std::log10(1.0 / e.rmse) : std::numeric_limits<double>::infinity();
+  e.psnr = psnr_of_mse(e.rmse * e.rmse);
   e.share_over_1 = static_cast<double>(over1) / n;
   e.share_over_2 = static_cast<double>(over2) / n;
   e.share_over_8 = static_cast<double>(over8) / n;

@@ -18,6 +18,22 @@ namespace abcube {
 // ImageError and image_error(a, b): <abcube/image.hpp>. Throws InputError when the
 // sizes differ (naming both).
 
+// The error over some pixels only, as an estimate of the whole image's: the mean squared
+// difference of the marked pixels (displayed values, averaged over the three channels, as
+// image_error's PSNR counts it), the standard error of that mean as an estimate of the
+// image's (simple random sampling without replacement), and the PSNRs of the estimate and
+// of its one-sided 95% upper bound. `only`: width x height, row-major, non-zero = counted.
+struct SampledError {
+  uint64_t pixels = 0;
+  double mse = 0, mse_standard_error = 0;
+  double psnr = 0;      // of mse
+  double psnr_low = 0;  // of mse + 1.645 standard errors: the image reaches it 95% of the time
+};
+SampledError sampled_error(const Image& a, const Image& b, const std::vector<uint8_t>& only);
+
+// 10 log10(1 / mse): PSNR with a peak of 1 (infinite for 0).
+double psnr_of_mse(double mse);
+
 // Share of pixels whose largest displayed channel |d| exceeds `threshold` (idiff's
 // -fail; the same 1e-6 slack as share_over_1/2). Throws InputError when sizes differ.
 double share_over(const Image& a, const Image& b, double threshold);

@@ -164,6 +164,10 @@ RenderSettings read_render(const Fields& f) {
     r.error_target = read_number(f.src(), *v, f.at("error_target"));
     check_range(f.src(), f.at("error_target"), r.error_target, 1e-12, 0.5);
   }
+  if (const Json* v = f.find("target_db")) {
+    r.target_db = read_number(f.src(), *v, f.at("target_db"));
+    check_range(f.src(), f.at("target_db"), r.target_db, MIN_TARGET_DB, MAX_TARGET_DB);
+  }
   return r;
 }
 
@@ -431,7 +435,7 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
   }
   if (const Json* render = top.find("render")) {
     scene.render = read_render(
-        Fields(src, *render, "render", {"method", "cube_resolution", "max_depth", "fresnel", "error_target"}));
+        Fields(src, *render, "render", {"method", "cube_resolution", "max_depth", "fresnel", "error_target", "target_db"}));
   }
   load_textures(st);
   // The loaders' small blocks freed since the last object's trim (the closed-surface test's,

@@ -434,7 +434,7 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
     }
     glm::dvec3 c(0.0);
     const std::pair<uint64_t, uint64_t> before = fallback ? searches_and_failures(*s) : std::pair<uint64_t, uint64_t>{};
-    if (count <= 1) {
+    if (count <= 1 || shader.one_point()) {
       c = shade_at(fragment_point(camera, *scene.triangles, f, x, y));
     } else {
       const glm::dvec3 first = shade_at(point[0]), last = shade_at(point[count - 1]);

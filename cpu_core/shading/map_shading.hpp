@@ -45,6 +45,11 @@ struct MapShadingOptions {
   // The resolve of intersecting fragments (resolve.hpp): exact priority masks, or the
   // thesis' Vis_front estimate (--resolve thesis).
   bool exact_priority = true;
+  // Shading points per camera fragment: the adaptive quarters (below), or one, at the
+  // centroid of its covered samples (--shading-points one: about half the shading of a
+  // covered pixel; an edge of a shadow or a reflection inside the pixel is then all or
+  // nothing).
+  bool one_point = false;
 };
 
 // Ray-level error against the exact tracer (thesis ch. 9), for the reflection rays of
@@ -112,6 +117,7 @@ class MapShader {
   // mode).
   bool refines_on_mesh() const { return options_.search.refine == SearchRefine::mesh; }
   bool exact_priority() const { return options_.exact_priority; }
+  bool one_point() const { return options_.one_point; }
 
  private:
   // A crossing set (media.hpp): the surface point shaded, the furthest crossing, the interface.

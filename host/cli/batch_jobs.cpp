@@ -49,6 +49,11 @@ class JobReader {
     }
     if (!j.is_object()) fail(line, "a job must be a JSON object");
     for (const auto& [key, value] : j.items()) read_key(job, key, value);
+    try {  // each value was checked alone; now the ones that contradict one another
+      check_render_options(job.setup(RenderSetup{}).render);
+    } catch (const OptionError& e) {
+      fail(line, quote(e.key) + ": " + e.reason);
+    }
     if (job.scene.empty()) fail(line, "\"scene\": required");
     if (job.out.empty()) fail(line, "\"out\": required");
     if (!image_format_supported(job.out)) fail(line, "\"out\": no image writer for " + quote_path(job.out));

@@ -156,6 +156,12 @@ std::vector<Entry> make_table() {
        "Error_Parallax target: the cube map's N from the bound 1/(2 N^2) of the thesis's error analysis", {}},
       [](RenderSetup& s, const json& v) { s.render.error_target = v.get<double>(); },
       [](const RenderSetup& s) { return s.render.error_target < 0 ? json() : json(s.render.error_target); });
+  add({"target_db", "--target-db", OptionKind::number, OptionScope::job, {}, MIN_TARGET_DB, MAX_TARGET_DB,
+       "the scene's render.target_db", "dB", {"abuffer"}, "only abuffer chooses its cube map's N from pilot renders",
+       "PSNR to reach against the exact tracer: abuffer picks the cube map's N from pilot renders checked against "
+       "exact rays (overrides the scene's cube_resolution)", {}},
+      [](RenderSetup& s, const json& v) { s.render.target_db = v.get<double>(); },
+      [](const RenderSetup& s) { return s.render.target_db < 0 ? json() : json(s.render.target_db); });
   add({"fresnel", "--fresnel", OptionKind::flag, OptionScope::job, {}, 0, 0, "the scene's render.fresnel", "", {}, "",
        "Schlick weights for reflect and transmit", {}},
       [](RenderSetup& s, const json& v) { s.render.fresnel = v.get<bool>(); },
@@ -259,6 +265,11 @@ std::vector<Entry> make_table() {
        "the environment map's lookup direction", {}},
       [](RenderSetup& s, const json& v) { s.render.envmap_lookup = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.envmap_lookup, d.envmap_lookup); });
+  add({"shading_points", "--shading-points", OptionKind::choice, OptionScope::job, {"quarters", "one"}, 0, 0,
+       d.shading_points, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
+       "shading points per camera fragment: quarters (2 to 4, more where they differ) | one (its centroid)", {}},
+      [](RenderSetup& s, const json& v) { s.render.shading_points = v.get<std::string>(); },
+      [d](const RenderSetup& s) { return unless(s.render.shading_points, d.shading_points); });
   add({"resolve", "--resolve", OptionKind::choice, OptionScope::job, {"exact", "thesis"}, 0, 0, d.resolve, "", MAP_METHODS,
        "the CPU A-buffer's resolve: abuffer, zbuffer, envmap, hybrid",
        "intersecting fragments: exact (per-sample priority masks) | thesis (the Vis_front estimate)", {}},
@@ -453,6 +464,12 @@ void check_render_options(const RenderOptions& options) {
     const json v = e.read(setup);
     if (!v.is_null()) check_value(e.spec, v);
   }
+  // Options that contradict one another.
+  if (options.target_db > 0 && (options.cube_resolution != 0 || options.error_target >= 0)) {
+    const OptionSpec& other = *find_render_option(options.cube_resolution != 0 ? "cube_res" : "error_target");
+    throw OptionError("target_db", "chooses the cube map's N, and so does " + other.key + " (" + other.flag +
+                                       "): give one");
+  }
 }
 
 void refuse_options_unused_by(const std::string& scene_method, const RenderOptions& options) {
@@ -475,6 +492,7 @@ RenderOptions without_unused_options(const RenderOptions& options, const std::st
   static const std::map<std::string, std::function<void(RenderOptions&, const RenderOptions&)>> RESET = {
       {"cube_res", [](RenderOptions& o, const RenderOptions& x) { o.cube_resolution = x.cube_resolution; }},
       {"error_target", [](RenderOptions& o, const RenderOptions& x) { o.error_target = x.error_target; }},
+      {"target_db", [](RenderOptions& o, const RenderOptions& x) { o.target_db = x.target_db; }},
       {"plan", [](RenderOptions& o, const RenderOptions& x) { o.plan_everything = x.plan_everything; }},
       {"search", [](RenderOptions& o, const RenderOptions& x) { o.search = x.search; }},
       {"refine", [](RenderOptions& o, const RenderOptions& x) { o.refine = x.refine; }},
@@ -483,6 +501,7 @@ RenderOptions without_unused_options(const RenderOptions& options, const std::st
       {"refraction", [](RenderOptions& o, const RenderOptions& x) { o.refraction = x.refraction; }},
       {"envmap_lookup", [](RenderOptions& o, const RenderOptions& x) { o.envmap_lookup = x.envmap_lookup; }},
       {"resolve", [](RenderOptions& o, const RenderOptions& x) { o.resolve = x.resolve; }},
+      {"shading_points", [](RenderOptions& o, const RenderOptions& x) { o.shading_points = x.shading_points; }},
       {"max_layers", [](RenderOptions& o, const RenderOptions& x) { o.max_layers = x.max_layers; }},
       {"gpu_mirrors", [](RenderOptions& o, const RenderOptions& x) { o.gpu_mirrors = x.gpu_mirrors; }},
       {"gpu_shadows", [](RenderOptions& o, const RenderOptions& x) { o.gpu_shadows = x.gpu_shadows; }},

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include <abcube/image.hpp>
 
@@ -14,6 +15,7 @@
 #include "reference/raytrace.hpp"
 #include "render/crosscheck.hpp"
 #include "render/stats_json.hpp"
+#include "render/target_db.hpp"
 #include "scene/plan.hpp"
 
 namespace abcube {
@@ -250,6 +252,26 @@ Image render_reference(MethodContext& mc, const char* key) {
   return image;
 }
 
+MapShadingOptions map_shading_options(const MethodContext& mc) {
+  MapShadingOptions options = mc.request.map;
+  // hybrid: abuffer's searches
+  options.method = mc.scene.render.method == Method::hybrid ? Method::abuffer : mc.scene.render.method;
+  options.walk_all_shadows = mc.request.plan_everything;
+  return options;
+}
+
+CubeMap build_cube_map(const MethodContext& mc, int n, const ABufferOptions& options, const RayTracer* reference) {
+  CubeMap m;
+  m.n = n;
+  Clock::time_point t0 = Clock::now();
+  m.cube = std::make_unique<CubeABuffer>(build_cube_abuffer(mc.scene, mc.scene.camera.position, n, options, &m.stats));
+  m.build_ms = ms_since(t0);
+  t0 = Clock::now();
+  m.shader = std::make_unique<MapShader>(mc.scene, *m.cube, map_shading_options(mc), reference, &mc.cache);
+  m.setup_ms = ms_since(t0);
+  return m;
+}
+
 Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   const SceneData& scene = mc.scene;
   const RenderRequest& r = mc.request;
@@ -260,36 +282,48 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   stats["plan"]["passes"] = passes;
   stats["plan"]["skipped"] = skipped;
   stats["plan"]["mode"] = r.plan_everything ? "everything" : "needed";
-  if (!plan.cube_map) return render_abuffer_local(scene, r.abuffer, &stats, r.map.exact_priority, only);
-  Clock::time_point t0 = Clock::now();
-  ABufferStats cs;
-  const CubeABuffer cube =
-      build_cube_abuffer(scene, scene.camera.position, scene.render.cube_resolution, r.abuffer, &cs);
-  stats["timings_ms"]["cube_abuffer"] = ms_since(t0);
-  stats["cube_abuffer"] = cube_abuffer_json(cs);
+  if (!plan.cube_map) {
+    if (scene.render.target_db > 0) {
+      stats["target_db"] = {{"target", scene.render.target_db},
+                            {"why", "no cube map: nothing reflects, refracts or casts a shadow, so N is not used"}};
+    }
+    return render_abuffer_local(scene, r.abuffer, &stats, r.map.exact_priority, only);
+  }
   std::unique_ptr<RayTracer> reference;
   if (r.reference) reference = std::make_unique<RayTracer>(scene, mc.cache.bvh());
-  MapShadingOptions options = r.map;
-  options.method =
-      scene.render.method == Method::hybrid ? Method::abuffer : scene.render.method;  // hybrid: abuffer's searches
-  options.walk_all_shadows = r.plan_everything;
-  t0 = Clock::now();
-  const MapShader shader(scene, cube, options, reference.get(), &mc.cache);
-  stats["timings_ms"]["map_setup"] = ms_since(t0);
-  t0 = Clock::now();
+  // Each A-buffer is budgeted with the other one held.
+  std::optional<ABuffer> camera;
   ABufferStats as;
-  ABufferOptions camera_options = r.abuffer;  // the cube A-buffer is held while it is built
-  camera_options.reserved_bytes += cs.bytes_total;
-  const ABuffer camera = build_camera_abuffer(scene, camera_options, &as);
-  stats["timings_ms"]["camera_abuffer"] = ms_since(t0);
-  t0 = Clock::now();
+  double camera_ms = 0;
+  const auto build_camera = [&](uint64_t reserved) {
+    const Clock::time_point t0 = Clock::now();
+    ABufferOptions camera_options = r.abuffer;
+    camera_options.reserved_bytes += reserved;
+    camera.emplace(build_camera_abuffer(scene, camera_options, &as));
+    camera_ms = ms_since(t0);
+  };
+  CubeMap map;
+  if (scene.render.method == Method::abuffer && scene.render.target_db > 0) {
+    build_camera(0);  // first: every pilot shades it
+    ABufferOptions cube_options = r.abuffer;
+    cube_options.reserved_bytes += as.bytes_total;
+    map = cube_map_for_target(mc, *camera, cube_options, reference.get());
+  } else {
+    map = build_cube_map(mc, scene.render.cube_resolution, r.abuffer, reference.get());
+    build_camera(map.stats.bytes_total);
+  }
+  stats["timings_ms"]["cube_abuffer"] = map.build_ms;
+  stats["cube_abuffer"] = cube_abuffer_json(map.stats);
+  stats["timings_ms"]["map_setup"] = map.setup_ms;
+  stats["timings_ms"]["camera_abuffer"] = camera_ms;
+  const Clock::time_point t0 = Clock::now();
   MapShadingStats ms;
-  Image image = render_with_map(scene, camera, shader, r.threads, &ms, mc.fallback, only);
+  Image image = render_with_map(scene, *camera, *map.shader, r.threads, &ms, mc.fallback, only);
   stats["timings_ms"]["shade_and_resolve"] = ms_since(t0);
   stats["abuffer"] = abuffer_json(as, false);
   stats["searches"] = map_shading_json(ms);
   if (reference) {
-    const double bound = parallax_bound(scene.render.cube_resolution);
+    const double bound = parallax_bound(map.n);
     stats["reference"]["ray_error"] = {{"rays", "reflection rays of camera-visible surfaces"},
                                        {"error_cp", error_stats_json(ms.errors.error_cp)},
                                        {"error_parallax", error_stats_json(ms.errors.error_parallax)},

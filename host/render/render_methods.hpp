@@ -2,6 +2,7 @@
 // needs and nothing more (the plan), with the per-scene data from the SceneCache.
 #pragma once
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -50,6 +51,20 @@ Image render_gpu(MethodContext& mc);
 // needs it (a reflecting or refracting material, a shadow-casting light). `only`
 // (optional): the pixels to render, the others black.
 Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only = nullptr);
+// A cube map at one N and the shader that searches it.
+struct CubeMap {
+  int n = 0;
+  std::unique_ptr<CubeABuffer> cube;  // by pointer: the shader refers to it
+  ABufferStats stats;
+  double build_ms = 0, setup_ms = 0;
+  std::unique_ptr<MapShader> shader;
+};
+// The map methods' shading options for this render.
+MapShadingOptions map_shading_options(const MethodContext& mc);
+// The cube A-buffer around the camera at `n`, within `options`' memory budget, and its
+// shader. `reference` (optional): the tracer the searches' ray errors are measured against.
+CubeMap build_cube_map(const MethodContext& mc, int n, const ABufferOptions& options, const RayTracer* reference);
+
 // The hybrid method (docs/design/gpu-exact-paths.md): the GPU's exact camera pass,
 // and the abuffer method on the CPU for the pixels whose samples meet a surface the GPU
 // only approximates.

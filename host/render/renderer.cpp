@@ -83,7 +83,11 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   if (!o.method.empty()) {
     rs.method = parse_checked(o.method, parse_method);
   }
+  if (o.target_db > 0) rs.target_db = o.target_db;
+  // An N the render asks for, or a bound that gives one, wins over the scene's target.
+  if (o.cube_resolution != 0 || o.error_target >= 0) rs.target_db = 0;
   if (o.error_target >= 0) rs.error_target = o.error_target;
+  if (rs.target_db > 0) rs.error_target = 0;  // the scene's target wins over its bound
   if (rs.error_target > 0 && o.cube_resolution == 0) {
     // thesis 9.3.4: the N whose bound 1/(2 N^2) meets the target (plan.hpp).
     rs.cube_resolution = resolution_for_error(rs.error_target);
@@ -117,6 +121,7 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   r.map.refraction = parse_checked(o.refraction, parse_refraction_mode);
   r.map.lookup = parse_checked(o.envmap_lookup, parse_envmap_lookup);
   r.map.exact_priority = o.resolve == "exact";
+  r.map.one_point = o.shading_points == "one";
   r.map.search.side_structure = o.side_structure;
   r.gpu.planar_mirrors = o.gpu_mirrors == "stencil";
   r.gpu.shadow_volumes = o.gpu_shadows == "volumes";
@@ -143,6 +148,11 @@ json request_stats(const SceneData& view, const RenderRequest& request) {
                      {"dropped_triangles", view.dropped_triangles},
                      {"objects", view.objects.size()},
                      {"lights", view.lights.size()}};
+  if (view.render.target_db > 0 && view.render.method != Method::abuffer) {
+    stats["target_db"] = {{"target", view.render.target_db},
+                          {"why", std::string("not used: only abuffer chooses its N from a target, the method is ") +
+                                      method_name(view.render.method)}};
+  }
   if (view.render.error_target > 0) {
     stats["error_target"] = {{"target", view.render.error_target},
                              {"cube_resolution", view.render.cube_resolution},
@@ -159,6 +169,7 @@ json request_stats(const SceneData& view, const RenderRequest& request) {
                              {"refraction", refraction_mode_name(request.map.refraction)},
                              {"envmap_lookup", envmap_lookup_name(request.map.lookup)},
                              {"resolve", request.map.exact_priority ? "exact" : "thesis"},
+                             {"shading_points", request.map.one_point ? "one" : "quarters"},
                              {"side_structure", request.map.search.side_structure},
                              {"fresnel", view.render.fresnel}};
   return stats;

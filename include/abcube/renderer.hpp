@@ -61,6 +61,7 @@ struct RenderOptions {
   int cube_resolution = 0;            // N texels per face edge (0 = render.cube_resolution, or error_target's)
   int max_depth = -1;                 // bounces (< 0 = render.max_depth)
   double error_target = -1;           // > 0: N from the Error_Parallax bound 1/(2 N^2) (< 0 = the scene's)
+  double target_db = -1;              // > 0: abuffer picks N to reach this PSNR against the tracer (< 0 = the scene's)
   std::optional<bool> fresnel;        // Schlick weights for kr and kt (unset = the scene's)
   int threads = 0;                    // 0 = the Renderer's (RendererOptions::threads)
   bool reference = false;             // also trace the exact reference: error figures in the stats
@@ -71,6 +72,7 @@ struct RenderOptions {
   double theta_max_deg = 2.0;         // thesis mode's acceptance angle, degrees
   std::string refraction = "search";  // search | thick_lens | thin_lens
   std::string envmap_lookup = "R";    // R | bisector | position (envmap method)
+  std::string shading_points = "quarters";  // per camera fragment: quarters (adaptive, 2 to 4) | one
   std::string resolve = "exact";      // intersecting fragments: exact (priority masks) | thesis (Vis_front)
   bool side_structure = true;         // searches also test the triangles the map cannot hold (false: --map-only)
   std::string gpu_mirrors =

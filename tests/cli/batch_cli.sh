@@ -54,6 +54,12 @@ check "malformed: exit 2" [ $status -eq 2 ]
 check "malformed: names file and line" grep -q "bad.jsonl:2: \"colour\": unknown key" err
 check "malformed: nothing rendered" [ ! -e m/1.png ]
 check "malformed: one line" [ "$(wc -l < err)" -eq 1 ]
+# Options each valid alone that contradict one another: a malformed line too.
+printf '{"scene": "cornell.json", "out": "m/1.png"}\n{"scene": "cornell.json", "out": "m/2.png", "target_db": 40, "cube_res": 64}\n' > both.jsonl
+"$ABCUBE" batch both.jsonl 2> err; status=$?
+check "target_db with cube_res: exit 2" [ $status -eq 2 ]
+check "target_db with cube_res: names line 2 ($(cat err))" grep -q 'both.jsonl:2: "target_db": chooses the cube map' err
+check "target_db with cube_res: nothing rendered" [ ! -e m/1.png ]
 printf '{"scene": "cornell.json", "out": "m/1.png"}\nnot json\n' > bad2.jsonl
 "$ABCUBE" batch bad2.jsonl 2> err; status=$?
 check "not JSON: exit 2 naming line 2" [ $status -eq 2 ]

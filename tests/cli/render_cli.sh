@@ -102,6 +102,28 @@ done
 check "--plan everything gives the same image" [ $? -eq 0 ]
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/p3.png" --error-target 1.25e-5 --stats "$WORK/p3.json" 2> /dev/null
 check "--error-target 1.25e-5 picks N = 200 (thesis 9.3.4)" grep -q '"cube_resolution": 200' "$WORK/p3.json"
+# --target-db: the stats name the N chosen, and that N rendered directly is the same image;
+# the scene's render.target_db does the same; --cube-res beside it is a contradiction.
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/t1.png" --target-db 35 --stats "$WORK/t1.json" 2> "$WORK/err"
+status=$?
+check "--target-db 35 renders ($(cat "$WORK/err"))" [ $status -eq 0 ]
+tn=$(/usr/bin/python3 -c 'import json,sys; t=json.load(open(sys.argv[1]))["target_db"]; print(t["cube_resolution"], t["shading_points"])' "$WORK/t1.json")
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/t2.png" --cube-res "${tn% *}" --shading-points "${tn#* }" 2> /dev/null
+check "--target-db's chosen plan ($tn) rendered directly is the same image" \
+  "$ABCUBE" compare "$WORK/t1.png" "$WORK/t2.png" --exact
+sed 's/"objects": \[/"render": {"target_db": 35}, "objects": [/' "$WORK/small.json" > "$WORK/target.json"
+"$ABCUBE" render "$WORK/target.json" -o "$WORK/t3.png" 2> /dev/null
+check "render.target_db in the scene is --target-db" "$ABCUBE" compare "$WORK/t1.png" "$WORK/t3.png" --exact
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/t4.png" --target-db 35 --cube-res 64 > /dev/null 2> "$WORK/err"
+status=$?
+check "--target-db with --cube-res exits 2 ($(cat "$WORK/err"))" [ $status -eq 2 ]
+check "--target-db with --cube-res: says why" grep -q -- "--target-db: chooses the cube map's N, and so does" "$WORK/err"
+check "--target-db with --cube-res: nothing written" [ ! -e "$WORK/t4.png" ]
+sed 's/"objects": \[/"render": {"target_db": 0}, "objects": [/' "$WORK/small.json" > "$WORK/target0.json"
+"$ABCUBE" render "$WORK/target0.json" -o "$WORK/t5.png" > /dev/null 2> "$WORK/err"
+status=$?
+check "render.target_db 0 exits 2 ($(cat "$WORK/err"))" [ $status -eq 2 ]
+check "render.target_db 0 names it" grep -q "render.target_db: must be" "$WORK/err"
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/rt.exr" --method raytrace 2> /dev/null
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/p4.png" --cube-res 64 --reference-image "$WORK/rt.exr" \
   --stats "$WORK/p4.json" 2> /dev/null

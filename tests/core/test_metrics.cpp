@@ -48,6 +48,34 @@ TEST(Metrics, ComparesAsDisplayedNotLinear) {
   EXPECT_EQ(image_error(Image(1, 1, 3, 1.0f), Image(1, 1, 3, 7.0f)).rmse, 0.0);
 }
 
+// The error of some pixels as an estimate of the image's: every pixel marked gives the
+// image's PSNR with no sampling error; half the pixels, the mean of theirs, and a lower
+// bound below the estimate when the errors vary.
+TEST(Metrics, SampledErrorEstimatesTheImagesError) {
+  Image a = displayed_flat(8, 4, 0.5f);
+  const Image b = displayed_flat(8, 4, 0.6f);
+  for (int x = 0; x < 8; ++x) {
+    for (int k = 0; k < 3; ++k) a.at(x, 0)[k] = srgb_decode(0.3f);  // row 0: 0.3 off
+  }
+  const ImageError whole = image_error(a, b);
+  const SampledError all = sampled_error(a, b, std::vector<uint8_t>(32, 1));
+  EXPECT_EQ(all.pixels, 32u);
+  EXPECT_NEAR(all.psnr, whole.psnr, 1e-9);
+  EXPECT_EQ(all.mse_standard_error, 0.0);
+  EXPECT_NEAR(all.psnr_low, whole.psnr, 1e-9);
+  std::vector<uint8_t> odd(32, 0);
+  for (size_t k = 1; k < 32; k += 2) odd[k] = 1;  // half of each row
+  const SampledError half = sampled_error(a, b, odd);
+  EXPECT_EQ(half.pixels, 16u);
+  EXPECT_NEAR(half.mse, whole.rmse * whole.rmse, 1e-12);  // every row equally sampled
+  EXPECT_GT(half.mse_standard_error, 0.0);
+  EXPECT_LT(half.psnr_low, half.psnr);
+  std::vector<uint8_t> row1(32, 0);
+  for (size_t k = 8; k < 16; ++k) row1[k] = 1;
+  EXPECT_NEAR(sampled_error(a, b, row1).psnr, 20.0, 1e-4);  // the 0.1 rows only
+  EXPECT_TRUE(std::isinf(psnr_of_mse(0.0)));
+}
+
 TEST(Metrics, SharesCountPixelsOverThresholds) {
   // Ten pixels; displayed differences 0, 1/255 (not over), 1.5/255, 2/255 (not over 2),
   // 3/255 in one channel only, and 5 equal pixels.

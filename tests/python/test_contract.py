@@ -228,6 +228,21 @@ def test_renderer_options_keywords(renderer, scene):
         renderer.render(scene, max_pixels=10)  # 32 x 24 > 10
 
 
+def test_target_db(renderer, scene):
+    # python.md: N and the work chosen for a PSNR target; the stats say what was chosen,
+    # and the chosen N rendered directly is the same image.
+    res = renderer.render(scene, method="abuffer", target_db=30, stats=True)
+    chosen = res.stats["target_db"]
+    assert chosen["target"] == 30 and chosen["reached"]
+    direct = renderer.render(scene, method="abuffer", cube_res=chosen["cube_resolution"],
+                             shading_points=chosen["shading_points"])
+    assert np.array_equal(res.image, direct)
+    with pytest.raises(abcube.SceneError, match="and so does cube_res"):
+        renderer.render(scene, target_db=40, cube_res=64)
+    with pytest.raises(abcube.SceneError, match="target_db"):
+        renderer.render(scene, method="raytrace", target_db=40)
+
+
 def find_key(tree, key):
     """The values of `key` anywhere in a nested dict."""
     if isinstance(tree, dict):

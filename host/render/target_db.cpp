@@ -1,0 +1,160 @@
+#include "render/target_db.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "base/parallel.hpp"
+#include "base/timer.hpp"
+#include "io/metrics.hpp"
+#include "reference/raytrace.hpp"
+
+namespace abcube {
+
+using nlohmann::json;
+
+namespace {
+
+// About 4096 sampled pixels (at most one in 4, at least one in 64): per-pixel error is
+// heavy-tailed (edges, mirrors), and the lower bound's width follows from the sample; the
+// pilots' cost, the exact tracer's above all, follows from the sample's size.
+constexpr double SAMPLES_WANTED = 4096;
+// A pilot that does not raise the best lower bound by this much has not improved; after
+// STALLED_PILOTS of them in a row, larger N is not expected to reach the target.
+constexpr double IMPROVEMENT_DB = 0.2;
+constexpr int STALLED_PILOTS = 2;
+
+uint64_t mix(uint64_t x) {  // splitmix64's finaliser: a fixed, well-spread hash
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+json number_or_null(double x) { return std::isfinite(x) ? json(x) : json(); }
+
+}  // namespace
+
+std::vector<int> target_ladder(int scene_n) {
+  std::vector<int> ladder;
+  const int top = std::max(1024, scene_n);
+  for (int n : {64, 96, 128, 192, 256, 384, 512, 768, 1024, 1536, 2048, 3072, 4096, 6144, 8192}) {
+    if (n <= top) ladder.push_back(n);
+  }
+  if (ladder.back() < top) ladder.push_back(top);
+  return ladder;
+}
+
+std::vector<uint8_t> pilot_pixels(int width, int height, int* block) {
+  const double pixels = static_cast<double>(width) * static_cast<double>(height);
+  const int b = std::clamp(static_cast<int>(std::floor(std::sqrt(pixels / SAMPLES_WANTED))), 2, 8);
+  *block = b;
+  std::vector<uint8_t> only(static_cast<size_t>(width) * static_cast<size_t>(height), 0);
+  for (int by = 0; by < height; by += b) {
+    for (int bx = 0; bx < width; bx += b) {
+      const uint64_t h = mix(static_cast<uint64_t>(by) * 0x10000ull + static_cast<uint64_t>(bx));
+      const int x = bx + static_cast<int>(h % static_cast<uint64_t>(std::min(b, width - bx)));
+      const int y = by + static_cast<int>((h >> 32) % static_cast<uint64_t>(std::min(b, height - by)));
+      only[static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)] = 1;
+    }
+  }
+  return only;
+}
+
+CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABufferOptions& cube_options,
+                            const RayTracer* reference) {
+  const SceneData& scene = mc.scene;
+  const double target = scene.render.target_db;
+  const Clock::time_point start = Clock::now();
+  int block = 0;
+  const std::vector<uint8_t> sample = pilot_pixels(scene.camera.width, scene.camera.height, &block);
+  // The exact tracer on the sampled pixels only.
+  RaytraceOptions ro;
+  ro.threads = mc.request.threads;
+  ro.bvh = mc.cache.bvh();
+  ro.only = &sample;
+  Clock::time_point t0 = Clock::now();
+  const Image exact = render_raytrace(scene, ro);
+  const double trace_ms = ms_since(t0);
+
+  json pilots = json::array();
+  CubeMap best;
+  SampledError best_error;
+  bool reached = false;
+  int stalled = 0;
+  std::string why;
+  for (const int n : target_ladder(scene.render.cube_resolution)) {
+    check_deadline();
+    t0 = Clock::now();
+    CubeMap m = build_cube_map(mc, n, cube_options, nullptr);
+    MapShadingStats ms;
+    const Image pilot = render_with_map(scene, camera, *m.shader, mc.request.threads, &ms, nullptr, &sample);
+    const SampledError e = sampled_error(pilot, exact, sample);
+    pilots.push_back({{"cube_resolution", n},
+                      {"shading_points", m.shader->one_point() ? "one" : "quarters"},
+                      {"psnr_db", number_or_null(e.psnr)},
+                      {"psnr_db_low", number_or_null(e.psnr_low)},
+                      {"ms", ms_since(t0)}});
+    const bool improved = !best.cube || e.psnr_low >= best_error.psnr_low + IMPROVEMENT_DB;
+    if (!best.cube || e.psnr_low > best_error.psnr_low) {
+      best = std::move(m);  // the smaller N keeps a tie
+      best_error = e;
+    }
+    if (e.psnr_low >= target) {
+      reached = true;
+      why = "the smallest N on the ladder whose predicted PSNR reaches the target";
+      break;
+    }
+    stalled = improved ? 0 : stalled + 1;
+    if (stalled >= STALLED_PILOTS) {
+      why = "the error stopped improving with N before the target: the best N found";
+      break;
+    }
+  }
+  if (why.empty()) why = "the ladder's largest N did not reach the target: the best N found";
+  // One shading point per fragment instead of the quarters, where it still reaches the
+  // target at the chosen N: about half the shading of a covered pixel.
+  MapShadingOptions chosen = map_shading_options(mc);
+  if (reached && !chosen.one_point) {
+    t0 = Clock::now();
+    MapShadingOptions one = chosen;
+    one.one_point = true;
+    auto shader = std::make_unique<MapShader>(scene, *best.cube, one, nullptr, &mc.cache);
+    MapShadingStats ms;
+    const Image pilot = render_with_map(scene, camera, *shader, mc.request.threads, &ms, nullptr, &sample);
+    const SampledError e = sampled_error(pilot, exact, sample);
+    pilots.push_back({{"cube_resolution", best.n},
+                      {"shading_points", "one"},
+                      {"psnr_db", number_or_null(e.psnr)},
+                      {"psnr_db_low", number_or_null(e.psnr_low)},
+                      {"ms", ms_since(t0)}});
+    if (e.psnr_low >= target) {
+      chosen = one;
+      best.shader = std::move(shader);
+      best_error = e;
+    }
+  }
+  if (reference) {  // the searches' ray errors, measured on the final render only
+    t0 = Clock::now();
+    best.shader = std::make_unique<MapShader>(scene, *best.cube, chosen, reference, &mc.cache);
+    best.setup_ms = ms_since(t0);
+  }
+  json& stats = mc.stats;
+  stats["size"]["cube_resolution"] = best.n;
+  stats["method_options"]["shading_points"] = chosen.one_point ? "one" : "quarters";
+  stats["target_db"] = {
+      {"target", target},
+      {"cube_resolution", best.n},
+      {"shading_points", chosen.one_point ? "one" : "quarters"},
+      {"scene_cube_resolution", scene.render.cube_resolution},
+      {"reached", reached},
+      {"why", why},
+      {"predicted_psnr_db", number_or_null(best_error.psnr)},
+      {"predicted_psnr_db_low", number_or_null(best_error.psnr_low)},
+      {"sample", {{"pixels", best_error.pixels}, {"block", block}, {"exact_trace_ms", trace_ms}}},
+      {"pilots", pilots}};
+  stats["timings_ms"]["target_pilots"] = ms_since(start);
+  return best;
+}
+
+}  // namespace abcube

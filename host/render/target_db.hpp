@@ -1,0 +1,31 @@
+// --target-db: the abuffer method's cube-map resolution N chosen for a PSNR target.
+//
+// Pilot renders, each judged against the exact tracer on a sample of pixels, climb a ladder
+// of N from small to large and stop at the first whose predicted PSNR (the one-sided 95%
+// lower bound of the sample's estimate, io/metrics.hpp sampled_error) reaches the target.
+// When the error stops improving first, the best N found is kept and the stats say the
+// target was not reached. The sample is one pixel in each b x b block (b from 2 to 8 as
+// the image grows), chosen by a fixed hash: the same pixels every run. At the N chosen, one
+// more pilot tries one shading point per fragment instead of the quarters, and keeps it
+// where it still reaches the target.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "render/render_methods.hpp"
+
+namespace abcube {
+
+// The ladder of N the pilots climb, up to max(1024, the scene's own N).
+std::vector<int> target_ladder(int scene_n);
+
+// The pilots' pixels: width x height, row-major, non-zero = sampled; `block` gets b.
+std::vector<uint8_t> pilot_pixels(int width, int height, int* block);
+
+// The cube map at the chosen N, its shader measuring ray errors against `reference` when
+// given. `camera` is the camera's A-buffer the pilots shade; `cube_options` budget the
+// cube with it held. Writes stats["target_db"] and timings_ms["target_pilots"].
+CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABufferOptions& cube_options,
+                            const RayTracer* reference);
+
+}  // namespace abcube

@@ -1,0 +1,127 @@
+// --target-db (render/target_db.hpp): the pilots' sample, the plan the stats report being
+// the plan rendered, the target reached against the exact tracer, and the options that
+// contradict it refused.
+#include <set>
+#include <utility>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <abcube/renderer.hpp>
+
+#include "api_test_support.hpp"
+#include "render/target_db.hpp"
+
+namespace abcube::test {
+namespace {
+
+using nlohmann::json;
+
+// One pixel in every b x b block, the partial blocks at the right and bottom edges too,
+// and the same pixels every time.
+TEST(TargetDb, PilotPixelsAreOnePerBlock) {
+  for (const auto& [w, h] : {std::pair{640, 480}, std::pair{97, 61}, std::pair{1, 1}, std::pair{3000, 7}}) {
+    int block = 0;
+    const std::vector<uint8_t> only = pilot_pixels(w, h, &block);
+    ASSERT_EQ(only.size(), static_cast<size_t>(w) * static_cast<size_t>(h));
+    EXPECT_GE(block, 2);
+    EXPECT_LE(block, 8);
+    std::vector<int> per_block(static_cast<size_t>((w + block - 1) / block) * static_cast<size_t>((h + block - 1) / block));
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        if (only[static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x)]) {
+          ++per_block[static_cast<size_t>(y / block) * static_cast<size_t>((w + block - 1) / block) +
+                      static_cast<size_t>(x / block)];
+        }
+      }
+    }
+    for (const int n : per_block) ASSERT_EQ(n, 1) << w << "x" << h << " block " << block;
+    int again = 0;
+    EXPECT_EQ(pilot_pixels(w, h, &again), only);
+  }
+  int block = 0;
+  pilot_pixels(640, 480, &block);
+  EXPECT_EQ(block, 8);  // about 4096 pixels of 307200
+  pilot_pixels(64, 48, &block);
+  EXPECT_EQ(block, 2);  // at least one pixel in four
+}
+
+TEST(TargetDb, LadderClimbsToTheScenesOwnN) {
+  EXPECT_EQ(target_ladder(512), (std::vector<int>{64, 96, 128, 192, 256, 384, 512, 768, 1024}));
+  EXPECT_EQ(target_ladder(2000).back(), 2000);
+  EXPECT_EQ(target_ladder(1536).back(), 1536);
+}
+
+// The N and the shading points the stats report give, rendered directly, the very image
+// --target-db rendered; that image reaches the target against the exact tracer; every
+// pilot is in the stats.
+TEST(TargetDb, TheChosenPlanIsTheImageAndReachesTheTarget) {
+  const Scene scene = Scene::load(scene_path("cornell.json"));
+  Renderer renderer;
+  RenderOptions o = small_options("abuffer", 96, 72, 0);
+  o.target_db = 36;
+  o.reference = true;
+  o.stats = true;
+  const RenderResult r = renderer.render(scene, o);
+  const json s = json::parse(r.stats.json);
+  ASSERT_TRUE(s.contains("target_db")) << r.stats.json;
+  const json& t = s["target_db"];
+  EXPECT_EQ(t["target"].get<double>(), 36.0);
+  EXPECT_TRUE(t["reached"].get<bool>()) << t.dump(1);
+  const int n = t["cube_resolution"].get<int>();
+  EXPECT_EQ(s["size"]["cube_resolution"].get<int>(), n);
+  EXPECT_EQ(t["scene_cube_resolution"].get<int>(), scene.cube_resolution());
+  ASSERT_GE(t["pilots"].size(), 1u);
+  std::set<int> tried;
+  for (const json& p : t["pilots"]) tried.insert(p["cube_resolution"].get<int>());
+  EXPECT_TRUE(tried.count(n)) << "the chosen N was not piloted";
+  EXPECT_GE(t["predicted_psnr_db_low"].get<double>(), 36.0);
+  ASSERT_TRUE(r.stats.psnr_db.has_value());
+  EXPECT_GE(*r.stats.psnr_db, 36.0) << "predicted " << t["predicted_psnr_db"] << ", low " << t["predicted_psnr_db_low"];
+
+  RenderOptions direct = small_options("abuffer", 96, 72, n);
+  direct.shading_points = t["shading_points"].get<std::string>();
+  EXPECT_TRUE(images_equal(renderer.render(scene, direct).image, r.image));
+}
+
+// A target no N reaches stops where the error stops improving, keeps the best N found,
+// and says so.
+TEST(TargetDb, AnUnreachableTargetKeepsTheBestAndSaysSo) {
+  const Scene scene = Scene::load(scene_path("cornell.json"));
+  Renderer renderer;
+  RenderOptions o = small_options("abuffer", 48, 36, 0);
+  o.target_db = 99;
+  o.stats = true;
+  const json t = json::parse(renderer.render(scene, o).stats.json)["target_db"];
+  EXPECT_FALSE(t["reached"].get<bool>()) << t.dump(1);
+  EXPECT_EQ(t["shading_points"], "quarters");
+  double best = -1;
+  int best_n = 0;
+  for (const json& p : t["pilots"]) {
+    if (p["psnr_db_low"].get<double>() > best) {
+      best = p["psnr_db_low"].get<double>();
+      best_n = p["cube_resolution"].get<int>();
+    }
+  }
+  EXPECT_EQ(t["cube_resolution"].get<int>(), best_n);
+  EXPECT_LT(t["pilots"].size(), target_ladder(scene.cube_resolution()).size() + 1) << "climbed past the stall";
+}
+
+TEST(TargetDb, OptionsThatAlsoSetNAreRefused) {
+  const Scene scene = Scene::load(scene_path("cornell.json"));
+  Renderer renderer;
+  RenderOptions o = small_options("abuffer", 16, 12, 64);
+  o.target_db = 40;
+  try {
+    renderer.render(scene, o);
+    FAIL() << "--target-db with --cube-res rendered";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "target_db: chooses the cube map's N, and so does cube_res (--cube-res): give one");
+  }
+  o.cube_resolution = 0;
+  o.target_db = 0.5;
+  EXPECT_THROW(renderer.render(scene, o), InputError);  // below the range of a PSNR in dB
+}
+
+}  // namespace
+}  // namespace abcube::test
