@@ -240,6 +240,54 @@ ObjFile parse_obj(const LoadState& st, const std::string& path, const std::strin
   return obj;
 }
 
+// The triangles an OBJ file's face lines make (n - 2 for a line of n corners), counted
+// without parsing, so that a mesh over the caps is refused before tinyobjloader holds it
+// (its arrays take about what the triangles will). A face continued onto the next line
+// with a backslash counts short: the count after parsing is the exact one.
+uint64_t count_face_triangles(const std::string& resolved) {
+  std::ifstream in(resolved, std::ios::binary);
+  std::vector<char> buffer(size_t{1} << 20);
+  uint64_t triangles = 0, corners = 0;
+  enum { line_start, leading_space, after_f, in_face, other } state = line_start;
+  bool in_token = false;
+  const auto end_face = [&] {
+    if (in_token) ++corners;
+    if (corners >= 3) triangles += corners - 2;
+    corners = 0;
+    in_token = false;
+  };
+  while (in) {
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    const std::streamsize got = in.gcount();
+    for (std::streamsize i = 0; i < got; ++i) {
+      const char c = buffer[static_cast<size_t>(i)];
+      if (c == '\n') {
+        if (state == in_face) end_face();
+        state = line_start;
+        continue;
+      }
+      const bool space = c == ' ' || c == '\t' || c == '\r';
+      switch (state) {
+        case line_start:
+        case leading_space:
+          state = space ? leading_space : c == 'f' ? after_f : other;
+          break;
+        case after_f:
+          state = space ? in_face : other;  // "f" then a blank: a face ("fo" is not)
+          break;
+        case in_face:
+          if (space && in_token) ++corners;
+          in_token = !space;
+          break;
+        case other:
+          break;
+      }
+    }
+  }
+  if (state == in_face) end_face();
+  return triangles;
+}
+
 // Triangles the faces of an OBJ file become (ear clipping: n - 2 per polygon of n corners).
 uint64_t obj_triangle_count(const ObjFile& obj) {
   uint64_t count = 0;
@@ -302,6 +350,14 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
               (st.limits.max_memory_bytes > 0 ? " of --max-memory" : " of memory available");
   }
   if (!problem.empty()) fail(st.src, path, "cannot read mesh " + quote_path(resolved) + ": " + problem);
+  // A face line of n corners takes at least 2n + 2 bytes ("f 1 2 3\n") for its n - 2
+  // triangles: a file that may hold more triangles than the caps leave room for is counted
+  // before it is parsed.
+  const uint64_t most = size / 2;
+  const uint64_t held = st.scene.triangles->triangle_count();
+  const bool over_cap = st.limits.max_triangles > 0 && held + most > st.limits.max_triangles;
+  const bool over_budget = st.memory_budget > 0 && held + most > st.memory_budget / SCENE_TRIANGLE_BYTES;
+  if (over_cap || over_budget) check_triangle_cap(st, path, count_face_triangles(resolved));
   const ObjFile obj = parse_obj(st, path, resolved);
   check_triangle_cap(st, path, obj_triangle_count(obj));  // before anything is made
   if (use_mtl) {

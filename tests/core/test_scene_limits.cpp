@@ -152,5 +152,27 @@ TEST(SceneLoadLimits, TriangleCapNamesTheCountAndTheCap) {
             "scene.json: objects[0].file: the scene would have 12 triangles, over the cap of 11 (max_triangles)");
 }
 
+// A mesh over the caps is refused from a count of its face lines, before it is parsed: a
+// file whose last face is broken gets the cap's message, not the parser's. Polygons count
+// n - 2, blanks and comments do not, and "fo" is no face.
+TEST(SceneLoadLimits, MeshOverTheCapsIsRefusedBeforeItIsParsed) {
+  TempDir dir;
+  std::string obj = "# a fan of quads and one hexagon\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 2 0\nv 1 2 0\n";
+  for (int k = 0; k < 500; ++k) obj += "f 1 2 3 4\n  f\t1 2  3\r\nfo 1 2 3\n";
+  obj += "f 1 2 3 4 5 6\nf 1 2 999999";  // the last face's index is out of range, no newline
+  dir.write("fan.obj", obj);
+  const std::string mesh = with_objects(R"([{"type": "mesh", "file": "fan.obj"}])").str();
+  LoadLimits limits;
+  const auto error = [&] { return input_error([&] { load_scene_text(mesh, "scene.json", dir.path().string(), limits); }, mesh); };
+  const std::string counted = std::to_string(500 * 3 + 4 + 1);
+  EXPECT_NE(error().find("has an index out of range"), std::string::npos) << "with no cap, the check after parsing: " << error();
+  limits.max_triangles = 1000;
+  EXPECT_EQ(error(), "scene.json: objects[0].file: the scene would have " + counted +
+                         " triangles, over the cap of 1000 (max_triangles)");
+  limits.max_triangles = 0;
+  limits.max_memory_bytes = 64 * 1024;  // 385 triangles at SCENE_TRIANGLE_BYTES
+  EXPECT_NE(error().find("the scene would have " + counted + " triangles, an estimated"), std::string::npos) << error();
+}
+
 }  // namespace
 }  // namespace abcube
