@@ -216,7 +216,10 @@ GlbChunks read_glb(const std::string& bytes) {
     return out;
   };
   if (bytes.size() < 12) return refuse("shorter than its 12-byte header");
-  if (u32(4) != 2) return refuse("version " + std::to_string(u32(4)) + " (only glTF 2.0 is read)");
+  if (u32(4) != 2) {
+    out.problem = "binary glTF version " + std::to_string(u32(4)) + ": only glTF 2.0 is read";
+    return out;
+  }
   // The header's length bounds every chunk; bytes after it are not part of the container.
   const uint64_t length = u32(8);
   if (length > bytes.size()) {

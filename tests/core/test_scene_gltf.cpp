@@ -249,7 +249,8 @@ TEST(SceneLoadGltf, GlbContainerLayoutIsChecked) {
   EXPECT_EQ(error_for(empty), prefix + "no JSON chunk");
   std::string version_one = good;
   version_one.replace(4, 4, u32_bytes(1));
-  EXPECT_EQ(error_for(version_one), prefix + "version 1 (only glTF 2.0 is read)");
+  EXPECT_EQ(error_for(version_one),
+            "scene.json: objects[0].file: \"quad.glb\": binary glTF version 1: only glTF 2.0 is read");
 }
 
 // Issue 18: what a glTF names must resolve inside --root (symbolic links followed); the
