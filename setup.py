@@ -38,13 +38,16 @@ class CMakeBuild(build_ext):
                             "-DCMAKE_BUILD_TYPE=Release", "-DABCUBE_BUILD_TESTS=OFF",
                             "-DABCUBE_BUILD_BENCH=OFF", f"-DABCUBE_PYTHON={sys.executable}"],
                            check=True)
-        subprocess.run(["cmake", "--build", str(build), "--target", "abcube_python"], check=True)
+        subprocess.run(["cmake", "--build", str(build), "--target", "abcube_python", "abcube_oiio"], check=True)
         built = sorted((build / "python").glob("abcube*.so"))
         if not built:
             raise RuntimeError(f"no abcube module in {build / 'python'} (is pybind11-dev installed?)")
         target = Path(self.get_ext_fullpath(ext.name))
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(built[-1], target)
+        # The image module (OpenImageIO's formats and texture filtering), loaded by the
+        # extension from beside itself on first need.
+        shutil.copy2(build / "libabcube_oiio.so", target.parent / "libabcube_oiio.so")
 
 
 setup(version=project_version(), ext_modules=[CMakeExtension("abcube")], cmdclass={"build_ext": CMakeBuild})

@@ -13,7 +13,7 @@ BASE=(
   build-essential cmake ninja-build git python3
   libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6
   libglm-dev python3-glad
-  libopenimageio-dev
+  libopenimageio-dev libpng-dev libopenexr-dev
   nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libembree-dev libcli11-dev
 )
 PYTHON=(python3-dev pybind11-dev python3-numpy python3-pip python3-venv python3-setuptools python3-wheel)

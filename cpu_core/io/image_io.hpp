@@ -1,4 +1,5 @@
-// Reading and writing images through OpenImageIO, chosen by the file's extension.
+// Reading and writing images, chosen by the file's extension: PNG and EXR built in
+// (io/image_codecs.hpp), every other format through the image module (io/image_module.hpp).
 #pragma once
 #include <string>
 

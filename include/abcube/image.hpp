@@ -30,7 +30,8 @@ struct Image {
   }
 };
 
-// Reads an image (OpenImageIO picks the format by extension): linear floats, sRGB-encoded
+// Reads an image (the format by extension: PNG and EXR built in, others through
+// OpenImageIO, loaded then): linear floats, sRGB-encoded
 // files (PNG, JPEG, ...) decoded. Throws InputError naming the file.
 Image read_image(const std::string& path);
 
@@ -40,7 +41,7 @@ Image read_image(const std::string& path);
 // only (no time stamp), so the same render always writes the same file.
 void write_image(const std::string& path, const Image& image);
 
-// Whether OpenImageIO has a writer for this file's extension.
+// Whether a writer handles this file's extension (PNG and EXR, or one of OpenImageIO's).
 bool image_format_supported(const std::string& path);
 // The extensions that have a writer ("exr", "png", ...), for messages.
 std::vector<std::string> writable_image_extensions();

@@ -25,6 +25,11 @@ for method in raytrace abuffer zbuffer envmap gpu hybrid; do
   env -i PATH="$WORK/prefix/bin:/usr/bin:/bin" abcube render "$SRC/scenes/cornell.json" -o "$WORK/p_$method.png" \
     --method "$method" "${options[@]}" 2> "$WORK/err" || { cat "$WORK/err"; fail "installed abcube render --method $method"; }
 done
+# The image module comes from the prefix: a texture and a TIFF need it.
+env -i PATH="$WORK/prefix/bin:/usr/bin:/bin" LD_DEBUG=files abcube render "$SRC/scenes/textured.json" \
+  -o "$WORK/p_textured.tif" --width 64 --height 48 --cube-res 32 2> "$WORK/err" ||
+  { tail -n 5 "$WORK/err"; fail "installed abcube, a texture to TIFF"; }
+grep -q "file=$WORK/prefix/[^ ]*/libabcube_oiio.so" "$WORK/err" || fail "the installed program did not load the prefix's image module"
 module=$(find "$WORK/prefix" -name 'abcube*.so' -path '*-packages/*' | head -n 1)
 [[ -n $module ]] || fail "no Python module under the prefix's site folder"
 site=$(dirname "$module")
@@ -46,6 +51,10 @@ assert abcube.__file__.startswith('$WORK/venv'), abcube.__file__
 scene = abcube.load_scene('$SRC/scenes/cornell.json')
 img = abcube.Renderer(gl='none').render(scene, method='raytrace', width=64, height=48)
 assert img.shape == (48, 64, 3) and img.mean() > 0.05, (img.shape, img.mean())
+# A texture needs the image module: the one pip put beside the extension.
+abcube.Renderer(gl='none').render(abcube.load_scene('$SRC/scenes/textured.json'), method='raytrace', width=32, height=24)
+modules = [l.split()[-1] for l in open('/proc/self/maps') if l.rstrip().endswith('libabcube_oiio.so')]
+assert modules and all(m.startswith('$WORK/venv/') for m in modules), modules
 print('pip: abcube', abcube.__version__, 'from', abcube.__file__)
 " || fail "import abcube from the venv"
 echo "1 passed, 0 failed"
