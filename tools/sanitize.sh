@@ -97,7 +97,7 @@ case $kind in
     # retrying is no answer.
     # Their host code is the osmesa.* twins' (the context aside), which keep leak checking.
     no_leaks='^cli\.crosscheck_cli$|^egl\.'
-    asan_ctest -E "^(RendererApi\.HundredEglRenderersInARow|hard\.generated)$|$decodes|$no_leaks" "$@" || exit 1
+    asan_ctest -E "^(RendererApi\.HundredEglRenderersInARow|hard\.generated|bundle\.clean)$|$decodes|$no_leaks" "$@" || exit 1
     ASAN_OPTIONS=$ASAN_OPTIONS:detect_leaks=0 asan_ctest -R "$no_leaks" "$@" || exit 1
     ASAN_OPTIONS=$ASAN_OPTIONS:fast_unwind_on_malloc=0 asan_ctest -R "$decodes" "$@"
     ;;
