@@ -122,7 +122,8 @@ std::string decode_png(const std::string& path, const unsigned char* bytes, size
 }
 
 std::string encode_png(const std::string& file, const Image& image) {
-  if (image.channels < 1 || image.channels > 4) return "PNG holds 1 to 4 channels, got " + std::to_string(image.channels);
+  if (image.channels < 1 || image.channels > 4)
+    return "PNG holds 1 to 4 channels, got " + std::to_string(image.channels);
   const auto state = std::make_unique<PngState>();
   PngState* s = state.get();
   // OpenImageIO's float to 8-bit conversion: v * 255 + 0.5, clamped, truncated.
@@ -252,7 +253,8 @@ std::string decode_exr(const std::string& path, const unsigned char* bytes, size
 
 std::string encode_exr(const std::string& file, const Image& image) {
   static const std::vector<std::vector<const char*>> NAMES = {{"Y"}, {"Y", "A"}, {"R", "G", "B"}, {"R", "G", "B", "A"}};
-  if (image.channels < 1 || image.channels > 4) return "abcube writes 1 to 4 channels, got " + std::to_string(image.channels);
+  if (image.channels < 1 || image.channels > 4)
+    return "abcube writes 1 to 4 channels, got " + std::to_string(image.channels);
   try {
     Imf::Header header(image.width, image.height);
     header.compression() = Imf::ZIP_COMPRESSION;
@@ -262,7 +264,8 @@ std::string encode_exr(const std::string& file, const Image& image) {
     const size_t xs = sizeof(float) * static_cast<size_t>(image.channels), ys = xs * static_cast<size_t>(image.width);
     char* base = const_cast<char*>(reinterpret_cast<const char*>(image.data.data()));
     Imf::FrameBuffer frame;
-    for (size_t k = 0; k < names.size(); ++k) frame.insert(names[k], Imf::Slice(Imf::FLOAT, base + sizeof(float) * k, xs, ys));
+    for (size_t k = 0; k < names.size(); ++k)
+      frame.insert(names[k], Imf::Slice(Imf::FLOAT, base + sizeof(float) * k, xs, ys));
     outfile.setFrameBuffer(frame);
     outfile.writePixels(image.height);
     return "";
@@ -289,24 +292,18 @@ Codec codec_of_bytes(const unsigned char* bytes, size_t size) {
 std::string decode_image(Codec codec, const std::string& path, const unsigned char* bytes, size_t size,
                          uint64_t max_pixels, DecodedImage* out) {
   switch (codec) {
-    case Codec::png:
-      return decode_png(path, bytes, size, max_pixels, out);
-    case Codec::exr:
-      return decode_exr(path, bytes, size, max_pixels, out);
-    case Codec::none:
-      break;
+    case Codec::png: return decode_png(path, bytes, size, max_pixels, out);
+    case Codec::exr: return decode_exr(path, bytes, size, max_pixels, out);
+    case Codec::none: break;
   }
   return "no built-in reader for it";
 }
 
 std::string encode_image(Codec codec, const std::string& file, const Image& image) {
   switch (codec) {
-    case Codec::png:
-      return encode_png(file, image);
-    case Codec::exr:
-      return encode_exr(file, image);
-    case Codec::none:
-      break;
+    case Codec::png: return encode_png(file, image);
+    case Codec::exr: return encode_exr(file, image);
+    case Codec::none: break;
   }
   return "no built-in writer for it";
 }

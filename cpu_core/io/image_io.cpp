@@ -57,16 +57,19 @@ void write_image(const std::string& path, const Image& image) {
                      ")");
   }
   const bool linear = is_float_format(path);
-  Image pixels = image;
+  Image encoded;  // 8-bit formats: the values sRGB-encoded; float formats take `image` as it is
   if (!linear) {
-    for (size_t k = 0; k < pixels.data.size(); ++k) {
+    encoded = image;
+    for (size_t k = 0; k < encoded.data.size(); ++k) {
       const bool alpha = image.channels == 4 && k % 4 == 3;
-      pixels.data[k] = alpha ? std::clamp(pixels.data[k], 0.f, 1.f) : srgb_encode(pixels.data[k]);
+      encoded.data[k] = alpha ? std::clamp(encoded.data[k], 0.f, 1.f) : srgb_encode(encoded.data[k]);
     }
   }
+  const Image& pixels = linear ? image : encoded;
   TemporaryFile temporary(path);
-  const std::string why = codec != Codec::none ? encode_image(codec, temporary.path(), pixels)
-                                               : image_module("writing " + quote_path(path)).write(path, temporary.path(), pixels, linear);
+  const std::string why =
+      codec != Codec::none ? encode_image(codec, temporary.path(), pixels)
+                           : image_module("writing " + quote_path(path)).write(path, temporary.path(), pixels, linear);
   if (!why.empty()) throw RuntimeFailure(path + ": cannot write image: " + one_line(why));
   temporary.commit();
 }
@@ -74,9 +77,10 @@ void write_image(const std::string& path, const Image& image) {
 Image read_image(const std::string& path) {
   DecodedImage decoded;
   const Codec codec = codec_of_path(path);
-  std::string why = codec != Codec::none
-                        ? decode_image(codec, path, nullptr, 0, 0, &decoded)
-                        : image_module("reading " + quote_path(path)).read(path, nullptr, 0, 0, &decoded.image, &decoded.encoded);
+  std::string why =
+      codec != Codec::none
+          ? decode_image(codec, path, nullptr, 0, 0, &decoded)
+          : image_module("reading " + quote_path(path)).read(path, nullptr, 0, 0, &decoded.image, &decoded.encoded);
   if (!why.empty()) throw InputError(path + ": cannot read image: " + one_line(why));
   Image& img = decoded.image;
   if (decoded.encoded) {

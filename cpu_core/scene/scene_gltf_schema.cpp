@@ -223,8 +223,7 @@ GlbChunks read_glb(const std::string& bytes) {
   // The header's length bounds every chunk; bytes after it are not part of the container.
   const uint64_t length = u32(8);
   if (length > bytes.size()) {
-    return refuse("the header says " + std::to_string(length) + " bytes, the file has " +
-                  std::to_string(bytes.size()));
+    return refuse("the header says " + std::to_string(length) + " bytes, the file has " + std::to_string(bytes.size()));
   }
   // Chunks: an 8-byte header (length, type), then the data, each wholly inside `length`.
   // The first is JSON; a BIN chunk may follow it.

@@ -434,8 +434,8 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
     scene.camera.fov_y_deg = c.fov_y_deg;
   }
   if (const Json* render = top.find("render")) {
-    scene.render = read_render(
-        Fields(src, *render, "render", {"method", "cube_resolution", "max_depth", "fresnel", "error_target", "target_db"}));
+    scene.render = read_render(Fields(
+        src, *render, "render", {"method", "cube_resolution", "max_depth", "fresnel", "error_target", "target_db"}));
   }
   load_textures(st);
   // The loaders' small blocks freed since the last object's trim (the closed-surface test's,

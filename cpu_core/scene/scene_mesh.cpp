@@ -269,9 +269,7 @@ uint64_t count_face_triangles(const std::string& resolved) {
       const bool space = c == ' ' || c == '\t' || c == '\r';
       switch (state) {
         case line_start:
-        case leading_space:
-          state = space ? leading_space : c == 'f' ? after_f : other;
-          break;
+        case leading_space: state = space ? leading_space : c == 'f' ? after_f : other; break;
         case after_f:
           state = space ? in_face : other;  // "f" then a blank: a face ("fo" is not)
           break;
@@ -279,8 +277,7 @@ uint64_t count_face_triangles(const std::string& resolved) {
           if (space && in_token) ++corners;
           in_token = !space;
           break;
-        case other:
-          break;
+        case other: break;
       }
     }
   }

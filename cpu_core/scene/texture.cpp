@@ -33,9 +33,9 @@ bool decode_texture(const unsigned char* bytes, size_t size, const std::string& 
   if (codec != Codec::none) {
     *why = decode_image(codec, name_hint, bytes, size, MAX_TEXTURE_TEXELS, &decoded);
   } else {
-    *why = image_module("decoding texture " + quote(name_hint))
-               .read(reader_name(name_hint, mime_type), bytes, size, MAX_TEXTURE_TEXELS, &decoded.image,
-                     &decoded.encoded);
+    *why =
+        image_module("decoding texture " + quote(name_hint))
+            .read(reader_name(name_hint, mime_type), bytes, size, MAX_TEXTURE_TEXELS, &decoded.image, &decoded.encoded);
   }
   if (!why->empty()) {
     *why = one_line(*why);
@@ -67,13 +67,7 @@ TextureSet::TextureSet(std::vector<TextureImage> images, std::vector<int> materi
     : images_(std::move(images)), material_image_(std::move(material_image)), sampler_(std::make_unique<Sampler>()) {
   std::vector<TexturePixels> pixels;
   for (const TextureImage& i : images_) pixels.push_back({i.width, i.height, i.rgb.data()});
-  try {
-    sampler_->sampler = image_module("textures").sampler(pixels);
-  } catch (const RuntimeFailure&) {
-    throw;
-  } catch (const std::exception& e) {
-    ABCUBE_CHECK(false, std::string("texture sampler: ") + e.what());
-  }
+  sampler_->sampler = image_module("textures").sampler(pixels);
 }
 
 TextureSet::~TextureSet() = default;

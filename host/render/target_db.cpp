@@ -142,17 +142,16 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
   json& stats = mc.stats;
   stats["size"]["cube_resolution"] = best.n;
   stats["method_options"]["shading_points"] = chosen.one_point ? "one" : "quarters";
-  stats["target_db"] = {
-      {"target", target},
-      {"cube_resolution", best.n},
-      {"shading_points", chosen.one_point ? "one" : "quarters"},
-      {"scene_cube_resolution", scene.render.cube_resolution},
-      {"reached", reached},
-      {"why", why},
-      {"predicted_psnr_db", number_or_null(best_error.psnr)},
-      {"predicted_psnr_db_low", number_or_null(best_error.psnr_low)},
-      {"sample", {{"pixels", best_error.pixels}, {"block", block}, {"exact_trace_ms", trace_ms}}},
-      {"pilots", pilots}};
+  stats["target_db"] = {{"target", target},
+                        {"cube_resolution", best.n},
+                        {"shading_points", chosen.one_point ? "one" : "quarters"},
+                        {"scene_cube_resolution", scene.render.cube_resolution},
+                        {"reached", reached},
+                        {"why", why},
+                        {"predicted_psnr_db", number_or_null(best_error.psnr)},
+                        {"predicted_psnr_db_low", number_or_null(best_error.psnr_low)},
+                        {"sample", {{"pixels", best_error.pixels}, {"block", block}, {"exact_trace_ms", trace_ms}}},
+                        {"pilots", pilots}};
   stats["timings_ms"]["target_pilots"] = ms_since(start);
   return best;
 }

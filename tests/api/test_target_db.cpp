@@ -26,7 +26,8 @@ TEST(TargetDb, PilotPixelsAreOnePerBlock) {
     ASSERT_EQ(only.size(), static_cast<size_t>(w) * static_cast<size_t>(h));
     EXPECT_GE(block, 2);
     EXPECT_LE(block, 8);
-    std::vector<int> per_block(static_cast<size_t>((w + block - 1) / block) * static_cast<size_t>((h + block - 1) / block));
+    std::vector<int> per_block(static_cast<size_t>((w + block - 1) / block) *
+                               static_cast<size_t>((h + block - 1) / block));
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) {
         if (only[static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x)]) {
@@ -52,16 +53,22 @@ TEST(TargetDb, LadderClimbsToTheScenesOwnN) {
   EXPECT_EQ(target_ladder(1536).back(), 1536);
 }
 
+// abuffer on cornell.json at width x height with --target-db `target`, stats kept.
+RenderOptions target_options(int width, int height, double target) {
+  RenderOptions o = small_options("abuffer", width, height, 0);
+  o.target_db = target;
+  o.stats = true;
+  return o;
+}
+
 // The N and the shading points the stats report give, rendered directly, the very image
 // --target-db rendered; that image reaches the target against the exact tracer; every
 // pilot is in the stats.
 TEST(TargetDb, TheChosenPlanIsTheImageAndReachesTheTarget) {
   const Scene scene = Scene::load(scene_path("cornell.json"));
   Renderer renderer;
-  RenderOptions o = small_options("abuffer", 96, 72, 0);
-  o.target_db = 36;
+  RenderOptions o = target_options(96, 72, 36);
   o.reference = true;
-  o.stats = true;
   const RenderResult r = renderer.render(scene, o);
   const json s = json::parse(r.stats.json);
   ASSERT_TRUE(s.contains("target_db")) << r.stats.json;
@@ -89,10 +96,7 @@ TEST(TargetDb, TheChosenPlanIsTheImageAndReachesTheTarget) {
 TEST(TargetDb, AnUnreachableTargetKeepsTheBestAndSaysSo) {
   const Scene scene = Scene::load(scene_path("cornell.json"));
   Renderer renderer;
-  RenderOptions o = small_options("abuffer", 48, 36, 0);
-  o.target_db = 99;
-  o.stats = true;
-  const json t = json::parse(renderer.render(scene, o).stats.json)["target_db"];
+  const json t = json::parse(renderer.render(scene, target_options(48, 36, 99)).stats.json)["target_db"];
   EXPECT_FALSE(t["reached"].get<bool>()) << t.dump(1);
   EXPECT_EQ(t["shading_points"], "quarters");
   double best = -1;

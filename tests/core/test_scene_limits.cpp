@@ -163,9 +163,12 @@ TEST(SceneLoadLimits, MeshOverTheCapsIsRefusedBeforeItIsParsed) {
   dir.write("fan.obj", obj);
   const std::string mesh = with_objects(R"([{"type": "mesh", "file": "fan.obj"}])").str();
   LoadLimits limits;
-  const auto error = [&] { return input_error([&] { load_scene_text(mesh, "scene.json", dir.path().string(), limits); }, mesh); };
+  const auto error = [&] {
+    return input_error([&] { load_scene_text(mesh, "scene.json", dir.path().string(), limits); }, mesh);
+  };
   const std::string counted = std::to_string(500 * 3 + 4 + 1);
-  EXPECT_NE(error().find("has an index out of range"), std::string::npos) << "with no cap, the check after parsing: " << error();
+  EXPECT_NE(error().find("has an index out of range"), std::string::npos)
+      << "with no cap, the check after parsing: " << error();
   limits.max_triangles = 1000;
   EXPECT_EQ(error(), "scene.json: objects[0].file: the scene would have " + counted +
                          " triangles, over the cap of 1000 (max_triangles)");

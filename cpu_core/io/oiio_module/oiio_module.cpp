@@ -202,7 +202,8 @@ class OiioModule : public ImageModule {
     }
     // Integer images are sRGB-encoded unless they say they are linear; float images are linear.
     const OIIO::TypeDesc::BASETYPE base = static_cast<OIIO::TypeDesc::BASETYPE>(spec.format.basetype);
-    const bool is_float = base == OIIO::TypeDesc::FLOAT || base == OIIO::TypeDesc::HALF || base == OIIO::TypeDesc::DOUBLE;
+    const bool is_float =
+        base == OIIO::TypeDesc::FLOAT || base == OIIO::TypeDesc::HALF || base == OIIO::TypeDesc::DOUBLE;
     *encoded = !is_float && !OIIO::Strutil::iequals(spec.get_string_attribute("oiio:ColorSpace"), "linear");
     const int channels = std::min(spec.nchannels, 4);
     *out = Image(spec.width, spec.height, channels);
