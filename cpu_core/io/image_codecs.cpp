@@ -209,7 +209,7 @@ std::vector<std::string> exr_channels(const Imf::ChannelList& list) {
   } else if (list.begin() != list.end()) {
     names = {list.begin().name()};
   }
-  if (!names.empty() && has("A")) names.push_back("A");
+  if (!names.empty() && names[0] != "A" && has("A")) names.push_back("A");
   return names;
 }
 
