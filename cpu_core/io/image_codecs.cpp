@@ -23,12 +23,6 @@ namespace abcube {
 
 namespace {
 
-std::string lower_extension(const std::string& path) {
-  std::string e = std::filesystem::path(path).extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return e;
-}
-
 // ---- PNG ------------------------------------------------------------------------------
 //
 // libpng reports errors by longjmp. Between setjmp and a longjmp only what a pointer set
@@ -275,6 +269,12 @@ std::string encode_exr(const std::string& file, const Image& image) {
 }
 
 }  // namespace
+
+std::string lower_extension(const std::string& path) {
+  std::string e = std::filesystem::path(path).extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return e;
+}
 
 Codec codec_of_path(const std::string& path) {
   const std::string e = lower_extension(path);

@@ -13,6 +13,9 @@ namespace abcube {
 
 enum class Codec { none, png, exr };
 
+// A file name's extension, dot included, in lower case (".png"; "" for none).
+std::string lower_extension(const std::string& path);
+
 // The codec of a file name's extension (.png, .exr, any case), or none.
 Codec codec_of_path(const std::string& path);
 // The codec of bytes by their signature (PNG's eight bytes, OpenEXR's magic), or none.

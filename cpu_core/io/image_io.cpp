@@ -29,12 +29,6 @@ float srgb_decode(float x) { return x <= 0.04045f ? x / 12.92f : std::pow((x + 0
 
 namespace {
 
-std::string lower_extension(const std::string& path) {
-  std::string e = fs::path(path).extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
-  return e;
-}
-
 bool is_float_format(const std::string& path) {
   const std::string e = lower_extension(path);
   return e == ".exr" || e == ".hdr" || e == ".pfm";

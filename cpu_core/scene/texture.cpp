@@ -58,21 +58,16 @@ bool decode_texture(const unsigned char* bytes, size_t size, const std::string& 
   return true;
 }
 
-// The image module's sampler over the linear pixels (io/image_module.hpp).
-struct TextureSet::Sampler {
-  std::unique_ptr<TextureSampler> sampler;
-};
-
 TextureSet::TextureSet(std::vector<TextureImage> images, std::vector<int> material_image)
-    : images_(std::move(images)), material_image_(std::move(material_image)), sampler_(std::make_unique<Sampler>()) {
+    : images_(std::move(images)), material_image_(std::move(material_image)) {
   std::vector<TexturePixels> pixels;
   for (const TextureImage& i : images_) pixels.push_back({i.width, i.height, i.rgb.data()});
-  sampler_->sampler = image_module("textures").sampler(pixels);
+  sampler_ = image_module("textures").sampler(pixels);
 }
 
 TextureSet::~TextureSet() = default;
 
-glm::dvec3 TextureSet::sample(int image, const glm::dvec2& uv) const { return sampler_->sampler->sample(image, uv); }
+glm::dvec3 TextureSet::sample(int image, const glm::dvec2& uv) const { return sampler_->sample(image, uv); }
 
 glm::dvec2 triangle_uv(const TriangleSoup& soup, uint32_t triangle, const glm::dvec3& w) {
   if (soup.uvs.empty()) return glm::dvec2(0.0);

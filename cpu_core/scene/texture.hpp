@@ -25,6 +25,8 @@
 
 namespace abcube {
 
+class TextureSampler;
+
 // One decoded texture: linear RGB floats, `width` x `height`, row 0 at the top of the
 // image (v = 1), as the file stores it.
 struct TextureImage {
@@ -61,10 +63,9 @@ class TextureSet {
   glm::dvec3 sample(int image, const glm::dvec2& uv) const;
 
  private:
-  struct Sampler;
   std::vector<TextureImage> images_;
   std::vector<int> material_image_;
-  std::unique_ptr<Sampler> sampler_;
+  std::unique_ptr<TextureSampler> sampler_;  // the image module's (io/image_module.hpp)
 };
 
 // The texture coordinates at barycentric weights `w` of triangle `triangle` ((0, 0) when
