@@ -108,7 +108,10 @@ for name in "${HARNESSES[@]}"; do
   corpus_size=$(find "$corpus" -type f | wc -l)
   if [[ $rc -ne 0 ]]; then
     status=1
-    tail -n 60 "$log"
+    # The report's head (its kind and the innermost frames), then the log's end.
+    first=$(grep -n -m1 -E '==ERROR:|runtime error:|ERROR: libFuzzer' "$log" | cut -d: -f1 || true)
+    [[ -n $first ]] && sed -n "${first},$((first + 40))p" "$log" && echo "..."
+    tail -n 15 "$log"
     echo "fuzz: $name FAILED (exit $rc); input: $(ls -t "$artifacts" | head -1 | sed "s|^|$artifacts/|")"
     summary+=("$name: FAILED after ${runs:-?} inputs")
   else

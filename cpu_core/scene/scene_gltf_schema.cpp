@@ -185,6 +185,43 @@ void check_material(const std::function<void(const std::string&, const std::stri
   }
 }
 
+// An image stored in a buffer view (glTF 5.11, 5.17): the view must exist and lie wholly
+// inside its buffer's declared byteLength. tinygltf sizes every buffer's data to that
+// byteLength but hands an image's view to the image callback unchecked, so a view past its
+// buffer would be read past the end of the buffer's data. (The views of accessors are
+// checked against the data itself when the geometry is read.)
+void check_image_views(const std::function<void(const std::string&, const std::string&)>& bad, const Json& doc) {
+  const auto images = doc.find("images");
+  if (images == doc.end()) return;
+  const auto views = doc.find("bufferViews");
+  const auto buffers = doc.find("buffers");
+  const size_t view_count = views == doc.end() ? 0 : views->size();
+  const size_t buffer_count = buffers == doc.end() ? 0 : buffers->size();
+  for (size_t i = 0; i < images->size(); ++i) {
+    const auto it = (*images)[i].find("bufferView");
+    if (it == (*images)[i].end()) continue;
+    const std::string at = member_path(index_path("images", i), "bufferView");
+    const uint64_t index = it->get<uint64_t>();
+    if (index >= view_count) {
+      bad(at, std::to_string(index) + " names no buffer view (the file has " + std::to_string(view_count) + ")");
+    }
+    const Json& view = (*views)[index];
+    const std::string view_at = index_path("bufferViews", index);
+    const uint64_t buffer = view.value("buffer", uint64_t{0});
+    if (!view.contains("buffer") || buffer >= buffer_count) {
+      bad(at, view_at + " names no buffer (the file has " + std::to_string(buffer_count) + ")");
+    }
+    const uint64_t offset = view.value("byteOffset", uint64_t{0});
+    const uint64_t length = view.value("byteLength", uint64_t{0});
+    const uint64_t capacity = (*buffers)[buffer].value("byteLength", uint64_t{0});
+    if (offset > capacity || length > capacity - offset) {
+      bad(at, view_at + " (byteOffset " + std::to_string(offset) + " + byteLength " + std::to_string(length) +
+                  ") passes the end of buffers[" + std::to_string(buffer) + "] (byteLength " +
+                  std::to_string(capacity) + ")");
+    }
+  }
+}
+
 }  // namespace
 
 // Percent-decoding of a URI (RFC 3986), as tinygltf decodes file URIs before it opens them.
@@ -300,6 +337,7 @@ void check_document(const Json& doc, const BadAt& bad, const CheckFile& check_fi
       if (array == "materials") check_material(bad, element, at);
     }
   }
+  check_image_views(bad, doc);
 }
 
 }  // namespace abcube::detail::gltf

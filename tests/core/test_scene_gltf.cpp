@@ -212,6 +212,38 @@ TEST(SceneLoadGltf, GlbImagesAreKeptEncoded) {
 
 // A .glb's chunks must lie inside its header's length before tinygltf reads them: a BIN
 // chunk whose length runs past the file would have it copy bytes from beyond the end.
+// An image's buffer view must lie inside its buffer (glTF 5.11). tinygltf hands an image's
+// buffer view to the image reader without that check: found by fuzz_gltf as a read past the
+// buffer.
+TEST(SceneLoadGltf, ImageBufferViewsLieInsideTheirBuffers) {
+  TempDir dir;
+  const auto error_for = [&](const std::string& view, const std::string& image) {
+    QuadGltf g;
+    g.extra = R"(, "images": [)" + image + "]";
+    std::string json = g.str();
+    const std::string last_view = R"("byteLength": 32}])";
+    const size_t at = json.find(last_view);
+    EXPECT_NE(at, std::string::npos);
+    json.replace(at, last_view.size(), R"("byteLength": 32}, )" + view + "]");
+    dir.write("quad.gltf", json);
+    dir.write("quad.bin", g.bin());
+    return load_error(gltf_scene(), dir.path().string());
+  };
+  const std::string prefix = "scene.json: objects[0].file: \"quad.gltf\": images[0].bufferView: ";
+  const std::string png = R"({"bufferView": 3, "mimeType": "image/png"})";
+  EXPECT_EQ(error_for(R"({"buffer": 0, "byteLength": 4000})", png),
+            prefix + "bufferViews[3] (byteOffset 0 + byteLength 4000) passes the end of buffers[0] (byteLength 92)");
+  EXPECT_EQ(error_for(R"({"buffer": 0, "byteOffset": 90, "byteLength": 4})", png),
+            prefix + "bufferViews[3] (byteOffset 90 + byteLength 4) passes the end of buffers[0] (byteLength 92)");
+  EXPECT_EQ(error_for(R"({"buffer": 0, "byteOffset": 18446744073709551615, "byteLength": 4})", png),
+            prefix + "bufferViews[3] (byteOffset 18446744073709551615 + byteLength 4) passes the end of buffers[0] "
+                     "(byteLength 92)");
+  EXPECT_EQ(error_for(R"({"buffer": 1, "byteLength": 4})", png),
+            prefix + "bufferViews[3] names no buffer (the file has 1)");
+  EXPECT_EQ(error_for(R"({"buffer": 0, "byteLength": 4})", R"({"bufferView": 7, "mimeType": "image/png"})"),
+            prefix + "7 names no buffer view (the file has 4)");
+}
+
 TEST(SceneLoadGltf, GlbContainerLayoutIsChecked) {
   TempDir dir;
   QuadGltf g;
