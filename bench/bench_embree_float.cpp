@@ -28,7 +28,7 @@
 #include <embree3/rtcore.h>
 
 #include "bench_common.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 #include "reference/raytrace.hpp"
 #include "scene/camera.hpp"
 #include "scene/scene_load.hpp"

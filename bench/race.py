@@ -25,7 +25,7 @@ Per scene:
   GOAL       abuffer at the own N: >= 40 dB, <= 0.5 x raytrace's time, <= 0.25 x POV-Ray's.
 
 PSNR is sRGB, `abcube compare` against the reference (the reference's own PSNR is infinite).
-POV-Ray's PSNR includes the model differences listed in cpu_core/io/pov_export.hpp.
+POV-Ray's PSNR includes the model differences listed in cpu_core/scene/pov_export.hpp.
 Writes REPORT.md and REPORT.csv.
 """
 import argparse

@@ -16,7 +16,7 @@ uniform int u_light_count;
 uniform vec3 u_ambient;
 
 // Light let through by one surface crossing a shadow segment: (1 - op) + op * kt * Od,
-// cpu_core/shading/shading.hpp blocker_transmittance (rule "shadows").
+// cpu_core/material/shading.hpp blocker_transmittance (rule "shadows").
 vec3 blocker_transmittance(MaterialGpu m) {
   float op = m.transmission.z;
   return vec3(1.0 - op) + (op * m.transmission.x) * m.color_ambient.rgb;

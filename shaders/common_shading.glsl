@@ -1,4 +1,4 @@
-// Phong local shading, the GLSL mirror of cpu_core/shading/shading.hpp (thesis ch. 6):
+// Phong local shading, the GLSL mirror of cpu_core/material/shading.hpp (thesis ch. 6):
 //   C = ka Ia Od + sum_l S_l I_l (kd Od max(0, N.L) + ks max(0, R.V)^n),  R = reflect(-L, N),
 // with N turned to face the viewer (two-sided lighting). p is relative to the eye.
 

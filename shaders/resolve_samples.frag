@@ -1,4 +1,4 @@
-// The box filter of the 4x8 samples of each pixel (raster/samples.hpp) on the GPU: the
+// The box filter of the 4x8 samples of each pixel (base/samples.hpp) on the GPU: the
 // camera tile's sample grid (u_samples, 8 columns and 4 rows a pixel) into one texel a
 // pixel, so that the exact camera pass reads back pixels, not samples. RGB: the mean of
 // the 32 samples (as the CPU resolve weighs its masks); alpha: how many of them met a

@@ -1,5 +1,5 @@
 // Shadow-map passes, rendered from a light (gl_shadow_maps.cpp build_shadow_maps). The CPU's
-// rule "shadows" (cpu_core/shading/shading.hpp): S_l is the product over every surface
+// rule "shadows" (cpu_core/material/shading.hpp): S_l is the product over every surface
 // crossing the segment P..L of blocker_transmittance. Opaque casters (transmittance 0 in
 // every channel) go to the distance map (u_peel < 0); the others are peeled front to back,
 // one layer per pass (u_peel = k >= 0: the nearest crossing behind layer k - 1, in the

@@ -1,4 +1,4 @@
-// Depth-fail counting of a light's shadow volume (cpu_core/scene/shadow_volume.hpp; Everitt
+// Depth-fail counting of a light's shadow volume (cpu_core/gpu_geometry/shadow_volume.hpp; Everitt
 // & Kilgard 2002): drawn with the depth test passing where the face lies behind or at the
 // visible surface (GL_LEQUAL in reversed Z) and additive blending, each outward-oriented
 // face adds +1 seen from behind (an exit) and -1 seen from the front (an entry). The sum is

@@ -14,16 +14,13 @@
 
 #include <glm/glm.hpp>
 
+#include "base/normal_encoding.hpp"
 #include "io/image.hpp"
 #include "raster/raster.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 #include "scene/scene_data.hpp"
 
 namespace abcube {
-
-// Octahedral unit-vector encoding, 16 bits per coordinate (Cigolle et al. 2014).
-uint32_t encode_octahedral(const glm::dvec3& unit);
-glm::dvec3 decode_octahedral(uint32_t code);
 
 // cos(20 degrees): fragments whose normals differ more do not merge (a crease).
 constexpr double MERGE_MIN_NORMAL_COS = 0.93969262078590838;

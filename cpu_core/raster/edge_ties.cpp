@@ -5,7 +5,7 @@
 #include <functional>
 
 #include "raster/raster.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 #include "scene/camera.hpp"
 
 namespace abcube {

@@ -13,7 +13,7 @@
 #include <glm/glm.hpp>
 
 #include "scene/camera.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 #include "scene/scene_data.hpp"
 
 namespace abcube {

@@ -10,8 +10,8 @@
 #include "scene/camera.hpp"
 #include "base/error.hpp"
 #include "base/parallel.hpp"
-#include "raster/samples.hpp"
-#include "shading/shading.hpp"
+#include "base/samples.hpp"
+#include "material/shading.hpp"
 #include "base/timer.hpp"
 
 namespace abcube {

@@ -17,7 +17,7 @@
 #include "reference/bvh.hpp"
 #include "io/image.hpp"
 #include "scene/scene_data.hpp"
-#include "shading/media.hpp"
+#include "material/media.hpp"
 
 namespace abcube {
 

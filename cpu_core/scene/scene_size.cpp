@@ -6,7 +6,7 @@
 #include "base/memory.hpp"
 #include "scene/scene_json.hpp"
 #include "scene/scene_load.hpp"
-#include "scene/shadow_volume.hpp"
+#include "scene/gpu_limits.hpp"
 
 namespace abcube {
 
@@ -21,7 +21,7 @@ constexpr uint64_t MIB = uint64_t{1} << 20;
 // arrays (gl_passes.cpp), counted at their largest, a copy with ids on every vertex, since
 // the estimate is made before the GL is opened, plus an allowance for what a software GL
 // holds while it draws them; a shadow-casting light's cube map of N x N floats; and its
-// shadow volumes (shadow_volume.hpp: a code a triangle and the runs of casting triangles,
+// shadow volumes (gpu_geometry/shadow_volume.hpp: a code a triangle and the runs of casting triangles,
 // twice, and the side pairing's buckets), counted for every gpu render since the method's
 // options are not read yet. docs/design/scene-size.md has the accounting.
 constexpr uint64_t VOLUME_TRIANGLE_BYTES = 2 * (2 + 8);

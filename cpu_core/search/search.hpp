@@ -22,7 +22,7 @@
 #include "raster/cube_map.hpp"
 #include "reference/bvh.hpp"
 #include "scene/scene_data.hpp"
-#include "shading/media.hpp"
+#include "material/media.hpp"
 
 namespace abcube {
 

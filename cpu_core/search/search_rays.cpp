@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "search/search_scan.hpp"
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 
 namespace abcube {
 

@@ -15,7 +15,7 @@
 #include "raster/raster.hpp"
 #include "reference/raytrace.hpp"
 #include "shading/resolve.hpp"
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 
 namespace abcube {
 

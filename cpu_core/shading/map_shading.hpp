@@ -22,7 +22,7 @@
 #include "scene/scene_data.hpp"
 #include "reference/raytrace.hpp"
 #include "search/search.hpp"
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 
 namespace abcube {
 

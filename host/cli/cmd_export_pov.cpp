@@ -1,12 +1,12 @@
 // abcube export-pov SCENE -o X.pov: the same triangles, camera, lights and materials for
-// POV-Ray 3.7 (mapping and residual differences: cpu_core/io/pov_export.hpp).
+// POV-Ray 3.7 (mapping and residual differences: cpu_core/scene/pov_export.hpp).
 #include <memory>
 
 #include <abcube/scene.hpp>
 
 #include "cli/cli_common.hpp"
 #include "io/image_io.hpp"
-#include "io/pov_export.hpp"
+#include "scene/pov_export.hpp"
 
 namespace abcube {
 

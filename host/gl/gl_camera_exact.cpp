@@ -22,7 +22,7 @@
 #include "gl/gl_passes.hpp"
 #include "gl/gl_passes_internal.hpp"
 #include "raster/cube_map.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 
 namespace abcube {
 

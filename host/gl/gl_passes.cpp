@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "raster/cube_map.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 #include "base/error.hpp"
 #include "base/parallel.hpp"
 #include "base/timer.hpp"

@@ -14,9 +14,9 @@
 
 #include "gl/gl_program.hpp"
 #include "io/image.hpp"
-#include "scene/planar_reflectors.hpp"
+#include "gpu_geometry/planar_reflectors.hpp"
 #include "scene/scene_data.hpp"
-#include "scene/shadow_volume.hpp"
+#include "gpu_geometry/shadow_volume.hpp"
 #include "shading/map_shading.hpp"
 
 namespace abcube {

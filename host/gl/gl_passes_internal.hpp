@@ -13,7 +13,7 @@
 #include "base/error.hpp"
 #include "gl/gl_passes.hpp"
 #include "raster/cube_map.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 
 namespace abcube {
 

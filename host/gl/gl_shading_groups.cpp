@@ -7,7 +7,7 @@
 #include <string>
 
 #include "gl/gl_passes_internal.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 
 namespace abcube {
 

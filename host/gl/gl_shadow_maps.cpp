@@ -10,7 +10,7 @@
 #include "base/timer.hpp"
 #include "gl/gl_passes_internal.hpp"
 #include "raster/cube_map.hpp"
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 
 namespace abcube {
 

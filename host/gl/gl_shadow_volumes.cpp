@@ -12,10 +12,10 @@
 #include "base/parallel.hpp"
 #include "base/timer.hpp"
 #include "gl/gl_passes_internal.hpp"
-#include "raster/samples.hpp"
-#include "scene/shadow_volume.hpp"
+#include "base/samples.hpp"
+#include "gpu_geometry/shadow_volume.hpp"
 #include "scene/tie_rule.hpp"
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 
 namespace abcube {
 

@@ -10,12 +10,12 @@
 #include "raster/abuffer.hpp"
 #include "raster/edge_ties.hpp"
 #include "raster/raster.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 #include "scene/camera.hpp"
 #include "raster/cube_map.hpp"
 #include "io/image_io.hpp"
 #include "shading/resolve.hpp"
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 #include "base/timer.hpp"
 
 namespace abcube {

@@ -11,7 +11,7 @@
 #include "base/timer.hpp"
 #include "io/metrics.hpp"
 #include "raster/edge_ties.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 #include "reference/raytrace.hpp"
 #include "render/crosscheck.hpp"
 #include "render/stats_json.hpp"

@@ -12,7 +12,7 @@
 
 #include <abcube/renderer.hpp>
 
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 #include "scene/camera.hpp"
 #include "scene/scene_data.hpp"
 
@@ -148,7 +148,7 @@ TEST(HardCases, ShadowOfAFinThroughTheCentre) {
   EXPECT_GE(with_side - map_only, 15.0) << "map only " << map_only << " dB";
 }
 
-// Touching and nested glass (issue 12 part 2; NESTED DIELECTRICS, cpu_core/shading/media.hpp):
+// Touching and nested glass (issue 12 part 2; NESTED DIELECTRICS, cpu_core/material/media.hpp):
 // a scene over a striped floor, lit, 96x72, N = 256, max_depth 6. `objects` is JSON.
 Scene glass_scene(const std::string& objects, const std::string& name) {
   std::ostringstream s;

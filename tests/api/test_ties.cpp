@@ -13,7 +13,7 @@
 
 #include <abcube/renderer.hpp>
 
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 #include "scene/camera.hpp"
 #include "scene/scene_data.hpp"
 #include "scene/tie_rule.hpp"

@@ -5,7 +5,7 @@
 
 #include "scene/camera.hpp"
 #include "raster/cube_map.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 
 namespace abcube {
 namespace {

@@ -4,7 +4,7 @@
 
 #include "abuffer_testkit.hpp"
 #include "raster/edge_ties.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 #include "reference/raytrace.hpp"
 
 namespace abcube {

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "reference/raytrace.hpp"
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 
 namespace abcube {
 namespace {

@@ -1,6 +1,6 @@
 // The CPU side of the gpu method's exact camera pass (issue 19): which triangles are planar
-// mirrors (scene/planar_reflectors.hpp), and the shadow volumes' geometry
-// (scene/shadow_volume.hpp): closed and consistently oriented, made of the right blockers.
+// mirrors (gpu_geometry/planar_reflectors.hpp), and the shadow volumes' geometry
+// (gpu_geometry/shadow_volume.hpp): closed and consistently oriented, made of the right blockers.
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -11,9 +11,9 @@
 #include <gtest/gtest.h>
 
 #include "raster/cube_map.hpp"
-#include "scene/planar_reflectors.hpp"
+#include "gpu_geometry/planar_reflectors.hpp"
 #include "scene/scene_load.hpp"
-#include "scene/shadow_volume.hpp"
+#include "gpu_geometry/shadow_volume.hpp"
 
 namespace abcube {
 namespace {

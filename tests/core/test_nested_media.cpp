@@ -1,4 +1,4 @@
-// NESTED DIELECTRICS (cpu_core/shading/media.hpp) with known answers: the direction of the
+// NESTED DIELECTRICS (cpu_core/material/media.hpp) with known answers: the direction of the
 // transmitted ray after each interface, from Snell's law for the chain of media, as the
 // exact tracer follows it (RayTracer::transmitted_path) and as the map searches follow it
 // (MapShader::transmitted_path). Parallel faces: sin(theta_k) = sin(theta_0) / n_k in a
@@ -13,7 +13,7 @@
 #include "raster/abuffer.hpp"
 #include "reference/raytrace.hpp"
 #include "shading/map_shading.hpp"
-#include "shading/media.hpp"
+#include "material/media.hpp"
 
 namespace abcube {
 namespace {

@@ -21,9 +21,9 @@
 #include "base/error.hpp"
 #include "io/image_io.hpp"
 #include "io/metrics.hpp"
-#include "io/pov_export.hpp"
+#include "scene/pov_export.hpp"
 #include "reference/raytrace.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 #include "scene/scene_load.hpp"
 
 // Scene builders, defined in test_raytrace.cpp.

@@ -19,7 +19,7 @@
 #include "reference/raytrace.hpp"
 #include "scene/scene_load.hpp"
 #include "scene/tie_rule.hpp"
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 
 // Scene builders for hand-made test scenes, independent of the scene loader. External
 // linkage: test_pov.cpp declares and uses them too.

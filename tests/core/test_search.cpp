@@ -19,7 +19,7 @@
 #include "reference/raytrace.hpp"
 #include "scene/scene_load.hpp"
 #include "search/search.hpp"
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 
 namespace abcube {
 namespace {

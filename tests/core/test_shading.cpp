@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 
 namespace abcube {
 namespace {

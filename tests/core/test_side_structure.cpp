@@ -9,7 +9,7 @@
 #include "abuffer_testkit.hpp"
 #include "raster/abuffer.hpp"
 #include "search/search.hpp"
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 
 namespace abcube {
 namespace {

@@ -7,7 +7,7 @@
 #include "raster/cube_map.hpp"
 #include "gl/gl_passes.hpp"
 #include "gl_test_support.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 
 namespace abcube {
 namespace {

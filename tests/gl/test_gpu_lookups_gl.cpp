@@ -8,9 +8,9 @@
 #include "scene/camera.hpp"
 #include "gl/gl_passes.hpp"
 #include "gl_test_support.hpp"
-#include "raster/samples.hpp"
+#include "base/samples.hpp"
 #include "reference/raytrace.hpp"
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 
 namespace abcube {
 namespace {

@@ -1,5 +1,5 @@
 // The GL passes against known answers: prepass distances inside a box, a Z-buffer image
-// of a quad, and the GLSL Phong mirror against cpu_core/shading/shading.hpp.
+// of a quad, and the GLSL Phong mirror against cpu_core/material/shading.hpp.
 #include <cmath>
 
 #include <glad/gl.h>
@@ -10,7 +10,7 @@
 #include "raster/cube_map.hpp"
 #include "gl/gl_passes.hpp"
 #include "gl_test_support.hpp"
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 
 namespace abcube {
 namespace {

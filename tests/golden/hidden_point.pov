@@ -1,5 +1,5 @@
 // Exported by abcube from hidden_point.json
-// z is mirrored: POV-Ray is left-handed (cpu_core/io/pov_export.hpp).
+// z is mirrored: POV-Ray is left-handed (abcube docs/design/pov-export.md).
 #version 3.7;
 global_settings {
   assumed_gamma 1.0

@@ -1,11 +1,11 @@
-#include "scene/shadow_volume.hpp"
+#include "gpu_geometry/shadow_volume.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
 
-#include "shading/shading.hpp"
+#include "material/shading.hpp"
 
 namespace abcube {
 
@@ -252,15 +252,15 @@ size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& so
     const glm::dvec4 planes[6] = {t * glm::dvec4(-1, 0, 0, 1),     t * glm::dvec4(1, 0, 0, 1),
                                   t * glm::dvec4(0, -1, 0, 1),     t * glm::dvec4(0, 1, 0, 1),
                                   t * glm::dvec4(0, 0, -scale, 1), plane ? *plane : glm::dvec4(0, 0, 0, 1)};
-    const int count = plane ? 6 : 5;
+    const int plane_count = plane ? 6 : 5;
     a.clear();
     for (const glm::vec4& p : corners) {
       a.push_back(p.w == 0.f ? Corner(glm::dvec3(p), 0.0) : Corner(glm::dvec3(p) - eye, 1.0));
     }
-    for (int q = 0; q < count; ++q) {  // every corner beyond one plane: nothing of it is seen
+    for (int q = 0; q < plane_count; ++q) {  // every corner beyond one plane: nothing of it is seen
       if (glm::dot(planes[q], a[0]) < 0.0 && glm::dot(planes[q], a[1]) < 0.0 && glm::dot(planes[q], a[2]) < 0.0) return;
     }
-    for (int q = 0; q < count && a.size() >= 3; ++q) {
+    for (int q = 0; q < plane_count && a.size() >= 3; ++q) {
       clip_polygon(a, planes[q], &b);
       a.swap(b);
     }
@@ -281,8 +281,8 @@ size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& so
   const size_t triangles = volume.caps.size();
   const size_t end = first + std::min(count, faces_at_infinity(volume) - std::min(first, faces_at_infinity(volume)));
   for (size_t f = first; f < std::min(end, triangles); ++f) {
-    const uint32_t t = static_cast<uint32_t>(f);
-    if (volume.caps[t] != NO_CAP) clip_face(far_cap(soup, t, volume.caps[t], volume.light), soup.object_id[t], 0u);
+    const uint32_t tri = static_cast<uint32_t>(f);
+    if (volume.caps[tri] != NO_CAP) clip_face(far_cap(soup, tri, volume.caps[tri], volume.light), soup.object_id[tri], 0u);
   }
   const std::vector<ShadowVolumeVertex>& sides = volume.side_vertices;
   for (size_t f = std::max(first, triangles); f < end; ++f) {

@@ -1,4 +1,4 @@
-#include "io/pov_export.hpp"
+#include "scene/pov_export.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -40,7 +40,7 @@ std::string comment_safe(const std::string& s) {
 
 void write_header(std::ostringstream& os, const SceneData& scene) {
   os << "// Exported by abcube from " << comment_safe(scene.file.empty() ? "(memory)" : scene.file) << "\n"
-     << "// z is mirrored: POV-Ray is left-handed (cpu_core/io/pov_export.hpp).\n"
+     << "// z is mirrored: POV-Ray is left-handed (abcube docs/design/pov-export.md).\n"
      << "#version 3.7;\n"
      << "global_settings {\n"
      << "  assumed_gamma 1.0\n"

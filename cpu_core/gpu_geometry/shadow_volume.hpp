@@ -14,6 +14,7 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/gpu_limits.hpp"
 #include "scene/scene_data.hpp"
 
 namespace abcube {
@@ -61,16 +62,6 @@ std::vector<uint8_t> lights_outside_closed(const SceneData& scene, const glm::dv
 // shadow), or the translucent ones (neither 0 nor 1: glass, veils; where their count is 0
 // no light is dimmed by them, elsewhere the product of their transmittances is needed).
 enum class Blockers { opaque, translucent };
-
-// Volumes a render counts at most (opaque, and translucent where any, per light): a layer
-// each of an R32F array (gl_shadow_volumes.cpp); lights past them keep their cube shadow
-// maps. The memory estimate (scene_size.cpp) counts no more.
-constexpr int MAX_VOLUME_LIGHTS = 128;
-
-// The side pairing of build_shadow_volume sorts the caps' edges (PAIRING_EDGE_BYTES each) in
-// buckets by a hash, about PAIRING_BUCKET_EDGES at once, with a bucket's byte per edge.
-constexpr uint64_t PAIRING_BUCKET_EDGES = uint64_t{1} << 20;
-constexpr uint64_t PAIRING_EDGE_BYTES = 32;
 
 // The volume of the light at `light` over the scene's blockers of that kind.
 ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light, Blockers kind = Blockers::opaque);

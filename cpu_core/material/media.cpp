@@ -1,5 +1,5 @@
 // NESTED DIELECTRICS (media.hpp): the stack, the priority and the crossing sets.
-#include "shading/media.hpp"
+#include "material/media.hpp"
 #include "scene/tie_rule.hpp"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-#include "scene/planar_reflectors.hpp"
+#include "gpu_geometry/planar_reflectors.hpp"
 
 #include <algorithm>
 #include <cmath>
