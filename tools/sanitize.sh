@@ -2,7 +2,7 @@
 # The checked builds of docs/robustness.md, each in its own build folder with gcc:
 #   tools/sanitize.sh asan   AddressSanitizer + UndefinedBehaviorSanitizer (build-asan): every
 #                            target but the benchmarks and the Python module, the ctest suite
-#                            but two long repetitive tests (below)
+#                            but the tests that repeat covered paths over many scenes (below)
 #   tools/sanitize.sh tsan   ThreadSanitizer (build-tsan): test_core, its multi-threaded tests
 # Any report fails the run (exit 1): undefined behaviour stops the program, and the
 # suppressions in tools/sanitizers/ each say why they are there.
@@ -75,10 +75,16 @@ case $kind in
     export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1:new_delete_type_mismatch=0
     export LSAN_OPTIONS=suppressions=$supp/lsan.supp:print_suppressions=0
     export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:suppressions=$supp/ubsan.supp
-    # Left out, to keep CI inside its time (the ordinary build runs them): the two tests
-    # that repeat one path many times, 100 EGL Renderers opened and closed (151 s under
-    # ASan; every GL test opens one) and the 22 generated hard scenes (160 s; their code is
-    # the renders of cli.golden_cli and the core tests).
+    # The sanitizers check code, not scenes: left out are the tests that run paths other
+    # tests already run, over many scenes or many times (the ordinary build runs them all):
+    # 100 EGL Renderers opened and closed (every GL test opens one), the 22 generated hard
+    # scenes, and the accuracy sweeps over generated scenes, cli.flat_mirrors (gpu and
+    # hybrid against the tracer), cli.gpu_shading (two gpu shadings) and cli.determinism
+    # (every method at three thread counts): their passes are those of cli.golden_cli, the
+    # osmesa.* GL tests and the core tests. The third-party corpus renders small
+    # (ABCUBE_CORPUS_ARGS): each file is still loaded whole.
+    export ABCUBE_CORPUS_ARGS="--size 96x72"
+    repeats='RendererApi\.HundredEglRenderersInARow|hard\.generated|cli\.flat_mirrors|cli\.gpu_shading|cli\.determinism'
     # The tests that decode broken images run apart, with whole stacks for LeakSanitizer
     # (fast_unwind_on_malloc=0, slower): OpenImageIO's PNG reader leaks a string when libpng
     # longjmps out of a corrupt image, and libstdc++'s missing frame pointers cut the stack
@@ -97,7 +103,7 @@ case $kind in
     # retrying is no answer.
     # Their host code is the osmesa.* twins' (the context aside), which keep leak checking.
     no_leaks='^cli\.crosscheck_cli$|^egl\.'
-    asan_ctest -E "^(RendererApi\.HundredEglRenderersInARow|hard\.generated|bundle\.clean)$|$decodes|$no_leaks" "$@" || exit 1
+    asan_ctest -E "^($repeats|bundle\.clean)$|$decodes|$no_leaks" "$@" || exit 1
     ASAN_OPTIONS=$ASAN_OPTIONS:detect_leaks=0 asan_ctest -R "$no_leaks" "$@" || exit 1
     ASAN_OPTIONS=$ASAN_OPTIONS:fast_unwind_on_malloc=0 asan_ctest -R "$decodes" "$@"
     ;;

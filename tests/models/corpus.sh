@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The third-party corpus (issue 15 part 5): every OBJ, glTF and GLB file of Debian's
+# The third-party corpus: every OBJ, glTF and GLB file of Debian's
 # assimp-testmodels (installed by tools/setup.sh) given to `abcube render` as the scene,
 # as a new user would. The expected outcome of each file is data: corpus.tsv beside this
 # script (path under the corpus, exit status, what the image must show, a fragment of
@@ -15,6 +15,9 @@
 # adds or drops fails the test, so none is skipped silently.
 #
 # Usage (ctest runs it so): bash corpus.sh /path/to/abcube /path/to/repo [CORPUS_DIR]
+# ABCUBE_CORPUS_ARGS, when set, is added to every render's arguments: the ASan stage of
+# tools/sanitize.sh renders at --size 96x72, since what it checks is the loading of each
+# file, not the tracer's millions of rays.
 set -u
 
 if [ $# -lt 2 ]; then
@@ -49,7 +52,8 @@ check_one() {
   local name out status problems=()
   name=$(echo "$path" | tr '/' '_')
   out="$WORK/$name.exr"
-  timeout 300 "$ABCUBE" render "$CORPUS/$path" -o "$out" --method raytrace --gl none --threads 1 \
+  # shellcheck disable=SC2086 # ABCUBE_CORPUS_ARGS is a list of words
+  timeout 300 "$ABCUBE" render "$CORPUS/$path" -o "$out" --method raytrace --gl none --threads 1 ${ABCUBE_CORPUS_ARGS:-} \
     > "$WORK/$name.stdout" 2> "$WORK/$name.stderr"
   status=$?
   [ "$status" -eq 124 ] && problems+=("still running after 300 s")
