@@ -2,6 +2,7 @@
 #include "shading/scene_cache.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <utility>
@@ -42,6 +43,10 @@ void MapShadingStats::merge(const MapShadingStats& o) {
   lens_transfers += o.lens_transfers;
   lens_fallbacks += o.lens_fallbacks;
   envmap_lookups += o.envmap_lookups;
+  multi_point_fragments += o.multi_point_fragments;
+  shadow_edge_fragments += o.shadow_edge_fragments;
+  shadow_edge_samples += o.shadow_edge_samples;
+  shadow_edge_pixels += o.shadow_edge_pixels;
   errors.merge(o.errors);
 }
 
@@ -89,13 +94,13 @@ MapShader::MapShader(const SceneData& scene, const CubeABuffer& cube, const MapS
 MapShader::~MapShader() = default;
 
 glm::dvec3 MapShader::shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
-                            MapShadingStats* stats) const {
+                            MapShadingStats* stats, PrimaryLights* direct) const {
   const MediumCrossing c{sp.triangle, !(glm::dot(sp.geometric_normal, dir) < 0.0), 0.0};
-  return shade(Crossed{sp, sp.point, ctx_->media().resolve(MediumStack{}, &c, 1)}, dir, depth, primary, stats);
+  return shade(Crossed{sp, sp.point, ctx_->media().resolve(MediumStack{}, &c, 1)}, dir, depth, primary, stats, direct);
 }
 
-glm::dvec3 MapShader::shade(const Crossed& cr, const glm::dvec3& dir, int depth, bool primary,
-                            MapShadingStats* stats) const {
+glm::dvec3 MapShader::shade(const Crossed& cr, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats,
+                            PrimaryLights* direct) const {
   const SurfacePoint& sp = cr.sp;
   const Material& m = scene_.materials[sp.material];
   // Coverage transparency of a found surface: the ray goes on behind it, same depth.
@@ -108,7 +113,7 @@ glm::dvec3 MapShader::shade(const Crossed& cr, const glm::dvec3& dir, int depth,
   const glm::dvec3 v = -dir;
   const glm::dvec3 n = face_forward(sp.shading_normal, v);
   const glm::dvec3 od = diffuse_color_at(scene_, sp.triangle, sp.point);
-  glm::dvec3 c = phong_ambient(m, scene_.ambient, od) + lights(sp, v, n, od, stats);
+  glm::dvec3 c = phong_ambient(m, scene_.ambient, od) + lights(sp, v, n, od, stats, depth == 0 ? direct : nullptr);
   const SecondaryWeights w =
       secondary_weights(m, scene_.render.fresnel, dir,
                         transmission_between(dir, sp.geometric_normal, sp.shading_normal, cr.itf.n_from, cr.itf.n_to),
@@ -128,14 +133,20 @@ glm::dvec3 MapShader::visibility(const glm::dvec3& p, const PointLight& light, M
 }
 
 glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n, const glm::dvec3& od,
-                             MapShadingStats* stats) const {
+                             MapShadingStats* stats, PrimaryLights* direct) const {
   const Material& m = scene_.materials[sp.material];
+  if (direct) {
+    direct->lit.assign(scene_.lights.size(), glm::dvec3(0.0));
+    direct->shadow.assign(scene_.lights.size(), glm::dvec3(1.0));
+  }
   glm::dvec3 c(0.0);
-  for (const PointLight& light : scene_.lights) {
+  for (size_t l = 0; l < scene_.lights.size(); ++l) {
+    const PointLight& light = scene_.lights[l];
     const glm::dvec3 to_light = light.position - sp.point;
     if (to_light == glm::dvec3(0.0)) continue;
     const glm::dvec3 lit = phong_light(m, n, v, glm::normalize(to_light), light.color, od);
     if (lit == glm::dvec3(0.0)) continue;
+    if (direct) direct->lit[l] = lit;
     if (!light.cast_shadows) {
       if (options_.walk_all_shadows) {
         const ShadowResult unused = shadow_search(*ctx_, sp.point, light.position, options_.search);
@@ -144,7 +155,9 @@ glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const 
       c += lit;
       continue;
     }
-    c += lit * visibility(sp.point, light, stats);
+    const glm::dvec3 shadow = visibility(sp.point, light, stats);
+    if (direct) direct->shadow[l] = shadow;
+    c += lit * shadow;
   }
   return c;
 }
@@ -312,7 +325,7 @@ glm::dvec3 MapShader::envmap_texel(int face, int i, int j) const {
     const glm::dvec3 v = glm::normalize(cube_.centre - p);
     const glm::dvec3 nn = face_forward(sp.shading_normal, v);
     const glm::dvec3 od = diffuse_color_at(scene_, sp.triangle, p);
-    return ShadedFragment{phong_ambient(m, scene_.ambient, od) + lights(sp, v, nn, od, nullptr), m.opacity};
+    return ShadedFragment{phong_ambient(m, scene_.ambient, od) + lights(sp, v, nn, od, nullptr, nullptr), m.opacity};
   };
   const SampleDepth depth{&buffer.view, &*scene_.triangles, i, j};
   return pack_under_mask(buffer.list(i, j), FULL_MASK, shade_fragment, *scene_.triangles, scene_.background, nullptr,
@@ -377,6 +390,78 @@ static bool differ(const glm::dvec3& a, const glm::dvec3& b) {
   return false;
 }
 
+// SHADOW EDGES (header): for each light whose visibility differs among the `count` shaded
+// points of fragment `f` at pixel (x, y), or that `forced` names (bit l: light l, the first
+// 64), the mean visibility of each quarter's covered samples replaces its point's, in the
+// quarter's colour.
+template <typename SurfaceAt>
+static void shadow_edges(const SceneData& scene, const ABuffer& camera, const Fragment& f, int x, int y,
+                         const CoverageMask* quarter, int count, const PrimaryLights* direct, uint64_t forced,
+                         glm::dvec3* colour, const SurfaceAt& surface_at, const MapShader& shader,
+                         MapShadingStats* stats) {
+  bool any = false;
+  for (size_t l = 0; l < scene.lights.size(); ++l) {
+    bool refine = l < 64 && ((forced >> l) & 1u) != 0;
+    for (int k = 1; k < count && !refine; ++k) refine = direct[k].shadow[l] != direct[0].shadow[l];
+    if (!refine) continue;
+    any = true;
+    for (int k = 0; k < count; ++k) {
+      if (direct[k].lit[l] == glm::dvec3(0.0)) continue;
+      glm::dvec3 sum(0.0);
+      for (CoverageMask m = quarter[k]; m; m &= m - 1) {
+        const int b = __builtin_ctz(m);
+        const glm::dvec3 p =
+            point_on_triangle_plane(camera.view, *scene.triangles, f.triangle(), x + sample_dx(b), y + sample_dy(b));
+        sum += shader.visibility(surface_at(p).point, scene.lights[l], stats);
+        ++stats->shadow_edge_samples;
+      }
+      colour[k] += direct[k].lit[l] * (sum / double(mask_count(quarter[k])) - direct[k].shadow[l]);
+    }
+  }
+  if (any) ++stats->shadow_edge_fragments;
+}
+
+// SHADOW EDGES between pixels (header): per pixel, the lights (the first 64) that its shaded
+// points saw wholly lit, and those they saw shadowed.
+struct PixelShadows {
+  std::vector<uint64_t> lit, dark;
+  // `all`: every one of the `count` points was shaded, else only the first and the last.
+  void note(size_t at, const SceneData& scene, const PrimaryLights* direct, int count, bool all) {
+    for (int k = 0; k < count; ++k) {
+      if (!all && k != 0 && k != count - 1) continue;  // given the mean of two, not shaded
+      for (size_t l = 0; l < std::min<size_t>(64, scene.lights.size()); ++l) {
+        if (!scene.lights[l].cast_shadows || direct[k].lit[l] == glm::dvec3(0.0)) continue;
+        (direct[k].shadow[l] == glm::dvec3(1.0) ? lit : dark)[at] |= uint64_t{1} << l;
+      }
+    }
+  }
+  // Per pixel, the lights it saw only lit where a 4-neighbour saw them only shadowed, or the
+  // reverse: an edge between their shading points. Pixels outside `only` (when given) get 0.
+  std::vector<uint64_t> across(int width, int height, const std::vector<uint8_t>* only) const {
+    std::vector<uint64_t> out(lit.size(), 0);
+    const auto at = [width](int x, int y) {
+      return static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
+    };
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const size_t p = at(x, y);
+        if (only && !(*only)[p]) continue;
+        const uint64_t pure_lit = lit[p] & ~dark[p], pure_dark = dark[p] & ~lit[p];
+        uint64_t edge = 0;
+        const auto against = [&](size_t q) {
+          edge |= (pure_lit & dark[q] & ~lit[q]) | (pure_dark & lit[q] & ~dark[q]);
+        };
+        if (x > 0) against(at(x - 1, y));
+        if (x + 1 < width) against(at(x + 1, y));
+        if (y > 0) against(at(x, y - 1));
+        if (y + 1 < height) against(at(x, y + 1));
+        out[p] = edge;
+      }
+    }
+    return out;
+  }
+};
+
 // Secondary searches and those of them that found nothing (the "fallback" AOV, header).
 static std::pair<uint64_t, uint64_t> searches_and_failures(const MapShadingStats& s) {
   const SearchStats& q = s.searches;
@@ -387,28 +472,68 @@ static std::pair<uint64_t, uint64_t> searches_and_failures(const MapShadingStats
   return {rays, failed};
 }
 
+// `only` and its 4-neighbours.
+static std::vector<uint8_t> with_neighbours(const std::vector<uint8_t>& only, int width, int height) {
+  std::vector<uint8_t> out(only);
+  const auto at = [width](int x, int y) {
+    return static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
+  };
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      if (!only[at(x, y)]) continue;
+      if (x > 0) out[at(x - 1, y)] = 1;
+      if (x + 1 < width) out[at(x + 1, y)] = 1;
+      if (y > 0) out[at(x, y - 1)] = 1;
+      if (y + 1 < height) out[at(x, y + 1)] = 1;
+    }
+  }
+  return out;
+}
+
 Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
-                      MapShadingStats* stats, Image* fallback, const std::vector<uint8_t>* only) {
+                      MapShadingStats* stats, Image* fallback, const std::vector<uint8_t>* only, bool neighbours) {
+  const size_t pixels = static_cast<size_t>(camera.width()) * static_cast<size_t>(camera.height());
   // Per pixel: secondary searches and failures (one resolve worker owns a row at a time).
   std::vector<std::pair<uint64_t, uint64_t>> pixel_searches;
-  if (fallback)
-    pixel_searches.assign(static_cast<size_t>(camera.width()) * static_cast<size_t>(camera.height()), {0, 0});
+  if (fallback) pixel_searches.assign(pixels, {0, 0});
   ResolveOptions ro;
   ro.threads = threads;
   ro.exact_priority = shader.exact_priority();
   ro.only = only;
-  // Statistics per resolve worker, merged at the end: no lock while shading.
-  std::vector<MapShadingStats> per_worker(static_cast<size_t>(resolve_workers(camera, ro)));
+  // SHADOW EDGES (header): what each pixel's points saw, and in the second pass the lights
+  // whose edge runs between a pixel's points and its neighbour's.
+  const bool edges =
+      shader.shadow_edges() && !shader.one_point() &&
+      std::any_of(scene.lights.begin(), scene.lights.end(), [](const PointLight& l) { return l.cast_shadows; });
+  PixelShadows seen;
+  std::vector<uint8_t> widened;
+  if (edges) {
+    seen.lit.assign(pixels, 0);
+    seen.dark.assign(pixels, 0);
+    if (only && neighbours) {
+      widened = with_neighbours(*only, camera.width(), camera.height());
+      ro.only = &widened;
+    }
+  }
+  std::vector<uint64_t> forced;
+  // Statistics per resolve worker, merged at the end: no lock while shading. The records of
+  // the points' lights too, reused fragment after fragment (their vectors keep their room).
+  const size_t workers = static_cast<size_t>(resolve_workers(camera, ro));
+  std::vector<MapShadingStats> per_worker(workers);
+  std::vector<std::array<PrimaryLights, 4>> worker_direct(workers);
   // The fragment shaded at its covered quarters, adaptively (header, QUARTER_SPLIT_SRGB).
   const WorkerPixelShader shade = [&](const Fragment& f, int x, int y, int worker) {
     MapShadingStats* s = &per_worker[static_cast<size_t>(worker)];
+    const size_t at = static_cast<size_t>(y) * static_cast<size_t>(camera.width()) + static_cast<size_t>(x);
+    const uint64_t force = forced.empty() ? 0 : forced[at];
     const glm::dvec3 eye = scene.camera.position;
     // One pixel's width seen from the eye, in radians (the mesh refinement's radius).
     const double pixel = glm::length(glm::normalize(camera.view.direction(x + 1.5, y + 0.5)) -
                                      glm::normalize(camera.view.direction(x + 0.5, y + 0.5)));
-    // A point of the fragment's plane, moved onto the surface the eye ray through it really
-    // crosses (a merged fragment keeps one triangle of several: abuffer.hpp MERGE).
-    const auto shade_at = [&](const glm::dvec3& p) {
+    // The surface the eye ray through a point of the fragment's plane really crosses: the
+    // point moved onto the mesh (a merged fragment keeps one triangle of several: abuffer.hpp
+    // MERGE).
+    const auto surface_at = [&](const glm::dvec3& p) {
       const glm::dvec3 dir = glm::normalize(p - eye);
       uint32_t tri = f.triangle();
       glm::dvec3 on = p;
@@ -418,10 +543,14 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
           mesh_crossing(shader.context(), eye, dir, f.triangle(), dist, dist * pixel, &tri, &l)) {
         on = eye + l * dir;
       }
-      return shader.shade(surface_point(scene, tri, on), dir, 0, true, s);
+      return surface_point(scene, tri, on);
+    };
+    const auto shade_at = [&](const glm::dvec3& p, PrimaryLights* direct) {
+      return shader.shade(surface_at(p), glm::normalize(p - eye), 0, true, s, direct);
     };
     glm::dvec3 point[4];
     double weight[4];
+    CoverageMask quarter[4];
     int count = 0;
     const double total = mask_count(f.mask);
     for (CoverageMask q : QUARTERS) {
@@ -430,27 +559,80 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
       const glm::dvec2 c = mask_centroid(m);
       point[count] = point_on_triangle_plane(camera.view, *scene.triangles, f.triangle(), x + c.x, y + c.y);
       weight[count] = mask_count(m) / total;
+      quarter[count] = m;
       ++count;
     }
     glm::dvec3 c(0.0);
     const std::pair<uint64_t, uint64_t> before = fallback ? searches_and_failures(*s) : std::pair<uint64_t, uint64_t>{};
-    if (count <= 1 || shader.one_point()) {
-      c = shade_at(fragment_point(camera, *scene.triangles, f, x, y));
+    PrimaryLights* const direct = worker_direct[static_cast<size_t>(worker)].data();
+    PrimaryLights* const record = edges ? direct : nullptr;
+    if (shader.one_point()) {
+      c = shade_at(fragment_point(camera, *scene.triangles, f, x, y), nullptr);
+    } else if (count <= 1) {
+      c = shade_at(fragment_point(camera, *scene.triangles, f, x, y), record);
+      if (record && force) shadow_edges(scene, camera, f, x, y, quarter, 1, direct, force, &c, surface_at, shader, s);
+      if (record) seen.note(at, scene, direct, 1, true);
     } else {
-      const glm::dvec3 first = shade_at(point[0]), last = shade_at(point[count - 1]);
-      c = weight[0] * first + weight[count - 1] * last;
-      const bool split = differ(first, last);
-      for (int k = 1; k + 1 < count; ++k) c += weight[k] * (split ? shade_at(point[k]) : 0.5 * (first + last));
+      ++s->multi_point_fragments;
+      const int last = count - 1;
+      glm::dvec3 colour[4];
+      colour[0] = shade_at(point[0], record ? &direct[0] : nullptr);
+      colour[last] = shade_at(point[last], record ? &direct[last] : nullptr);
+      const bool ends_differ = record && direct[0].shadow != direct[last].shadow;
+      const bool split = force != 0 || ends_differ || differ(colour[0], colour[last]);
+      for (int k = 1; k < last; ++k) {
+        colour[k] = split ? shade_at(point[k], record ? &direct[k] : nullptr) : 0.5 * (colour[0] + colour[last]);
+      }
+      if (record && split) {
+        shadow_edges(scene, camera, f, x, y, quarter, count, direct, force, colour, surface_at, shader, s);
+      }
+      if (record) seen.note(at, scene, direct, count, split);
+      c = weight[0] * colour[0] + weight[last] * colour[last];
+      for (int k = 1; k < last; ++k) c += weight[k] * colour[k];
     }
     if (fallback) {
       const std::pair<uint64_t, uint64_t> after = searches_and_failures(*s);
-      auto& p = pixel_searches[static_cast<size_t>(y) * static_cast<size_t>(camera.width()) + static_cast<size_t>(x)];
+      auto& p = pixel_searches[at];
       p.first += after.first - before.first;
       p.second += after.second - before.second;
     }
     return ShadedFragment{c, scene.materials[scene.triangles->material_id[f.triangle()]].opacity};
   };
   Image image = resolve_image_per_worker(camera, *scene.triangles, shade, scene.background, ro);
+  if (edges) {
+    // The second pass: the pixels an edge runs beside, shaded again with those lights'
+    // samples searched; their searches are counted once more, as they were made.
+    forced = seen.across(camera.width(), camera.height(), only);
+    std::vector<uint8_t> again(pixels, 0);
+    uint64_t flagged = 0;
+    for (size_t p = 0; p < pixels; ++p) {
+      if (!forced[p]) continue;
+      again[p] = 1;
+      ++flagged;
+      if (fallback) pixel_searches[p] = {0, 0};
+    }
+    if (!widened.empty()) {  // the neighbours shaded for their points: black again, as `only` says
+      for (size_t p = 0; p < pixels; ++p) {
+        if ((*only)[p]) continue;
+        std::fill_n(image.data.begin() + static_cast<std::ptrdiff_t>(p * static_cast<size_t>(image.channels)),
+                    image.channels, 0.f);
+        if (fallback) pixel_searches[p] = {0, 0};
+      }
+    }
+    if (flagged > 0) {
+      ResolveOptions second = ro;
+      second.only = &again;
+      const Image redone = resolve_image_per_worker(camera, *scene.triangles, shade, scene.background, second);
+      for (size_t p = 0; p < pixels; ++p) {
+        if (!again[p]) continue;
+        for (int ch = 0; ch < image.channels; ++ch) {
+          image.data[p * static_cast<size_t>(image.channels) + static_cast<size_t>(ch)] =
+              redone.data[p * static_cast<size_t>(image.channels) + static_cast<size_t>(ch)];
+        }
+      }
+    }
+    per_worker[0].shadow_edge_pixels += flagged;
+  }
   if (stats) {
     for (const MapShadingStats& s : per_worker) stats->merge(s);
   }

@@ -50,6 +50,9 @@ struct MapShadingOptions {
   // covered pixel; an edge of a shadow or a reflection inside the pixel is then all or
   // nothing).
   bool one_point = false;
+  // SHADOW EDGES (below): where a camera fragment's shading points disagree about a light,
+  // each covered sample gets its own shadow answer. Off: the points' answers stand.
+  bool shadow_edges = true;
 };
 
 // Ray-level error against the exact tracer (thesis ch. 9), for the reflection rays of
@@ -65,6 +68,10 @@ struct MapShadingStats {
   SearchStats searches;
   uint64_t lens_transfers = 0, lens_fallbacks = 0;  // fallbacks: transfer refused, searched
   uint64_t envmap_lookups = 0;
+  // Camera fragments shaded at more than one point; those refined at a shadow edge (SHADOW
+  // EDGES), the sample shadow searches they made, and the pixels shaded a second time for
+  // an edge beside them.
+  uint64_t multi_point_fragments = 0, shadow_edge_fragments = 0, shadow_edge_samples = 0, shadow_edge_pixels = 0;
   RayErrors errors;  // filled only when a reference tracer is given
   void merge(const MapShadingStats& o);
 };
@@ -80,6 +87,29 @@ struct MapShadingStats {
 // channel) are the others shaded too, else they take the mean of the two.
 // docs/design/map-shading.md says where this matters.
 constexpr double QUARTER_SPLIT_SRGB = 1.0 / 255.0;
+//
+// SHADOW EDGES. A shadow's edge through a fragment would still be decided at those points:
+// a step a pixel where the tracer's 32 samples make a ramp. The colour of a primary point is
+// linear in each light's visibility S_l (shading.hpp: the local term is
+// sum_l S_l * phong_light_l), so where the shaded points' S_l differ for some light, that
+// light's shadow is searched again from every covered sample (its point of the triangle's
+// plane, moved onto the mesh as the shading points are), and each quarter's colour takes
+// the mean S_l of its samples in place of its point's: c_q += phong_light_l(q) * (mean - S_l(q)).
+// Every quarter is then shaded, so that each has its own phong_light_l.
+// An edge can also pass between the points, meeting none of them: then the pixel's points
+// all see one answer and a neighbour's points the other. A second pass shades again the
+// pixels whose points saw a light (of the first 64) only lit where a 4-neighbour's saw it
+// only shadowed, or the reverse, refining that light in all their fragments. Where all
+// agree nothing changes and nothing more is searched: the cost falls where edges are (the
+// stats' "shadow_edges"). A shadow thinner than the points' spacing, seen by no point of
+// any pixel, is not seen.
+
+// The direct light one primary point received, light by light (scene.lights' order):
+// `lit` the unshadowed term (phong_light; 0 where the light is behind the surface), `shadow`
+// the visibility its shadow search gave (1 for a light that casts no shadow).
+struct PrimaryLights {
+  std::vector<glm::dvec3> lit, shadow;
+};
 
 struct SurfacePoint {
   glm::dvec3 point{0.0};
@@ -102,8 +132,11 @@ class MapShader {
   // The colour of surface point `sp` seen along unit `dir` at bounce `depth`. `primary`
   // marks a camera fragment: its coverage transparency is the resolve's business, and
   // its reflection rays are the ones measured against the reference.
-  glm::dvec3 shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
-                   MapShadingStats* stats) const;
+  // `direct` (optional) receives what the point's own lights gave it (depth 0 only).
+  glm::dvec3 shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats,
+                   PrimaryLights* direct = nullptr) const;
+  // S_l of `light` at `p`: the shadow search's transmittance (thesis 8.3).
+  glm::dvec3 visibility(const glm::dvec3& p, const PointLight& light, MapShadingStats* stats) const;
 
   // The path of the transmitted weight alone from `origin` (in air, not a surface) along
   // `dir`, answered by the searches: the ray after each interface, as
@@ -118,6 +151,7 @@ class MapShader {
   bool refines_on_mesh() const { return options_.search.refine == SearchRefine::mesh; }
   bool exact_priority() const { return options_.exact_priority; }
   bool one_point() const { return options_.one_point; }
+  bool shadow_edges() const { return options_.shadow_edges; }
 
  private:
   // A crossing set (media.hpp): the surface point shaded, the furthest crossing, the interface.
@@ -130,13 +164,13 @@ class MapShader {
                       MapShadingStats* stats) const;
   Crossed crossing_set(const glm::dvec3& w, const glm::dvec3& dir, const SearchResult& r,
                        const MediumStack& stack) const;
-  glm::dvec3 shade(const Crossed& c, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats) const;
+  glm::dvec3 shade(const Crossed& c, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats,
+                   PrimaryLights* direct = nullptr) const;
   Ray transmitted_ray(const Crossed& c, const Transmission& tr, MediumStack* stack) const;
   glm::dvec3 trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, const MediumStack& stack,
                    MapShadingStats* stats, SearchResult* found) const;
   glm::dvec3 lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n, const glm::dvec3& od,
-                    MapShadingStats* stats) const;
-  glm::dvec3 visibility(const glm::dvec3& p, const PointLight& light, MapShadingStats* stats) const;
+                    MapShadingStats* stats, PrimaryLights* direct) const;
   glm::dvec3 reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary, const MediumStack& stack,
                        MapShadingStats* stats) const;
   glm::dvec3 transmitted(const Crossed& c, const glm::dvec3& dir, int depth, MapShadingStats* stats) const;
@@ -164,7 +198,12 @@ class MapShader {
 // (a reflection or refraction-exit miss, a shadow walk on a zero-area surface or
 // aborted, a lens transfer refused), 0 where none was made.
 // `only` (optional): the pixels to render (ResolveOptions::only); the others stay black.
+// With `only`, SHADOW EDGES between pixels need the neighbours' points too: `neighbours`
+// shades the 4-neighbours of `only`'s pixels as well (their colours are dropped); without
+// it an edge between an `only` pixel and one outside is left to the points (the pilots of
+// --target-db, single pixels apart, would pay five pixels for one).
 Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
-                      MapShadingStats* stats, Image* fallback = nullptr, const std::vector<uint8_t>* only = nullptr);
+                      MapShadingStats* stats, Image* fallback = nullptr, const std::vector<uint8_t>* only = nullptr,
+                      bool neighbours = true);
 
 }  // namespace abcube

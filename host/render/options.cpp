@@ -270,6 +270,13 @@ std::vector<Entry> make_table() {
        "shading points per camera fragment: quarters (2 to 4, more where they differ) | one (its centroid)", {}},
       [](RenderSetup& s, const json& v) { s.render.shading_points = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.shading_points, d.shading_points); });
+  add({"shadow_edges", "--shadow-edges", OptionKind::choice, OptionScope::job, {"samples", "points"}, 0, 0,
+       d.shadow_edges, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
+       "a shadow's edge inside a camera fragment: samples (searched again from each covered sample where the "
+       "shading points disagree) | points (the shading points' answers)",
+       {}},
+      [](RenderSetup& s, const json& v) { s.render.shadow_edges = v.get<std::string>(); },
+      [d](const RenderSetup& s) { return unless(s.render.shadow_edges, d.shadow_edges); });
   add({"resolve", "--resolve", OptionKind::choice, OptionScope::job, {"exact", "thesis"}, 0, 0, d.resolve, "", MAP_METHODS,
        "the CPU A-buffer's resolve: abuffer, zbuffer, envmap, hybrid",
        "intersecting fragments: exact (per-sample priority masks) | thesis (the Vis_front estimate)", {}},
@@ -502,6 +509,7 @@ RenderOptions without_unused_options(const RenderOptions& options, const std::st
       {"envmap_lookup", [](RenderOptions& o, const RenderOptions& x) { o.envmap_lookup = x.envmap_lookup; }},
       {"resolve", [](RenderOptions& o, const RenderOptions& x) { o.resolve = x.resolve; }},
       {"shading_points", [](RenderOptions& o, const RenderOptions& x) { o.shading_points = x.shading_points; }},
+      {"shadow_edges", [](RenderOptions& o, const RenderOptions& x) { o.shadow_edges = x.shadow_edges; }},
       {"max_layers", [](RenderOptions& o, const RenderOptions& x) { o.max_layers = x.max_layers; }},
       {"gpu_mirrors", [](RenderOptions& o, const RenderOptions& x) { o.gpu_mirrors = x.gpu_mirrors; }},
       {"gpu_shadows", [](RenderOptions& o, const RenderOptions& x) { o.gpu_shadows = x.gpu_shadows; }},

@@ -122,6 +122,7 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   r.map.lookup = parse_checked(o.envmap_lookup, parse_envmap_lookup);
   r.map.exact_priority = o.resolve == "exact";
   r.map.one_point = o.shading_points == "one";
+  r.map.shadow_edges = o.shadow_edges == "samples";
   r.map.search.side_structure = o.side_structure;
   r.gpu.planar_mirrors = o.gpu_mirrors == "stencil";
   r.gpu.shadow_volumes = o.gpu_shadows == "volumes";
@@ -170,6 +171,7 @@ json request_stats(const SceneData& view, const RenderRequest& request) {
                              {"envmap_lookup", envmap_lookup_name(request.map.lookup)},
                              {"resolve", request.map.exact_priority ? "exact" : "thesis"},
                              {"shading_points", request.map.one_point ? "one" : "quarters"},
+                             {"shadow_edges", request.map.shadow_edges ? "samples" : "points"},
                              {"side_structure", request.map.search.side_structure},
                              {"fresnel", view.render.fresnel}};
   return stats;

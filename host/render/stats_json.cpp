@@ -22,12 +22,19 @@ json search_kind_json(const SearchKindStats& s) {
 }
 
 json map_shading_json(const MapShadingStats& ms) {
-  return {{"reflection", search_kind_json(ms.searches.reflection)},
-          {"refraction_exit", search_kind_json(ms.searches.refraction_exit)},
-          {"shadow", search_kind_json(ms.searches.shadow)},
-          {"lens_transfers", ms.lens_transfers},
-          {"lens_fallbacks", ms.lens_fallbacks},
-          {"envmap_lookups", ms.envmap_lookups}};
+  return {
+      {"reflection", search_kind_json(ms.searches.reflection)},
+      {"refraction_exit", search_kind_json(ms.searches.refraction_exit)},
+      {"shadow", search_kind_json(ms.searches.shadow)},
+      {"lens_transfers", ms.lens_transfers},
+      {"lens_fallbacks", ms.lens_fallbacks},
+      {"envmap_lookups", ms.envmap_lookups},
+      {"shadow_edges",
+       {{"multi_point_fragments", ms.multi_point_fragments},
+        {"fragments", ms.shadow_edge_fragments},
+        {"share", ms.multi_point_fragments ? double(ms.shadow_edge_fragments) / double(ms.multi_point_fragments) : 0.0},
+        {"sample_searches", ms.shadow_edge_samples},
+        {"pixels_shaded_again", ms.shadow_edge_pixels}}}};
 }
 
 json error_stats_json(const ErrorStats& e) {

@@ -88,7 +88,7 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
     t0 = Clock::now();
     CubeMap m = build_cube_map(mc, n, cube_options, nullptr);
     MapShadingStats ms;
-    const Image pilot = render_with_map(scene, camera, *m.shader, mc.request.threads, &ms, nullptr, &sample);
+    const Image pilot = render_with_map(scene, camera, *m.shader, mc.request.threads, &ms, nullptr, &sample, false);
     const SampledError e = sampled_error(pilot, exact, sample);
     pilots.push_back({{"cube_resolution", n},
                       {"shading_points", m.shader->one_point() ? "one" : "quarters"},
@@ -121,7 +121,7 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
     one.one_point = true;
     auto shader = std::make_unique<MapShader>(scene, *best.cube, one, nullptr, &mc.cache);
     MapShadingStats ms;
-    const Image pilot = render_with_map(scene, camera, *shader, mc.request.threads, &ms, nullptr, &sample);
+    const Image pilot = render_with_map(scene, camera, *shader, mc.request.threads, &ms, nullptr, &sample, false);
     const SampledError e = sampled_error(pilot, exact, sample);
     pilots.push_back({{"cube_resolution", best.n},
                       {"shading_points", "one"},
