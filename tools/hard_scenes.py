@@ -444,6 +444,121 @@ def t_seams(rng, ctx):
     return scene(rng, camera_looking(eye, view, rng.uniform(60, 90)), lights, mats, objs)
 
 
+# --- third-party models ---------------------------------------------------------------
+#
+# The models_in_rooms template places files of Debian's assimp-testmodels (installed by
+# `tools/setup.sh --test`): textured glTF (as .gltf and as .glb) and OBJ (one with an MTL
+# and a JPEG texture, one without). Their bounds are read from the files themselves.
+MODEL_CORPUS = "/usr/share/assimp/models"
+MODELS = (
+    "glTF2/BoxTextured-glTF/BoxTextured.gltf",
+    "glTF2/BoxTextured-glTF-Binary/BoxTextured.glb",
+    "OBJ/WusonOBJ.obj",
+    "OBJ/spider.obj",
+)
+
+
+def mat4_mul(a, b):
+    return [[sum(a[i][k] * b[k][j] for k in range(4)) for j in range(4)] for i in range(4)]
+
+
+def node_matrix(node):
+    """A glTF node's local matrix (its `matrix`, column-major, or T * R * S)."""
+    if "matrix" in node:
+        m = node["matrix"]
+        return [[m[c * 4 + r] for c in range(4)] for r in range(4)]
+    tx, ty, tz = node.get("translation", [0, 0, 0])
+    qx, qy, qz, qw = node.get("rotation", [0, 0, 0, 1])
+    sx, sy, sz = node.get("scale", [1, 1, 1])
+    rot = [[1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
+           [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)],
+           [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)]]
+    scale = (sx, sy, sz)
+    out = [[rot[r][c] * scale[c] for c in range(3)] + [(tx, ty, tz)[r]] for r in range(3)]
+    return out + [[0, 0, 0, 1]]
+
+
+def model_bounds(path):
+    """The axis-aligned bounds [lo, hi] of a model file's points: an OBJ's `v` lines, or a
+    glTF's POSITION accessors' min and max through its scene's node matrices."""
+    lo, hi = [math.inf] * 3, [-math.inf] * 3
+
+    def grow(p):
+        for i in range(3):
+            lo[i], hi[i] = min(lo[i], p[i]), max(hi[i], p[i])
+
+    if path.endswith(".obj"):
+        with open(path, errors="replace") as f:
+            for line in f:
+                if line.startswith("v "):
+                    grow([float(x) for x in line.split()[1:4]])
+        return lo, hi
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:4] == b"glTF":   # the JSON chunk of a .glb
+        length = int.from_bytes(data[12:16], "little")
+        data = data[20:20 + length]
+    doc = json.loads(data)
+    identity = [[float(r == c) for c in range(4)] for r in range(4)]
+
+    def visit(index, parent):
+        node = doc["nodes"][index]
+        world = mat4_mul(parent, node_matrix(node))
+        if "mesh" in node:
+            for prim in doc["meshes"][node["mesh"]]["primitives"]:
+                acc = doc["accessors"][prim["attributes"]["POSITION"]]
+                a, b = acc["min"], acc["max"]
+                for corner in ([x, y, z] for x in (a[0], b[0]) for y in (a[1], b[1]) for z in (a[2], b[2])):
+                    grow([sum(world[r][c] * corner[c] for c in range(3)) + world[r][3] for r in range(3)])
+        for child in node.get("children", []):
+            visit(child, world)
+
+    for root in doc["scenes"][doc.get("scene", 0)]["nodes"]:
+        visit(root, identity)
+    return lo, hi
+
+
+def t_models_in_rooms(rng, ctx):
+    """One or two third-party models (MODELS), each scaled to 0.5..1.3 m and standing on the
+    floor of a room (floor, back and side walls) beside boxes, spheres, a chrome sphere and a
+    glass one, under two shadow-casting lights: the models' edges, thin parts and textures,
+    directly, in the chrome and through the glass."""
+    mats = {"floor": diffuse(rng), "wall": diffuse(rng), "chrome": mirror_material(rng),
+            "glass": glass_material()}
+    objs = [floor(8, "floor"),
+            quad([0, 2.0, -4.0], [4.0, 0, 0], [0, 2.0, 0], "wall"),
+            quad([-4.0, 2.0, 0], [0, 0, -4.0], [0, 2.0, 0], "wall")]
+    count = rng.randint(1, 2)
+    for i, name in enumerate(rng.sample(MODELS, count)):
+        path = os.path.join(MODEL_CORPUS, name)
+        if not os.path.exists(path):
+            raise SystemExit("hard_scenes.py: models_in_rooms needs %s: install assimp-testmodels "
+                             "(bash tools/setup.sh --test) or leave the template out (--templates)" % path)
+        lo, hi = model_bounds(path)
+        size = max(hi[i2] - lo[i2] for i2 in range(3))
+        s = rng.uniform(0.5, 1.3) / size
+        centre = [(lo[0] + hi[0]) / 2, lo[1], (lo[2] + hi[2]) / 2]   # the base's middle
+        x = -0.7 + 1.4 * i + rng.uniform(-0.3, 0.3)
+        z = rng.uniform(-1.2, 0.2)
+        kind = "gltf" if name.endswith((".gltf", ".glb")) else "mesh"
+        objs.append({"type": kind, "file": path,
+                     "transform": {"scale": round(s, 9), "translate": r6([x - s * centre[0], -s * centre[1],
+                                                                         z - s * centre[2]])}})
+        if kind == "mesh" and name.endswith("WusonOBJ.obj"):
+            mats["wuson"] = diffuse(rng, lo=0.4, specular=0.3)
+            objs[-1]["material"] = "wuson"
+    objs += scatter_props(rng, mats, rng.randint(1, 3), 0.12, 0.3, ring=(1.6, 3.0))
+    r = rng.uniform(0.25, 0.4)
+    objs.append(sphere([rng.uniform(1.2, 2.0), r, rng.uniform(-2.0, -0.5)], r, "chrome", 32))
+    r = rng.uniform(0.2, 0.35)
+    objs.append(sphere([rng.uniform(-1.6, -0.8), r, rng.uniform(0.6, 1.4)], r, "glass", 32))
+    lights = [point_light([rng.uniform(-2, 2), rng.uniform(3, 4), rng.uniform(0, 2.5)], 0.8),
+              point_light([rng.uniform(-3, 3), rng.uniform(2, 3), rng.uniform(1, 3)], 0.4)]
+    eye = [rng.uniform(-1.5, 1.5), rng.uniform(1.0, 2.2), rng.uniform(2.8, 4.2)]
+    ctx["min_depth"] = 2
+    return scene(rng, camera_looking(eye, [0, 0.5, -0.6], rng.uniform(45, 60)), lights, mats, objs)
+
+
 TEMPLATES = {
     "decal": t_decal,
     "coplanar": t_coplanar,
@@ -456,6 +571,7 @@ TEMPLATES = {
     "light_on_surface": t_light_on_surface,
     "km_scale": t_km_scale,
     "seams": t_seams,
+    "models_in_rooms": t_models_in_rooms,
 }
 
 
