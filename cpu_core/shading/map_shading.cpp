@@ -1,10 +1,12 @@
 #include "shading/map_shading.hpp"
 #include "shading/scene_cache.hpp"
+#include "shading/shadow_edges.hpp"
 
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <functional>
 #include <utility>
 
 #include "scene/camera.hpp"
@@ -390,78 +392,6 @@ static bool differ(const glm::dvec3& a, const glm::dvec3& b) {
   return false;
 }
 
-// SHADOW EDGES (header): for each light whose visibility differs among the `count` shaded
-// points of fragment `f` at pixel (x, y), or that `forced` names (bit l: light l, the first
-// 64), the mean visibility of each quarter's covered samples replaces its point's, in the
-// quarter's colour.
-template <typename SurfaceAt>
-static void shadow_edges(const SceneData& scene, const ABuffer& camera, const Fragment& f, int x, int y,
-                         const CoverageMask* quarter, int count, const PrimaryLights* direct, uint64_t forced,
-                         glm::dvec3* colour, const SurfaceAt& surface_at, const MapShader& shader,
-                         MapShadingStats* stats) {
-  bool any = false;
-  for (size_t l = 0; l < scene.lights.size(); ++l) {
-    bool refine = l < 64 && ((forced >> l) & 1u) != 0;
-    for (int k = 1; k < count && !refine; ++k) refine = direct[k].shadow[l] != direct[0].shadow[l];
-    if (!refine) continue;
-    any = true;
-    for (int k = 0; k < count; ++k) {
-      if (direct[k].lit[l] == glm::dvec3(0.0)) continue;
-      glm::dvec3 sum(0.0);
-      for (CoverageMask m = quarter[k]; m; m &= m - 1) {
-        const int b = __builtin_ctz(m);
-        const glm::dvec3 p =
-            point_on_triangle_plane(camera.view, *scene.triangles, f.triangle(), x + sample_dx(b), y + sample_dy(b));
-        sum += shader.visibility(surface_at(p).point, scene.lights[l], stats);
-        ++stats->shadow_edge_samples;
-      }
-      colour[k] += direct[k].lit[l] * (sum / double(mask_count(quarter[k])) - direct[k].shadow[l]);
-    }
-  }
-  if (any) ++stats->shadow_edge_fragments;
-}
-
-// SHADOW EDGES between pixels (header): per pixel, the lights (the first 64) that its shaded
-// points saw wholly lit, and those they saw shadowed.
-struct PixelShadows {
-  std::vector<uint64_t> lit, dark;
-  // `all`: every one of the `count` points was shaded, else only the first and the last.
-  void note(size_t at, const SceneData& scene, const PrimaryLights* direct, int count, bool all) {
-    for (int k = 0; k < count; ++k) {
-      if (!all && k != 0 && k != count - 1) continue;  // given the mean of two, not shaded
-      for (size_t l = 0; l < std::min<size_t>(64, scene.lights.size()); ++l) {
-        if (!scene.lights[l].cast_shadows || direct[k].lit[l] == glm::dvec3(0.0)) continue;
-        (direct[k].shadow[l] == glm::dvec3(1.0) ? lit : dark)[at] |= uint64_t{1} << l;
-      }
-    }
-  }
-  // Per pixel, the lights it saw only lit where a 4-neighbour saw them only shadowed, or the
-  // reverse: an edge between their shading points. Pixels outside `only` (when given) get 0.
-  std::vector<uint64_t> across(int width, int height, const std::vector<uint8_t>* only) const {
-    std::vector<uint64_t> out(lit.size(), 0);
-    const auto at = [width](int x, int y) {
-      return static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
-    };
-    for (int y = 0; y < height; ++y) {
-      for (int x = 0; x < width; ++x) {
-        const size_t p = at(x, y);
-        if (only && !(*only)[p]) continue;
-        const uint64_t pure_lit = lit[p] & ~dark[p], pure_dark = dark[p] & ~lit[p];
-        uint64_t edge = 0;
-        const auto against = [&](size_t q) {
-          edge |= (pure_lit & dark[q] & ~lit[q]) | (pure_dark & lit[q] & ~dark[q]);
-        };
-        if (x > 0) against(at(x - 1, y));
-        if (x + 1 < width) against(at(x + 1, y));
-        if (y > 0) against(at(x, y - 1));
-        if (y + 1 < height) against(at(x, y + 1));
-        out[p] = edge;
-      }
-    }
-    return out;
-  }
-};
-
 // Secondary searches and those of them that found nothing (the "fallback" AOV, header).
 static std::pair<uint64_t, uint64_t> searches_and_failures(const MapShadingStats& s) {
   const SearchStats& q = s.searches;
@@ -470,24 +400,6 @@ static std::pair<uint64_t, uint64_t> searches_and_failures(const MapShadingStats
   const uint64_t failed =
       q.reflection.misses + q.refraction_exit.misses + q.shadow.zero_area + q.shadow.aborted + s.lens_fallbacks;
   return {rays, failed};
-}
-
-// `only` and its 4-neighbours.
-static std::vector<uint8_t> with_neighbours(const std::vector<uint8_t>& only, int width, int height) {
-  std::vector<uint8_t> out(only);
-  const auto at = [width](int x, int y) {
-    return static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
-  };
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      if (!only[at(x, y)]) continue;
-      if (x > 0) out[at(x - 1, y)] = 1;
-      if (x + 1 < width) out[at(x + 1, y)] = 1;
-      if (y > 0) out[at(x, y - 1)] = 1;
-      if (y + 1 < height) out[at(x, y + 1)] = 1;
-    }
-  }
-  return out;
 }
 
 Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
@@ -545,6 +457,9 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
       }
       return surface_point(scene, tri, on);
     };
+    const std::function<glm::dvec3(const glm::dvec3&)> on_surface = [&](const glm::dvec3& p) {
+      return surface_at(p).point;
+    };
     const auto shade_at = [&](const glm::dvec3& p, PrimaryLights* direct) {
       return shader.shade(surface_at(p), glm::normalize(p - eye), 0, true, s, direct);
     };
@@ -570,7 +485,9 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
       c = shade_at(fragment_point(camera, *scene.triangles, f, x, y), nullptr);
     } else if (count <= 1) {
       c = shade_at(fragment_point(camera, *scene.triangles, f, x, y), record);
-      if (record && force) shadow_edges(scene, camera, f, x, y, quarter, 1, direct, force, &c, surface_at, shader, s);
+      if (record && force) {
+        refine_shadow_edges(scene, camera, f, x, y, quarter, 1, direct, force, &c, on_surface, shader, s);
+      }
       if (record) seen.note(at, scene, direct, 1, true);
     } else {
       ++s->multi_point_fragments;
@@ -584,7 +501,7 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
         colour[k] = split ? shade_at(point[k], record ? &direct[k] : nullptr) : 0.5 * (colour[0] + colour[last]);
       }
       if (record && split) {
-        shadow_edges(scene, camera, f, x, y, quarter, count, direct, force, colour, surface_at, shader, s);
+        refine_shadow_edges(scene, camera, f, x, y, quarter, count, direct, force, colour, on_surface, shader, s);
       }
       if (record) seen.note(at, scene, direct, count, split);
       c = weight[0] * colour[0] + weight[last] * colour[last];

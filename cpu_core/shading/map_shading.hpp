@@ -88,14 +88,15 @@ struct MapShadingStats {
 // docs/design/map-shading.md says where this matters.
 constexpr double QUARTER_SPLIT_SRGB = 1.0 / 255.0;
 //
-// SHADOW EDGES. A shadow's edge through a fragment would still be decided at those points:
-// a step a pixel where the tracer's 32 samples make a ramp. The colour of a primary point is
-// linear in each light's visibility S_l (shading.hpp: the local term is
-// sum_l S_l * phong_light_l), so where the shaded points' S_l differ for some light, that
-// light's shadow is searched again from every covered sample (its point of the triangle's
-// plane, moved onto the mesh as the shading points are), and each quarter's colour takes
-// the mean S_l of its samples in place of its point's: c_q += phong_light_l(q) * (mean - S_l(q)).
-// Every quarter is then shaded, so that each has its own phong_light_l.
+// SHADOW EDGES (shadow_edges.hpp). A shadow's edge through a fragment would still be
+// decided at those points: a step a pixel where the tracer's 32 samples make a ramp. The
+// colour of a primary point is linear in each light's visibility S_l (shading.hpp: the
+// local term is sum_l S_l * phong_light_l), so where the shaded points' S_l differ for some
+// light, that light's shadow is searched again from every covered sample (its point of the
+// triangle's plane, moved onto the mesh as the shading points are), and each quarter's
+// colour takes the mean S_l of its samples in place of its point's:
+// c_q += phong_light_l(q) * (mean - S_l(q)). Every quarter is then shaded, so that each has
+// its own phong_light_l.
 // An edge can also pass between the points, meeting none of them: then the pixel's points
 // all see one answer and a neighbour's points the other. A second pass shades again the
 // pixels whose points saw a light (of the first 64) only lit where a 4-neighbour's saw it

@@ -1,0 +1,88 @@
+#include "shading/shadow_edges.hpp"
+
+#include <algorithm>
+
+#include "raster/raster.hpp"
+
+namespace abcube {
+
+namespace {
+
+size_t pixel_index(int width, int x, int y) {
+  return static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
+}
+
+}  // namespace
+
+void refine_shadow_edges(const SceneData& scene, const ABuffer& camera, const Fragment& f, int x, int y,
+                         const CoverageMask* quarter, int count, const PrimaryLights* direct, uint64_t forced,
+                         glm::dvec3* colour, const std::function<glm::dvec3(const glm::dvec3&)>& on_surface,
+                         const MapShader& shader, MapShadingStats* stats) {
+  bool any = false;
+  for (size_t l = 0; l < scene.lights.size(); ++l) {
+    bool refine = l < 64 && ((forced >> l) & 1u) != 0;
+    for (int k = 1; k < count && !refine; ++k) refine = direct[k].shadow[l] != direct[0].shadow[l];
+    if (!refine) continue;
+    any = true;
+    for (int k = 0; k < count; ++k) {
+      if (direct[k].lit[l] == glm::dvec3(0.0)) continue;
+      glm::dvec3 sum(0.0);
+      for (CoverageMask m = quarter[k]; m; m &= m - 1) {
+        const int b = __builtin_ctz(m);
+        const glm::dvec3 p =
+            point_on_triangle_plane(camera.view, *scene.triangles, f.triangle(), x + sample_dx(b), y + sample_dy(b));
+        sum += shader.visibility(on_surface(p), scene.lights[l], stats);
+        ++stats->shadow_edge_samples;
+      }
+      colour[k] += direct[k].lit[l] * (sum / double(mask_count(quarter[k])) - direct[k].shadow[l]);
+    }
+  }
+  if (any) ++stats->shadow_edge_fragments;
+}
+
+void PixelShadows::note(size_t at, const SceneData& scene, const PrimaryLights* direct, int count, bool all) {
+  for (int k = 0; k < count; ++k) {
+    if (!all && k != 0 && k != count - 1) continue;  // given the mean of two, not shaded
+    for (size_t l = 0; l < std::min<size_t>(64, scene.lights.size()); ++l) {
+      if (!scene.lights[l].cast_shadows || direct[k].lit[l] == glm::dvec3(0.0)) continue;
+      (direct[k].shadow[l] == glm::dvec3(1.0) ? lit : dark)[at] |= uint64_t{1} << l;
+    }
+  }
+}
+
+std::vector<uint64_t> PixelShadows::across(int width, int height, const std::vector<uint8_t>* only) const {
+  std::vector<uint64_t> out(lit.size(), 0);
+  const auto at = [width](int x, int y) { return pixel_index(width, x, y); };
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const size_t p = at(x, y);
+      if (only && !(*only)[p]) continue;
+      const uint64_t pure_lit = lit[p] & ~dark[p], pure_dark = dark[p] & ~lit[p];
+      uint64_t edge = 0;
+      const auto against = [&](size_t q) { edge |= (pure_lit & dark[q] & ~lit[q]) | (pure_dark & lit[q] & ~dark[q]); };
+      if (x > 0) against(at(x - 1, y));
+      if (x + 1 < width) against(at(x + 1, y));
+      if (y > 0) against(at(x, y - 1));
+      if (y + 1 < height) against(at(x, y + 1));
+      out[p] = edge;
+    }
+  }
+  return out;
+}
+
+std::vector<uint8_t> with_neighbours(const std::vector<uint8_t>& only, int width, int height) {
+  std::vector<uint8_t> out(only);
+  const auto at = [width](int x, int y) { return pixel_index(width, x, y); };
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      if (!only[at(x, y)]) continue;
+      if (x > 0) out[at(x - 1, y)] = 1;
+      if (x + 1 < width) out[at(x + 1, y)] = 1;
+      if (y > 0) out[at(x, y - 1)] = 1;
+      if (y + 1 < height) out[at(x, y + 1)] = 1;
+    }
+  }
+  return out;
+}
+
+}  // namespace abcube
