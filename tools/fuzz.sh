@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs the libFuzzer harnesses of tests/fuzz (docs/robustness.md) for SECONDS each
 # (default 60), one after the other, each on one core.
-#   tools/fuzz.sh [SECONDS] [HARNESS...]     HARNESS: scene_json obj gltf batch_jobs (default all)
+#   tools/fuzz.sh [SECONDS] [HARNESS[:SECONDS]...]   HARNESS: scene_json obj gltf batch_jobs (default
+#                                                    all), each for its own SECONDS where given
 # Builds build-fuzz with clang-14 (address and undefined-behaviour checks, ABCUBE_FUZZ=ON),
 # seeds each harness with its committed seeds (tests/fuzz/corpus), the inputs that once
 # crashed (tests/fuzz/regressions), the repository's scenes and meshes and, when installed,
@@ -23,7 +24,8 @@ if [[ ! -f $BUILD/build.ninja ]]; then
   CC=clang-14 CXX=clang++-14 cmake -S . -B "$BUILD" -G Ninja -DABCUBE_FUZZ=ON -DABCUBE_BUILD_TESTS=OFF \
     -DABCUBE_BUILD_BENCH=OFF > "$BUILD.configure.log" 2>&1 || { cat "$BUILD.configure.log"; exit 1; }
 fi
-cmake --build "$BUILD" --target "${HARNESSES[@]/#/fuzz_}"
+NAMES=("${HARNESSES[@]%%:*}")
+cmake --build "$BUILD" --target "${NAMES[@]/#/fuzz_}"
 
 # One OBJ as the obj harness's input: the file, and after a line "#MTL" the MTL file its
 # first mtllib names (renamed in.mtl, the name the harness writes it under).
@@ -87,7 +89,10 @@ export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/tools/sanitizers/lsan.supp
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 status=0
 summary=()
-for name in "${HARNESSES[@]}"; do
+for harness in "${HARNESSES[@]}"; do
+  name=${harness%%:*}
+  seconds=$SECONDS_EACH
+  [[ $harness == *:* ]] && seconds=${harness#*:}
   corpus=$BUILD/corpus/$name
   artifacts=$BUILD/artifacts/$name
   mkdir -p "$corpus" "$artifacts"
@@ -95,14 +100,14 @@ for name in "${HARNESSES[@]}"; do
   inputs=("$corpus" tests/fuzz/corpus/$name "$BUILD/seeds/$name")
   [[ -d tests/fuzz/regressions/$name ]] && inputs+=(tests/fuzz/regressions/$name)
   log=$BUILD/fuzz_$name.log
-  echo "fuzz: $name for ${SECONDS_EACH} s (log $log)"
+  echo "fuzz: $name for ${seconds} s (log $log)"
   rc=0
   # gltf decodes images through OpenImageIO: whole stacks for LeakSanitizer
   # (fast_unwind_on_malloc=0, 6x slower), which libstdc++ (no frame pointers) otherwise cuts
   # at two frames, too few for the PNG reader's entry in tools/sanitizers/lsan.supp to match.
   unwind=""
   [[ $name == gltf ]] && unwind=":fast_unwind_on_malloc=0"
-  ASAN_OPTIONS="$ASAN_OPTIONS$unwind" "$BUILD/tests/fuzz/fuzz_$name" -max_total_time="$SECONDS_EACH" -rss_limit_mb=2048 -timeout=10 -max_len=65536 \
+  ASAN_OPTIONS="$ASAN_OPTIONS$unwind" "$BUILD/tests/fuzz/fuzz_$name" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 -max_len=65536 \
     -print_final_stats=1 -artifact_prefix="$artifacts/" "${inputs[@]}" > "$log" 2>&1 || rc=$?
   runs=$(sed -n 's/^stat::number_of_executed_units:[[:space:]]*//p' "$log" | tail -1)
   corpus_size=$(find "$corpus" -type f | wc -l)
@@ -115,7 +120,7 @@ for name in "${HARNESSES[@]}"; do
     echo "fuzz: $name FAILED (exit $rc); input: $(ls -t "$artifacts" | head -1 | sed "s|^|$artifacts/|")"
     summary+=("$name: FAILED after ${runs:-?} inputs")
   else
-    summary+=("$name: ${runs:-?} inputs in ${SECONDS_EACH} s, no failure; corpus $corpus_size files")
+    summary+=("$name: ${runs:-?} inputs in ${seconds} s, no failure; corpus $corpus_size files")
   fi
 done
 printf 'fuzz: %s\n' "${summary[@]}"
