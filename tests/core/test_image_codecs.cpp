@@ -37,6 +37,16 @@ class ImageCodecs : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  // Writes `img` as `file` in `codec`, then decodes it from the file and from its bytes in
+  // memory (whose codec the magic must name).
+  void round_trip(Codec codec, const std::string& file, const Image& img, DecodedImage* from_file,
+                  DecodedImage* from_memory) {
+    ASSERT_EQ(encode_image(codec, file, img), "");
+    ASSERT_EQ(decode_image(codec, file, nullptr, 0, 0, from_file), "");
+    const std::vector<unsigned char> bytes = file_bytes(file);
+    EXPECT_EQ(codec_of_bytes(bytes.data(), bytes.size()), codec);
+    ASSERT_EQ(decode_image(codec, file, bytes.data(), bytes.size(), 0, from_memory), "");
+  }
   fs::path dir_;
 };
 
@@ -44,12 +54,8 @@ TEST_F(ImageCodecs, PngRoundTripsEveryChannelCountFromFileAndMemory) {
   for (int c = 1; c <= 4; ++c) {
     const Image img = ramp(7, 5, c);
     const std::string file = path("c" + std::to_string(c) + ".png");
-    ASSERT_EQ(encode_image(Codec::png, file, img), "");
     DecodedImage from_file, from_memory;
-    ASSERT_EQ(decode_image(Codec::png, file, nullptr, 0, 0, &from_file), "");
-    const std::vector<unsigned char> bytes = file_bytes(file);
-    EXPECT_EQ(codec_of_bytes(bytes.data(), bytes.size()), Codec::png);
-    ASSERT_EQ(decode_image(Codec::png, file, bytes.data(), bytes.size(), 0, &from_memory), "");
+    ASSERT_NO_FATAL_FAILURE(round_trip(Codec::png, file, img, &from_file, &from_memory));
     EXPECT_TRUE(from_file.encoded);
     ASSERT_EQ(from_file.image.channels, c);
     ASSERT_EQ(from_file.image.width, 7);
@@ -67,12 +73,8 @@ TEST_F(ImageCodecs, ExrRoundTripsFloatsExactly) {
     img.data[0] = 7.25f;  // HDR values stay
     img.data[1] = -0.5f;
     const std::string file = path("c" + std::to_string(c) + ".exr");
-    ASSERT_EQ(encode_image(Codec::exr, file, img), "");
     DecodedImage from_file, from_memory;
-    ASSERT_EQ(decode_image(Codec::exr, file, nullptr, 0, 0, &from_file), "");
-    const std::vector<unsigned char> bytes = file_bytes(file);
-    EXPECT_EQ(codec_of_bytes(bytes.data(), bytes.size()), Codec::exr);
-    ASSERT_EQ(decode_image(Codec::exr, file, bytes.data(), bytes.size(), 0, &from_memory), "");
+    ASSERT_NO_FATAL_FAILURE(round_trip(Codec::exr, file, img, &from_file, &from_memory));
     EXPECT_FALSE(from_file.encoded);
     ASSERT_EQ(from_file.image.channels, c);
     EXPECT_EQ(from_file.image.data, img.data);
