@@ -16,7 +16,7 @@ layout(rgba32f, binding = 0) uniform image2D u_target;
 uniform bool u_pixels;  // the camera's own view: uniform pixels go to the two images below
 layout(rgba32f, binding = 1) uniform writeonly image2D u_pixel_color;
 layout(rgba32f, binding = 2) uniform writeonly image2D u_pixel_weight;
-// The scene's arrays (gl_passes.cpp): positions and normals as the soup holds them, 3 floats
+// The scene's arrays (gl_scene_buffers.cpp): positions and normals as the soup holds them, 3 floats
 // a vertex; each triangle's material.
 layout(std430, binding = 3) readonly buffer Positions { float positions[]; };
 layout(std430, binding = 4) readonly buffer Uvs { vec2 uvs[]; };

@@ -1,5 +1,5 @@
 // Scene data shared by the GL passes: materials and point lights in SSBOs, indexed by the
-// per-vertex material id. Layout mirrors host/gl/gl_passes.cpp (std430).
+// per-vertex material id. Layout mirrors host/gl/gl_scene_buffers.cpp (std430).
 struct MaterialGpu {
   vec4 color_ambient;  // rgb = Od, a = ka
   vec4 coefficients;   // x = kd, y = ks, z = shininess n, w = kr (reflect)
@@ -40,7 +40,7 @@ uniform samplerCube u_environment_map;
 
 // Base-colour textures (cpu_core/scene/texture.hpp THE RULE): Od =
 // colour * texture(uv), linear RGB, repeat, trilinear over GL's mipmaps. The images are
-// grouped by size into up to MAX_TEXTURE_ARRAYS 2D arrays (gl_passes.cpp); a material's
+// grouped by size into up to MAX_TEXTURE_ARRAYS 2D arrays (gl_scene_buffers.cpp); a material's
 // transmission.w = array + MAX_TEXTURE_ARRAYS * layer. Each array is sampled in its own
 // branch with the derivatives taken outside it (uniform control flow), so the index need
 // not be uniform.

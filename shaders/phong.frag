@@ -1,6 +1,6 @@
 // Z-buffer colour pass: local Phong per point light, shadows from the cube shadow maps when
 // they are bound, and Blinn-Newell environment lookups when the environment map is bound.
-// The camera view of a scene with coverage transparency is peeled (gl_passes.cpp
+// The camera view of a scene with coverage transparency is peeled (gl_camera_pass.cpp
 // camera_color): pass u_peel = k >= 1 keeps only what lies behind layer k - 1 at this
 // sample, in the order (distance, triangle); alpha is the material's opacity.
 in vec3 v_relative;

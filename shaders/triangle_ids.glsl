@@ -1,6 +1,6 @@
 // Each triangle's object and material, read at the drawn vertex's triangle (gl_VertexID / 3:
 // the scene's vertex arrays hold 3 vertices a triangle, drawn as they are or by index) from
-// the soup's own per-triangle arrays (gl_passes.cpp), instead of 8 bytes of attributes a
+// the soup's own per-triangle arrays (gl_scene_buffers.cpp), instead of 8 bytes of attributes a
 // vertex. Prepended to scene.vert where the GL gives its vertex stage enough storage buffers
 // (gl_passes_internal.hpp OBJECT_IDS_BINDING, MATERIAL_IDS_BINDING); elsewhere each vertex
 // carries its ids as attributes 2 and 3.

@@ -1,5 +1,5 @@
 // The shadow volumes' near caps (cpu_core/gpu_geometry/shadow_volume.hpp, gl_shadow_volumes.cpp
-// count_volumes): the volume program draws the scene's own vertex buffer, so that each cap
+// GlShadowVolumes::count): the volume program draws the scene's own vertex buffer, so that each cap
 // is its surface's triangle, the same vertices in the same order through the same transform
 // (the same depth at every sample), and reads each triangle's code here: 0 none (the
 // triangle casts nothing in this volume), 1 a cap as wound, 2 a cap oriented against its

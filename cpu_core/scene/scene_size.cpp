@@ -18,7 +18,7 @@ constexpr uint64_t MIB = uint64_t{1} << 20;
 // the A-buffer's per-pixel index and room for the AOVs and the reference image; a cube texel
 // its distance, the A-buffer's index and the searches' block bounds and pyramid (or the gpu
 // method's cube textures); a triangle SCENE_TRIANGLE_BYTES. The gpu method adds the GL's
-// arrays (gl_passes.cpp), counted at their largest, a copy with ids on every vertex, since
+// arrays (gl_scene_buffers.cpp), counted at their largest, a copy with ids on every vertex, since
 // the estimate is made before the GL is opened, plus an allowance for what a software GL
 // holds while it draws them; a shadow-casting light's cube map of N x N floats; and its
 // shadow volumes (gpu_geometry/shadow_volume.hpp: a code a triangle and the runs of casting triangles,

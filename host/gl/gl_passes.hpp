@@ -1,11 +1,9 @@
 // The GL passes over one uploaded scene (GlScene): the six cube faces around a centre
-// (distance prepass, Z-buffer colour, the environment map: gl_environment.cpp), the cube
-// shadow maps with their translucent peels (gl_shadow_maps.cpp), and the camera view: Z-buffer
-// Phong, or the exact camera pass (planar mirrors by the stencil, gl_camera_exact.cpp; shadow
-// volumes, gl_shadow_volumes.cpp; the colour shaded once a pixel and surface,
-// gl_shading_groups.cpp) with its per-pixel flags for the hybrid method; and crosscheck's
-// probes (camera objects; shadow probe, gl_shadow_volumes.cpp). The upload, the draw calls and
-// the other passes are gl_passes.cpp's. Results are read back into cpu_core image types.
+// (distance prepass, Z-buffer colour, the environment map), the cube shadow maps with their
+// translucent peels, and the camera view: Z-buffer Phong, or the exact camera pass (planar
+// mirrors by the stencil, shadow volumes, the colour shaded once a pixel and surface) with its
+// per-pixel flags for the hybrid method. Each technique is a unit of its own under host/gl/;
+// GlScene is their front. Results are read back into cpu_core image types.
 #pragma once
 #include <glad/gl.h>
 
@@ -16,7 +14,6 @@
 #include "io/image.hpp"
 #include "gpu_geometry/planar_reflectors.hpp"
 #include "scene/scene_data.hpp"
-#include "gpu_geometry/shadow_volume.hpp"
 #include "shading/map_shading.hpp"
 
 namespace abcube {
@@ -106,6 +103,9 @@ void check_gl_limits(const SceneData& scene);
 // That limit: shadow-casting lights the current GL context holds for the gpu method.
 int gl_shadow_light_limit();
 
+class GlExactCamera;
+struct GlSceneParts;
+
 // How GlScene gives the GL the soup (both off: as a GL without the features gets it).
 struct GlSceneOptions {
   // The buffers over the soup's own memory where the GL can (GL_AMD_pinned_memory); false
@@ -116,8 +116,9 @@ struct GlSceneOptions {
   bool triangle_ids = true;
 };
 
-// The scene uploaded to the current GL context. Needs a current GL 4.5 context for its
-// whole life (gl_context.hpp).
+// The scene uploaded to the current GL context, and the passes over it: a small front over
+// one unit per technique (gl_scene_parts.hpp lists them). Needs a current GL 4.5 context for
+// its whole life (gl_context.hpp).
 class GlScene {
  public:
   explicit GlScene(const SceneData& scene, const GlSceneOptions& options = {});
@@ -125,18 +126,20 @@ class GlScene {
   GlScene(const GlScene&) = delete;
   GlScene& operator=(const GlScene&) = delete;
 
-  // Distance prepass over the six faces around `center`: per texel the Euclidean distance
-  // to the nearest surface (NO_DISTANCE where none) and its object id (NO_OBJECT), faces
-  // as cube_map.hpp defines them. `ids` may be null. Faces of n_s x n_t texels; n_t = 0
-  // means square (a 8x, 4x supersampled face checks the 4x8 sample positions).
+  // Distance prepass over the six faces around `center` (gl_cube_passes.cpp): per texel the
+  // Euclidean distance to the nearest surface (NO_DISTANCE where none) and its object id
+  // (NO_OBJECT), faces as cube_map.hpp defines them. `ids` may be null. Faces of n_s x n_t
+  // texels; n_t = 0 means square (a 8x, 4x supersampled face checks the 4x8 sample positions).
   void cube_distance(const glm::dvec3& center, int n, CubeImage* distance, CubeIds* ids, int n_t = 0);
 
   // Z-buffer Phong colour of the six faces seen from `center` (no shadows).
   CubeImage cube_color(const glm::dvec3& center, int n);
 
-  // Z-buffer Phong image of the camera view, sampled at `samples`. Uses the shadow maps
-  // and the environment map when they have been built. mask_4x8 renders the view at 8x
-  // the columns and 4x the rows, in tiles, and averages each pixel's 32 samples.
+  // Z-buffer Phong image of the camera view, sampled at `samples` (gl_camera_pass.cpp). Uses
+  // the shadow maps and the environment map when they have been built. mask_4x8 renders the
+  // view at 8x the columns and 4x the rows, in tiles, and averages each pixel's 32 samples;
+  // it is the exact camera pass (gl_camera_exact.cpp) where set_exact_camera asks for it and
+  // it applies.
   Image camera_color(const Camera& camera, CameraSamples samples = CameraSamples::pixel_centre);
 
   // The object id the Z-buffer sees at each of the camera's 4x8 samples per pixel
@@ -144,172 +147,60 @@ class GlScene {
   // Pixel (x, y), sample k is at row 4 y + k / 8, column 8 x + k % 8.
   std::vector<uint32_t> camera_objects(const Camera& camera);
 
-  // One cube shadow map per light with cast_shadows, at n x n per face; later colour passes
-  // are shadowed by them (the CPU's rule "shadows", shading.hpp): the distance to the
-  // nearest opaque caster, and the translucent casters in front of it peeled into up to
-  // MAX_SHADOW_PEELS layers, whose transmittances multiply. Returns how many lights. Maps
-  // of the same size built before are kept (the lights do not change).
+  // One cube shadow map per light with cast_shadows, at n x n per face (gl_shadow_maps.hpp);
+  // later colour passes are shadowed by them. Returns how many lights. Maps of the same
+  // size built before are kept.
   int build_shadow_maps(int n);
   // Translucent layers the last build_shadow_maps peeled (0: no translucent caster), and
   // whether crossings were left beyond MAX_SHADOW_PEELS.
-  int shadow_peels() const { return static_cast<int>(shadow_peels_.size()); }
-  bool shadow_peels_capped() const { return shadow_peels_capped_; }
+  int shadow_peels() const;
+  bool shadow_peels_capped() const;
   // Layers the last camera_color drew (1 without coverage transparency), and whether
   // samples were left beyond MAX_CAMERA_LAYERS.
   int camera_layers() const { return camera_layers_; }
   bool camera_layers_capped() const { return camera_layers_capped_; }
 
   // The Z-buffer colour of the six faces around `center` (with shadows if built) kept on
-  // the GPU as a cube texture; later camera passes look it up for kr and kt (Blinn & Newell
-  // 1976, the `gpu` method's reflections).
+  // the GPU as a cube texture (gl_environment.hpp); later camera passes look it up for kr
+  // and kt.
   void build_environment(const glm::dvec3& center, int n);
   // Later camera passes look up no environment (max_depth 0, or nothing reflects).
   void drop_environment();
   // How later camera passes look the environment up: the envmap method's lookup direction
   // (R, bisector, position) and Schlick's weights for kr and kt (shading.hpp).
-  void set_environment_lookup(EnvmapLookup lookup, bool fresnel) {
-    lookup_ = lookup;
-    fresnel_ = fresnel;
-  }
-
-  // abcube crosscheck: at the visible surface of each camera sample (the 4x8 grid, row 0 at
-  // the top, as camera_objects), for the first 16 shadow-casting lights (`lights`, probe bit
-  // k = lights[k]): the lights blocked by an opaque blocker according to the shadow volumes,
-  // according to the cube shadow maps (build_shadow_maps first), and the lights the surface
-  // faces.
-  struct ShadowProbe {
-    std::vector<int> lights;
-    std::vector<uint16_t> volume, map, lit;
-  };
-  ShadowProbe camera_shadow_probe(const Camera& camera);
+  void set_environment_lookup(EnvmapLookup lookup, bool fresnel);
 
   // The exact camera pass (ExactCameraOptions): later camera_color calls use it where it
   // applies; exact_camera_stats() says what the last one did.
-  void set_exact_camera(const ExactCameraOptions& options) { exact_ = options; }
-  const ExactCameraStats& exact_camera_stats() const { return exact_stats_; }
+  void set_exact_camera(const ExactCameraOptions& options);
+  const ExactCameraStats& exact_camera_stats() const;
   // Whether the next mask_4x8 camera pass would be the exact one (the options set, the
   // scene, this GL); exact_camera_stats() then says why not.
-  bool exact_camera_possible() { return plan_exact_camera(); }
-  const PlanarReflectors& planar_reflectors() const { return reflectors_; }
-  const std::vector<uint8_t>& exact_pixels() const { return exact_pixels_; }
+  bool exact_camera_possible();
+  const PlanarReflectors& planar_reflectors() const;
+  const std::vector<uint8_t>& exact_pixels() const;
 
   // Textures sampled at level 0 with zero derivatives (bilinear), as the CPU's point
   // samples, instead of trilinear over the pass's footprint: `abcube crosscheck` compares
   // the lookups, not the two filters.
-  void set_texture_level0(bool on) { texture_level0_ = on; }
+  void set_texture_level0(bool on);
 
-  const GpuTimings& timings() const { return timings_; }
+  const GpuTimings& timings() const;
   // Whether the vertex buffers are the soup's own memory (GL_AMD_pinned_memory), not a copy.
-  bool soup_pinned() const { return pinned_; }
+  bool soup_pinned() const;
   // Whether the vertex stage reads each triangle's ids from the soup's arrays (triangle_ids.glsl).
-  bool triangle_ids() const { return triangle_ids_; }
-  double near_distance() const { return near_; }
-  int max_size() const { return max_size_; }
+  bool triangle_ids() const;
+  double near_distance() const;
+  int max_size() const;
+
+  // The techniques' shared parts, for the passes outside this class (gl_shadow_probe.hpp).
+  GlSceneParts& parts() { return *parts_; }
 
  private:
-  struct Target;
-  struct ExactBuffers;
-  struct MirrorView;
-  void draw(const GlProgram& program, const glm::mat4& clip, const glm::dvec3& center);
-  // The view's uniforms (clip, model, eye, clip plane, mirror left out) set on `program`.
-  void set_view(const GlProgram& program, const glm::mat4& clip, const MirrorView& view);
-  void draw_scene(const GlProgram& program, const glm::mat4& clip, const MirrorView& view);
-  void draw_reflector(const GlProgram& program, const glm::mat4& clip, const MirrorView& view, size_t r);
-  Image camera_color_exact(const Camera& camera);
-  bool plan_exact_camera();  // what the next camera pass can do exactly (exact_stats_)
-  void render_view(const glm::mat4& clip, const MirrorView& view, int* views_left);
-  void count_volumes(const glm::mat4& clip, const MirrorView& view);
-  void fill_region(int level, const glm::vec4& colour);
-  void build_volumes();
-  std::string exact_mirrors_why_not() const;
-  void make_exact_programs();
-  void bind_lookups(const GlProgram& program, bool with_environment);
-  void bind_lookup_target(int n);
-  void clear_lookup_target(int n, bool distance);
-  void upload_lights(const glm::dvec3& center);
-  Target& target(int width, int height, bool distance_pass);
-
-  const SceneData& scene_;
-  // The scene's arrays: positions, normals, texture coordinates, each triangle's object and
-  // material are the soup's (soup_buffer); vertex_ids_ each vertex's ids, where the vertex
-  // stage reads no storage buffer of triangle ids (triangle_ids_ false).
-  GLuint vao_ = 0, positions_ = 0, normals_ = 0, object_ids_ = 0, material_ids_ = 0, vertex_ids_ = 0;
-  GLuint uv_vbo_ = 0, materials_ = 0, lights_ = 0;
-  bool triangle_ids_ = false;
-  // scene.vert and what goes before it: `before`, then triangle_ids.glsl where it is used.
-  std::vector<const char*> scene_vertex_stage(const char* before = nullptr) const;
-  bool pin_soup_ = true;
-  bool pinned_ = false;  // every soup buffer is the soup's memory
-  // A GL buffer holding `bytes` at `data`: that memory itself when pin_soup_ and the GL
-  // can (the soup must then outlive the buffer), else a copy.
-  GLuint soup_buffer(const void* data, size_t bytes);
-  std::vector<GLuint> texture_arrays_;   // by size class; the material's code names array and layer
-  std::vector<float> upload_textures();  // per material: -1, or array + MAX_TEXTURE_ARRAYS * layer
-  GLuint shadow_maps_ = 0, environment_ = 0, lookup_fbo_ = 0, lookup_depth_ = 0;
-  std::vector<GLuint> shadow_peels_;  // one cube-map array (a layer per light and face) per peel
-  bool shadow_peels_capped_ = false;
+  std::unique_ptr<GlSceneParts> parts_;
+  std::unique_ptr<GlExactCamera> exact_;
   int camera_layers_ = 0;
   bool camera_layers_capped_ = false;
-  int shadow_n_ = 0;
-  std::vector<int> shadow_layer_;  // per light, -1 when it casts no shadows
-  GLsizei vertex_count_ = 0;
-  double near_ = 1e-4;
-  int max_size_ = 0;
-  void draw_shadow_casters(GLuint maps);
-  void peel_translucent_casters(int n, int layers);
-  // The lookup target's size (bind_lookup_target).
-  int n_of_lookup_ = 0;
-  // How camera passes look the environment up (set_environment_lookup).
-  EnvmapLookup lookup_ = EnvmapLookup::reflected;
-  bool fresnel_ = false;  // Schlick's weights for kr and kt (shading.hpp)
-  bool texture_level0_ = false;
-  std::unique_ptr<GlProgram> distance_program_, phong_program_, shadow_program_;
-  std::unique_ptr<Target> target_;
-  GpuTimings timings_;
-  // The exact camera pass: the planar reflectors, each one's triangles as an index range of
-  // portal_ebo_, the per-vertex reflector ids (portal_vbo_); the shadow volumes, one per
-  // volume light (its index in volume_lights_ is its bit); its programs and buffers.
-  ExactCameraOptions exact_;
-  ExactCameraStats exact_stats_;
-  std::vector<uint8_t> exact_pixels_;
-  bool shadows_approximate_ = false;  // shadows from maps (no volumes), or lights past the volume counts
-  PlanarReflectors reflectors_;
-  GLuint portal_vbo_ = 0, portal_ebo_ = 0;
-  std::vector<std::pair<size_t, size_t>> portal_ranges_;  // first index, count
-  bool volumes_built_ = false;
-  std::vector<int> volume_lights_;    // light index per count (its layer)
-  std::vector<int> volume_bit_;       // per light: its opaque blockers' count, or -1
-  std::vector<int> translucent_bit_;  // per light: its translucent blockers' count, or -1
-  // Each volume light's volume (shadow_volume.hpp): its caps' codes, also in a storage
-  // buffer each (volume_caps_, read by scene.vert's VOLUME_CAPS when the scene's own vertex
-  // buffer draws the near caps), and its sides; its faces at infinity are clipped per view
-  // and tile on the CPU into clipped_volume_ and drawn from clipped_vbo_.
-  std::vector<ShadowVolume> volumes_;
-  std::vector<GLuint> volume_caps_;
-  struct CapRuns {  // runs of consecutive casting triangles, as vertex ranges of the scene's buffer
-    std::vector<GLint> first;
-    std::vector<GLsizei> count;
-  };
-  std::vector<CapRuns> cap_runs_;
-  std::vector<ShadowVolumeVertex> clipped_volume_;
-  GLuint clipped_vao_ = 0, clipped_vbo_ = 0;
-  void draw_faces_at_infinity(int layer, const glm::mat4& clip, const MirrorView& view);
-  std::string volume_caps_why_not() const;
-  std::unique_ptr<GlProgram> exact_program_, fill_program_, volume_program_, probe_program_, resolve_program_;
-  std::unique_ptr<GlProgram> ids_program_, groups_program_,
-      depth_program_;  // per-group shading (camera_ids, camera_groups)
-  struct VisibilityBuffers;
-  std::unique_ptr<VisibilityBuffers> visibility_;
-  void shade_groups(const glm::mat4& clip, const MirrorView& view, bool volumes);
-  // Shading::pixels, unless its keys cannot hold every volume light's bit (camera_ids.frag:
-  // 32) or the vertex buffer is larger than a shader storage block may be (the reason, "" when
-  // it can).
-  std::string shade_pixels_why_not() const;
-  bool shade_pixels() const { return exact_stats_.shading_pixels; }
-  GLuint resolve_fbo_ = 0, resolve_texture_ = 0;  // a tile's pixels (resolve_samples.frag)
-  int resolve_w_ = 0, resolve_h_ = 0;
-  GLuint recursed_ = 0;  // per view: which mirrors had their view drawn (camera_exact.frag)
-  std::unique_ptr<ExactBuffers> exact_buffers_;
 };
 
 }  // namespace abcube

@@ -1,6 +1,6 @@
-// Internal to the GL passes (gl_passes.cpp, gl_shadow_maps.cpp, gl_environment.cpp,
-// gl_camera_exact.cpp, gl_shadow_volumes.cpp, gl_shading_groups.cpp): texture units, the pass
-// state, the stencil test, the framebuffers, the views of the exact camera pass.
+// Internal to the GL passes (host/gl/gl_*.cpp): texture units and storage bindings, the pass
+// state, the stencil test, the camera's sample tiles, the framebuffers the passes render
+// into, and the view a draw is made through.
 #pragma once
 #include <glad/gl.h>
 
@@ -128,74 +128,47 @@ inline glm::mat4 SampleTiles::matrix(int64_t x0, int64_t y0) const {
 
 // One framebuffer: distance (R32F) + object id (R32UI), or colour (RGBA32F); depth 32F with
 // 8 stencil bits (the mirror levels of gl_camera_exact.cpp).
-struct GlScene::Target {
+struct GlTarget {
   int width = 0, height = 0;
   bool distance_pass = false;
   GLuint fbo = 0, color0 = 0, color1 = 0, depth = 0;
 
-  Target(int w, int h, bool distance) : width(w), height(h), distance_pass(distance) {
-    glGenFramebuffers(1, &fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    auto make = [&](GLenum format, GLenum attachment) {
-      GLuint tex = 0;
-      glGenTextures(1, &tex);
-      glBindTexture(GL_TEXTURE_2D, tex);
-      glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
-      glFramebufferTexture2D(GL_FRAMEBUFFER, attachment, GL_TEXTURE_2D, tex, 0);
-      return tex;
-    };
-    color0 = make(distance ? GL_R32F : GL_RGBA32F, GL_COLOR_ATTACHMENT0);
-    color1 = make(distance ? GL_R32UI : GL_RG32F, GL_COLOR_ATTACHMENT1);
-    depth = make(GL_DEPTH32F_STENCIL8, GL_DEPTH_STENCIL_ATTACHMENT);
-    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    glDrawBuffers(2, buffers);
-    const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    if (status != GL_FRAMEBUFFER_COMPLETE) {
-      throw RuntimeFailure("framebuffer " + std::to_string(w) + "x" + std::to_string(h) + " incomplete (status " +
-                           std::to_string(status) + ")");
-    }
-  }
-  ~Target() {
-    const GLuint textures[] = {color0, color1, depth};
-    glDeleteTextures(3, textures);
-    glDeleteFramebuffers(1, &fbo);
-  }
+  GlTarget(int w, int h, bool distance);
+  ~GlTarget();
+  GlTarget(const GlTarget&) = delete;
+  GlTarget& operator=(const GlTarget&) = delete;
 
   // Binds the target, sets the state every pass relies on, and clears it.
-  void clear(const glm::dvec3& background) const {
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glViewport(0, 0, width, height);
-    set_pass_state();
-    glClearBufferfi(GL_DEPTH_STENCIL, 0, 0.f, 0);  // reversed Z: 0 is infinitely far; stencil level 0
-    if (distance_pass) {
-      const float far[4] = {NO_DISTANCE, 0, 0, 0};
-      const GLuint none[4] = {NO_OBJECT, 0, 0, 0};
-      glClearBufferfv(GL_COLOR, 0, far);
-      glClearBufferuiv(GL_COLOR, 1, none);
-    } else {
-      const float bg[4] = {float(background.x), float(background.y), float(background.z), 1.f};
-      const float none[4] = {NO_DISTANCE, -1.f, 0, 0};
-      glClearBufferfv(GL_COLOR, 0, bg);
-      glClearBufferfv(GL_COLOR, 1, none);
-    }
-  }
-
+  void clear(const glm::dvec3& background) const;
   // Reads attachment `index` into `out` (`components` values per texel, GL row order).
-  void read(int index, GLenum format, GLenum type, void* out) const {
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
-    glReadBuffer(GL_COLOR_ATTACHMENT0 + static_cast<GLenum>(index));
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, width, height, format, type, out);
-  }
+  void read(int index, GLenum format, GLenum type, void* out) const;
 };
 
-// One view of the exact camera pass (gl_camera_exact.cpp): level 0 is the camera's own;
-// level L + 1 is what a planar mirror seen at level L shows. The scene is drawn through
-// `model` (the reflections about the mirrors passed, composed: world -> virtual world),
-// shaded at its own positions as seen from `eye` (the camera unfolded through the mirrors,
-// in world coordinates), keeping what lies on `plane`'s positive side (the last mirror's
-// front), without the mirror `skip` (its reflector + 1) it is seen through.
-struct GlScene::MirrorView {
+// The framebuffer that renders into the cube lookup textures (the shadow maps, the
+// environment map): an n x n depth buffer, the colour attached by the pass, face by face.
+struct LookupTarget {
+  GLuint fbo = 0, depth = 0;
+  int n = 0;
+
+  LookupTarget() = default;
+  ~LookupTarget();
+  LookupTarget(const LookupTarget&) = delete;
+  LookupTarget& operator=(const LookupTarget&) = delete;
+
+  // Binds the framebuffer with a new n x n depth buffer.
+  void bind(int size);
+  // Clears it (a shadow map: +infinity; the environment: `background`).
+  void clear(bool distance, const glm::dvec3& background) const;
+};
+
+// The view a draw is made through. Level 0 is the camera's own (or a cube face's); level
+// L + 1 is what a planar mirror seen at level L shows (gl_camera_exact.cpp). The scene is
+// drawn through `model` (the reflections about the mirrors passed, composed: world ->
+// virtual world), shaded at its own positions as seen from `eye` (the camera unfolded
+// through the mirrors, in world coordinates), keeping what lies on `plane`'s positive side
+// (the last mirror's front), without the mirror `skip` (its reflector + 1) it is seen
+// through.
+struct MirrorView {
   int level = 0;
   glm::dmat4 model{1.0};
   glm::dvec3 eye{0.0};
@@ -204,85 +177,17 @@ struct GlScene::MirrorView {
   // The tile's pixels the view can reach (x, y, width, height): the bounds of its mirror's
   // projection within its parent's (a scissor: the stencil decides, this saves the work).
   glm::ivec4 scissor{0, 0, 0, 0};
-};
 
-// The exact camera pass's buffers beside the camera Target (same size, same depth-stencil
-// texture): the shadow-volume counts, a layer of an R32F array per volume light (additive),
-// drawn through one framebuffer whose colour is the layer being counted. (A layer a light
-// rather than four lights a layer of RGBA32F: a scene blends only the bytes of its lights.)
-struct GlScene::ExactBuffers {
-  int width = 0, height = 0, layers = 0;
-  GLuint counts = 0, fbo = 0;
-
-  ExactBuffers(const Target& t, int lights) : width(t.width), height(t.height), layers(lights) {
-    glGenTextures(1, &counts);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, counts);
-    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_R32F, width, height, std::max(layers, 1));
-    // One level, read by texelFetch: complete only with a filter that needs no mipmaps.
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glGenFramebuffers(1, &fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, counts, 0, 0);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, t.depth, 0);
-    const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    if (status != GL_FRAMEBUFFER_COMPLETE) {
-      throw RuntimeFailure("shadow-volume framebuffer incomplete (status " + std::to_string(status) + ")");
-    }
-  }
-  ~ExactBuffers() {
-    glDeleteTextures(1, &counts);
-    glDeleteFramebuffers(1, &fbo);
+  // The view's transform without its translation: scene.vert draws relative to the eye, so
+  // the reflections act on a relative vertex by their linear part alone.
+  glm::dmat4 linear() const {
+    glm::dmat4 l = model;
+    l[3] = glm::dvec4(0.0, 0.0, 0.0, 1.0);
+    return l;
   }
 };
 
-// The per-group shading's buffers beside the camera Target (gl_shading_groups.cpp): the key
-// of each sample of a view (camera_ids.frag, RG32UI, drawn with the target's
-// depth-stencil), and a framebuffer with no attachment, one pixel of it per 8 x 4 samples
-// of the target; the colour and weight of the camera view's pixels shaded whole (RGBA32F,
-// one texel a pixel).
-struct GlScene::VisibilityBuffers {
-  int width = 0, height = 0;
-  GLuint ids = 0, fbo = 0, pixels_fbo = 0, pixel_color = 0, pixel_weight = 0;
-
-  explicit VisibilityBuffers(const Target& t) : width(t.width), height(t.height) {
-    const auto make = [](GLenum format, int w, int h) {
-      GLuint tex = 0;
-      glGenTextures(1, &tex);
-      glBindTexture(GL_TEXTURE_2D, tex);
-      glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-      return tex;
-    };
-    ids = make(GL_RG32UI, width, height);
-    pixel_color = make(GL_RGBA32F, width / MASK_COLUMNS, height / MASK_ROWS);
-    pixel_weight = make(GL_RGBA32F, width / MASK_COLUMNS, height / MASK_ROWS);
-    glGenFramebuffers(1, &fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, ids, 0);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, t.depth, 0);
-    check("visibility");
-    glGenFramebuffers(1, &pixels_fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, pixels_fbo);
-    glFramebufferParameteri(GL_FRAMEBUFFER, GL_FRAMEBUFFER_DEFAULT_WIDTH, width / MASK_COLUMNS);
-    glFramebufferParameteri(GL_FRAMEBUFFER, GL_FRAMEBUFFER_DEFAULT_HEIGHT, height / MASK_ROWS);
-    check("per-pixel shading");
-  }
-  ~VisibilityBuffers() {
-    const GLuint textures[] = {ids, pixel_color, pixel_weight};
-    glDeleteTextures(3, textures);
-    const GLuint fbos[] = {fbo, pixels_fbo};
-    glDeleteFramebuffers(2, fbos);
-  }
-
- private:
-  static void check(const char* what) {
-    const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    if (status != GL_FRAMEBUFFER_COMPLETE) {
-      throw RuntimeFailure(std::string(what) + " framebuffer incomplete (status " + std::to_string(status) + ")");
-    }
-  }
-};
+// Throws RuntimeFailure naming `what` when the bound framebuffer is incomplete.
+void check_framebuffer(const std::string& what);
 
 }  // namespace abcube

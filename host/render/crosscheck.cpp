@@ -15,6 +15,7 @@
 #include "raster/cube_map.hpp"
 #include "io/image_io.hpp"
 #include "shading/resolve.hpp"
+#include "gl/gl_shadow_probe.hpp"
 #include "material/shading.hpp"
 #include "base/timer.hpp"
 
@@ -200,28 +201,17 @@ struct ExactShadows {
 
 constexpr double GRAZING_COSINE = 1e-3;
 
-void compare_shadows(const SceneData& scene, int n, int threads, GlScene& gl, CrosscheckResult* r) {
-  Camera camera = scene.camera;
-  if (camera.width > SHADOW_CHECK_MAX_WIDTH) {
-    camera.height =
-        std::max(1, static_cast<int>(std::lround(double(camera.height) * SHADOW_CHECK_MAX_WIDTH / camera.width)));
-    camera.width = SHADOW_CHECK_MAX_WIDTH;
-  }
-  r->shadow_width = camera.width;
-  r->shadow_height = camera.height;
-  gl.build_shadow_maps(n);
-  const GlScene::ShadowProbe probe = gl.camera_shadow_probe(camera);
-  const std::vector<uint32_t> gpu_ids = gl.camera_objects(camera);
-  r->shadow_lights = static_cast<int>(probe.lights.size());
-  if (probe.lights.empty()) return;
-
+// The exact tracer's shadows, and the CPU's shadow search's, at the visible surface of each
+// camera sample, for the probed lights.
+ExactShadows trace_shadows(const SceneData& scene, const Camera& camera, int n, int threads, double near_distance,
+                           const std::vector<int>& lights) {
   const RayTracer tracer(scene);
   ABufferOptions options;
   options.threads = threads;
-  options.near_distance = gl.near_distance();
+  options.near_distance = near_distance;
   const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, n, options);
   const SearchContext context(scene, cube);
-  const RasterView view = camera_view(make_camera_frame(camera), gl.near_distance());
+  const RasterView view = camera_view(make_camera_frame(camera), near_distance);
   const int64_t gw = int64_t{camera.width} * MASK_COLUMNS, gh = int64_t{camera.height} * MASK_ROWS;
   ExactShadows exact;
   exact.object.assign(static_cast<size_t>(gw * gh), NO_OBJECT);
@@ -239,8 +229,8 @@ void compare_shadows(const SceneData& scene, int n, int threads, GlScene& gl, Cr
       exact.object[g] = hit.object_id;
       const glm::dvec3 v = glm::normalize(-dir);
       const glm::dvec3 nrm = face_forward(hit.shading_normal, v);
-      for (size_t b = 0; b < probe.lights.size(); ++b) {
-        const PointLight& light = scene.lights[static_cast<size_t>(probe.lights[b])];
+      for (size_t b = 0; b < lights.size(); ++b) {
+        const PointLight& light = scene.lights[static_cast<size_t>(lights[b])];
         // Faces the light, by more than grazing: at N.L below GRAZING_COSINE the light adds
         // less than that share of its full diffuse term, and whether it is blocked is
         // decided by rounding (a light on a surface: the floor under it, seen by the GPU's
@@ -256,6 +246,14 @@ void compare_shadows(const SceneData& scene, int n, int threads, GlScene& gl, Cr
       }
     }
   });
+  return exact;
+}
+
+// Each sample and light both sides light: the volumes', the maps' and the search's answers
+// against the tracer's, also counted apart where the 3x3 samples around agree (interior).
+void tally_shadows(const ExactShadows& exact, const GlShadowProbe& probe, const std::vector<uint32_t>& gpu_ids,
+                   const Camera& camera, CrosscheckResult* r) {
+  const int64_t gw = int64_t{camera.width} * MASK_COLUMNS, gh = int64_t{camera.height} * MASK_ROWS;
   r->shadow_disagreement = Image(camera.width, camera.height, 1);
   std::vector<int> pairs_of_pixel(static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height), 0);
   for (int64_t gy = 0; gy < gh; ++gy) {
@@ -298,6 +296,25 @@ void compare_shadows(const SceneData& scene, int n, int threads, GlScene& gl, Cr
   for (size_t p = 0; p < pairs_of_pixel.size(); ++p) {
     if (pairs_of_pixel[p] > 0) r->shadow_disagreement.data[p] /= float(pairs_of_pixel[p]);
   }
+}
+
+void compare_shadows(const SceneData& scene, int n, int threads, GlScene& gl, CrosscheckResult* r) {
+  Camera camera = scene.camera;
+  if (camera.width > SHADOW_CHECK_MAX_WIDTH) {
+    camera.height =
+        std::max(1, static_cast<int>(std::lround(double(camera.height) * SHADOW_CHECK_MAX_WIDTH / camera.width)));
+    camera.width = SHADOW_CHECK_MAX_WIDTH;
+  }
+  r->shadow_width = camera.width;
+  r->shadow_height = camera.height;
+  gl.build_shadow_maps(n);
+  const GlShadowProbe probe = probe_camera_shadows(gl, camera);
+  const std::vector<uint32_t> gpu_ids = gl.camera_objects(camera);
+  r->shadow_lights = static_cast<int>(probe.lights.size());
+  if (probe.lights.empty()) return;
+
+  const ExactShadows exact = trace_shadows(scene, camera, n, threads, gl.near_distance(), probe.lights);
+  tally_shadows(exact, probe, gpu_ids, camera, r);
 }
 
 }  // namespace
