@@ -11,6 +11,38 @@ namespace {
 // Whether material m reflects as a plain mirror: kr > 0, no refraction, opaque.
 bool mirror_material(const Material& m) { return m.reflect > 0.0 && m.transmit == 0.0 && m.opacity == 1.0; }
 
+// Faceted objects, then the smallest reflectors past MAX_REFLECTORS, are left to the cube
+// maps; ids are given to the ones kept.
+void keep_largest(const TriangleSoup& soup, PlanarReflectors* found) {
+  PlanarReflectors& out = *found;
+  std::map<uint32_t, size_t> planes_of_object;
+  for (const PlanarReflector& p : out.reflectors) ++planes_of_object[p.object];
+  std::vector<std::pair<double, size_t>> by_area;
+  for (size_t r = 0; r < out.reflectors.size(); ++r) {
+    double area = 0;
+    for (const uint32_t t : out.reflectors[r].triangles) {
+      const size_t v = 3 * static_cast<size_t>(t);
+      const glm::dvec3 a(soup.positions[v]), b(soup.positions[v + 1]), c(soup.positions[v + 2]);
+      area += 0.5 * glm::length(glm::cross(b - a, c - a));
+    }
+    if (planes_of_object[out.reflectors[r].object] <= MAX_PLANES_PER_OBJECT) by_area.emplace_back(-area, r);
+  }
+  std::stable_sort(by_area.begin(), by_area.end());
+  std::vector<bool> keep(out.reflectors.size(), false);
+  for (size_t k = 0; k < by_area.size() && k < MAX_REFLECTORS; ++k) keep[by_area[k].second] = true;
+  std::vector<PlanarReflector> kept;
+  for (size_t r = 0; r < out.reflectors.size(); ++r) {
+    if (!keep[r]) {
+      out.curved_triangles += out.reflectors[r].triangles.size();
+      continue;
+    }
+    for (const uint32_t t : out.reflectors[r].triangles)
+      out.reflector_of_triangle[t] = static_cast<uint32_t>(kept.size() + 1);
+    kept.push_back(std::move(out.reflectors[r]));
+  }
+  out.reflectors = std::move(kept);
+}
+
 }  // namespace
 
 PlanarReflectors find_planar_reflectors(const SceneData& scene) {
@@ -64,34 +96,7 @@ PlanarReflectors find_planar_reflectors(const SceneData& scene) {
     }
     out.reflectors[r].triangles.push_back(t);
   }
-  // Faceted objects, then the smallest reflectors past MAX_REFLECTORS, are left to the
-  // cube maps; ids are given to the ones kept.
-  std::map<uint32_t, size_t> planes_of_object;
-  for (const PlanarReflector& p : out.reflectors) ++planes_of_object[p.object];
-  std::vector<std::pair<double, size_t>> by_area;
-  for (size_t r = 0; r < out.reflectors.size(); ++r) {
-    double area = 0;
-    for (const uint32_t t : out.reflectors[r].triangles) {
-      const size_t v = 3 * static_cast<size_t>(t);
-      const glm::dvec3 a(soup.positions[v]), b(soup.positions[v + 1]), c(soup.positions[v + 2]);
-      area += 0.5 * glm::length(glm::cross(b - a, c - a));
-    }
-    if (planes_of_object[out.reflectors[r].object] <= MAX_PLANES_PER_OBJECT) by_area.emplace_back(-area, r);
-  }
-  std::stable_sort(by_area.begin(), by_area.end());
-  std::vector<bool> keep(out.reflectors.size(), false);
-  for (size_t k = 0; k < by_area.size() && k < MAX_REFLECTORS; ++k) keep[by_area[k].second] = true;
-  std::vector<PlanarReflector> kept;
-  for (size_t r = 0; r < out.reflectors.size(); ++r) {
-    if (!keep[r]) {
-      out.curved_triangles += out.reflectors[r].triangles.size();
-      continue;
-    }
-    for (const uint32_t t : out.reflectors[r].triangles)
-      out.reflector_of_triangle[t] = static_cast<uint32_t>(kept.size() + 1);
-    kept.push_back(std::move(out.reflectors[r]));
-  }
-  out.reflectors = std::move(kept);
+  keep_largest(soup, &out);
   return out;
 }
 

@@ -85,11 +85,14 @@ std::vector<uint8_t> lights_outside_closed(const SceneData& scene, const glm::dv
   return outside;
 }
 
-ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light, Blockers kind) {
+namespace {
+
+// The caps: each triangle that casts for `kind` gets its cap, oriented (reversed: (a, c, b))
+// to face the light.
+void mark_caps(const SceneData& scene, const glm::dvec3& light, Blockers kind, ShadowVolume* out) {
   const TriangleSoup& soup = *scene.triangles;
   const std::vector<uint8_t> outside = lights_outside_closed(scene, light);
-  uint64_t left_out = 0;
-  // Whether triangle t casts, and how its cap is oriented (reversed: (a, c, b)).
+  // Whether triangle t casts, and how its cap is oriented.
   auto casts = [&](uint32_t t, bool* reversed) {
     const glm::dvec3 through = blocker_transmittance(scene.materials[soup.material_id[t]]);
     const bool opaque = through == glm::dvec3(0.0), clear = through == glm::dvec3(1.0);
@@ -109,40 +112,75 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
     // strictly outside which the light lies drop theirs (tests/cli/flat_mirrors.sh,
     // light_on_mirror_1_4; ShadowVolume.AClosedBoxCastsFromEveryFace).
     if (*reversed && outside[soup.object_id[t]]) {
-      ++left_out;
+      ++out->facing_away_left_out;
       return false;
     }
     return true;
   };
-  ShadowVolume out;
-  out.light = light;
-  out.caps.assign(soup.triangle_count(), NO_CAP);
+  out->caps.assign(soup.triangle_count(), NO_CAP);
   for (uint32_t t = 0; t < soup.triangle_count(); ++t) {
     bool reversed = false;
     if (!casts(t, &reversed)) continue;
-    out.caps[t] = reversed ? CAP_REVERSED : CAP;
-    ++out.blockers;
+    out->caps[t] = reversed ? CAP_REVERSED : CAP;
+    ++out->blockers;
   }
-  out.facing_away_left_out = left_out;
+}
+
+// Calls f(i, edge) for the i-th edge u -> w of the oriented caps, in a fixed order.
+template <class F>
+void for_each_cap_edge(const TriangleSoup& soup, const ShadowVolume& volume, const F& f) {
+  uint64_t i = 0;
+  for (uint32_t t = 0; t < soup.triangle_count(); ++t) {
+    if (volume.caps[t] == NO_CAP) continue;
+    const bool reversed = volume.caps[t] == CAP_REVERSED;
+    const glm::vec3* p = &soup.positions[3 * static_cast<size_t>(t)];
+    const int cap[3] = {0, reversed ? 2 : 1, reversed ? 1 : 2};
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3& u = p[cap[k]];
+      const glm::vec3& w = p[cap[(k + 1) % 3]];
+      const bool forward = bits(u) < bits(w);
+      f(i++, DirectedEdge{forward ? u : w, forward ? w : u, soup.object_id[t], forward});
+    }
+  }
+}
+
+// The sides of a set of cap edges holding every copy of each of its edges: sorted, per edge
+// the directions that do not cancel in pairs, each a side drawn outward.
+void add_sides(std::vector<DirectedEdge>* edges, const glm::dvec3& light, ShadowVolume* out) {
+  std::sort(edges->begin(), edges->end(),
+            [](const DirectedEdge& x, const DirectedEdge& y) { return x.key() < y.key(); });
+  const std::vector<DirectedEdge>& sorted = *edges;
+  for (size_t i = 0; i < sorted.size();) {
+    size_t j = i;
+    long net = 0;
+    const std::array<uint32_t, 6> key = sorted[i].key();
+    for (; j < sorted.size() && sorted[j].key() == key; ++j) net += sorted[j].forward ? 1 : -1;
+    const long count = net < 0 ? -net : net;
+    out->sides_cancelled += (j - i) - static_cast<size_t>(count);
+    out->sides += static_cast<uint64_t>(count);
+    const DirectedEdge& e = sorted[i];
+    const glm::vec3 u = net > 0 ? e.lo : e.hi;
+    const glm::vec3 w = net > 0 ? e.hi : e.lo;
+    for (long n = 0; n < count; ++n) {
+      // The side of edge u -> w, outward: (u, u_inf, w_inf) and (u, w_inf, w).
+      const glm::vec4 u1(u, 1.f), w1(w, 1.f), ui = at_infinity(u, light), wi = at_infinity(w, light);
+      for (const glm::vec4& q : {u1, ui, wi, u1, wi, w1}) out->side_vertices.push_back({q, e.object, 0u});
+    }
+    i = j;
+  }
+}
+
+}  // namespace
+
+ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light, Blockers kind) {
+  const TriangleSoup& soup = *scene.triangles;
+  ShadowVolume out;
+  out.light = light;
+  mark_caps(scene, light, kind, &out);
   // The oriented caps' edges u -> w, sorted: per edge, the directions that do not cancel in
   // pairs are its sides. In buckets by a hash of the edge's endpoints, a bucket sorted at a
   // time, so that about PAIRING_BUCKET_EDGES edges are held at once whatever the scene's
   // size (all of them at once would set the gpu method's peak memory).
-  const auto for_each_edge = [&](const auto& f) {
-    uint64_t i = 0;
-    for (uint32_t t = 0; t < soup.triangle_count(); ++t) {
-      if (out.caps[t] == NO_CAP) continue;
-      const bool reversed = out.caps[t] == CAP_REVERSED;
-      const glm::vec3* p = &soup.positions[3 * static_cast<size_t>(t)];
-      const int cap[3] = {0, reversed ? 2 : 1, reversed ? 1 : 2};
-      for (int k = 0; k < 3; ++k) {
-        const glm::vec3& u = p[cap[k]];
-        const glm::vec3& w = p[cap[(k + 1) % 3]];
-        const bool forward = bits(u) < bits(w);
-        f(i++, DirectedEdge{forward ? u : w, forward ? w : u, soup.object_id[t], forward});
-      }
-    }
-  };
   const uint64_t edge_count = 3 * out.blockers;
   const uint32_t buckets = static_cast<uint32_t>(
       std::clamp<uint64_t>((edge_count + PAIRING_BUCKET_EDGES - 1) / PAIRING_BUCKET_EDGES, 1, 255));
@@ -150,7 +188,7 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
   std::vector<uint64_t> bucket_size(buckets, 0);
   if (buckets > 1) {
     bucket_of.resize(edge_count);
-    for_each_edge([&](uint64_t i, const DirectedEdge& e) {
+    for_each_cap_edge(soup, out, [&](uint64_t i, const DirectedEdge& e) {
       bucket_of[i] = static_cast<uint8_t>(e.hash() % buckets);
       ++bucket_size[bucket_of[i]];
     });
@@ -161,29 +199,10 @@ ShadowVolume build_shadow_volume(const SceneData& scene, const glm::dvec3& light
   edges.reserve(*std::max_element(bucket_size.begin(), bucket_size.end()));
   for (uint32_t bucket = 0; bucket < buckets; ++bucket) {
     edges.clear();
-    for_each_edge([&](uint64_t i, const DirectedEdge& e) {
+    for_each_cap_edge(soup, out, [&](uint64_t i, const DirectedEdge& e) {
       if (buckets == 1 || bucket_of[i] == bucket) edges.push_back(e);
     });
-    std::sort(edges.begin(), edges.end(),
-              [](const DirectedEdge& x, const DirectedEdge& y) { return x.key() < y.key(); });
-    for (size_t i = 0; i < edges.size();) {
-      size_t j = i;
-      long net = 0;
-      const std::array<uint32_t, 6> key = edges[i].key();
-      for (; j < edges.size() && edges[j].key() == key; ++j) net += edges[j].forward ? 1 : -1;
-      const long count = net < 0 ? -net : net;
-      out.sides_cancelled += (j - i) - static_cast<size_t>(count);
-      out.sides += static_cast<uint64_t>(count);
-      const DirectedEdge& e = edges[i];
-      const glm::vec3 u = net > 0 ? e.lo : e.hi;
-      const glm::vec3 w = net > 0 ? e.hi : e.lo;
-      for (long n = 0; n < count; ++n) {
-        // The side of edge u -> w, outward: (u, u_inf, w_inf) and (u, w_inf, w).
-        const glm::vec4 u1(u, 1.f), w1(w, 1.f), ui = at_infinity(u, light), wi = at_infinity(w, light);
-        for (const glm::vec4& q : {u1, ui, wi, u1, wi, w1}) out.side_vertices.push_back({q, e.object, 0u});
-      }
-      i = j;
-    }
+    add_sides(&edges, light, &out);
   }
   return out;
 }
@@ -282,7 +301,8 @@ size_t clip_faces_at_infinity(const ShadowVolume& volume, const TriangleSoup& so
   const size_t end = first + std::min(count, faces_at_infinity(volume) - std::min(first, faces_at_infinity(volume)));
   for (size_t f = first; f < std::min(end, triangles); ++f) {
     const uint32_t tri = static_cast<uint32_t>(f);
-    if (volume.caps[tri] != NO_CAP) clip_face(far_cap(soup, tri, volume.caps[tri], volume.light), soup.object_id[tri], 0u);
+    if (volume.caps[tri] != NO_CAP)
+      clip_face(far_cap(soup, tri, volume.caps[tri], volume.light), soup.object_id[tri], 0u);
   }
   const std::vector<ShadowVolumeVertex>& sides = volume.side_vertices;
   for (size_t f = std::max(first, triangles); f < end; ++f) {

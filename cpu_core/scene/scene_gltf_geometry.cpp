@@ -309,6 +309,16 @@ void GltfReader::add_primitive(const tg::Primitive& prim, const std::string& at,
       }
     }
   }
+  const std::vector<std::array<uint32_t, 3>> tris = primitive_triangles(prim, at, mode, p.count);
+  check_triangle_cap(st_, path_, out_.triangle_count() + tris.size());
+  if (st_.scene.triangles->triangle_count() + out_.triangle_count() + tris.size() > MAX_TRIANGLES) {
+    bad("", "the scene would exceed " + std::to_string(MAX_TRIANGLES) + " triangles");
+  }
+  append_triangles(tris, p, nrm, uv, material, world);
+}
+
+std::vector<std::array<uint32_t, 3>> GltfReader::primitive_triangles(const tg::Primitive& prim, const std::string& at,
+                                                                     int mode, size_t count) {
   // The vertex list: the indices, or 0 ... count - 1.
   std::vector<uint32_t> list;
   if (prim.indices >= 0) {
@@ -318,13 +328,13 @@ void GltfReader::add_primitive(const tg::Primitive& prim, const std::string& at,
                                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT});
     list.reserve(idx.count);
     for (double v : idx.values) {
-      if (v >= static_cast<double>(p.count)) {
-        bad(iat, "index " + format_number(v) + " out of range (" + std::to_string(p.count) + " vertices)");
+      if (v >= static_cast<double>(count)) {
+        bad(iat, "index " + format_number(v) + " out of range (" + std::to_string(count) + " vertices)");
       }
       list.push_back(static_cast<uint32_t>(v));
     }
   } else {
-    for (size_t i = 0; i < p.count; ++i) list.push_back(static_cast<uint32_t>(i));
+    for (size_t i = 0; i < count; ++i) list.push_back(static_cast<uint32_t>(i));
   }
   std::vector<std::array<uint32_t, 3>> tris;
   if (mode == TINYGLTF_MODE_TRIANGLES) {
@@ -338,10 +348,11 @@ void GltfReader::add_primitive(const tg::Primitive& prim, const std::string& at,
   } else {
     for (size_t i = 1; i + 1 < list.size(); ++i) tris.push_back({list[i], list[i + 1], list[0]});
   }
-  check_triangle_cap(st_, path_, out_.triangle_count() + tris.size());
-  if (st_.scene.triangles->triangle_count() + out_.triangle_count() + tris.size() > MAX_TRIANGLES) {
-    bad("", "the scene would exceed " + std::to_string(MAX_TRIANGLES) + " triangles");
-  }
+  return tris;
+}
+
+void GltfReader::append_triangles(const std::vector<std::array<uint32_t, 3>>& tris, const Accessed& p,
+                                  const Accessed& nrm, const Accessed& uv, int material, const glm::dmat4& world) {
   const glm::dmat3 linear(world);
   const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(linear));
   const bool mirrors = glm::determinant(linear) < 0;

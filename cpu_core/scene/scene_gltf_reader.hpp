@@ -3,6 +3,7 @@
 // accessors and primitives into triangles, scene_gltf_materials.cpp maps materials, textures,
 // cameras and lights). Internal to scene loading.
 #pragma once
+#include <array>
 #include <cstddef>
 #include <functional>
 #include <initializer_list>
@@ -116,6 +117,13 @@ class GltfReader {
                          std::initializer_list<int> component_types, bool allow_normalized_only = false) const;
 
   void add_primitive(const tg::Primitive& prim, const std::string& at, const glm::dmat4& world);
+  // The primitive's triangles as vertex indices (its indices or 0 ... count - 1, assembled
+  // by `mode`: triangles, strip or fan).
+  std::vector<std::array<uint32_t, 3>> primitive_triangles(const tg::Primitive& prim, const std::string& at, int mode,
+                                                           size_t count);
+  // The triangles' vertices, transformed by `world`, appended to the mesh.
+  void append_triangles(const std::vector<std::array<uint32_t, 3>>& tris, const Accessed& positions,
+                        const Accessed& normals, const Accessed& uvs, int material, const glm::dmat4& world);
 
   // ---- materials ----
   const tg::Material* material_at(int index) const;

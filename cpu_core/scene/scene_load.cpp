@@ -269,28 +269,54 @@ bool uses_texture(const SceneData& scene, uint32_t material, const std::vector<i
   return false;
 }
 
+// The fields an object of `type` may have (a located InputError for an unknown type).
+std::vector<const char*> object_fields(const LoadState& st, const Json& type_value, const std::string& type,
+                                       const std::string& path) {
+  if (type == "triangle" || type == "quad") return {"type", "vertices", "material", "transform"};
+  if (type == "box") return {"type", "min", "max", "material", "transform"};
+  if (type == "sphere") return {"type", "center", "radius", "segments", "material", "transform"};
+  if (type == "mesh") return {"type", "file", "material", "transform"};
+  if (type == "gltf") return {"type", "file", "material", "transform", "use_camera"};
+  fail(st.src, member_path(path, "type"),
+       "must be one of triangle, quad, box, sphere, mesh, gltf, got " + describe(type_value));
+}
+
+// A glTF file's lights, placed by the object's transform, and its camera when the object
+// asks for it and no other was given.
+void add_extras(LoadState& st, const GltfExtras& extras, const AffineMap& map, bool use_camera) {
+  for (PointLight light : extras.lights) {
+    light.position = map.point(light.position);
+    st.scene.lights.push_back(light);
+  }
+  if (use_camera && extras.has_camera && !st.file_camera) {
+    Camera c;
+    c.position = map.point(extras.camera_position);
+    c.look_at = map.point(extras.camera_look_at);
+    c.up = map.linear * extras.camera_up;
+    c.fov_y_deg = extras.camera_fov_y_deg;
+    st.file_camera = c;
+  }
+}
+
+// An object with no triangles loads and renders (nothing), but an empty export, a wrong
+// file or a mistyped vertex is the likely cause: a warning says so.
+void warn_empty(LoadState& st, const Fields& f, const std::string& type, const std::string& path, size_t faces) {
+  const bool named_file = type == "mesh" || type == "gltf";
+  const std::string what =
+      named_file ? (type == "gltf" ? "glTF " : "mesh ") + quote_path(read_string(st.src, f.need("file"), f.at("file")))
+                 : type;
+  st.scene.warnings.push_back(one_line(st.src.name + ": " + (named_file ? f.at("file") : path) + ": warning: " + what +
+                                       " has no triangles" +
+                                       (faces > 0 ? " of nonzero area (" + std::to_string(faces) + " dropped)" : "")));
+}
+
 void read_object(LoadState& st, const Json& v, size_t index) {
   const std::string path = index_path("objects", index);
   if (!v.is_object()) fail(st.src, path, "must be an object, got " + describe(v));
   const auto type_it = v.find("type");
   if (type_it == v.end()) fail(st.src, member_path(path, "type"), "missing required field");
   const std::string type = read_string(st.src, *type_it, member_path(path, "type"));
-  std::vector<const char*> known;
-  if (type == "triangle" || type == "quad") {
-    known = {"type", "vertices", "material", "transform"};
-  } else if (type == "box") {
-    known = {"type", "min", "max", "material", "transform"};
-  } else if (type == "sphere") {
-    known = {"type", "center", "radius", "segments", "material", "transform"};
-  } else if (type == "mesh") {
-    known = {"type", "file", "material", "transform"};
-  } else if (type == "gltf") {
-    known = {"type", "file", "material", "transform", "use_camera"};
-  } else {
-    fail(st.src, member_path(path, "type"),
-         "must be one of triangle, quad, box, sphere, mesh, gltf, got " + describe(*type_it));
-  }
-  const Fields f(st.src, v, path, known);
+  const Fields f(st.src, v, path, object_fields(st, *type_it, type, path));
 
   SceneObject obj;
   obj.type = type;
@@ -330,18 +356,7 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   obj.first_triangle = static_cast<uint32_t>(soup.triangle_count());
   const AffineMap map = make_affine_map(transform);
   st.scene.dropped_triangles += append_triangles(local, map, id, obj.material, &soup);
-  for (PointLight light : extras.lights) {
-    light.position = map.point(light.position);
-    st.scene.lights.push_back(light);
-  }
-  if (use_camera && extras.has_camera && !st.file_camera) {
-    Camera c;
-    c.position = map.point(extras.camera_position);
-    c.look_at = map.point(extras.camera_look_at);
-    c.up = map.linear * extras.camera_up;
-    c.fov_y_deg = extras.camera_fov_y_deg;
-    st.file_camera = c;
-  }
+  add_extras(st, extras, map, use_camera);
   obj.triangle_count = static_cast<uint32_t>(soup.triangle_count() - obj.first_triangle);
   const bool per_face_materials = !local.material.empty();
   const bool from_file = local.indexed;
@@ -350,17 +365,7 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   if (!material && per_face_materials) {
     obj.material = obj.triangle_count > 0 ? soup.material_id[obj.first_triangle] : default_material(st);
   }
-  if (obj.triangle_count == 0) {
-    // Loads and renders (nothing), but an empty export, a wrong file or a mistyped vertex
-    // is the likely cause.
-    const bool named_file = type == "mesh" || type == "gltf";
-    const std::string what = named_file ? (type == "gltf" ? "glTF " : "mesh ") +
-                                              quote_path(read_string(st.src, f.need("file"), f.at("file")))
-                                        : type;
-    st.scene.warnings.push_back(
-        one_line(st.src.name + ": " + (named_file ? f.at("file") : path) + ": warning: " + what + " has no triangles" +
-                 (faces > 0 ? " of nonzero area (" + std::to_string(faces) + " dropped)" : "")));
-  }
+  if (obj.triangle_count == 0) warn_empty(st, f, type, path, faces);
   // A closed surface has an inside; make its geometric normals point out of it.
   obj.closed = is_closed_surface(soup, obj.first_triangle, obj.triangle_count);
   if (obj.closed && signed_volume(soup, obj.first_triangle, obj.triangle_count) < 0) {

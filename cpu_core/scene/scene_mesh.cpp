@@ -333,12 +333,22 @@ void check_inside_root(const LoadState& st, const std::string& path, const std::
   }
 }
 
-LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
-  const std::string path = f.at("file");
-  const std::string file = read_string(st.src, f.need("file"), path);
-  if (file.empty()) fail(st.src, path, "must name an OBJ file, got \"\"");
-  const std::string resolved = resolve_mesh_path(st.src, file);
-  check_inside_root(st, path, file, resolved);
+// A missing MTL file or material is what Assimp, Blender and three.js forgive: the faces
+// get the default material, and one warning line names the first (and counts the rest).
+void warn_missing_mtl(LoadState& st, const std::string& path, const std::string& file, const ObjFile& obj) {
+  std::vector<std::string> missing = find_lines(obj.warning, "not found");
+  if (!missing.empty()) {
+    std::string more;
+    if (missing.size() > 1) more = " (and " + std::to_string(missing.size() - 1) + " more)";
+    st.scene.warnings.push_back(one_line(st.src.name + ": " + path + ": warning: mesh " + quote_path(file) + ": " +
+                                         missing_material_message(missing.front()) + more +
+                                         "; the default material is used"));
+  }
+}
+
+// Refuses, with its place, an OBJ file that cannot be read or is larger than the memory
+// budget, and one that holds more triangles than the caps leave room for.
+void check_obj_file(LoadState& st, const std::string& path, const std::string& resolved) {
   std::string problem = input_file_problem(resolved, st.limits.max_mesh_bytes);
   std::error_code ec;
   const uint64_t size = problem.empty() ? std::filesystem::file_size(resolved, ec) : 0;
@@ -355,43 +365,17 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
   const bool over_cap = st.limits.max_triangles > 0 && held + most > st.limits.max_triangles;
   const bool over_budget = st.memory_budget > 0 && held + most > st.memory_budget / SCENE_TRIANGLE_BYTES;
   if (over_cap || over_budget) check_triangle_cap(st, path, count_face_triangles(resolved));
-  const ObjFile obj = parse_obj(st, path, resolved);
-  check_triangle_cap(st, path, obj_triangle_count(obj));  // before anything is made
-  if (use_mtl) {
-    // A missing MTL file or material is what Assimp, Blender and three.js forgive: the faces
-    // get the default material, and one warning line names the first (and counts the rest).
-    std::vector<std::string> missing = find_lines(obj.warning, "not found");
-    if (!missing.empty()) {
-      std::string more;
-      if (missing.size() > 1) more = " (and " + std::to_string(missing.size() - 1) + " more)";
-      st.scene.warnings.push_back(one_line(st.src.name + ": " + path + ": warning: mesh " + quote_path(file) + ": " +
-                                           missing_material_message(missing.front()) + more +
-                                           "; the default material is used"));
-    }
-  }
-  const std::vector<uint32_t> mtl_ids =
-      use_mtl ? mtl_material_ids(st, path, file, resolved, obj.materials, obj.mtl_file_of) : std::vector<uint32_t>{};
+}
+
+// The OBJ file's faces as triangles of `m` (its vertex arrays filled), each with its MTL
+// material when `use_mtl` (mtl_ids: per material of the file, the scene's).
+void add_obj_faces(LoadState& st, const std::string& path, const std::string& resolved, const ObjFile& obj,
+                   const std::vector<uint32_t>& mtl_ids, bool use_mtl, LocalMesh* out) {
+  LocalMesh& m = *out;
   const tinyobj::attrib_t& a = obj.attrib;
   const int vertex_count = static_cast<int>(a.vertices.size() / 3);
   const int normal_count = static_cast<int>(a.normals.size() / 3);
   const int uv_count = static_cast<int>(a.texcoords.size() / 2);
-  LocalMesh m;
-  m.indexed = true;
-  m.positions.reserve(static_cast<size_t>(vertex_count));
-  for (size_t v = 0; v < static_cast<size_t>(vertex_count); ++v) {
-    m.positions.emplace_back(a.vertices[3 * v], a.vertices[3 * v + 1], a.vertices[3 * v + 2]);
-  }
-  m.normals.reserve(static_cast<size_t>(normal_count));
-  for (size_t v = 0; v < static_cast<size_t>(normal_count); ++v) {
-    m.normals.emplace_back(a.normals[3 * v], a.normals[3 * v + 1], a.normals[3 * v + 2]);
-  }
-  m.uvs.reserve(static_cast<size_t>(uv_count));
-  for (size_t v = 0; v < static_cast<size_t>(uv_count); ++v) {
-    m.uvs.emplace_back(a.texcoords[2 * v], a.texcoords[2 * v + 1]);
-    if (!std::isfinite(m.uvs.back().x) || !std::isfinite(m.uvs.back().y)) {
-      fail(st.src, path, "mesh " + quote_path(resolved) + ": vt " + std::to_string(v + 1) + " is not finite");
-    }
-  }
   const uint64_t triangles = obj_triangle_count(obj);
   m.position_index.reserve(3 * triangles);
   m.normal_index.reserve(3 * triangles);
@@ -428,6 +412,42 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
       }
     }
   }
+}
+
+LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
+  const std::string path = f.at("file");
+  const std::string file = read_string(st.src, f.need("file"), path);
+  if (file.empty()) fail(st.src, path, "must name an OBJ file, got \"\"");
+  const std::string resolved = resolve_mesh_path(st.src, file);
+  check_inside_root(st, path, file, resolved);
+  check_obj_file(st, path, resolved);
+  const ObjFile obj = parse_obj(st, path, resolved);
+  check_triangle_cap(st, path, obj_triangle_count(obj));  // before anything is made
+  if (use_mtl) warn_missing_mtl(st, path, file, obj);
+  const std::vector<uint32_t> mtl_ids =
+      use_mtl ? mtl_material_ids(st, path, file, resolved, obj.materials, obj.mtl_file_of) : std::vector<uint32_t>{};
+  const tinyobj::attrib_t& a = obj.attrib;
+  const int vertex_count = static_cast<int>(a.vertices.size() / 3);
+  const int normal_count = static_cast<int>(a.normals.size() / 3);
+  const int uv_count = static_cast<int>(a.texcoords.size() / 2);
+  LocalMesh m;
+  m.indexed = true;
+  m.positions.reserve(static_cast<size_t>(vertex_count));
+  for (size_t v = 0; v < static_cast<size_t>(vertex_count); ++v) {
+    m.positions.emplace_back(a.vertices[3 * v], a.vertices[3 * v + 1], a.vertices[3 * v + 2]);
+  }
+  m.normals.reserve(static_cast<size_t>(normal_count));
+  for (size_t v = 0; v < static_cast<size_t>(normal_count); ++v) {
+    m.normals.emplace_back(a.normals[3 * v], a.normals[3 * v + 1], a.normals[3 * v + 2]);
+  }
+  m.uvs.reserve(static_cast<size_t>(uv_count));
+  for (size_t v = 0; v < static_cast<size_t>(uv_count); ++v) {
+    m.uvs.emplace_back(a.texcoords[2 * v], a.texcoords[2 * v + 1]);
+    if (!std::isfinite(m.uvs.back().x) || !std::isfinite(m.uvs.back().y)) {
+      fail(st.src, path, "mesh " + quote_path(resolved) + ": vt " + std::to_string(v + 1) + " is not finite");
+    }
+  }
+  add_obj_faces(st, path, resolved, obj, mtl_ids, use_mtl, &m);
   return m;
 }
 

@@ -125,58 +125,63 @@ json unless(const T& value, const T& fallback) {
   return value == fallback ? json() : json(value);
 }
 
-// The table reads as a table: one option an entry, its spec on a line or two.
-// clang-format off
-std::vector<Entry> make_table() {
-  const RenderOptions d;  // the defaults
-  const RendererOptions rd;
-  std::vector<Entry> t;
-  const auto add = [&](OptionSpec spec, std::function<void(RenderSetup&, const json&)> apply,
-                       std::function<json(const RenderSetup&)> read) {
-    t.push_back({std::move(spec), std::move(apply), std::move(read)});
-  };
-  const auto vec3_of = [](const json& v) { return std::array<double, 3>{v[0].get<double>(), v[1].get<double>(), v[2].get<double>()}; };
-  const auto opt_vec3 = [](const std::optional<std::array<double, 3>>& v) { return v ? json(*v) : json(); };
+// The table reads as a table: one option an entry, its spec on a line or two, a function a
+// group of options in the order --help lists them.
+using Apply = std::function<void(RenderSetup&, const json&)>;
+using Read = std::function<json(const RenderSetup&)>;
+using Table = std::vector<Entry>;
 
-  // ---- what to render
-  add({"method", "--method", OptionKind::choice, OptionScope::job, method_names(), 0, 0, "the scene's render.method", "",
+void add(Table& t, OptionSpec spec, Apply apply, Read read) {
+  t.push_back({std::move(spec), std::move(apply), std::move(read)});
+}
+std::array<double, 3> vec3_of(const json& v) {
+  return std::array<double, 3>{v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
+}
+json opt_vec3(const std::optional<std::array<double, 3>>& v) { return v ? json(*v) : json(); }
+
+// clang-format off
+// What to render.
+void add_what_to_render(Table& t) {
+  add(t, {"method", "--method", OptionKind::choice, OptionScope::job, method_names(), 0, 0, "the scene's render.method", "",
        {}, "", "the rendering method", {}},
       [](RenderSetup& s, const json& v) { s.render.method = v.get<std::string>(); },
       [](const RenderSetup& s) { return unless(s.render.method, std::string()); });
-  add({"cube_res", "--cube-res", OptionKind::integer, OptionScope::job, {}, 1, 16384, "the scene's render.cube_resolution",
+  add(t, {"cube_res", "--cube-res", OptionKind::integer, OptionScope::job, {}, 1, 16384, "the scene's render.cube_resolution",
        "texels", all_but_raytrace(), "the exact tracer builds no cube map", "cube map face edge N", {}},
       [](RenderSetup& s, const json& v) { s.render.cube_resolution = v.get<int>(); },
       [](const RenderSetup& s) { return unless(s.render.cube_resolution, 0); });
-  add({"max_depth", "--max-depth", OptionKind::integer, OptionScope::job, {}, 0, 64, "the scene's render.max_depth",
+  add(t, {"max_depth", "--max-depth", OptionKind::integer, OptionScope::job, {}, 0, 64, "the scene's render.max_depth",
        "bounces", {}, "", "bounces of reflection and refraction", {}},
       [](RenderSetup& s, const json& v) { s.render.max_depth = v.get<int>(); },
       [](const RenderSetup& s) { return unless(s.render.max_depth, -1); });
-  add({"error_target", "--error-target", OptionKind::number, OptionScope::job, {}, 1e-12, 0.5,
+  add(t, {"error_target", "--error-target", OptionKind::number, OptionScope::job, {}, 1e-12, 0.5,
        "the scene's render.error_target", "", all_but_raytrace(), "it picks the cube map's N; the exact tracer has no map",
        "Error_Parallax target: the cube map's N from the bound 1/(2 N^2) of the thesis's error analysis", {}},
       [](RenderSetup& s, const json& v) { s.render.error_target = v.get<double>(); },
       [](const RenderSetup& s) { return s.render.error_target < 0 ? json() : json(s.render.error_target); });
-  add({"target_db", "--target-db", OptionKind::number, OptionScope::job, {}, MIN_TARGET_DB, MAX_TARGET_DB,
+  add(t, {"target_db", "--target-db", OptionKind::number, OptionScope::job, {}, MIN_TARGET_DB, MAX_TARGET_DB,
        "the scene's render.target_db", "dB", {"abuffer"}, "only abuffer chooses its cube map's N from pilot renders",
        "PSNR to reach against the exact tracer: abuffer picks the cube map's N from pilot renders checked against "
        "exact rays (overrides the scene's cube_resolution)", {}},
       [](RenderSetup& s, const json& v) { s.render.target_db = v.get<double>(); },
       [](const RenderSetup& s) { return s.render.target_db < 0 ? json() : json(s.render.target_db); });
-  add({"fresnel", "--fresnel", OptionKind::flag, OptionScope::job, {}, 0, 0, "the scene's render.fresnel", "", {}, "",
+  add(t, {"fresnel", "--fresnel", OptionKind::flag, OptionScope::job, {}, 0, 0, "the scene's render.fresnel", "", {}, "",
        "Schlick weights for reflect and transmit", {}},
       [](RenderSetup& s, const json& v) { s.render.fresnel = v.get<bool>(); },
       [](const RenderSetup& s) { return s.render.fresnel ? json(*s.render.fresnel) : json(); });
+}
 
-  // ---- the camera (only the values given change; the rest come from the scene)
-  add({"width", "--width", OptionKind::integer, OptionScope::job, {}, 1, 32768, "the scene's camera.width", "pixels", {},
+// The camera: only the values given change; the rest come from the scene.
+void add_camera(Table& t) {
+  add(t, {"width", "--width", OptionKind::integer, OptionScope::job, {}, 1, 32768, "the scene's camera.width", "pixels", {},
        "", "image width", {}},
       [](RenderSetup& s, const json& v) { s.render.camera.width = v.get<int>(); },
       [](const RenderSetup& s) { return s.render.camera.width ? json(*s.render.camera.width) : json(); });
-  add({"height", "--height", OptionKind::integer, OptionScope::job, {}, 1, 32768, "the scene's camera.height", "pixels",
+  add(t, {"height", "--height", OptionKind::integer, OptionScope::job, {}, 1, 32768, "the scene's camera.height", "pixels",
        {}, "", "image height", {}},
       [](RenderSetup& s, const json& v) { s.render.camera.height = v.get<int>(); },
       [](const RenderSetup& s) { return s.render.camera.height ? json(*s.render.camera.height) : json(); });
-  add({"size", "--size", OptionKind::text, OptionScope::job, {}, 0, 0, "the scene's camera.width x camera.height",
+  add(t, {"size", "--size", OptionKind::text, OptionScope::job, {}, 0, 0, "the scene's camera.width x camera.height",
        "pixels", {}, "", "image size WxH, e.g. 320x240 (width and height at once)", {}},
       [](RenderSetup& s, const json& v) {
         const std::string text = v.get<std::string>();
@@ -190,23 +195,23 @@ std::vector<Entry> make_table() {
         s.render.camera.height = h;
       },
       [](const RenderSetup&) { return json(); });  // read as width and height
-  add({"fov_y", "--fov", OptionKind::number, OptionScope::job, {}, 1e-6, 179.999999, "the scene's camera.fov_y",
+  add(t, {"fov_y", "--fov", OptionKind::number, OptionScope::job, {}, 1e-6, 179.999999, "the scene's camera.fov_y",
        "degrees", {}, "", "vertical field of view", {}},
       [](RenderSetup& s, const json& v) { s.render.camera.fov_y = v.get<double>(); },
       [](const RenderSetup& s) { return s.render.camera.fov_y ? json(*s.render.camera.fov_y) : json(); });
-  add({"camera_position", "--camera-position", OptionKind::vec3, OptionScope::job, {}, 0, 0, "the scene's camera.position",
+  add(t, {"camera_position", "--camera-position", OptionKind::vec3, OptionScope::job, {}, 0, 0, "the scene's camera.position",
        "world units", {}, "", "where the camera is, X,Y,Z", {}},
-      [vec3_of](RenderSetup& s, const json& v) { s.render.camera.position = vec3_of(v); },
-      [opt_vec3](const RenderSetup& s) { return opt_vec3(s.render.camera.position); });
-  add({"look_at", "--look-at", OptionKind::vec3, OptionScope::job, {}, 0, 0, "the scene's camera.look_at", "world units",
+      [](RenderSetup& s, const json& v) { s.render.camera.position = vec3_of(v); },
+      [](const RenderSetup& s) { return opt_vec3(s.render.camera.position); });
+  add(t, {"look_at", "--look-at", OptionKind::vec3, OptionScope::job, {}, 0, 0, "the scene's camera.look_at", "world units",
        {}, "", "the point the camera looks at, X,Y,Z", {}},
-      [vec3_of](RenderSetup& s, const json& v) { s.render.camera.look_at = vec3_of(v); },
-      [opt_vec3](const RenderSetup& s) { return opt_vec3(s.render.camera.look_at); });
-  add({"up", "--up", OptionKind::vec3, OptionScope::job, {}, 0, 0, "the scene's camera.up", "", {}, "",
+      [](RenderSetup& s, const json& v) { s.render.camera.look_at = vec3_of(v); },
+      [](const RenderSetup& s) { return opt_vec3(s.render.camera.look_at); });
+  add(t, {"up", "--up", OptionKind::vec3, OptionScope::job, {}, 0, 0, "the scene's camera.up", "", {}, "",
        "the camera's up direction, X,Y,Z", {}},
-      [vec3_of](RenderSetup& s, const json& v) { s.render.camera.up = vec3_of(v); },
-      [opt_vec3](const RenderSetup& s) { return opt_vec3(s.render.camera.up); });
-  add({"set", "--set", OptionKind::setting, OptionScope::job, {}, 0, 0, "none", "", {}, "",
+      [](RenderSetup& s, const json& v) { s.render.camera.up = vec3_of(v); },
+      [](const RenderSetup& s) { return opt_vec3(s.render.camera.up); });
+  add(t, {"set", "--set", OptionKind::setting, OptionScope::job, {}, 0, 0, "none", "", {}, "",
        "replace a value of the scene file, KEY=VALUE (VALUE as JSON, else a string): camera.fov_y=30, "
        "render.max_depth=2, lights[0].position=[1,4,2]; repeatable", {}},
       [](RenderSetup& s, const json& v) {
@@ -218,135 +223,156 @@ std::vector<Entry> make_table() {
         for (const SceneOverride& x : s.set) o[x.path] = json::parse(x.value, nullptr, false);
         return o;
       });
+}
 
-  // ---- outputs and the reference
-  add({"aovs", "--aovs", OptionKind::names, OptionScope::job, {"distance", "normal", "object_id", "shadowed", "fallback"}, 0, 0,
+// Outputs and the reference.
+void add_outputs(Table& t) {
+  add(t, {"aovs", "--aovs", OptionKind::names, OptionScope::job, {"distance", "normal", "object_id", "shadowed", "fallback"}, 0, 0,
        "none", "", {}, "", "extra outputs beside the image, comma-separated (OUT_STEM.NAME.exr)", {}},
       [](RenderSetup& s, const json& v) { s.render.aovs = v.get<std::vector<std::string>>(); },
       [](const RenderSetup& s) { return s.render.aovs.empty() ? json() : json(s.render.aovs); });
-  add({"reference", "--reference", OptionKind::flag, OptionScope::job, {}, 0, 0, "false", "", {}, "",
+  add(t, {"reference", "--reference", OptionKind::flag, OptionScope::job, {}, 0, 0, "false", "", {}, "",
        "also trace the exact reference; error figures in the stats", {}},
       [](RenderSetup& s, const json& v) { s.render.reference = v.get<bool>(); },
       [](const RenderSetup& s) { return unless(s.render.reference, false); });
-  add({"reference_image", "--reference-image", OptionKind::path, OptionScope::job, {}, 0, 0, "none", "", {}, "",
+  add(t, {"reference_image", "--reference-image", OptionKind::path, OptionScope::job, {}, 0, 0, "none", "", {}, "",
        "the exact image rendered before (implies reference)", {}},
       [](RenderSetup& s, const json& v) { s.render.reference_image = v.get<std::string>(); },
       [](const RenderSetup& s) { return unless(s.render.reference_image, std::string()); });
-  add({"plan", "--plan", OptionKind::choice, OptionScope::job, {"needed", "everything"}, 0, 0, "needed", "",
+  add(t, {"plan", "--plan", OptionKind::choice, OptionScope::job, {"needed", "everything"}, 0, 0, "needed", "",
        all_but_raytrace(), "the exact tracer skips no pass", "everything: run and time the passes the plan skips", {}},
       [](RenderSetup& s, const json& v) { s.render.plan_everything = v.get<std::string>() == "everything"; },
       [](const RenderSetup& s) { return s.render.plan_everything ? json("everything") : json(); });
+}
 
-  // ---- the map methods
+// The map methods.
+void add_map_methods(Table& t) {
+  const RenderOptions d;  // the defaults
   const char* searches = "map searches: abuffer, zbuffer, envmap, hybrid";
-  add({"search", "--search", OptionKind::choice, OptionScope::job, {"crossing", "thesis"}, 0, 0, d.search, "", MAP_METHODS,
+  add(t, {"search", "--search", OptionKind::choice, OptionScope::job, {"crossing", "thesis"}, 0, 0, d.search, "", MAP_METHODS,
        searches, "map search mode", {}},
       [](RenderSetup& s, const json& v) { s.render.search = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.search, d.search); });
-  add({"refine", "--refine", OptionKind::choice, OptionScope::job, {"mesh", "plane"}, 0, 0, d.refine, "", MAP_METHODS,
+  add(t, {"refine", "--refine", OptionKind::choice, OptionScope::job, {"mesh", "plane"}, 0, 0, d.refine, "", MAP_METHODS,
        searches, "how a crossing is refined", {}},
       [](RenderSetup& s, const json& v) { s.render.refine = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.refine, d.refine); });
-  add({"theta_max_deg", "--theta-max", OptionKind::number, OptionScope::job, {}, 1e-6, 90, format_limit(d.theta_max_deg),
+  add(t, {"theta_max_deg", "--theta-max", OptionKind::number, OptionScope::job, {}, 1e-6, 90, format_limit(d.theta_max_deg),
        "degrees", MAP_METHODS, searches, "the thesis search mode's acceptance angle", {}},
       [](RenderSetup& s, const json& v) { s.render.theta_max_deg = v.get<double>(); },
       [d](const RenderSetup& s) { return unless(s.render.theta_max_deg, d.theta_max_deg); });
-  add({"map_only", "--map-only", OptionKind::flag, OptionScope::job, {}, 0, 0, "false", "", MAP_METHODS, searches,
+  add(t, {"map_only", "--map-only", OptionKind::flag, OptionScope::job, {}, 0, 0, "false", "", MAP_METHODS, searches,
        "searches see only the map: no side structure for the triangles it cannot hold", {}},
       [](RenderSetup& s, const json& v) { s.render.side_structure = !v.get<bool>(); },
       [](const RenderSetup& s) { return s.render.side_structure ? json() : json(true); });
-  add({"refraction", "--refraction", OptionKind::choice, OptionScope::job, {"search", "thick_lens", "thin_lens"}, 0, 0,
+  add(t, {"refraction", "--refraction", OptionKind::choice, OptionScope::job, {"search", "thick_lens", "thin_lens"}, 0, 0,
        d.refraction, "", {"abuffer", "zbuffer", "hybrid"}, "the lens replaces an exit search: abuffer, zbuffer, hybrid",
        "how a ray leaves a refracting object", {}},
       [](RenderSetup& s, const json& v) { s.render.refraction = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.refraction, d.refraction); });
-  add({"envmap_lookup", "--envmap-lookup", OptionKind::choice, OptionScope::job, {"R", "bisector", "position"}, 0, 0,
+  add(t, {"envmap_lookup", "--envmap-lookup", OptionKind::choice, OptionScope::job, {"R", "bisector", "position"}, 0, 0,
        d.envmap_lookup, "", {"envmap", "gpu"}, "environment map lookups: envmap, gpu",
        "the environment map's lookup direction", {}},
       [](RenderSetup& s, const json& v) { s.render.envmap_lookup = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.envmap_lookup, d.envmap_lookup); });
-  add({"shading_points", "--shading-points", OptionKind::choice, OptionScope::job, {"quarters", "one"}, 0, 0,
+  add(t, {"shading_points", "--shading-points", OptionKind::choice, OptionScope::job, {"quarters", "one"}, 0, 0,
        d.shading_points, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
        "shading points per camera fragment: quarters (2 to 4, more where they differ) | one (its centroid)", {}},
       [](RenderSetup& s, const json& v) { s.render.shading_points = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.shading_points, d.shading_points); });
-  add({"shadow_edges", "--shadow-edges", OptionKind::choice, OptionScope::job, {"samples", "points"}, 0, 0,
+  add(t, {"shadow_edges", "--shadow-edges", OptionKind::choice, OptionScope::job, {"samples", "points"}, 0, 0,
        d.shadow_edges, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
        "a shadow's edge inside a camera fragment: samples (searched again from each covered sample where the "
        "shading points disagree) | points (the shading points' answers)",
        {}},
       [](RenderSetup& s, const json& v) { s.render.shadow_edges = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.shadow_edges, d.shadow_edges); });
-  add({"resolve", "--resolve", OptionKind::choice, OptionScope::job, {"exact", "thesis"}, 0, 0, d.resolve, "", MAP_METHODS,
+  add(t, {"resolve", "--resolve", OptionKind::choice, OptionScope::job, {"exact", "thesis"}, 0, 0, d.resolve, "", MAP_METHODS,
        "the CPU A-buffer's resolve: abuffer, zbuffer, envmap, hybrid",
        "intersecting fragments: exact (per-sample priority masks) | thesis (the Vis_front estimate)", {}},
       [](RenderSetup& s, const json& v) { s.render.resolve = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.resolve, d.resolve); });
-  add({"max_layers", "--max-layers", OptionKind::integer, OptionScope::job, {}, 0, 4294967295.0, "0 (all)", "layers",
+  add(t, {"max_layers", "--max-layers", OptionKind::integer, OptionScope::job, {}, 0, 4294967295.0, "0 (all)", "layers",
        MAP_METHODS, "the CPU A-buffer's lists: abuffer, zbuffer, envmap, hybrid", "A-buffer layers kept per list, 0 = all", {}},
       [](RenderSetup& s, const json& v) { s.render.max_layers = v.get<uint32_t>(); },
       [](const RenderSetup& s) { return unless(s.render.max_layers, uint32_t{0}); });
+}
 
-  // ---- the gpu method's camera pass (gpu and hybrid)
+// The camera pass of the gpu and hybrid methods.
+void add_gpu_camera(Table& t) {
+  const RenderOptions d;  // the defaults
   const char* gpu = "the GPU's camera pass: gpu, hybrid";
-  add({"gpu_mirrors", "--gpu-mirrors", OptionKind::choice, OptionScope::job, {"stencil", "envmap"}, 0, 0, d.gpu_mirrors,
+  add(t, {"gpu_mirrors", "--gpu-mirrors", OptionKind::choice, OptionScope::job, {"stencil", "envmap"}, 0, 0, d.gpu_mirrors,
        "", GPU_METHODS, gpu, "planar mirrors by the stencil test (exact) | from the cube texture", {}},
       [](RenderSetup& s, const json& v) { s.render.gpu_mirrors = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.gpu_mirrors, d.gpu_mirrors); });
-  add({"gpu_shadows", "--gpu-shadows", OptionKind::choice, OptionScope::job, {"volumes", "maps"}, 0, 0, d.gpu_shadows, "",
+  add(t, {"gpu_shadows", "--gpu-shadows", OptionKind::choice, OptionScope::job, {"volumes", "maps"}, 0, 0, d.gpu_shadows, "",
        GPU_METHODS, gpu, "shadow volumes (exact) | cube shadow maps", {}},
       [](RenderSetup& s, const json& v) { s.render.gpu_shadows = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.gpu_shadows, d.gpu_shadows); });
-  add({"gpu_max_views", "--gpu-max-views", OptionKind::integer, OptionScope::job, {}, 0, 1 << 20,
+  add(t, {"gpu_max_views", "--gpu-max-views", OptionKind::integer, OptionScope::job, {}, 0, 1 << 20,
        std::to_string(d.gpu_max_views), "views", GPU_METHODS, gpu,
        "mirror views drawn per camera tile, at most (a mirror past it shows the cube texture)", {}},
       [](RenderSetup& s, const json& v) { s.render.gpu_max_views = v.get<int>(); },
       [d](const RenderSetup& s) { return unless(s.render.gpu_max_views, d.gpu_max_views); });
-  add({"gpu_shading", "--gpu-shading", OptionKind::choice, OptionScope::job, {"pixels", "samples"}, 0, 0, d.gpu_shading,
+  add(t, {"gpu_shading", "--gpu-shading", OptionKind::choice, OptionScope::job, {"pixels", "samples"}, 0, 0, d.gpu_shading,
        "", GPU_METHODS, gpu, "shade once a pixel and surface (samples grouped) | once a sample", {}},
       [](RenderSetup& s, const json& v) { s.render.gpu_shading = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.gpu_shading, d.gpu_shading); });
+}
 
-  // ---- resources and limits
-  add({"threads", "--threads", OptionKind::integer, OptionScope::job, {}, 0, 4096, "0 (every core)", "threads", {}, "",
+// Resources and limits.
+void add_resources(Table& t) {
+  const RendererOptions rd;
+  add(t, {"threads", "--threads", OptionKind::integer, OptionScope::job, {}, 0, 4096, "0 (every core)", "threads", {}, "",
        "worker threads, 0 = every core", {}},
       [](RenderSetup& s, const json& v) {
         s.render.threads = v.get<int>();
         s.renderer.threads = v.get<int>();
       },
       [](const RenderSetup& s) { return unless(s.render.threads, 0); });
-  add({"timeout", "--timeout", OptionKind::number, OptionScope::job, {}, 0, 1e9, "0 (no limit)", "seconds", {}, "",
+  add(t, {"timeout", "--timeout", OptionKind::number, OptionScope::job, {}, 0, 1e9, "0 (no limit)", "seconds", {}, "",
        "stop the render past this many seconds (exit 1), 0 = no limit", {}},
       [](RenderSetup& s, const json& v) { s.render.timeout_s = v.get<double>(); },
       [](const RenderSetup& s) { return unless(s.render.timeout_s, 0.0); });
-  add({"max_memory", "--max-memory", OptionKind::integer, OptionScope::job, {}, 0, 1073741824.0, "0 (the memory available)",
+  add(t, {"max_memory", "--max-memory", OptionKind::integer, OptionScope::job, {}, 0, 1073741824.0, "0 (the memory available)",
        "MiB", {}, "", "the whole render's memory budget (scene, A-buffers, maps, images)", {"max_memory_mib"}},
       [](RenderSetup& s, const json& v) {
         s.render.max_memory_mib = v.get<uint64_t>();
         s.limits.max_memory_mib = v.get<uint64_t>();  // the scene's triangles are checked as they load
       },
       [](const RenderSetup& s) { return unless(s.render.max_memory_mib, uint64_t{0}); });
-  add({"max_pixels", "--max-pixels", OptionKind::integer, OptionScope::job, {}, 0, 9.0e15, "0 (no cap)", "pixels", {}, "",
+  add(t, {"max_pixels", "--max-pixels", OptionKind::integer, OptionScope::job, {}, 0, 9.0e15, "0 (no cap)", "pixels", {}, "",
        "refuse a larger camera image", {}},
       [](RenderSetup& s, const json& v) { s.render.max_pixels = v.get<uint64_t>(); },
       [](const RenderSetup& s) { return unless(s.render.max_pixels, uint64_t{0}); });
-  add({"max_triangles", "--max-triangles", OptionKind::integer, OptionScope::scene, {}, 0, 9.0e15, "0 (no cap)",
+  add(t, {"max_triangles", "--max-triangles", OptionKind::integer, OptionScope::scene, {}, 0, 9.0e15, "0 (no cap)",
        "triangles", {}, "", "refuse a scene with more triangles", {}},
       [](RenderSetup& s, const json& v) { s.limits.max_triangles = v.get<uint64_t>(); },
       [](const RenderSetup& s) { return unless(s.limits.max_triangles, uint64_t{0}); });
-  add({"root", "--root", OptionKind::path, OptionScope::scene, {}, 0, 0, "anywhere", "", {}, "",
+  add(t, {"root", "--root", OptionKind::path, OptionScope::scene, {}, 0, 0, "anywhere", "", {}, "",
        "untrusted scenes: every file they reference must resolve inside this folder", {}},
       [](RenderSetup& s, const json& v) { s.limits.root = v.get<std::string>(); },
       [](const RenderSetup& s) { return unless(s.limits.root, std::string()); });
-  add({"gl", "--gl", OptionKind::choice, OptionScope::process,
+  add(t, {"gl", "--gl", OptionKind::choice, OptionScope::process,
        {"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"}, 0, 0, rd.gl, "", {}, "",
        "GL path (auto: EGL device, EGL surfaceless, OSMesa, then none)", {}},
       [](RenderSetup& s, const json& v) { s.renderer.gl = v.get<std::string>(); },
       [rd](const RenderSetup& s) { return unless(s.renderer.gl, rd.gl); });
-  add({"gl_device", "--gl-device", OptionKind::integer, OptionScope::process, {}, 0, 1024,
+  add(t, {"gl_device", "--gl-device", OptionKind::integer, OptionScope::process, {}, 0, 1024,
        "ABCUBE_EGL_DEVICE, else the first GPU", "", {}, "", "EGL device index", {}},
       [](RenderSetup& s, const json& v) { s.renderer.gl_device = v.get<int>(); },
       [rd](const RenderSetup& s) { return unless(s.renderer.gl_device, rd.gl_device); });
+}
+
+std::vector<Entry> make_table() {
+  Table t;
+  add_what_to_render(t);
+  add_camera(t);
+  add_outputs(t);
+  add_map_methods(t);
+  add_gpu_camera(t);
+  add_resources(t);
   return t;
 }
 // clang-format on

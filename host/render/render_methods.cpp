@@ -143,6 +143,53 @@ void copy_pixels(const Image& from, const std::vector<uint8_t>& mask, Image* to)
 
 }  // namespace
 
+namespace {
+
+// The hybrid method's pixels the GPU kept but where its snapped vertices may have decided a
+// sample unlike the exact rules (edge_ties.hpp: exact only up to its sub-pixel grid): their
+// surfaces are all exact ones, so the exact tracer renders them into `image`. Returns how
+// many.
+size_t trace_edge_ties(MethodContext& mc, const std::vector<uint8_t>& on_gpu, Image* image) {
+  const Clock::time_point t0 = Clock::now();
+  std::vector<uint8_t> traced = edge_tie_pixels(mc.scene);
+  size_t traced_pixels = 0;
+  for (size_t p = 0; p < traced.size(); ++p) {
+    traced[p] = traced[p] && on_gpu[p] ? 1 : 0;
+    traced_pixels += traced[p];
+  }
+  mc.stats["timings_ms"]["edge_ties"] = ms_since(t0);
+  if (traced_pixels == 0) return 0;
+  RaytraceOptions options;
+  options.threads = mc.request.threads;
+  options.bvh = mc.cache.bvh();
+  options.only = &traced;
+  const Clock::time_point t1 = Clock::now();
+  const Image part = render_raytrace(mc.scene, options, nullptr);
+  mc.stats["timings_ms"]["edge_ties_traced"] = ms_since(t1);
+  copy_pixels(part, traced, image);
+  return traced_pixels;
+}
+
+// The abuffer method for the pixels `only` marks (null: every pixel, `image` replaced),
+// copied into `image`; its timings as "cpu.*", and its stats returned.
+json render_cpu_pixels(MethodContext& mc, const std::vector<uint8_t>* only, Image* image) {
+  json cpu_stats, out;
+  MethodContext cpu_mc{mc.scene, mc.cache, mc.request, cpu_stats, mc.progress, nullptr, {}, mc.fallback};
+  const Image part = render_map_method(cpu_mc, only);
+  if (only) {
+    copy_pixels(part, *only, image);
+  } else {
+    *image = part;
+  }
+  for (const auto& [k, v] : cpu_stats["timings_ms"].items()) mc.stats["timings_ms"]["cpu." + k] = v;
+  for (const char* key : {"plan", "cube_abuffer", "abuffer", "searches"}) {
+    if (cpu_stats.contains(key)) out[key] = cpu_stats[key];
+  }
+  return out;
+}
+
+}  // namespace
+
 // HYBRID: each kind of surface by the path that is exact and cheaper. The GPU renders the
 // camera view by its exact camera pass (planar mirrors by the stencil test, opaque shadows
 // by volumes, textures point-sampled as the CPU does), building no cube map at all; each
@@ -175,28 +222,11 @@ Image render_hybrid(MethodContext& mc) {
   // The pixels the GPU would have kept but where its snapped vertices may have decided a
   // sample unlike the exact rules (edge_ties.hpp: exact only up to its sub-pixel grid):
   // their surfaces are all exact ones, so the exact tracer renders them.
-  std::vector<uint8_t> traced;
   size_t traced_pixels = 0;
   if (exact_pass) {
     const std::vector<uint8_t>& on_gpu = gl.exact_pixels();
     for (size_t p = 0; p < cpu.size(); ++p) cpu[p] = on_gpu[p] ? 0 : 1;
-    const Clock::time_point t0 = Clock::now();
-    traced = edge_tie_pixels(scene);
-    for (size_t p = 0; p < cpu.size(); ++p) {
-      traced[p] = traced[p] && on_gpu[p] ? 1 : 0;
-      traced_pixels += traced[p];
-    }
-    stats["timings_ms"]["edge_ties"] = ms_since(t0);
-  }
-  if (traced_pixels > 0) {
-    RaytraceOptions options;
-    options.threads = mc.request.threads;
-    options.bvh = mc.cache.bvh();
-    options.only = &traced;
-    const Clock::time_point t0 = Clock::now();
-    const Image part = render_raytrace(scene, options, nullptr);
-    stats["timings_ms"]["edge_ties_traced"] = ms_since(t0);
-    copy_pixels(part, traced, &image);
+    traced_pixels = trace_edge_ties(mc, on_gpu, &image);
   }
   const size_t cpu_pixels = static_cast<size_t>(std::count(cpu.begin(), cpu.end(), 1));
   const GpuTimings& t = gl.timings();
@@ -213,16 +243,8 @@ Image render_hybrid(MethodContext& mc) {
                  {"pixels_traced_edge_ties", traced_pixels}};
   if (!exact_pass) hybrid["why_all_cpu"] = ex.mirrors_why.empty() ? ex.volumes_why : ex.mirrors_why;
   if (cpu_pixels > 0) {
-    // The abuffer method for those pixels alone (its stats under "cpu").
-    json cpu_stats;
-    MethodContext cpu_mc{scene, mc.cache, mc.request, cpu_stats, mc.progress, nullptr, {}, mc.fallback};
-    const Image part = render_map_method(cpu_mc, exact_pass ? &cpu : nullptr);
-    if (!exact_pass) image = part;
-    if (exact_pass) copy_pixels(part, cpu, &image);
-    for (const auto& [k, v] : cpu_stats["timings_ms"].items()) stats["timings_ms"]["cpu." + k] = v;
-    for (const char* key : {"plan", "cube_abuffer", "abuffer", "searches"}) {
-      if (cpu_stats.contains(key)) hybrid["cpu"][key] = cpu_stats[key];
-    }
+    const json cpu_stats = render_cpu_pixels(mc, exact_pass ? &cpu : nullptr, &image);
+    if (!cpu_stats.is_null()) hybrid["cpu"] = cpu_stats;
   } else {
     hybrid["cpu"] = "skipped: every pixel is exact on the GPU (no cube map built)";
   }

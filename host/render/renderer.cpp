@@ -196,6 +196,28 @@ RenderStats render_stats(const json& stats, int built, std::optional<double> psn
   return rs;
 }
 
+// The render's time limit from `start` (none when timeout_s is 0).
+Deadline render_deadline(Clock::time_point start, double timeout_s) {
+  if (timeout_s < 0 || std::isnan(timeout_s)) {
+    throw InputError("timeout: must be >= 0 seconds, got " + std::to_string(timeout_s));
+  }
+  Deadline deadline;
+  if (timeout_s > 0) {
+    deadline.seconds = timeout_s;
+    deadline.at = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  }
+  return deadline;
+}
+
+// What a render built of the per-scene data, between the cache's counts `before` and `after`.
+json scene_data_stats(const SceneCache::Builds& before, const SceneCache::Builds& after, int built, double load_ms) {
+  return {{"built_by_this_render", built},
+          {"scene_load_ms", load_ms},
+          {"mesh_neighbours", {{"built", after.neighbours - before.neighbours}, {"ms", after.neighbours_ms}}},
+          {"lens_fits", {{"built", after.lenses - before.lenses}, {"ms", after.lenses_ms}}},
+          {"bvh", {{"built", after.bvh - before.bvh}, {"ms", after.bvh_ms}}}};
+}
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -235,6 +257,34 @@ struct Renderer::Impl {
     }
     return *gl_scene;
   }
+
+  // The gpu and hybrid methods: GL opened (a clear error where no path works), the scene
+  // uploaded unless it is the last one's, then the method.
+  Image render_on_gl(const Scene& scene, MethodContext& mc) {
+    const SceneData& view = mc.scene;
+    json& stats = mc.stats;
+    const Clock::time_point t0 = Clock::now();
+    const bool first_open = !gl_tried;
+    GlContext* ctx = open_gl();
+    const std::string which = std::string("--method ") + method_name(view.render.method);
+    if (!ctx) {
+      if (gl_choice == GlChoice::none) throw InputError(which + " needs OpenGL, but --gl none was given");
+      std::string log = gl_log;
+      for (char& c : log) c = c == '\n' ? ';' : c;
+      throw RuntimeFailure(which + " needs OpenGL and no GL path works here: " + log);
+    }
+    stats["gl"] = gl_json(ctx);
+    stats["timings_ms"]["gl_init"] = first_open ? ms_since(t0) : 0.0;
+    check_gl_limits(view);  // before the upload
+    bool uploaded = false;
+    mc.gl_scene = &gl_scene_for(scene, &uploaded);
+    // The soup's positions and normals as the GL's vertex buffers: the same memory, or a copy.
+    stats["gl"]["scene_buffers"] = mc.gl_scene->soup_pinned() ? "pinned" : "copied";
+    // Each triangle's ids: read by the vertex stage from the soup's arrays, or carried by every vertex.
+    stats["gl"]["scene_ids"] = mc.gl_scene->triangle_ids() ? "per triangle" : "per vertex";
+    if (!uploaded) mc.gl_before = mc.gl_scene->timings();  // else its upload is this render's
+    return view.render.method == Method::gpu ? render_gpu(mc) : render_hybrid(mc);
+  }
 };
 
 Renderer::Renderer(const RendererOptions& options) : impl_(std::make_unique<Impl>()) {
@@ -271,14 +321,7 @@ bool stop_requested() { return stop_request().load(std::memory_order_relaxed) !=
 RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) {
   const std::lock_guard<std::mutex> lock(impl_->mutex);
   const Clock::time_point start = Clock::now();
-  Deadline deadline;
-  if (options.timeout_s < 0 || std::isnan(options.timeout_s)) {
-    throw InputError("timeout: must be >= 0 seconds, got " + std::to_string(options.timeout_s));
-  }
-  if (options.timeout_s > 0) {
-    deadline.seconds = options.timeout_s;
-    deadline.at = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.timeout_s));
-  }
+  const Deadline deadline = render_deadline(start, options.timeout_s);
   const ScopedDeadline scope(options.timeout_s > 0 ? &deadline : nullptr);
 
   SceneData view;
@@ -292,30 +335,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   Image image;
   switch (view.render.method) {
     case Method::gpu:
-    case Method::hybrid: {
-      const Clock::time_point t0 = Clock::now();
-      const bool first_open = !impl_->gl_tried;
-      GlContext* ctx = impl_->open_gl();
-      const std::string which = std::string("--method ") + method_name(view.render.method);
-      if (!ctx) {
-        if (impl_->gl_choice == GlChoice::none) throw InputError(which + " needs OpenGL, but --gl none was given");
-        std::string log = impl_->gl_log;
-        for (char& c : log) c = c == '\n' ? ';' : c;
-        throw RuntimeFailure(which + " needs OpenGL and no GL path works here: " + log);
-      }
-      stats["gl"] = gl_json(ctx);
-      stats["timings_ms"]["gl_init"] = first_open ? ms_since(t0) : 0.0;
-      check_gl_limits(view);  // before the upload
-      bool uploaded = false;
-      mc.gl_scene = &impl_->gl_scene_for(scene, &uploaded);
-      // The soup's positions and normals as the GL's vertex buffers: the same memory, or a copy.
-      stats["gl"]["scene_buffers"] = mc.gl_scene->soup_pinned() ? "pinned" : "copied";
-      // Each triangle's ids: read by the vertex stage from the soup's arrays, or carried by every vertex.
-      stats["gl"]["scene_ids"] = mc.gl_scene->triangle_ids() ? "per triangle" : "per vertex";
-      if (!uploaded) mc.gl_before = mc.gl_scene->timings();  // else its upload is this render's
-      image = view.render.method == Method::gpu ? render_gpu(mc) : render_hybrid(mc);
-      break;
-    }
+    case Method::hybrid: image = impl_->render_on_gl(scene, mc); break;
     case Method::abuffer:
     case Method::zbuffer:
     case Method::envmap:
@@ -341,12 +361,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   // What this render built of the per-scene data (0 when an earlier render did).
   const SceneCache::Builds after = scene.cache().builds();
   const int built = (after.neighbours - before.neighbours) + (after.lenses - before.lenses) + (after.bvh - before.bvh);
-  stats["scene_data"] = {
-      {"built_by_this_render", built},
-      {"scene_load_ms", scene.load_ms()},
-      {"mesh_neighbours", {{"built", after.neighbours - before.neighbours}, {"ms", after.neighbours_ms}}},
-      {"lens_fits", {{"built", after.lenses - before.lenses}, {"ms", after.lenses_ms}}},
-      {"bvh", {{"built", after.bvh - before.bvh}, {"ms", after.bvh_ms}}}};
+  stats["scene_data"] = scene_data_stats(before, after, built, scene.load_ms());
   ++impl_->renders;
   stats["renderer"] = {{"renders", impl_->renders}};
   stats["timings_ms"]["total"] = ms_since(start);
