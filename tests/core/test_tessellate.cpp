@@ -1,0 +1,140 @@
+// The primitives' tessellation and the object transform (cpu_core/scene/tessellate.cpp),
+// through the loader: known answers for boxes, spheres and transforms, and the closed-surface
+// test.
+#include "scene_load_fixtures.hpp"
+
+namespace abcube {
+namespace {
+
+using namespace scene_test;
+
+// ---- Geometry --------------------------------------------------------------------------
+
+TEST(SceneLoadGeometry, ZeroAreaTrianglesAreDroppedAndCounted) {
+  const SceneData s = load_text(with_objects(R"([
+      {"type": "triangle", "vertices": [[0,0,0],[1,1,1],[2,2,2]]},
+      {"type": "triangle", "vertices": [[0,0,0],[0,0,0],[1,0,0]]},
+      {"type": "quad", "vertices": [[0,0,0],[1,0,0],[2,0,0],[0,1,0]]},
+      {"type": "triangle", "vertices": [[1e30,0,0],[0,1e30,0],[0,0,1e30]], "transform": {"scale": 1e30}},
+      {"type": "triangle", "vertices": [[0,0,0],[1e-6,0,0],[0,1e-6,0]]},
+      {"type": "triangle", "vertices": [[0,0,0],[1e6,0,0],[0,1e6,0]]}])")
+                                    .str());
+  ASSERT_EQ(s.objects.size(), 6u);
+  EXPECT_EQ(s.dropped_triangles, 4u);  // collinear, repeated vertex, half the quad, overflow
+  const uint32_t expected[6] = {0, 0, 1, 0, 1, 1};
+  for (size_t i = 0; i < 6; ++i) EXPECT_EQ(s.objects[i].triangle_count, expected[i]) << i;
+  EXPECT_EQ(s.triangles->triangle_count(), 3u);
+  EXPECT_FALSE(s.objects[0].closed);
+}
+
+TEST(SceneLoadGeometry, BoxIsClosedWithOutwardFlatNormals) {
+  const SceneData s = load_text(with_objects(R"([{"type": "box", "min": [-1,0,2], "max": [0,2,5]}])").str());
+  const SceneObject& box = s.objects[0];
+  EXPECT_EQ(box.triangle_count, 12u);
+  EXPECT_TRUE(box.closed);
+  EXPECT_TRUE(edges_shared_twice(s, box));
+  EXPECT_NEAR(object_volume(s, box), 1.0 * 2.0 * 3.0, 1e-9);
+  const glm::dvec3 center(-0.5, 1, 3.5);
+  for (size_t t = 0; t < 12; ++t) {
+    const glm::dvec3 n = geometric_normal(s, t);
+    const glm::dvec3 mid = (corner(s, t, 0) + corner(s, t, 1) + corner(s, t, 2)) / 3.0;
+    EXPECT_GT(glm::dot(n, mid - center), 0.0) << t;                             // outward
+    EXPECT_NEAR(std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z), 1.0, 1e-12);  // axis-aligned
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(glm::length(glm::dvec3(s.triangles->normals[3 * t + static_cast<size_t>(k)]) - n), 0.0, 1e-6);
+    }
+  }
+}
+
+TEST(SceneLoadGeometry, SphereIsClosedWithOutwardSmoothNormals) {
+  for (int segments : {3, 7, 32, 65}) {
+    const std::string objects =
+        R"([{"type": "sphere", "center": [1,2,3], "radius": 2, "segments": )" + std::to_string(segments) + "}]";
+    const SceneData s = load_text(with_objects(objects).str());
+    const SceneObject& o = s.objects[0];
+    const int rings = std::max(2, segments / 2);
+    EXPECT_EQ(o.triangle_count, static_cast<uint32_t>(2 * segments * (rings - 1))) << segments;
+    EXPECT_TRUE(o.closed) << segments;
+    EXPECT_TRUE(edges_shared_twice(s, o)) << segments;
+    const double v = object_volume(s, o), ball = 4.0 / 3.0 * M_PI * 8.0;
+    EXPECT_GT(v, 0.0);
+    EXPECT_LT(v, ball);  // inscribed polyhedron
+    if (segments >= 32) EXPECT_GT(v, 0.97 * ball) << segments;
+    const glm::dvec3 c(1, 2, 3);
+    for (size_t t = 0; t < o.triangle_count; ++t) {
+      const glm::dvec3 g = geometric_normal(s, t);
+      for (int k = 0; k < 3; ++k) {
+        const glm::dvec3 p = corner(s, t, k);
+        const glm::dvec3 n(s.triangles->normals[3 * t + static_cast<size_t>(k)]);
+        EXPECT_NEAR(glm::length(p - c), 2.0, 1e-5);
+        EXPECT_NEAR(glm::length(n - glm::normalize(p - c)), 0.0, 1e-5);
+        EXPECT_GT(glm::dot(n, g), 0.0);  // smooth and geometric normals agree on outside
+      }
+    }
+  }
+  // The default is 32 segments.
+  EXPECT_EQ(load_text(SceneText().str()).objects[0].triangle_count, 2u * 32 * 15);
+}
+
+TEST(SceneLoadGeometry, TransformScalesThenRotatesXYZThenTranslates) {
+  // (1,2,3) scaled by (2,3,4) is (2,6,12); 90 degrees about x: (2,-12,6); about y: (6,-12,-2);
+  // about z: (12,6,-2); translated by (10,20,30): (22,26,28).
+  const SceneData s = load_text(with_objects(R"([{"type": "triangle", "vertices": [[1,2,3],[2,2,3],[1,3,3]],
+      "transform": {"scale": [2,3,4], "rotate_deg": [90,90,90], "translate": [10,20,30]}}])")
+                                    .str());
+  ASSERT_EQ(s.triangles->triangle_count(), 1u);
+  const glm::dvec3 p = corner(s, 0, 0);
+  EXPECT_NEAR(p.x, 22, 1e-5);
+  EXPECT_NEAR(p.y, 26, 1e-5);
+  EXPECT_NEAR(p.z, 28, 1e-5);
+  // The triangle's normal +z goes through the same rotations: z -> -y -> -y -> +x.
+  const glm::dvec3 n(s.triangles->normals[0]);
+  EXPECT_NEAR(glm::length(n - glm::dvec3(1, 0, 0)), 0.0, 1e-6);
+  EXPECT_NEAR(glm::length(geometric_normal(s, 0) - glm::dvec3(1, 0, 0)), 0.0, 1e-6);
+}
+
+TEST(SceneLoadGeometry, MirroringTransformKeepsNormalsOutward) {
+  const SceneData s = load_text(with_objects(R"([
+      {"type": "box", "min": [0,0,0], "max": [1,2,3], "transform": {"scale": [-1,1,1]}},
+      {"type": "triangle", "vertices": [[0,0,0],[1,0,0],[0,1,0]], "transform": {"scale": [1,1,-2]}},
+      {"type": "sphere", "center": [0,0,0], "radius": 1, "transform": {"scale": [2,-1,1]}}])")
+                                    .str());
+  EXPECT_TRUE(s.objects[0].closed);
+  EXPECT_NEAR(object_volume(s, s.objects[0]), 6.0, 1e-9);
+  // The triangle faced +z; mirrored in z, the surface it becomes still faces the side its
+  // normal maps to: the inverse transpose of diag(1,1,-2) takes +z to -z.
+  EXPECT_NEAR(glm::length(geometric_normal(s, s.objects[1].first_triangle) - glm::dvec3(0, 0, -1)), 0.0, 1e-6);
+  // Ellipsoid x/2, -y, z: normals by the inverse transpose, n ~ (p.x/4, p.y, p.z).
+  const SceneObject& e = s.objects[2];
+  EXPECT_TRUE(e.closed);
+  EXPECT_GT(object_volume(s, e), 0.0);
+  for (size_t t = e.first_triangle; t < e.first_triangle + e.triangle_count; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3 p = corner(s, t, k);
+      const glm::dvec3 n(s.triangles->normals[3 * t + static_cast<size_t>(k)]);
+      EXPECT_NEAR(glm::length(n - glm::normalize(glm::dvec3(p.x / 4, p.y, p.z))), 0.0, 1e-5);
+    }
+  }
+}
+
+TEST(SceneLoadGeometry, QuarterTurnsKeepBoxesAxisAligned) {
+  const SceneData s = load_text(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,2,3],
+      "transform": {"rotate_deg": [0,90,0]}}])")
+                                    .str());
+  const Bounds b = s.bounds();
+  EXPECT_EQ(b.lo, glm::dvec3(0, 0, -1));
+  EXPECT_EQ(b.hi, glm::dvec3(3, 2, 0));
+}
+
+// ---- Tessellation helpers --------------------------------------------------------------
+
+TEST(Tessellate, ClosedSurfaceNeedsConsistentOrientation) {
+  SceneData s = load_text(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1]}])").str());
+  EXPECT_TRUE(is_closed_surface(*s.triangles, 0, 12));
+  EXPECT_FALSE(is_closed_surface(*s.triangles, 0, 11));                         // a hole
+  std::swap(s.triangles.edit().positions[1], s.triangles.edit().positions[2]);  // one face turned over
+  EXPECT_FALSE(is_closed_surface(*s.triangles, 0, 12));
+}
+
+}  // namespace
+}  // namespace abcube
