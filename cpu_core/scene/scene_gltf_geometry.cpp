@@ -166,6 +166,65 @@ void GltfReader::visit(int index, const glm::dmat4& parent, const std::string& f
   (*on_path)[static_cast<size_t>(index)] = false;
 }
 
+// Where `count` elements of `element` bytes start in bufferView `view` at `offset`, and their
+// stride; refused (at `vat`) unless they lie inside the view and the view inside its buffer.
+const unsigned char* GltfReader::view_bytes(int view, size_t offset, size_t count, size_t element, size_t* stride,
+                                            const std::string& vat) const {
+  if (view < 0 || static_cast<size_t>(view) >= model_.bufferViews.size()) {
+    bad(vat, "bufferView " + std::to_string(view) + " out of range");
+  }
+  const tg::BufferView& bv = model_.bufferViews[static_cast<size_t>(view)];
+  if (bv.buffer < 0 || static_cast<size_t>(bv.buffer) >= model_.buffers.size()) {
+    bad(vat, "bufferViews[" + std::to_string(view) + "].buffer out of range");
+  }
+  const tg::Buffer& buf = model_.buffers[static_cast<size_t>(bv.buffer)];
+  if (bv.byteOffset > buf.data.size() || bv.byteLength > buf.data.size() - bv.byteOffset) {
+    bad(vat, "bufferViews[" + std::to_string(view) + "] runs past the end of its buffer (" +
+                 std::to_string(buf.data.size()) + " bytes)");
+  }
+  *stride = bv.byteStride ? bv.byteStride : element;
+  if (*stride < element) bad(vat, "byteStride " + std::to_string(*stride) + " is less than an element's bytes");
+  if (count > 0 && (offset > bv.byteLength || (count - 1) > (bv.byteLength - offset) / *stride ||
+                    (count - 1) * *stride + element > bv.byteLength - offset)) {
+    bad(vat, std::to_string(count) + " elements run past the end of bufferViews[" + std::to_string(view) + "] (" +
+                 std::to_string(bv.byteLength) + " bytes)");
+  }
+  return buf.data.data() + bv.byteOffset + offset;
+}
+
+// The accessor's sparse substitution (glTF 3.6.2.3) applied to its values.
+void GltfReader::apply_sparse(const tg::Accessor& a, const std::string& aat, size_t elem, Accessed* accessed) const {
+  Accessed& out = *accessed;
+  const size_t n = a.sparse.count < 0 ? 0 : static_cast<size_t>(a.sparse.count);
+  const int ict = a.sparse.indices.componentType;
+  if (ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+      ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
+    bad(aat + ".sparse.indices",
+        std::string("componentType ") + component_name(ict) + ", expected an unsigned integer");
+  }
+  size_t istride = 0, vstride = 0;
+  const unsigned char* ip =
+      view_bytes(a.sparse.indices.bufferView, static_cast<size_t>(std::max(0, a.sparse.indices.byteOffset)), n,
+                 component_bytes(ict), &istride, aat + ".sparse.indices");
+  const unsigned char* vp =
+      view_bytes(a.sparse.values.bufferView, static_cast<size_t>(std::max(0, a.sparse.values.byteOffset)), n, elem,
+                 &vstride, aat + ".sparse.values");
+  istride = component_bytes(ict);  // sparse data is tightly packed
+  vstride = elem;
+  for (size_t i = 0; i < n; ++i) {
+    const double target = read_component(ip + i * istride, ict, false);
+    if (target >= static_cast<double>(a.count)) {
+      bad(aat + ".sparse.indices",
+          "index " + format_number(target) + " out of range (" + std::to_string(a.count) + " elements)");
+    }
+    for (int k = 0; k < out.n; ++k) {
+      out.values[static_cast<size_t>(target) * static_cast<size_t>(out.n) + static_cast<size_t>(k)] =
+          read_component(vp + i * vstride + static_cast<size_t>(k) * component_bytes(a.componentType),
+                         a.componentType, a.normalized);
+    }
+  }
+}
+
 // The accessor's elements as doubles (normalized integers mapped), checked against the
 // types allowed and against its buffer view and buffer.
 Accessed GltfReader::read_accessor(int index, const std::string& at, std::initializer_list<int> types,
@@ -195,29 +254,6 @@ Accessed GltfReader::read_accessor(int index, const std::string& at, std::initia
   const size_t elem = component_bytes(a.componentType) * static_cast<size_t>(out.n);
   if (a.count > 3 * MAX_TRIANGLES) bad(aat, "count " + std::to_string(a.count) + " is more than this program holds");
   out.values.assign(a.count * static_cast<size_t>(out.n), 0.0);  // no bufferView: zeros (glTF 3.6.2.3)
-  const auto view_bytes = [&](int view, size_t offset, size_t count, size_t element, size_t* stride,
-                              const std::string& vat) -> const unsigned char* {
-    if (view < 0 || static_cast<size_t>(view) >= model_.bufferViews.size()) {
-      bad(vat, "bufferView " + std::to_string(view) + " out of range");
-    }
-    const tg::BufferView& bv = model_.bufferViews[static_cast<size_t>(view)];
-    if (bv.buffer < 0 || static_cast<size_t>(bv.buffer) >= model_.buffers.size()) {
-      bad(vat, "bufferViews[" + std::to_string(view) + "].buffer out of range");
-    }
-    const tg::Buffer& buf = model_.buffers[static_cast<size_t>(bv.buffer)];
-    if (bv.byteOffset > buf.data.size() || bv.byteLength > buf.data.size() - bv.byteOffset) {
-      bad(vat, "bufferViews[" + std::to_string(view) + "] runs past the end of its buffer (" +
-                   std::to_string(buf.data.size()) + " bytes)");
-    }
-    *stride = bv.byteStride ? bv.byteStride : element;
-    if (*stride < element) bad(vat, "byteStride " + std::to_string(*stride) + " is less than an element's bytes");
-    if (count > 0 && (offset > bv.byteLength || (count - 1) > (bv.byteLength - offset) / *stride ||
-                      (count - 1) * *stride + element > bv.byteLength - offset)) {
-      bad(vat, std::to_string(count) + " elements run past the end of bufferViews[" + std::to_string(view) + "] (" +
-                   std::to_string(bv.byteLength) + " bytes)");
-    }
-    return buf.data.data() + bv.byteOffset + offset;
-  };
   if (a.bufferView >= 0) {
     size_t stride = 0;
     const unsigned char* p = view_bytes(a.bufferView, a.byteOffset, a.count, elem, &stride, aat);
@@ -229,36 +265,7 @@ Accessed GltfReader::read_accessor(int index, const std::string& at, std::initia
       }
     }
   }
-  if (a.sparse.isSparse) {
-    const size_t n = a.sparse.count < 0 ? 0 : static_cast<size_t>(a.sparse.count);
-    const int ict = a.sparse.indices.componentType;
-    if (ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-        ict != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
-      bad(aat + ".sparse.indices",
-          std::string("componentType ") + component_name(ict) + ", expected an unsigned integer");
-    }
-    size_t istride = 0, vstride = 0;
-    const unsigned char* ip =
-        view_bytes(a.sparse.indices.bufferView, static_cast<size_t>(std::max(0, a.sparse.indices.byteOffset)), n,
-                   component_bytes(ict), &istride, aat + ".sparse.indices");
-    const unsigned char* vp =
-        view_bytes(a.sparse.values.bufferView, static_cast<size_t>(std::max(0, a.sparse.values.byteOffset)), n, elem,
-                   &vstride, aat + ".sparse.values");
-    istride = component_bytes(ict);  // sparse data is tightly packed
-    vstride = elem;
-    for (size_t i = 0; i < n; ++i) {
-      const double target = read_component(ip + i * istride, ict, false);
-      if (target >= static_cast<double>(a.count)) {
-        bad(aat + ".sparse.indices",
-            "index " + format_number(target) + " out of range (" + std::to_string(a.count) + " elements)");
-      }
-      for (int k = 0; k < out.n; ++k) {
-        out.values[static_cast<size_t>(target) * static_cast<size_t>(out.n) + static_cast<size_t>(k)] =
-            read_component(vp + i * vstride + static_cast<size_t>(k) * component_bytes(a.componentType),
-                           a.componentType, a.normalized);
-      }
-    }
-  }
+  if (a.sparse.isSparse) apply_sparse(a, aat, elem, &out);
   for (size_t i = 0; i < out.values.size(); ++i) {
     if (!std::isfinite(out.values[i])) {
       bad(aat, "element " + std::to_string(i / static_cast<size_t>(out.n)) + " is not finite (" +

@@ -113,6 +113,9 @@ class GltfReader {
 
   // The accessor's elements as doubles (normalized integers mapped), checked against the
   // types allowed and against its buffer view and buffer.
+  const unsigned char* view_bytes(int view, size_t offset, size_t count, size_t element, size_t* stride,
+                                  const std::string& vat) const;
+  void apply_sparse(const tg::Accessor& a, const std::string& aat, size_t elem, Accessed* accessed) const;
   Accessed read_accessor(int index, const std::string& at, std::initializer_list<int> types,
                          std::initializer_list<int> component_types, bool allow_normalized_only = false) const;
 

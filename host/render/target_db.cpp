@@ -61,22 +61,53 @@ std::vector<uint8_t> pilot_pixels(int width, int height, int* block) {
   return only;
 }
 
+namespace {
+
+// The pilots' pixels (pilot_pixels) and the exact tracer's colour there.
+struct PilotSample {
+  int block = 0;
+  std::vector<uint8_t> pixels;
+  Image exact;
+  double trace_ms = 0;
+};
+
+PilotSample pilot_sample(MethodContext& mc) {
+  PilotSample s;
+  s.pixels = pilot_pixels(mc.scene.camera.width, mc.scene.camera.height, &s.block);
+  RaytraceOptions ro;
+  ro.threads = mc.request.threads;
+  ro.bvh = mc.cache.bvh();
+  ro.only = &s.pixels;
+  const Clock::time_point t0 = Clock::now();
+  s.exact = render_raytrace(mc.scene, ro);
+  s.trace_ms = ms_since(t0);
+  return s;
+}
+
+// A pilot: the sampled pixels rendered by `shader`, their error against the tracer's, and a
+// line of the stats' "pilots" (its time counted from `t0`, its cube map's build included).
+SampledError run_pilot(MethodContext& mc, const ABuffer& camera, const MapShader& shader, const PilotSample& sample,
+                       int n, Clock::time_point t0, json* pilots) {
+  MapShadingStats ms;
+  const Image pilot =
+      render_with_map(mc.scene, camera, shader, mc.request.threads, &ms, nullptr, &sample.pixels, false);
+  const SampledError e = sampled_error(pilot, sample.exact, sample.pixels);
+  pilots->push_back({{"cube_resolution", n},
+                     {"shading_points", shader.one_point() ? "one" : "quarters"},
+                     {"psnr_db", number_or_null(e.psnr)},
+                     {"psnr_db_low", number_or_null(e.psnr_low)},
+                     {"ms", ms_since(t0)}});
+  return e;
+}
+
+}  // namespace
+
 CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABufferOptions& cube_options,
                             const RayTracer* reference) {
   const SceneData& scene = mc.scene;
   const double target = scene.render.target_db;
   const Clock::time_point start = Clock::now();
-  int block = 0;
-  const std::vector<uint8_t> sample = pilot_pixels(scene.camera.width, scene.camera.height, &block);
-  // The exact tracer on the sampled pixels only.
-  RaytraceOptions ro;
-  ro.threads = mc.request.threads;
-  ro.bvh = mc.cache.bvh();
-  ro.only = &sample;
-  Clock::time_point t0 = Clock::now();
-  const Image exact = render_raytrace(scene, ro);
-  const double trace_ms = ms_since(t0);
-
+  const PilotSample sample = pilot_sample(mc);
   json pilots = json::array();
   CubeMap best;
   SampledError best_error;
@@ -85,16 +116,9 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
   std::string why;
   for (const int n : target_ladder(scene.render.cube_resolution)) {
     check_deadline();
-    t0 = Clock::now();
+    const Clock::time_point t0 = Clock::now();
     CubeMap m = build_cube_map(mc, n, cube_options, nullptr);
-    MapShadingStats ms;
-    const Image pilot = render_with_map(scene, camera, *m.shader, mc.request.threads, &ms, nullptr, &sample, false);
-    const SampledError e = sampled_error(pilot, exact, sample);
-    pilots.push_back({{"cube_resolution", n},
-                      {"shading_points", m.shader->one_point() ? "one" : "quarters"},
-                      {"psnr_db", number_or_null(e.psnr)},
-                      {"psnr_db_low", number_or_null(e.psnr_low)},
-                      {"ms", ms_since(t0)}});
+    const SampledError e = run_pilot(mc, camera, *m.shader, sample, n, t0, &pilots);
     const bool improved = !best.cube || e.psnr_low >= best_error.psnr_low + IMPROVEMENT_DB;
     if (!best.cube || e.psnr_low > best_error.psnr_low) {
       best = std::move(m);  // the smaller N keeps a tie
@@ -116,18 +140,11 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
   // target at the chosen N: about half the shading of a covered pixel.
   MapShadingOptions chosen = map_shading_options(mc);
   if (reached && !chosen.one_point) {
-    t0 = Clock::now();
+    const Clock::time_point t0 = Clock::now();
     MapShadingOptions one = chosen;
     one.one_point = true;
     auto shader = std::make_unique<MapShader>(scene, *best.cube, one, nullptr, &mc.cache);
-    MapShadingStats ms;
-    const Image pilot = render_with_map(scene, camera, *shader, mc.request.threads, &ms, nullptr, &sample, false);
-    const SampledError e = sampled_error(pilot, exact, sample);
-    pilots.push_back({{"cube_resolution", best.n},
-                      {"shading_points", "one"},
-                      {"psnr_db", number_or_null(e.psnr)},
-                      {"psnr_db_low", number_or_null(e.psnr_low)},
-                      {"ms", ms_since(t0)}});
+    const SampledError e = run_pilot(mc, camera, *shader, sample, best.n, t0, &pilots);
     if (e.psnr_low >= target) {
       chosen = one;
       best.shader = std::move(shader);
@@ -135,23 +152,24 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
     }
   }
   if (reference) {  // the searches' ray errors, measured on the final render only
-    t0 = Clock::now();
+    const Clock::time_point t0 = Clock::now();
     best.shader = std::make_unique<MapShader>(scene, *best.cube, chosen, reference, &mc.cache);
     best.setup_ms = ms_since(t0);
   }
   json& stats = mc.stats;
   stats["size"]["cube_resolution"] = best.n;
   stats["method_options"]["shading_points"] = chosen.one_point ? "one" : "quarters";
-  stats["target_db"] = {{"target", target},
-                        {"cube_resolution", best.n},
-                        {"shading_points", chosen.one_point ? "one" : "quarters"},
-                        {"scene_cube_resolution", scene.render.cube_resolution},
-                        {"reached", reached},
-                        {"why", why},
-                        {"predicted_psnr_db", number_or_null(best_error.psnr)},
-                        {"predicted_psnr_db_low", number_or_null(best_error.psnr_low)},
-                        {"sample", {{"pixels", best_error.pixels}, {"block", block}, {"exact_trace_ms", trace_ms}}},
-                        {"pilots", pilots}};
+  stats["target_db"] = {
+      {"target", target},
+      {"cube_resolution", best.n},
+      {"shading_points", chosen.one_point ? "one" : "quarters"},
+      {"scene_cube_resolution", scene.render.cube_resolution},
+      {"reached", reached},
+      {"why", why},
+      {"predicted_psnr_db", number_or_null(best_error.psnr)},
+      {"predicted_psnr_db_low", number_or_null(best_error.psnr_low)},
+      {"sample", {{"pixels", best_error.pixels}, {"block", sample.block}, {"exact_trace_ms", sample.trace_ms}}},
+      {"pilots", pilots}};
   stats["timings_ms"]["target_pilots"] = ms_since(start);
   return best;
 }
