@@ -53,6 +53,9 @@ struct MapShadingOptions {
   // SHADOW EDGES (below): where a camera fragment's shading points disagree about a light,
   // each covered sample gets its own shadow answer. Off: the points' answers stand.
   bool shadow_edges = true;
+  // A textured fragment's base colour averaged over the covered samples each shading point
+  // stands for (render_with_map), else looked up at the point.
+  bool texture_samples = true;
 };
 
 // Ray-level error against the exact tracer (thesis ch. 9), for the reflection rays of
@@ -117,6 +120,10 @@ struct SurfacePoint {
   glm::dvec3 geometric_normal{0.0};  // unit, cross(b-a, c-a)
   glm::dvec3 shading_normal{0.0};    // unit, interpolated vertex normals
   uint32_t triangle = 0, object = 0, material = 0;
+  // Od given by the caller (render_with_map: a textured camera fragment's base colour
+  // averaged over the samples its shading point stands for), else looked up at `point`.
+  bool diffuse_given = false;
+  glm::dvec3 diffuse{0.0};
 };
 SurfacePoint surface_point(const SceneData& scene, uint32_t triangle, const glm::dvec3& point);
 
@@ -153,6 +160,7 @@ class MapShader {
   bool exact_priority() const { return options_.exact_priority; }
   bool one_point() const { return options_.one_point; }
   bool shadow_edges() const { return options_.shadow_edges; }
+  bool texture_samples() const { return options_.texture_samples; }
 
  private:
   // A crossing set (media.hpp): the surface point shaded, the furthest crossing, the interface.

@@ -14,6 +14,7 @@
 #include "scene/camera.hpp"
 #include "raster/cube_map.hpp"
 #include "io/image_io.hpp"
+#include "shading/fragment_texture.hpp"
 #include "shading/resolve.hpp"
 #include "gl/gl_shadow_probe.hpp"
 #include "material/shading.hpp"
@@ -23,12 +24,17 @@ namespace abcube {
 
 namespace {
 
-// Local Phong of a camera A-buffer fragment at the point it stands for (shading.hpp).
-PixelShader local_phong_shader(const SceneData& scene, const ABuffer& buffer) {
-  return [&scene, &buffer](const Fragment& f, int x, int y) {
+// Local Phong of a camera A-buffer fragment at the point it stands for (shading.hpp); a
+// textured one's base colour looked up there, or averaged over its covered samples
+// (`texture_samples`: fragment_texture.hpp).
+PixelShader local_phong_shader(const SceneData& scene, const ABuffer& buffer, bool texture_samples) {
+  return [&scene, &buffer, texture_samples](const Fragment& f, int x, int y) {
     const Material& m = scene.materials[scene.triangles->material_id[f.triangle()]];
     const glm::dvec3 p = fragment_point(buffer, *scene.triangles, f, x, y);
-    const glm::dvec3 od = diffuse_color_at(scene, f.triangle(), p);
+    glm::dvec3 od;
+    if (!texture_samples || !mean_diffuse_color(scene, buffer.view, f.triangle(), x, y, f.mask, &od)) {
+      od = diffuse_color_at(scene, f.triangle(), p);
+    }
     return ShadedFragment{phong_local(m, p, f.shading_normal(), scene.camera.position, scene.ambient, scene.lights, od),
                           m.opacity};
   };
@@ -123,7 +129,8 @@ void compare_camera(const SceneData& scene, int threads, GlScene& gl, Crosscheck
   const ABuffer camera = build_camera_abuffer(scene, options);
   ResolveOptions ro;
   ro.threads = threads;
-  const Image cpu = resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera), scene.background, ro);
+  const Image cpu =
+      resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera, false), scene.background, ro);
   r->cpu_image = cpu;
   // Interior: one triangle over all 32 samples and the centre, none of them at an edge tie
   // (edge_ties.hpp).
@@ -401,7 +408,7 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
 }
 
 Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options, nlohmann::json* stats,
-                           bool exact_priority, const std::vector<uint8_t>* only) {
+                           bool exact_priority, bool texture_samples, const std::vector<uint8_t>* only) {
   ABufferStats s;
   Clock::time_point t0 = Clock::now();
   const ABuffer camera = build_camera_abuffer(scene, options, &s);
@@ -411,7 +418,8 @@ Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options
   ro.exact_priority = exact_priority;
   ro.only = only;
   t0 = Clock::now();
-  Image image = resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera), scene.background, ro);
+  Image image =
+      resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera, texture_samples), scene.background, ro);
   (*stats)["timings_ms"]["camera_abuffer"] = build_ms;
   (*stats)["timings_ms"]["resolve"] = ms_since(t0);
   (*stats)["abuffer"] = {{"fragments", s.fragments},

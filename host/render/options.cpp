@@ -287,6 +287,13 @@ void add_map_methods(Table& t) {
        {}},
       [](RenderSetup& s, const json& v) { s.render.shadow_edges = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.shadow_edges, d.shadow_edges); });
+  add(t, {"texture_lookups", "--texture-lookups", OptionKind::choice, OptionScope::job, {"samples", "points"}, 0, 0,
+       d.texture_lookups, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
+       "a textured fragment's base colour: samples (averaged over the covered samples each shading point stands "
+       "for) | points (looked up at the shading points)",
+       {}},
+      [](RenderSetup& s, const json& v) { s.render.texture_lookups = v.get<std::string>(); },
+      [d](const RenderSetup& s) { return unless(s.render.texture_lookups, d.texture_lookups); });
   add(t, {"resolve", "--resolve", OptionKind::choice, OptionScope::job, {"exact", "thesis"}, 0, 0, d.resolve, "", MAP_METHODS,
        "the CPU A-buffer's resolve: abuffer, zbuffer, envmap, hybrid",
        "intersecting fragments: exact (per-sample priority masks) | thesis (the Vis_front estimate)", {}},
@@ -536,6 +543,7 @@ RenderOptions without_unused_options(const RenderOptions& options, const std::st
       {"resolve", [](RenderOptions& o, const RenderOptions& x) { o.resolve = x.resolve; }},
       {"shading_points", [](RenderOptions& o, const RenderOptions& x) { o.shading_points = x.shading_points; }},
       {"shadow_edges", [](RenderOptions& o, const RenderOptions& x) { o.shadow_edges = x.shadow_edges; }},
+      {"texture_lookups", [](RenderOptions& o, const RenderOptions& x) { o.texture_lookups = x.texture_lookups; }},
       {"max_layers", [](RenderOptions& o, const RenderOptions& x) { o.max_layers = x.max_layers; }},
       {"gpu_mirrors", [](RenderOptions& o, const RenderOptions& x) { o.gpu_mirrors = x.gpu_mirrors; }},
       {"gpu_shadows", [](RenderOptions& o, const RenderOptions& x) { o.gpu_shadows = x.gpu_shadows; }},

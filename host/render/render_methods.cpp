@@ -309,7 +309,7 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
       stats["target_db"] = {{"target", scene.render.target_db},
                             {"why", "no cube map: nothing reflects, refracts or casts a shadow, so N is not used"}};
     }
-    return render_abuffer_local(scene, r.abuffer, &stats, r.map.exact_priority, only);
+    return render_abuffer_local(scene, r.abuffer, &stats, r.map.exact_priority, r.map.texture_samples, only);
   }
   std::unique_ptr<RayTracer> reference;
   if (r.reference) reference = std::make_unique<RayTracer>(scene, mc.cache.bvh());

@@ -73,6 +73,7 @@ struct RenderOptions {
   std::string refraction = "search";  // search | thick_lens | thin_lens
   std::string envmap_lookup = "R";    // R | bisector | position (envmap method)
   std::string shading_points = "quarters";  // per camera fragment: quarters (adaptive, 2 to 4) | one
+  std::string texture_lookups = "samples";  // a textured fragment's base colour: samples (averaged) | points
   std::string shadow_edges = "samples";     // a shadow edge inside a fragment: samples (each its own) | points
   std::string resolve = "exact";            // intersecting fragments: exact (priority masks) | thesis (Vis_front)
   bool side_structure = true;               // searches also test the triangles the map cannot hold (false: --map-only)

@@ -1,13 +1,18 @@
 // Edges inside a pixel, against answers known in closed form: a straight shadow edge
 // crossing a floor at a shallow angle (each pixel's lit share is the share of its 32
-// samples whose floor point the blocker leaves lit: map_shading.hpp SHADOW EDGES), and a
-// wire a tenth of a pixel wide (its covered share is the share of samples inside it).
+// samples whose floor point the blocker leaves lit: map_shading.hpp SHADOW EDGES), a wire a
+// tenth of a pixel wide (its covered share is the share of samples inside it), and a
+// texture's edges finer than the shading points (each pixel the mean of its samples' texels,
+// as the exact tracer sees them).
 #include <cmath>
+#include <filesystem>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <abcube/image.hpp>
 #include <abcube/renderer.hpp>
 
 #include "api_test_support.hpp"
@@ -158,6 +163,60 @@ TEST(Edges, AWireATenthOfAPixelWideCoversItsSamples) {
     }
   }
   EXPECT_GE(covered_pixels, SIZE / 2);  // the wire is seen, in some pixels only: it is thin
+}
+
+// A floor under ambient light alone, textured with a checkerboard of 64 x 64 squares, 0 and
+// 1, that spans 2 units of floor: a square is 0.43 pixel wide, finer than the shading points'
+// spacing (half a pixel). With each shading point's base colour averaged over the samples it
+// stands for (map_render.cpp), every pixel is the mean of its 32 samples' texels, as the exact
+// tracer's 32 rays see them: the colour is affine in the base colour, and ambient light is
+// the same at every point. `lookups`: the --texture-lookups value; `cube_map`: through the
+// map methods' shading (the plan's passes all run), else the local shading this scene needs.
+double texture_error(const std::string& lookups, bool cube_map) {
+  const std::string dir = ::testing::TempDir() + "abcube_texture_edges";
+  std::filesystem::create_directories(dir);
+  Image checker(64, 64, 3);
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      for (int c = 0; c < 3; ++c)
+        checker.data[(static_cast<size_t>(y) * 64 + static_cast<size_t>(x)) * 3 + c] = float((x + y) % 2);
+    }
+  }
+  write_image(dir + "/checker.exr", checker);
+  const std::string text = R"({"version": 1,
+    "camera": {"position": [0.013, 4, 0.021], "look_at": [0.013, 0, 0.021], "up": [0.3, 0, -1], "fov_y": 40,
+               "width": )" +
+                           std::to_string(SIZE) + R"(, "height": )" + std::to_string(SIZE) + R"(},
+    "background": [0, 0, 0], "ambient": [1, 1, 1], "lights": [],
+    "materials": {"floor": {"color": [1, 1, 1], "ambient": 1, "texture": "checker.exr"}},
+    "objects": [{"type": "quad", "vertices": [[-1, 0, -1], [-1, 0, 1], [1, 0, 1], [1, 0, -1]], "material": "floor"}],
+    "render": {"method": "abuffer", "cube_resolution": 64, "max_depth": 0}})";
+  const Scene scene = Scene::from_json(text, "checker.json", dir);
+  Renderer renderer;
+  RenderOptions o;
+  o.stats = false;
+  o.method = "raytrace";
+  const RenderResult exact = renderer.render(scene, o);
+  o.method = "abuffer";
+  o.texture_lookups = lookups;
+  o.plan_everything = cube_map;
+  const RenderResult a = renderer.render(scene, o);
+  double worst = 0;
+  for (size_t k = 0; k < a.image.data.size(); ++k)
+    worst = std::max(worst, double(std::fabs(a.image.data[k] - exact.image.data[k])));
+  return worst;
+}
+
+TEST(Edges, ATextureFinerThanTheShadingPointsIsTheMeanOfItsSamples) {
+  EXPECT_LT(texture_error("samples", false), 1e-4);
+  EXPECT_LT(texture_error("samples", true), 1e-4);
+}
+
+// Looked up at the shading points alone, the checkerboard's pixels are off by a good share
+// of its contrast: the test above can fail.
+TEST(Edges, AtTheShadingPointsAloneATextureAliases) {
+  EXPECT_GT(texture_error("points", false), 0.1);
+  EXPECT_GT(texture_error("points", true), 0.1);
 }
 
 }  // namespace

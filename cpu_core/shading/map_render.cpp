@@ -1,0 +1,285 @@
+// The camera's fragments shaded by a MapShader and resolved (render_with_map, header):
+// each fragment at its covered quarters, adaptively, and the shadow edges' second pass.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <utility>
+#include <vector>
+
+#include "base/samples.hpp"
+#include "io/image_io.hpp"
+#include "raster/abuffer.hpp"
+#include "raster/raster.hpp"
+#include "search/search.hpp"
+#include "scene/texture.hpp"
+#include "shading/fragment_texture.hpp"
+#include "shading/map_shading.hpp"
+#include "shading/resolve.hpp"
+#include "shading/shadow_edges.hpp"
+
+namespace abcube {
+
+namespace {
+
+// The quarters of the 4x8 mask (samples.hpp): columns 0-3 / 4-7 of rows 0-1 / 2-3.
+constexpr CoverageMask QUARTERS[4] = {0x00000f0fu, 0x0000f0f0u, 0x0f0f0000u, 0xf0f00000u};
+
+// Is the sRGB-encoded difference of two colours above QUARTER_SPLIT_SRGB in any channel?
+bool differ(const glm::dvec3& a, const glm::dvec3& b) {
+  for (int k = 0; k < 3; ++k) {
+    const double ea = srgb_encode(static_cast<float>(std::clamp(a[k], 0.0, 1.0)));
+    const double eb = srgb_encode(static_cast<float>(std::clamp(b[k], 0.0, 1.0)));
+    if (std::fabs(ea - eb) > QUARTER_SPLIT_SRGB) return true;
+  }
+  return false;
+}
+
+// Secondary searches and those of them that found nothing (the "fallback" AOV, header).
+std::pair<uint64_t, uint64_t> searches_and_failures(const MapShadingStats& s) {
+  const SearchStats& q = s.searches;
+  const uint64_t rays =
+      q.reflection.rays + q.refraction_exit.rays + q.shadow.rays + s.lens_transfers + s.lens_fallbacks;
+  const uint64_t failed =
+      q.reflection.misses + q.refraction_exit.misses + q.shadow.zero_area + q.shadow.aborted + s.lens_fallbacks;
+  return {rays, failed};
+}
+
+// A fragment's covered quarters: their centroids on its triangle's plane, their shares of
+// its coverage, their masks.
+struct Quarters {
+  glm::dvec3 point[4];
+  double weight[4];
+  CoverageMask mask[4];
+  int count = 0;
+};
+
+// One render_with_map call: its inputs, the per-worker statistics and light records, and
+// what the shadow edges' passes share.
+class MapRender {
+ public:
+  MapRender(const SceneData& scene, const ABuffer& camera, const MapShader& shader, Image* fallback,
+            const std::vector<uint8_t>* only)
+      : scene_(scene),
+        camera_(camera),
+        shader_(shader),
+        fallback_(fallback),
+        only_(only),
+        pixels_(static_cast<size_t>(camera.width()) * static_cast<size_t>(camera.height())) {
+    if (fallback_) pixel_searches_.assign(pixels_, {0, 0});
+    edges_ = shader.shadow_edges() && !shader.one_point() &&
+             std::any_of(scene.lights.begin(), scene.lights.end(), [](const PointLight& l) { return l.cast_shadows; });
+    if (edges_) {
+      seen_.lit.assign(pixels_, 0);
+      seen_.dark.assign(pixels_, 0);
+    }
+  }
+
+  Image render(int threads, bool neighbours, MapShadingStats* stats) {
+    ResolveOptions ro;
+    ro.threads = threads;
+    ro.exact_priority = shader_.exact_priority();
+    ro.only = only_;
+    // SHADOW EDGES (header): what each pixel's points saw, and in the second pass the lights
+    // whose edge runs between a pixel's points and its neighbour's.
+    if (edges_ && only_ && neighbours) {
+      widened_ = with_neighbours(*only_, camera_.width(), camera_.height());
+      ro.only = &widened_;
+    }
+    // Statistics per resolve worker, merged at the end: no lock while shading. The records
+    // of the points' lights too, reused fragment after fragment (their vectors keep their room).
+    const size_t workers = static_cast<size_t>(resolve_workers(camera_, ro));
+    per_worker_.assign(workers, MapShadingStats{});
+    worker_direct_.resize(workers);
+    const WorkerPixelShader shade = [this](const Fragment& f, int x, int y, int worker) {
+      return shade_fragment(f, x, y, worker);
+    };
+    Image image = resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, ro);
+    if (edges_) second_pass(shade, ro, &image);
+    if (stats) {
+      for (const MapShadingStats& s : per_worker_) stats->merge(s);
+    }
+    if (fallback_) {
+      *fallback_ = Image(camera_.width(), camera_.height(), 1, 0.f);
+      for (size_t k = 0; k < pixel_searches_.size(); ++k) {
+        const auto [rays, failed] = pixel_searches_[k];
+        if (rays > 0) fallback_->data[k] = static_cast<float>(static_cast<double>(failed) / static_cast<double>(rays));
+      }
+    }
+    return image;
+  }
+
+ private:
+  // The fragment shaded at its covered quarters, adaptively (header, QUARTER_SPLIT_SRGB).
+  ShadedFragment shade_fragment(const Fragment& f, int x, int y, int worker) {
+    MapShadingStats* s = &per_worker_[static_cast<size_t>(worker)];
+    const size_t at = static_cast<size_t>(y) * static_cast<size_t>(camera_.width()) + static_cast<size_t>(x);
+    const std::pair<uint64_t, uint64_t> before =
+        fallback_ ? searches_and_failures(*s) : std::pair<uint64_t, uint64_t>{};
+    glm::dvec3 c;
+    if (shader_.one_point()) {
+      c = shade_at(f, x, y, fragment_point(camera_, *scene_.triangles, f, x, y), f.mask, nullptr, s);
+    } else {
+      c = shade_quarters(f, x, y, at, worker, s);
+    }
+    if (fallback_) {
+      const std::pair<uint64_t, uint64_t> after = searches_and_failures(*s);
+      auto& p = pixel_searches_[at];
+      p.first += after.first - before.first;
+      p.second += after.second - before.second;
+    }
+    return ShadedFragment{c, scene_.materials[scene_.triangles->material_id[f.triangle()]].opacity};
+  }
+
+  // The surface the eye ray through a point of the fragment's plane really crosses: the
+  // point moved onto the mesh (a merged fragment keeps one triangle of several: abuffer.hpp
+  // MERGE).
+  SurfacePoint surface_at(const Fragment& f, int x, int y, const glm::dvec3& p) const {
+    const glm::dvec3 eye = scene_.camera.position;
+    // One pixel's width seen from the eye, in radians (the mesh refinement's radius).
+    const double pixel = glm::length(glm::normalize(camera_.view.direction(x + 1.5, y + 0.5)) -
+                                     glm::normalize(camera_.view.direction(x + 0.5, y + 0.5)));
+    const glm::dvec3 dir = glm::normalize(p - eye);
+    uint32_t tri = f.triangle();
+    glm::dvec3 on = p;
+    double l = 0;
+    const double dist = glm::length(p - eye);
+    if (shader_.refines_on_mesh() &&
+        mesh_crossing(shader_.context(), eye, dir, f.triangle(), dist, dist * pixel, &tri, &l)) {
+      on = eye + l * dir;
+    }
+    return surface_point(scene_, tri, on);
+  }
+
+  // The colour at point p of the fragment's plane, standing for the covered samples `mask`:
+  // a textured surface takes its base colour averaged over those samples, as the exact
+  // tracer's 32 rays a pixel see it; the light, shadows and secondary rays are the point's.
+  glm::dvec3 shade_at(const Fragment& f, int x, int y, const glm::dvec3& p, CoverageMask mask, PrimaryLights* direct,
+                      MapShadingStats* s) const {
+    const glm::dvec3 eye = scene_.camera.position;
+    SurfacePoint sp = surface_at(f, x, y, p);
+    if (shader_.texture_samples() && sp.material == scene_.triangles->material_id[f.triangle()]) {
+      sp.diffuse_given = mean_diffuse_color(scene_, camera_.view, f.triangle(), x, y, mask, &sp.diffuse);
+    }
+    return shader_.shade(sp, glm::normalize(p - eye), 0, true, s, direct);
+  }
+
+  Quarters quarters(const Fragment& f, int x, int y) const {
+    Quarters q;
+    const double total = mask_count(f.mask);
+    for (CoverageMask quarter : QUARTERS) {
+      const CoverageMask m = f.mask & quarter;
+      if (!m) continue;
+      const glm::dvec2 c = mask_centroid(m);
+      q.point[q.count] = point_on_triangle_plane(camera_.view, *scene_.triangles, f.triangle(), x + c.x, y + c.y);
+      q.weight[q.count] = mask_count(m) / total;
+      q.mask[q.count] = m;
+      ++q.count;
+    }
+    return q;
+  }
+
+  // The fragment's two end quarters shaded, the ones between too where the ends differ (or
+  // a shadow edge is forced), each quarter's samples searched again along a shadow's edge.
+  glm::dvec3 shade_quarters(const Fragment& f, int x, int y, size_t at, int worker, MapShadingStats* s) {
+    const uint64_t force = forced_.empty() ? 0 : forced_[at];
+    const std::function<glm::dvec3(const glm::dvec3&)> on_surface = [&](const glm::dvec3& p) {
+      return surface_at(f, x, y, p).point;
+    };
+    const Quarters q = quarters(f, x, y);
+    PrimaryLights* const direct = worker_direct_[static_cast<size_t>(worker)].data();
+    PrimaryLights* const record = edges_ ? direct : nullptr;
+    if (q.count <= 1) {
+      glm::dvec3 c = shade_at(f, x, y, fragment_point(camera_, *scene_.triangles, f, x, y), f.mask, record, s);
+      if (record && force) {
+        refine_shadow_edges(scene_, camera_, f, x, y, q.mask, 1, direct, force, &c, on_surface, shader_, s);
+      }
+      if (record) seen_.note(at, scene_, direct, 1, true);
+      return c;
+    }
+    ++s->multi_point_fragments;
+    const int last = q.count - 1;
+    glm::dvec3 colour[4];
+    colour[0] = shade_at(f, x, y, q.point[0], q.mask[0], record ? &direct[0] : nullptr, s);
+    colour[last] = shade_at(f, x, y, q.point[last], q.mask[last], record ? &direct[last] : nullptr, s);
+    const bool ends_differ = record && direct[0].shadow != direct[last].shadow;
+    // A texture may differ between quarters whose ends agree: each of them is shaded with
+    // its own samples' base colour (--texture-lookups samples).
+    const bool split = force != 0 || ends_differ || differ(colour[0], colour[last]) || textured(f);
+    for (int k = 1; k < last; ++k) {
+      colour[k] = split ? shade_at(f, x, y, q.point[k], q.mask[k], record ? &direct[k] : nullptr, s)
+                        : 0.5 * (colour[0] + colour[last]);
+    }
+    if (record && split) {
+      refine_shadow_edges(scene_, camera_, f, x, y, q.mask, q.count, direct, force, colour, on_surface, shader_, s);
+    }
+    if (record) seen_.note(at, scene_, direct, q.count, split);
+    glm::dvec3 c = q.weight[0] * colour[0] + q.weight[last] * colour[last];
+    for (int k = 1; k < last; ++k) c += q.weight[k] * colour[k];
+    return c;
+  }
+
+  // Whether fragment f's base colour is averaged over its samples: a textured material, with
+  // --texture-lookups samples.
+  bool textured(const Fragment& f) const {
+    return shader_.texture_samples() && scene_.textures &&
+           scene_.textures->image_of(scene_.triangles->material_id[f.triangle()]) >= 0;
+  }
+
+  // The second pass: the pixels an edge runs beside, shaded again with those lights' samples
+  // searched; their searches are counted once more, as they were made.
+  void second_pass(const WorkerPixelShader& shade, const ResolveOptions& ro, Image* image) {
+    forced_ = seen_.across(camera_.width(), camera_.height(), only_);
+    std::vector<uint8_t> again(pixels_, 0);
+    uint64_t flagged = 0;
+    for (size_t p = 0; p < pixels_; ++p) {
+      if (!forced_[p]) continue;
+      again[p] = 1;
+      ++flagged;
+      if (fallback_) pixel_searches_[p] = {0, 0};
+    }
+    const size_t channels = static_cast<size_t>(image->channels);
+    if (!widened_.empty()) {  // the neighbours shaded for their points: black again, as `only` says
+      for (size_t p = 0; p < pixels_; ++p) {
+        if ((*only_)[p]) continue;
+        std::fill_n(image->data.begin() + static_cast<std::ptrdiff_t>(p * channels), image->channels, 0.f);
+        if (fallback_) pixel_searches_[p] = {0, 0};
+      }
+    }
+    if (flagged > 0) {
+      ResolveOptions second = ro;
+      second.only = &again;
+      const Image redone = resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, second);
+      for (size_t p = 0; p < pixels_; ++p) {
+        if (!again[p]) continue;
+        for (size_t ch = 0; ch < channels; ++ch) image->data[p * channels + ch] = redone.data[p * channels + ch];
+      }
+    }
+    per_worker_[0].shadow_edge_pixels += flagged;
+  }
+
+  const SceneData& scene_;
+  const ABuffer& camera_;
+  const MapShader& shader_;
+  Image* const fallback_;
+  const std::vector<uint8_t>* const only_;
+  const size_t pixels_;
+  bool edges_ = false;
+  // Per pixel: secondary searches and failures (one resolve worker owns a row at a time).
+  std::vector<std::pair<uint64_t, uint64_t>> pixel_searches_;
+  PixelShadows seen_;
+  std::vector<uint8_t> widened_;
+  std::vector<uint64_t> forced_;  // per pixel, the lights whose edge the second pass searches
+  std::vector<MapShadingStats> per_worker_;
+  std::vector<std::array<PrimaryLights, 4>> worker_direct_;
+};
+
+}  // namespace
+
+Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
+                      MapShadingStats* stats, Image* fallback, const std::vector<uint8_t>* only, bool neighbours) {
+  MapRender render(scene, camera, shader, fallback, only);
+  return render.render(threads, neighbours, stats);
+}
+
+}  // namespace abcube
