@@ -43,6 +43,18 @@ glm::dvec3 pack(FragmentList list, CoverageMask search, Shade&& shade, const Tri
     }
     return sc->shaded[i];
   };
+  // A fragment seen over only part of its mask, where another's plane passes in front of
+  // its own inside the pixel: shaded over the samples where it is seen (its shading points
+  // then lie there, not on its hidden part, which may be in another light: a floor running
+  // on behind a wall), and not kept (its whole-mask shade stays the cached one).
+  const auto shaded_over = [&](size_t i, CoverageMask seen) -> ShadedFragment {
+    if ((list[i].mask & ~seen) == 0) return shaded(i);
+    Fragment part = list[i];
+    part.mask = seen;
+    ShadedFragment s = shade(part);
+    s.opacity = std::clamp(s.opacity, 0.0, 1.0);
+    return s;
+  };
   glm::dvec3 colour(0.0);
   sc->stack.push_back({0, search, 1.0});
   while (!sc->stack.empty()) {
@@ -72,14 +84,15 @@ glm::dvec3 pack(FragmentList list, CoverageMask search, Shade&& shade, const Tri
       const CoverageMask behind = depth->nearer(f, list[j], in & list[j].mask), front = in & ~behind;
       if (behind != 0) {
         const double w_b = w_in * (mask_count(behind) / static_cast<double>(mask_count(in)));
-        const ShadedFragment& sn = shaded(j);
-        colour += (w_b * sn.opacity) * sn.colour + (w_b * (1.0 - sn.opacity) * sf.opacity) * sf.colour;
+        const ShadedFragment sn = shaded_over(j, behind);
+        const glm::dvec3 f_colour = sn.opacity < 1.0 ? shaded_over(i, behind).colour : glm::dvec3(0.0);
+        colour += (w_b * sn.opacity) * sn.colour + (w_b * (1.0 - sn.opacity) * sf.opacity) * f_colour;
         const double through = w_b * (1.0 - sn.opacity) * (1.0 - sf.opacity);
         if (through > 0.0) sc->stack.push_back({j + 1, behind, through});
       }
       if (front != 0) {
         const double w_f = w_in * (mask_count(front) / static_cast<double>(mask_count(in)));
-        colour += (w_f * sf.opacity) * sf.colour;
+        colour += (w_f * sf.opacity) * shaded_over(i, front).colour;
         if (sf.opacity < 1.0) sc->stack.push_back({i + 1, front, w_f * (1.0 - sf.opacity)});
       }
       continue;

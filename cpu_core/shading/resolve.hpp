@@ -2,9 +2,10 @@
 // 5.2.1.1 and 5.2.1.2). The first fragment over the search mask splits it into `in` and
 // `out`; where the next fragment of another object overlaps it in z, EXACT PRIORITY MASKS
 // (thesis 11.2.4) decide per sample by THE TIE RULE which plane is seen first (given the
-// pixel's SampleDepth), or the thesis' Vis estimate from the z ranges does (without it).
-// pack is evaluated with an explicit stack of (list position, mask, weight) items: no stack
-// overflow on long lists, each fragment shaded at most once, at most 32 items a position.
+// pixel's SampleDepth), each of the two shaded over the samples where it is seen; or the
+// thesis' Vis estimate from the z ranges does (without it). pack is evaluated with an
+// explicit stack of (list position, mask, weight) items: no stack overflow on long lists,
+// each fragment shaded at most once over its mask, at most 32 items a position.
 // docs/design/resolve.md has the pseudo-code and the whole argument.
 #pragma once
 #include <functional>
