@@ -149,3 +149,47 @@ def test_product_source_holds_no_history():
     out = subprocess.run(["git", "-C", str(SRC), "grep", "-nE", r"20[0-9]{2}-[01][0-9]-[0-3][0-9]|[Ii]ssue [0-9]+",
                           "--", "cpu_core", "host", "include", "python", "shaders"], capture_output=True, text=True)
     assert out.returncode == 1 and not out.stdout, out.stdout[:2000]
+
+
+PRODUCT_DIRS = ("cpu_core", "host", "include", "python", "shaders")
+MAX_FILE_LINES = 600
+MAX_FUNCTION_LINES = 80
+
+
+def product_sources():
+    out = subprocess.run(["git", "-C", str(SRC), "ls-files", "--", *PRODUCT_DIRS], capture_output=True, text=True,
+                         check=True).stdout.split()
+    return [SRC / p for p in out if Path(p).suffix in (".cpp", ".hpp", ".h", ".glsl", ".vert", ".frag", ".py")]
+
+
+def test_product_files_are_short():
+    """One concept a unit: no product source file runs past MAX_FILE_LINES lines."""
+    long = [f"{p.relative_to(SRC)}: {n} lines" for p in product_sources()
+            if (n := len(p.read_text().splitlines())) > MAX_FILE_LINES]
+    assert not long, long
+
+
+def long_functions(lines, limit):
+    """(first line, length) of each function of a C++ file longer than `limit` lines. The
+    sources are formatted by .clang-format: outside a class, a function's signature starts at
+    column 0 and its body closes with a lone "}" at column 0, every line between indented."""
+    out = []
+    for end, line in enumerate(lines):
+        if line.rstrip() != "}":
+            continue
+        start = end - 1
+        while start >= 0 and not (lines[start][:1].strip() and lines[start][:2] != "//" and lines[start][:1] != "#"):
+            start -= 1
+        if start >= 0 and end - start + 1 > limit:
+            out.append((start + 1, end - start + 1))
+    return out
+
+
+def test_product_functions_are_short():
+    """No C++ function of the product outside a class runs past MAX_FUNCTION_LINES lines."""
+    long = []
+    for path in product_sources():
+        if path.suffix in (".cpp", ".hpp", ".h"):
+            long += [f"{path.relative_to(SRC)}:{first}: {n} lines"
+                     for first, n in long_functions(path.read_text().splitlines(), MAX_FUNCTION_LINES)]
+    assert not long, long
