@@ -135,6 +135,7 @@ class MapRender {
   // point moved onto the mesh (a merged fragment keeps one triangle of several: abuffer.hpp
   // MERGE).
   SurfacePoint surface_at(const Fragment& f, int x, int y, const glm::dvec3& p) const {
+    if (!shader_.refines_on_mesh()) return surface_point(scene_, f.triangle(), p);
     const glm::dvec3 eye = scene_.camera.position;
     // One pixel's width seen from the eye, in radians (the mesh refinement's radius).
     const double pixel = glm::length(glm::normalize(camera_.view.direction(x + 1.5, y + 0.5)) -
@@ -144,10 +145,7 @@ class MapRender {
     glm::dvec3 on = p;
     double l = 0;
     const double dist = glm::length(p - eye);
-    if (shader_.refines_on_mesh() &&
-        mesh_crossing(shader_.context(), eye, dir, f.triangle(), dist, dist * pixel, &tri, &l)) {
-      on = eye + l * dir;
-    }
+    if (mesh_crossing(shader_.context(), eye, dir, f.triangle(), dist, dist * pixel, &tri, &l)) on = eye + l * dir;
     return surface_point(scene_, tri, on);
   }
 
