@@ -23,4 +23,13 @@ constexpr int sample_index(int col, int row) { return row * MASK_COLUMNS + col; 
 
 inline int mask_count(CoverageMask m) { return __builtin_popcount(m); }
 
+// The sides of a pixel, as bits, and those that sample k lies on (its column 0 or 7, its
+// row 0 or 3): where what a sample sees touches the next pixel.
+constexpr uint8_t SIDE_LEFT = 1, SIDE_RIGHT = 2, SIDE_TOP = 4, SIDE_BOTTOM = 8;
+constexpr uint8_t sample_sides(int k) {
+  const int col = k % MASK_COLUMNS, row = k / MASK_COLUMNS;
+  return static_cast<uint8_t>((col == 0 ? SIDE_LEFT : 0) | (col == MASK_COLUMNS - 1 ? SIDE_RIGHT : 0) |
+                              (row == 0 ? SIDE_TOP : 0) | (row == MASK_ROWS - 1 ? SIDE_BOTTOM : 0));
+}
+
 }  // namespace abcube

@@ -52,8 +52,13 @@ constexpr int THESIS_WINDOW_TEXELS = 2;
 // Default self offsets per mode, in texels at W (SELF-HITS, docs/design/search.md).
 constexpr double SELF_OFFSET_CROSSING_TEXELS = 1e-3;
 constexpr double SELF_OFFSET_THESIS_TEXELS = 0.5;
-// MESH REFINEMENT: the most triangles one refinement floods before it gives up (unknown).
-constexpr size_t REFINE_MAX_TRIANGLES = 32;
+// MESH REFINEMENT: the most steps of its straight walk, and the most triangles its flood
+// visits before it gives up (unknown). A flood must see every triangle near the ray to say
+// it passes by: where a model's triangles are smaller than a texel (a scanned or subdivided
+// mesh at a modest N), 32 left such rays to the plane tolerance, which took the extension of
+// a small triangle's plane for a crossing (false self-shadows on the Wuson).
+constexpr size_t REFINE_MAX_STEPS = 32;
+constexpr size_t REFINE_MAX_TRIANGLES = 128;
 
 struct SearchOptions {
   SearchMode mode = SearchMode::crossing;

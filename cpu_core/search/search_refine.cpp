@@ -66,7 +66,7 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
   // of the current plane lies furthest outside of, while the next is near the ray. On a
   // smooth patch this reaches the triangle crossed in a few steps.
   uint32_t walker = start;
-  for (size_t step = 0; step < REFINE_MAX_TRIANGLES; ++step) {
+  for (size_t step = 0; step < REFINE_MAX_STEPS; ++step) {
     const PlaneCrossing c = plane_crossing(ctx, q, walker);
     if (c.l == INF) break;
     if (c.outside_edge < 0) {  // on this triangle

@@ -16,6 +16,7 @@
 #include "shading/fragment_texture.hpp"
 #include "shading/map_shading.hpp"
 #include "shading/resolve.hpp"
+#include "shading/secondary_edges.hpp"
 #include "shading/shadow_edges.hpp"
 
 namespace abcube {
@@ -31,6 +32,24 @@ bool differ(const glm::dvec3& a, const glm::dvec3& b) {
     const double ea = srgb_encode(static_cast<float>(std::clamp(a[k], 0.0, 1.0)));
     const double eb = srgb_encode(static_cast<float>(std::clamp(b[k], 0.0, 1.0)));
     if (std::fabs(ea - eb) > QUARTER_SPLIT_SRGB) return true;
+  }
+  return false;
+}
+
+// Do any two of the `count` colours differ (above)?
+bool any_differ(const glm::dvec3* colour, int count) {
+  for (int a = 0; a < count; ++a) {
+    for (int b = a + 1; b < count; ++b) {
+      if (differ(colour[a], colour[b])) return true;
+    }
+  }
+  return false;
+}
+
+// Did the secondary rays of the `count` points find different surfaces (PrimaryLights::trail)?
+bool trails_differ(const PrimaryLights* direct, int count) {
+  for (int k = 1; k < count; ++k) {
+    if (direct[k].trail != direct[0].trail) return true;
   }
   return false;
 }
@@ -55,7 +74,7 @@ struct Quarters {
 };
 
 // One render_with_map call: its inputs, the per-worker statistics and light records, and
-// what the shadow edges' passes share.
+// what the shadow and secondary edges' passes share.
 class MapRender {
  public:
   MapRender(const SceneData& scene, const ABuffer& camera, const MapShader& shader, Image* fallback,
@@ -72,7 +91,11 @@ class MapRender {
     if (edges_) {
       seen_.lit.assign(pixels_, 0);
       seen_.dark.assign(pixels_, 0);
+      seen_.sides.assign(pixels_, 0);
     }
+    trails_on_ = shader.secondary_edges() && !shader.one_point() && scene.render.max_depth > 0 &&
+                 std::any_of(scene.materials.begin(), scene.materials.end(),
+                             [](const Material& m) { return m.reflect > 0.0 || m.transmit > 0.0; });
   }
 
   Image render(int threads, bool neighbours, MapShadingStats* stats) {
@@ -80,9 +103,9 @@ class MapRender {
     ro.threads = threads;
     ro.exact_priority = shader_.exact_priority();
     ro.only = only_;
-    // SHADOW EDGES (header): what each pixel's points saw, and in the second pass the lights
-    // whose edge runs between a pixel's points and its neighbour's.
-    if (edges_ && only_ && neighbours) {
+    // SHADOW EDGES and SECONDARY EDGES (header): what each pixel's points saw, and in the
+    // second pass the pixels an edge runs between whose points and their neighbour's.
+    if ((edges_ || trails_on_) && only_ && neighbours) {
       widened_ = with_neighbours(*only_, camera_.width(), camera_.height());
       ro.only = &widened_;
     }
@@ -91,11 +114,12 @@ class MapRender {
     const size_t workers = static_cast<size_t>(resolve_workers(camera_, ro));
     per_worker_.assign(workers, MapShadingStats{});
     worker_direct_.resize(workers);
+    if (trails_on_) trails_ = PixelTrails(pixels_, workers);
     const WorkerPixelShader shade = [this](const Fragment& f, int x, int y, int worker) {
       return shade_fragment(f, x, y, worker);
     };
     Image image = resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, ro);
-    if (edges_) second_pass(shade, ro, &image);
+    if (edges_ || trails_on_) second_pass(shade, ro, &image);
     if (stats) {
       for (const MapShadingStats& s : per_worker_) stats->merge(s);
     }
@@ -181,18 +205,27 @@ class MapRender {
   // a shadow edge is forced), each quarter's samples searched again along a shadow's edge.
   glm::dvec3 shade_quarters(const Fragment& f, int x, int y, size_t at, int worker, MapShadingStats* s) {
     const uint64_t force = forced_.empty() ? 0 : forced_[at];
+    const bool force_secondary = !forced_secondary_.empty() && forced_secondary_[at];
     const std::function<glm::dvec3(const glm::dvec3&)> on_surface = [&](const glm::dvec3& p) {
       return surface_at(f, x, y, p).point;
     };
     const Quarters q = quarters(f, x, y);
     PrimaryLights* const direct = worker_direct_[static_cast<size_t>(worker)].data();
-    PrimaryLights* const record = edges_ ? direct : nullptr;
+    const bool secondary = secondary_edges(f);
+    // What the points' lights gave (SHADOW EDGES) and their secondary rays found (SECONDARY EDGES).
+    PrimaryLights* const record = edges_ || secondary ? direct : nullptr;
     if (q.count <= 1) {
-      glm::dvec3 c = shade_at(f, x, y, fragment_point(camera_, *scene_.triangles, f, x, y), f.mask, record, s);
-      if (record && force) {
-        refine_shadow_edges(scene_, camera_, f, x, y, q.mask, 1, direct, force, &c, on_surface, shader_, s);
+      if (secondary && force_secondary) {
+        ++s->secondary_edge_fragments;
+        return shade_samples(f, x, y, f.mask, worker, s);
       }
-      if (record) seen_.note(at, scene_, direct, 1, true);
+      glm::dvec3 c = shade_at(f, x, y, fragment_point(camera_, *scene_.triangles, f, x, y), f.mask, record, s);
+      if (secondary && !trails_.empty()) trails_.note_point(at, direct[0].trail);
+      if (edges_ && force) {
+        refine_shadow_edges(scene_, camera_, f, x, y, q.mask, 1, direct, force, &c, on_surface, shader_, s,
+                            &seen_.sides[at]);
+      }
+      if (edges_) seen_.note(at, scene_, direct, 1, true);
       return c;
     }
     ++s->multi_point_fragments;
@@ -200,21 +233,65 @@ class MapRender {
     glm::dvec3 colour[4];
     colour[0] = shade_at(f, x, y, q.point[0], q.mask[0], record ? &direct[0] : nullptr, s);
     colour[last] = shade_at(f, x, y, q.point[last], q.mask[last], record ? &direct[last] : nullptr, s);
-    const bool ends_differ = record && direct[0].shadow != direct[last].shadow;
+    const bool ends_differ = edges_ && direct[0].shadow != direct[last].shadow;
     // A texture may differ between quarters whose ends agree: each of them is shaded with
-    // its own samples' base colour (--texture-lookups samples).
-    const bool split = force != 0 || ends_differ || differ(colour[0], colour[last]) || textured(f);
+    // its own samples' base colour (--texture-lookups samples). A mirror's or glass's quarters
+    // are all shaded, so that SECONDARY EDGES compares them all.
+    const bool split = force != 0 || ends_differ || differ(colour[0], colour[last]) || textured(f) || secondary;
     for (int k = 1; k < last; ++k) {
       colour[k] = split ? shade_at(f, x, y, q.point[k], q.mask[k], record ? &direct[k] : nullptr, s)
                         : 0.5 * (colour[0] + colour[last]);
     }
-    if (record && split) {
-      refine_shadow_edges(scene_, camera_, f, x, y, q.mask, q.count, direct, force, colour, on_surface, shader_, s);
+    const bool refined =
+        secondary && (force_secondary || (trails_differ(direct, q.count) && any_differ(colour, q.count)));
+    if (secondary && !refined && !trails_.empty()) {
+      for (int k = 0; k < q.count; ++k) trails_.note_point(at, direct[k].trail);
     }
-    if (record) seen_.note(at, scene_, direct, q.count, split);
+    if (refined) {
+      // SECONDARY EDGES (map_shading.hpp): each sample shaded at its own point, its own
+      // shadows with it; the trails its samples found on each side of the pixel noted.
+      SideTrails sides;
+      for (int k = 0; k < q.count; ++k) colour[k] = shade_samples(f, x, y, q.mask[k], worker, s, &sides);
+      ++s->secondary_edge_fragments;
+      if (!trails_.empty()) {
+        trails_.note_several(at);
+        trails_.note_sides(at, worker, sides);
+      }
+    } else if (edges_ && split) {
+      refine_shadow_edges(scene_, camera_, f, x, y, q.mask, q.count, direct, force, colour, on_surface, shader_, s,
+                          &seen_.sides[at]);
+    }
+    if (edges_) seen_.note(at, scene_, direct, q.count, split);
     glm::dvec3 c = q.weight[0] * colour[0] + q.weight[last] * colour[last];
     for (int k = 1; k < last; ++k) c += q.weight[k] * colour[k];
     return c;
+  }
+
+  // Whether fragment f is refined by SECONDARY EDGES: a material with a reflection or
+  // transmission term, bounces left, --secondary-edges samples.
+  bool secondary_edges(const Fragment& f) const {
+    const Material& m = scene_.materials[scene_.triangles->material_id[f.triangle()]];
+    return shader_.secondary_edges() && scene_.render.max_depth > 0 && (m.reflect > 0.0 || m.transmit > 0.0);
+  }
+
+  // The mean colour of the covered samples `mask` of fragment f, each shaded at its own point
+  // of the fragment's plane (its texture lookup that sample's alone); `sides` (optional)
+  // gains the trails of the samples on each side of the pixel.
+  glm::dvec3 shade_samples(const Fragment& f, int x, int y, CoverageMask mask, int worker, MapShadingStats* s,
+                           SideTrails* sides = nullptr) {
+    PrimaryLights* const record = &worker_direct_[static_cast<size_t>(worker)][4];
+    glm::dvec3 sum(0.0);
+    for (CoverageMask m = mask; m; m &= m - 1) {
+      const int b = __builtin_ctz(m);
+      const glm::dvec3 p =
+          point_on_triangle_plane(camera_.view, *scene_.triangles, f.triangle(), x + sample_dx(b), y + sample_dy(b));
+      sum += shade_at(f, x, y, p, CoverageMask{1} << b, record, s);
+      ++s->secondary_edge_samples;
+      for (int side = 0; sides && side < 4; ++side) {
+        if (sample_sides(b) & (1 << side)) (*sides)[static_cast<size_t>(side)].add(record->trail);
+      }
+    }
+    return sum / double(mask_count(mask));
   }
 
   // Whether fragment f's base colour is averaged over its samples: a textured material, with
@@ -225,15 +302,19 @@ class MapRender {
   }
 
   // The second pass: the pixels an edge runs beside, shaded again with those lights' samples
-  // searched; their searches are counted once more, as they were made.
+  // searched, or their secondary fragments shaded at their samples; their searches are
+  // counted once more, as they were made.
   void second_pass(const WorkerPixelShader& shade, const ResolveOptions& ro, Image* image) {
-    forced_ = seen_.across(camera_.width(), camera_.height(), only_);
+    if (edges_) forced_ = seen_.across(camera_.width(), camera_.height(), only_);
+    if (trails_on_) forced_secondary_ = trails_.across(camera_.width(), camera_.height(), only_);
     std::vector<uint8_t> again(pixels_, 0);
-    uint64_t flagged = 0;
+    uint64_t flagged = 0, flagged_secondary = 0;
     for (size_t p = 0; p < pixels_; ++p) {
-      if (!forced_[p]) continue;
+      const bool light = !forced_.empty() && forced_[p], secondary = !forced_secondary_.empty() && forced_secondary_[p];
+      if (!light && !secondary) continue;
       again[p] = 1;
-      ++flagged;
+      flagged += light ? 1 : 0;
+      flagged_secondary += secondary ? 1 : 0;
       if (fallback_) pixel_searches_[p] = {0, 0};
     }
     const size_t channels = static_cast<size_t>(image->channels);
@@ -244,7 +325,7 @@ class MapRender {
         if (fallback_) pixel_searches_[p] = {0, 0};
       }
     }
-    if (flagged > 0) {
+    if (flagged + flagged_secondary > 0) {
       ResolveOptions second = ro;
       second.only = &again;
       const Image redone = resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, second);
@@ -254,6 +335,7 @@ class MapRender {
       }
     }
     per_worker_[0].shadow_edge_pixels += flagged;
+    per_worker_[0].secondary_edge_pixels += flagged_secondary;
   }
 
   const SceneData& scene_;
@@ -269,7 +351,11 @@ class MapRender {
   std::vector<uint8_t> widened_;
   std::vector<uint64_t> forced_;  // per pixel, the lights whose edge the second pass searches
   std::vector<MapShadingStats> per_worker_;
-  std::vector<std::array<PrimaryLights, 4>> worker_direct_;
+  // Per worker: the records of a fragment's four points, and of one sample (shade_samples).
+  std::vector<std::array<PrimaryLights, 5>> worker_direct_;
+  bool trails_on_ = false;
+  PixelTrails trails_;
+  std::vector<uint8_t> forced_secondary_;  // per pixel, 1: its secondary fragments shaded at their samples
 };
 
 }  // namespace

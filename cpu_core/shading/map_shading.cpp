@@ -49,6 +49,9 @@ void MapShadingStats::merge(const MapShadingStats& o) {
   shadow_edge_fragments += o.shadow_edge_fragments;
   shadow_edge_samples += o.shadow_edge_samples;
   shadow_edge_pixels += o.shadow_edge_pixels;
+  secondary_edge_fragments += o.secondary_edge_fragments;
+  secondary_edge_samples += o.secondary_edge_samples;
+  secondary_edge_pixels += o.secondary_edge_pixels;
   errors.merge(o.errors);
 }
 
@@ -98,18 +101,20 @@ MapShader::~MapShader() = default;
 glm::dvec3 MapShader::shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
                             MapShadingStats* stats, PrimaryLights* direct) const {
   const MediumCrossing c{sp.triangle, !(glm::dot(sp.geometric_normal, dir) < 0.0), 0.0};
-  return shade(Crossed{sp, sp.point, ctx_->media().resolve(MediumStack{}, &c, 1)}, dir, depth, primary, stats, direct);
+  if (direct) direct->trail = 0;
+  return shade(Crossed{sp, sp.point, ctx_->media().resolve(MediumStack{}, &c, 1)}, dir, depth, primary, stats, direct,
+               direct ? &direct->trail : nullptr);
 }
 
 glm::dvec3 MapShader::shade(const Crossed& cr, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats,
-                            PrimaryLights* direct) const {
+                            PrimaryLights* direct, uint64_t* trail) const {
   const SurfacePoint& sp = cr.sp;
   const Material& m = scene_.materials[sp.material];
   // Coverage transparency of a found surface: the ray goes on behind it, same depth.
   glm::dvec3 behind(0.0);
   const bool blend = !primary && m.opacity < 1.0;
   if (blend) {
-    behind = trace(cr.far, dir, depth, cr.itf.after, stats, nullptr);
+    behind = trace(cr.far, dir, depth, cr.itf.after, stats, nullptr, trail);
     if (m.opacity <= 0.0) return behind;
   }
   const glm::dvec3 v = -dir;
@@ -121,9 +126,9 @@ glm::dvec3 MapShader::shade(const Crossed& cr, const glm::dvec3& dir, int depth,
                         transmission_between(dir, sp.geometric_normal, sp.shading_normal, cr.itf.n_from, cr.itf.n_to),
                         sp.geometric_normal);
   if (depth < scene_.render.max_depth && w.reflect > 0.0) {
-    c += w.reflect * reflected(sp, dir, depth, primary, cr.itf.before, stats);
+    c += w.reflect * reflected(sp, dir, depth, primary, cr.itf.before, stats, trail);
   }
-  if (depth < scene_.render.max_depth && w.transmit > 0.0) c += w.transmit * transmitted(cr, dir, depth, stats);
+  if (depth < scene_.render.max_depth && w.transmit > 0.0) c += w.transmit * transmitted(cr, dir, depth, stats, trail);
   return blend ? blend_coverage(m.opacity, c, behind) : c;
 }
 
@@ -201,20 +206,24 @@ MapShader::Crossed MapShader::crossing_set(const glm::dvec3& w, const glm::dvec3
 
 // What a ray from w along dir finds in the map, shaded one bounce deeper (or background).
 glm::dvec3 MapShader::trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, const MediumStack& stack,
-                            MapShadingStats* stats, SearchResult* found) const {
+                            MapShadingStats* stats, SearchResult* found, uint64_t* trail) const {
   const SearchResult r = search(w, dir, stack, stats);
   if (found) *found = r;
+  if (trail) {  // an order-dependent mix of the object found (0: none)
+    const uint64_t id = r.hit ? uint64_t{scene_.triangles->object_id[r.triangle]} + 1 : 0;
+    *trail = (*trail ^ id) * 0x9e3779b97f4a7c15ull + 0x632be59bd9b4e019ull;
+  }
   if (!r.hit) return scene_.background;
   const Crossed c = crossing_set(w, dir, r, stack);
   if (c.itf.pass) {  // no interface: the same ray goes on from the crossing
     if (c.itf.after.passes > MEDIA_MAX_PASSES) return scene_.background;
-    return trace(c.far, dir, depth, c.itf.after, stats, nullptr);
+    return trace(c.far, dir, depth, c.itf.after, stats, nullptr, trail);
   }
-  return shade(c, dir, depth, false, stats);
+  return shade(c, dir, depth, false, stats, nullptr, trail);
 }
 
 glm::dvec3 MapShader::reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
-                                const MediumStack& stack, MapShadingStats* stats) const {
+                                const MediumStack& stack, MapShadingStats* stats, uint64_t* trail) const {
   const glm::dvec3 r = glm::normalize(reflect_dir(dir, sp.shading_normal));
   if (options_.method == Method::envmap) {
     if (stats) ++stats->envmap_lookups;
@@ -223,7 +232,7 @@ glm::dvec3 MapShader::reflected(const SurfacePoint& sp, const glm::dvec3& dir, i
     return envmap_at(lookup);
   }
   SearchResult found;
-  const glm::dvec3 c = trace(sp.point, r, depth + 1, stack, stats, &found);
+  const glm::dvec3 c = trace(sp.point, r, depth + 1, stack, stats, &found, trail);
   if (primary && reference_ && stats) measure(sp.point, r, &found, nullptr, stats);
   return c;
 }
@@ -235,7 +244,8 @@ Ray MapShader::transmitted_ray(const Crossed& c, const Transmission& tr, MediumS
   return {tr.total_internal_reflection ? c.sp.point : c.far, glm::normalize(tr.dir)};
 }
 
-glm::dvec3 MapShader::transmitted(const Crossed& c, const glm::dvec3& dir, int depth, MapShadingStats* stats) const {
+glm::dvec3 MapShader::transmitted(const Crossed& c, const glm::dvec3& dir, int depth, MapShadingStats* stats,
+                                  uint64_t* trail) const {
   const SurfacePoint& sp = c.sp;
   const Transmission tr = transmission_between(dir, sp.geometric_normal, sp.shading_normal, c.itf.n_from, c.itf.n_to);
   if (options_.method == Method::envmap) {
@@ -248,13 +258,13 @@ glm::dvec3 MapShader::transmitted(const Crossed& c, const glm::dvec3& dir, int d
     LensRay out;
     if (lens_transfer(lenses_[static_cast<size_t>(lens)], options_.refraction, sp.point, dir, &out)) {
       if (stats) ++stats->lens_transfers;
-      return trace(out.point, out.dir, depth + 1, MediumStack{}, stats, nullptr);
+      return trace(out.point, out.dir, depth + 1, MediumStack{}, stats, nullptr, trail);
     }
     if (stats) ++stats->lens_fallbacks;
   }
   MediumStack stack;
   const Ray ray = transmitted_ray(c, tr, &stack);
-  return trace(ray.origin, ray.dir, depth + 1, stack, stats, nullptr);
+  return trace(ray.origin, ray.dir, depth + 1, stack, stats, nullptr, trail);
 }
 
 std::vector<Ray> MapShader::transmitted_path(const glm::dvec3& origin, const glm::dvec3& dir, int max_rays) const {

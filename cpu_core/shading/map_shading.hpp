@@ -56,6 +56,9 @@ struct MapShadingOptions {
   // A textured fragment's base colour averaged over the covered samples each shading point
   // stands for (render_with_map), else looked up at the point.
   bool texture_samples = true;
+  // SECONDARY EDGES (below): a mirror or glass fragment whose shading points disagree is
+  // shaded at each covered sample. Off: the points' colours stand.
+  bool secondary_edges = true;
 };
 
 // Ray-level error against the exact tracer (thesis ch. 9), for the reflection rays of
@@ -75,6 +78,9 @@ struct MapShadingStats {
   // EDGES), the sample shadow searches they made, and the pixels shaded a second time for
   // an edge beside them.
   uint64_t multi_point_fragments = 0, shadow_edge_fragments = 0, shadow_edge_samples = 0, shadow_edge_pixels = 0;
+  // Camera fragments with a secondary term shaded at each covered sample (SECONDARY EDGES),
+  // the samples shaded, and the pixels shaded a second time for an edge beside them.
+  uint64_t secondary_edge_fragments = 0, secondary_edge_samples = 0, secondary_edge_pixels = 0;
   RayErrors errors;  // filled only when a reference tracer is given
   void merge(const MapShadingStats& o);
 };
@@ -101,18 +107,37 @@ constexpr double QUARTER_SPLIT_SRGB = 1.0 / 255.0;
 // c_q += phong_light_l(q) * (mean - S_l(q)). Every quarter is then shaded, so that each has
 // its own phong_light_l.
 // An edge can also pass between the points, meeting none of them: then the pixel's points
-// all see one answer and a neighbour's points the other. A second pass shades again the
-// pixels whose points saw a light (of the first 64) only lit where a 4-neighbour's saw it
-// only shadowed, or the reverse, refining that light in all their fragments. Where all
-// agree nothing changes and nothing more is searched: the cost falls where edges are (the
-// stats' "shadow_edges"). A shadow thinner than the points' spacing, seen by no point of
-// any pixel, is not seen.
+// all see one answer and a neighbour's points the other. And a shadow thinner than the
+// points' spacing (a spider's leg) is met by a point here and there along its length, and
+// runs on into the next pixels between their points. A second pass shades again the pixels
+// whose points saw a light (of the first 64) only lit where a 4-neighbour's saw it only
+// shadowed, or the reverse; and those whose points saw it only lit next to a neighbour whose
+// points disagreed and whose samples found a shadowed one on the side the two pixels share
+// (PixelShadows::sides), or the reverse. Those lights are refined in all their fragments.
+// Where all agree nothing changes and nothing more is searched: the cost falls where edges
+// are (the stats' "shadow_edges"). A shadow thinner than the points' spacing, met by no
+// point of a pixel or its neighbours, is not seen.
+//
+// SECONDARY EDGES. A mirror's or glass's fragment shows what its reflected and refracted
+// rays find, and an edge of that (a silhouette, a model's thin leg seen in the chrome or
+// through the glass) would be decided at the points too. So every covered quarter of such a
+// fragment (a material with kr or kt, bounces left) is shaded; where their secondary rays
+// found different surfaces (PrimaryLights::trail) and their colours differ by more than
+// QUARTER_SPLIT_SRGB, each quarter's colour becomes the mean of its covered samples, each
+// shaded at its own point (its own searches, shadows and texture lookup), as the tracer's
+// 32 rays see the pixel (--secondary-edges samples; the stats' "secondary_edges"). Quarters
+// that see one surface keep their points' colours, however that surface's shading varies:
+// the cost falls on the fragments a silhouette of the secondary image crosses.
 
 // The direct light one primary point received, light by light (scene.lights' order):
 // `lit` the unshadowed term (phong_light; 0 where the light is behind the surface), `shadow`
 // the visibility its shadow search gave (1 for a light that casts no shadow).
 struct PrimaryLights {
   std::vector<glm::dvec3> lit, shadow;
+  // The objects the point's secondary rays found (reflected, transmitted, through coverage
+  // transparency, at every depth; 0 for a miss), hashed in the order they were found: two
+  // points whose trails differ see different surfaces in a mirror or through glass.
+  uint64_t trail = 0;
 };
 
 struct SurfacePoint {
@@ -161,6 +186,7 @@ class MapShader {
   bool one_point() const { return options_.one_point; }
   bool shadow_edges() const { return options_.shadow_edges; }
   bool texture_samples() const { return options_.texture_samples; }
+  bool secondary_edges() const { return options_.secondary_edges; }
 
  private:
   // A crossing set (media.hpp): the surface point shaded, the furthest crossing, the interface.
@@ -173,16 +199,19 @@ class MapShader {
                       MapShadingStats* stats) const;
   Crossed crossing_set(const glm::dvec3& w, const glm::dvec3& dir, const SearchResult& r,
                        const MediumStack& stack) const;
+  // `trail` (optional): the surfaces every search below this one found, hashed in order
+  // (PrimaryLights::trail).
   glm::dvec3 shade(const Crossed& c, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats,
-                   PrimaryLights* direct = nullptr) const;
+                   PrimaryLights* direct, uint64_t* trail) const;
   Ray transmitted_ray(const Crossed& c, const Transmission& tr, MediumStack* stack) const;
   glm::dvec3 trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, const MediumStack& stack,
-                   MapShadingStats* stats, SearchResult* found) const;
+                   MapShadingStats* stats, SearchResult* found, uint64_t* trail) const;
   glm::dvec3 lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n, const glm::dvec3& od,
                     MapShadingStats* stats, PrimaryLights* direct) const;
   glm::dvec3 reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary, const MediumStack& stack,
-                       MapShadingStats* stats) const;
-  glm::dvec3 transmitted(const Crossed& c, const glm::dvec3& dir, int depth, MapShadingStats* stats) const;
+                       MapShadingStats* stats, uint64_t* trail) const;
+  glm::dvec3 transmitted(const Crossed& c, const glm::dvec3& dir, int depth, MapShadingStats* stats,
+                         uint64_t* trail) const;
   glm::dvec3 envmap_direction(const glm::dvec3& w, const glm::dvec3& r) const;
   glm::dvec3 envmap_at(const glm::dvec3& direction) const;
   void measure(const glm::dvec3& w, const glm::dvec3& r, const SearchResult* found, const glm::dvec3* lookup,

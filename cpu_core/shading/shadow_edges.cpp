@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "base/samples.hpp"
 #include "raster/raster.hpp"
 
 namespace abcube {
@@ -17,7 +18,7 @@ size_t pixel_index(int width, int x, int y) {
 void refine_shadow_edges(const SceneData& scene, const ABuffer& camera, const Fragment& f, int x, int y,
                          const CoverageMask* quarter, int count, const PrimaryLights* direct, uint64_t forced,
                          glm::dvec3* colour, const std::function<glm::dvec3(const glm::dvec3&)>& on_surface,
-                         const MapShader& shader, MapShadingStats* stats) {
+                         const MapShader& shader, MapShadingStats* stats, uint8_t* sides) {
   bool any = false;
   for (size_t l = 0; l < scene.lights.size(); ++l) {
     bool refine = l < 64 && ((forced >> l) & 1u) != 0;
@@ -31,8 +32,12 @@ void refine_shadow_edges(const SceneData& scene, const ABuffer& camera, const Fr
         const int b = __builtin_ctz(m);
         const glm::dvec3 p =
             point_on_triangle_plane(camera.view, *scene.triangles, f.triangle(), x + sample_dx(b), y + sample_dy(b));
-        sum += shader.visibility(on_surface(p), scene.lights[l], stats);
+        const glm::dvec3 v = shader.visibility(on_surface(p), scene.lights[l], stats);
+        sum += v;
         ++stats->shadow_edge_samples;
+        if (sides)
+          *sides =
+              static_cast<uint8_t>(*sides | sample_sides(b) << (v == glm::dvec3(1.0) ? PixelShadows::LIT_SIDES : 0));
       }
       colour[k] += direct[k].lit[l] * (sum / double(mask_count(quarter[k])) - direct[k].shadow[l]);
     }
@@ -59,11 +64,18 @@ std::vector<uint64_t> PixelShadows::across(int width, int height, const std::vec
       if (only && !(*only)[p]) continue;
       const uint64_t pure_lit = lit[p] & ~dark[p], pure_dark = dark[p] & ~lit[p];
       uint64_t edge = 0;
-      const auto against = [&](size_t q) { edge |= (pure_lit & dark[q] & ~lit[q]) | (pure_dark & lit[q] & ~dark[q]); };
-      if (x > 0) against(at(x - 1, y));
-      if (x + 1 < width) against(at(x + 1, y));
-      if (y > 0) against(at(x, y - 1));
-      if (y + 1 < height) against(at(x, y + 1));
+      // q: a 4-neighbour; side: q's side that faces this pixel.
+      const auto against = [&](size_t q, uint8_t side) {
+        edge |= (pure_lit & dark[q] & ~lit[q]) | (pure_dark & lit[q] & ~dark[q]);
+        const uint8_t s = sides.empty() ? 0 : sides[q];
+        const uint64_t mixed = dark[q] & lit[q];
+        if (s & side) edge |= pure_lit & mixed;
+        if (s & (side << LIT_SIDES)) edge |= pure_dark & mixed;
+      };
+      if (x > 0) against(at(x - 1, y), SIDE_RIGHT);
+      if (x + 1 < width) against(at(x + 1, y), SIDE_LEFT);
+      if (y > 0) against(at(x, y - 1), SIDE_BOTTOM);
+      if (y + 1 < height) against(at(x, y + 1), SIDE_TOP);
       out[p] = edge;
     }
   }

@@ -287,6 +287,13 @@ void add_map_methods(Table& t) {
        {}},
       [](RenderSetup& s, const json& v) { s.render.shadow_edges = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.shadow_edges, d.shadow_edges); });
+  add(t, {"secondary_edges", "--secondary-edges", OptionKind::choice, OptionScope::job, {"samples", "points"}, 0, 0,
+       d.secondary_edges, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
+       "what a mirror or glass fragment shows: samples (shaded again at each covered sample where its shading "
+       "points disagree) | points (the shading points' answers)",
+       {}},
+      [](RenderSetup& s, const json& v) { s.render.secondary_edges = v.get<std::string>(); },
+      [d](const RenderSetup& s) { return unless(s.render.secondary_edges, d.secondary_edges); });
   add(t, {"texture_lookups", "--texture-lookups", OptionKind::choice, OptionScope::job, {"samples", "points"}, 0, 0,
        d.texture_lookups, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
        "a textured fragment's base colour: samples (averaged over the covered samples each shading point stands "
@@ -507,8 +514,8 @@ void check_render_options(const RenderOptions& options) {
   // Options that contradict one another.
   if (options.target_db > 0 && (options.cube_resolution != 0 || options.error_target >= 0)) {
     const OptionSpec& other = *find_render_option(options.cube_resolution != 0 ? "cube_res" : "error_target");
-    throw OptionError("target_db", "chooses the cube map's N, and so does " + other.key + " (" + other.flag +
-                                       "): give one");
+    throw OptionError("target_db",
+                      "chooses the cube map's N, and so does " + other.key + " (" + other.flag + "): give one");
   }
 }
 
@@ -543,6 +550,7 @@ RenderOptions without_unused_options(const RenderOptions& options, const std::st
       {"resolve", [](RenderOptions& o, const RenderOptions& x) { o.resolve = x.resolve; }},
       {"shading_points", [](RenderOptions& o, const RenderOptions& x) { o.shading_points = x.shading_points; }},
       {"shadow_edges", [](RenderOptions& o, const RenderOptions& x) { o.shadow_edges = x.shadow_edges; }},
+      {"secondary_edges", [](RenderOptions& o, const RenderOptions& x) { o.secondary_edges = x.secondary_edges; }},
       {"texture_lookups", [](RenderOptions& o, const RenderOptions& x) { o.texture_lookups = x.texture_lookups; }},
       {"max_layers", [](RenderOptions& o, const RenderOptions& x) { o.max_layers = x.max_layers; }},
       {"gpu_mirrors", [](RenderOptions& o, const RenderOptions& x) { o.gpu_mirrors = x.gpu_mirrors; }},

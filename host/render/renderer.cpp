@@ -124,6 +124,7 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   r.map.one_point = o.shading_points == "one";
   r.map.shadow_edges = o.shadow_edges == "samples";
   r.map.texture_samples = o.texture_lookups == "samples";
+  r.map.secondary_edges = o.secondary_edges == "samples";
   r.map.search.side_structure = o.side_structure;
   r.gpu.planar_mirrors = o.gpu_mirrors == "stencil";
   r.gpu.shadow_volumes = o.gpu_shadows == "volumes";
@@ -174,6 +175,7 @@ json request_stats(const SceneData& view, const RenderRequest& request) {
                              {"shading_points", request.map.one_point ? "one" : "quarters"},
                              {"shadow_edges", request.map.shadow_edges ? "samples" : "points"},
                              {"texture_lookups", request.map.texture_samples ? "samples" : "points"},
+                             {"secondary_edges", request.map.secondary_edges ? "samples" : "points"},
                              {"side_structure", request.map.search.side_structure},
                              {"fresnel", view.render.fresnel}};
   return stats;

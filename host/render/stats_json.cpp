@@ -34,7 +34,13 @@ json map_shading_json(const MapShadingStats& ms) {
         {"fragments", ms.shadow_edge_fragments},
         {"share", ms.multi_point_fragments ? double(ms.shadow_edge_fragments) / double(ms.multi_point_fragments) : 0.0},
         {"sample_searches", ms.shadow_edge_samples},
-        {"pixels_shaded_again", ms.shadow_edge_pixels}}}};
+        {"pixels_shaded_again", ms.shadow_edge_pixels}}},
+      {"secondary_edges",
+       {{"fragments", ms.secondary_edge_fragments},
+        {"share",
+         ms.multi_point_fragments ? double(ms.secondary_edge_fragments) / double(ms.multi_point_fragments) : 0.0},
+        {"samples_shaded", ms.secondary_edge_samples},
+        {"pixels_shaded_again", ms.secondary_edge_pixels}}}};
 }
 
 json error_stats_json(const ErrorStats& e) {

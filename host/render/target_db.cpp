@@ -94,10 +94,35 @@ SampledError run_pilot(MethodContext& mc, const ABuffer& camera, const MapShader
   const SampledError e = sampled_error(pilot, sample.exact, sample.pixels);
   pilots->push_back({{"cube_resolution", n},
                      {"shading_points", shader.one_point() ? "one" : "quarters"},
+                     {"shadow_edges", shader.shadow_edges() ? "samples" : "points"},
+                     {"secondary_edges", shader.secondary_edges() ? "samples" : "points"},
                      {"psnr_db", number_or_null(e.psnr)},
                      {"psnr_db_low", number_or_null(e.psnr_low)},
                      {"ms", ms_since(t0)}});
   return e;
+}
+
+// The shading plans cheaper than `chosen`, cheapest first: one shading point per fragment
+// (about half the shading of a covered pixel, and no edges refined at the samples), then the
+// quarters with neither SHADOW EDGES nor SECONDARY EDGES, then without SECONDARY EDGES
+// alone (map_shading.hpp: each costs where its edges are).
+std::vector<MapShadingOptions> cheaper_plans(const MapShadingOptions& chosen) {
+  std::vector<MapShadingOptions> plans;
+  if (chosen.one_point) return plans;
+  MapShadingOptions one = chosen;
+  one.one_point = true;
+  plans.push_back(one);
+  if (chosen.shadow_edges && chosen.secondary_edges) {
+    MapShadingOptions neither = chosen;
+    neither.shadow_edges = neither.secondary_edges = false;
+    plans.push_back(neither);
+  }
+  if (chosen.secondary_edges) {
+    MapShadingOptions no_secondary = chosen;
+    no_secondary.secondary_edges = false;
+    plans.push_back(no_secondary);
+  }
+  return plans;
 }
 
 }  // namespace
@@ -136,19 +161,17 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
     }
   }
   if (why.empty()) why = "the ladder's largest N did not reach the target: the best N found";
-  // One shading point per fragment instead of the quarters, where it still reaches the
-  // target at the chosen N: about half the shading of a covered pixel.
+  // At the chosen N, the cheapest shading plan that still reaches the target.
   MapShadingOptions chosen = map_shading_options(mc);
-  if (reached && !chosen.one_point) {
+  for (const MapShadingOptions& plan : reached ? cheaper_plans(chosen) : std::vector<MapShadingOptions>{}) {
     const Clock::time_point t0 = Clock::now();
-    MapShadingOptions one = chosen;
-    one.one_point = true;
-    auto shader = std::make_unique<MapShader>(scene, *best.cube, one, nullptr, &mc.cache);
+    auto shader = std::make_unique<MapShader>(scene, *best.cube, plan, nullptr, &mc.cache);
     const SampledError e = run_pilot(mc, camera, *shader, sample, best.n, t0, &pilots);
     if (e.psnr_low >= target) {
-      chosen = one;
+      chosen = plan;
       best.shader = std::move(shader);
       best_error = e;
+      break;
     }
   }
   if (reference) {  // the searches' ray errors, measured on the final render only
@@ -158,11 +181,17 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
   }
   json& stats = mc.stats;
   stats["size"]["cube_resolution"] = best.n;
+  const char* shadow_edges = chosen.shadow_edges && !chosen.one_point ? "samples" : "points";
+  const char* secondary_edges = chosen.secondary_edges && !chosen.one_point ? "samples" : "points";
   stats["method_options"]["shading_points"] = chosen.one_point ? "one" : "quarters";
+  stats["method_options"]["shadow_edges"] = shadow_edges;
+  stats["method_options"]["secondary_edges"] = secondary_edges;
   stats["target_db"] = {
       {"target", target},
       {"cube_resolution", best.n},
       {"shading_points", chosen.one_point ? "one" : "quarters"},
+      {"shadow_edges", shadow_edges},
+      {"secondary_edges", secondary_edges},
       {"scene_cube_resolution", scene.render.cube_resolution},
       {"reached", reached},
       {"why", why},

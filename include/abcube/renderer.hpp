@@ -75,6 +75,7 @@ struct RenderOptions {
   std::string shading_points = "quarters";  // per camera fragment: quarters (adaptive, 2 to 4) | one
   std::string texture_lookups = "samples";  // a textured fragment's base colour: samples (averaged) | points
   std::string shadow_edges = "samples";     // a shadow edge inside a fragment: samples (each its own) | points
+  std::string secondary_edges = "samples";  // reflections and refractions inside a fragment: samples | points
   std::string resolve = "exact";            // intersecting fragments: exact (priority masks) | thesis (Vis_front)
   bool side_structure = true;               // searches also test the triangles the map cannot hold (false: --map-only)
   std::string gpu_mirrors =

@@ -1,9 +1,10 @@
 // Edges inside a pixel, against answers known in closed form: a straight shadow edge
 // crossing a floor at a shallow angle (each pixel's lit share is the share of its 32
 // samples whose floor point the blocker leaves lit: map_shading.hpp SHADOW EDGES), a wire a
-// tenth of a pixel wide (its covered share is the share of samples inside it), and a
-// texture's edges finer than the shading points (each pixel the mean of its samples' texels,
-// as the exact tracer sees them).
+// tenth of a pixel wide (its covered share is the share of samples inside it), a texture's
+// edges finer than the shading points (each pixel the mean of its samples' texels, as the
+// exact tracer sees them), and a straight edge seen in a mirror (each pixel's share is that
+// of its samples whose reflected ray meets the white quad: map_shading.hpp SECONDARY EDGES).
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -217,6 +218,75 @@ TEST(Edges, ATextureFinerThanTheShadingPointsIsTheMeanOfItsSamples) {
 TEST(Edges, AtTheShadingPointsAloneATextureAliases) {
   EXPECT_GT(texture_error("points", false), 0.1);
   EXPECT_GT(texture_error("points", true), 0.1);
+}
+
+// Seen straight down from (0, 4, 0) as above: a perfect mirror at y = 0 (it shows only what
+// it reflects), and above the camera, out of its view, a white quad at y = 8 lit by ambient
+// light alone, covering z < 0.2 + 0.1 x of that plane, on a black background. A sample's
+// reflected ray is its eye ray mirrored in y = 0, so each pixel's value is the share of its
+// samples whose mirrored ray meets the quad. The cube map must place the quad's edge to a
+// sample: seen from the mirror, the edge is 12 from the mirrored eye where the floor is 4, so
+// a sample row (1/4 pixel, 0.018 on the floor) is 0.055 on the quad's plane, where N = 512
+// puts texels about 4.5 * (pi / 2) / 512 = 0.014 wide.
+struct MirrorEdge {
+  double worst = 0;
+  int edge_pixels = 0;
+  nlohmann::json stats;
+};
+MirrorEdge mirror_edge_error(const std::string& secondary_edges) {
+  const std::string text = R"({"version": 1,
+    "camera": {"position": [0, 4, 0], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov_y": 40, "width": )" +
+                           std::to_string(SIZE) + R"(, "height": )" + std::to_string(SIZE) + R"(},
+    "background": [0, 0, 0], "ambient": [1, 1, 1], "lights": [],
+    "materials": {"mirror": {"color": [0, 0, 0], "ambient": 0, "diffuse": 0, "specular": 0, "reflect": 1},
+                  "white": {"color": [1, 1, 1], "ambient": 1}},
+    "objects": [
+      {"type": "quad", "vertices": [[-8, 0, -8], [-8, 0, 8], [8, 0, 8], [8, 0, -8]], "material": "mirror"},
+      {"type": "quad", "vertices": [[-9, 8, -0.7], [9, 8, 1.1], [9, 8, -30], [-9, 8, -30]], "material": "white"}],
+    "render": {"method": "abuffer", "cube_resolution": 512, "max_depth": 1}})";
+  const Scene scene = Scene::from_json(text, "mirror_edge.json");
+  Renderer renderer;
+  RenderOptions o;
+  o.secondary_edges = secondary_edges;
+  const RenderResult r = renderer.render(scene, o);
+  MirrorEdge e;
+  e.stats = nlohmann::json::parse(r.stats.json);
+  const CameraFrame frame = overhead_frame();
+  for (int y = 0; y < SIZE; ++y) {
+    for (int x = 0; x < SIZE; ++x) {
+      int white = 0;
+      for (int k = 0; k < MASK_SAMPLES; ++k) {
+        glm::dvec3 d = frame.direction(x + sample_dx(k), y + sample_dy(k));
+        const glm::dvec3 p = frame.eye + (-frame.eye.y / d.y) * d;  // on the mirror
+        d.y = -d.y;
+        const glm::dvec3 q = p + (8.0 / d.y) * d;  // on the quad's plane
+        white += q.z < 0.2 + 0.1 * q.x ? 1 : 0;
+      }
+      const double known = white / double(MASK_SAMPLES);
+      e.edge_pixels += known > 0.0 && known < 1.0 ? 1 : 0;
+      const size_t at = (static_cast<size_t>(y) * SIZE + static_cast<size_t>(x)) * 3;
+      e.worst = std::max(e.worst, std::fabs(r.image.data[at] - known));
+    }
+  }
+  return e;
+}
+
+// Every pixel within one sample (1/32) of its known share, the pixels whose points all miss
+// the edge too, and only the edge's fragments shaded at their samples.
+TEST(Edges, AnEdgeSeenInAMirrorIsWithinOneSampleOfItsShare) {
+  const MirrorEdge e = mirror_edge_error("samples");
+  EXPECT_GE(e.edge_pixels, SIZE / 2);  // the edge crosses the image
+  EXPECT_LE(e.worst, 1.0 / 32.0);
+  const nlohmann::json& s = e.stats["searches"]["secondary_edges"];
+  EXPECT_GT(s["fragments"].get<uint64_t>(), 0u) << s.dump();
+  EXPECT_LT(s["fragments"].get<uint64_t>(), uint64_t{4} * SIZE) << s.dump();  // only along the edge
+}
+
+// At the shading points alone the reflected edge steps: the test above can fail.
+TEST(Edges, AtTheShadingPointsAloneAnEdgeSeenInAMirrorSteps) {
+  const MirrorEdge e = mirror_edge_error("points");
+  EXPECT_GT(e.worst, 1.0 / 32.0);
+  EXPECT_EQ(e.stats["searches"]["secondary_edges"]["fragments"].get<uint64_t>(), 0u);
 }
 
 }  // namespace

@@ -88,6 +88,8 @@ TEST(TargetDb, TheChosenPlanIsTheImageAndReachesTheTarget) {
 
   RenderOptions direct = small_options("abuffer", 96, 72, n);
   direct.shading_points = t["shading_points"].get<std::string>();
+  direct.shadow_edges = t["shadow_edges"].get<std::string>();
+  direct.secondary_edges = t["secondary_edges"].get<std::string>();
   EXPECT_TRUE(images_equal(renderer.render(scene, direct).image, r.image));
 }
 

@@ -107,8 +107,10 @@ check "--error-target 1.25e-5 picks N = 200 (thesis 9.3.4)" grep -q '"cube_resol
 "$ABCUBE" render "$WORK/small.json" -o "$WORK/t1.png" --target-db 35 --stats "$WORK/t1.json" 2> "$WORK/err"
 status=$?
 check "--target-db 35 renders ($(cat "$WORK/err"))" [ $status -eq 0 ]
-tn=$(/usr/bin/python3 -c 'import json,sys; t=json.load(open(sys.argv[1]))["target_db"]; print(t["cube_resolution"], t["shading_points"])' "$WORK/t1.json")
-"$ABCUBE" render "$WORK/small.json" -o "$WORK/t2.png" --cube-res "${tn% *}" --shading-points "${tn#* }" 2> /dev/null
+tn=$(/usr/bin/python3 -c 'import json,sys; t=json.load(open(sys.argv[1]))["target_db"]; print(t["cube_resolution"], t["shading_points"], t["shadow_edges"], t["secondary_edges"])' "$WORK/t1.json")
+read -r t_n t_points t_shadow t_secondary <<< "$tn"
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/t2.png" --cube-res "$t_n" --shading-points "$t_points" \
+  --shadow-edges "$t_shadow" --secondary-edges "$t_secondary" 2> /dev/null
 check "--target-db's chosen plan ($tn) rendered directly is the same image" \
   "$ABCUBE" compare "$WORK/t1.png" "$WORK/t2.png" --exact
 sed 's/"objects": \[/"render": {"target_db": 35}, "objects": [/' "$WORK/small.json" > "$WORK/target.json"

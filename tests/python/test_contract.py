@@ -235,7 +235,8 @@ def test_target_db(renderer, scene):
     chosen = res.stats["target_db"]
     assert chosen["target"] == 30 and chosen["reached"]
     direct = renderer.render(scene, method="abuffer", cube_res=chosen["cube_resolution"],
-                             shading_points=chosen["shading_points"])
+                             shading_points=chosen["shading_points"], shadow_edges=chosen["shadow_edges"],
+                             secondary_edges=chosen["secondary_edges"])
     assert np.array_equal(res.image, direct)
     with pytest.raises(abcube.SceneError, match="and so does cube_res"):
         renderer.render(scene, target_db=40, cube_res=64)
