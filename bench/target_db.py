@@ -18,7 +18,9 @@ Per scene, one whole process each (wall clock, /usr/bin/time):
   own        `abcube render` (abuffer at the scene's N);
   target     `abcube render --target-db T`.
 PSNR of each abuffer image against the reference by `abcube compare` (sRGB). The stats of
-the target run give the N and shading points chosen and the predicted PSNR.
+the target run give the N and shading plan chosen and the predicted PSNR. The plan: `one`
+shading point a fragment, or the `quarters` with the edges refined at the samples
+(`+ shadow`: --shadow-edges samples, `+ secondary`: --secondary-edges samples).
 Writes REPORT.md and REPORT.csv.
 """
 import argparse
@@ -54,6 +56,14 @@ def generate(args, out):
         template = ("room", "outdoor")[k % 2]
         scenes.append(race_scenes.write(os.path.join(out, "race"), template, args.seed + k // 2))
     return scenes
+
+
+def plan(t):
+    """The shading plan --target-db chose (its stats' target_db object), in a few words."""
+    if t.get("shading_points", "-") != "quarters":
+        return t.get("shading_points", "-")
+    edges = [name for name in ("shadow", "secondary") if t.get(name + "_edges") == "samples"]
+    return " + ".join(["quarters"] + edges)
 
 
 def main(argv=None):
@@ -97,7 +107,7 @@ def main(argv=None):
             "own_n": own_n,
             "own_db": race.psnr(abcube, own, ref),
             "chosen_n": t.get("cube_resolution", "-"),
-            "points": t.get("shading_points", "-"),
+            "points": plan(t),
             "predicted_db_low": t.get("predicted_psnr_db_low"),
             "target_db": race.psnr(abcube, target, ref),
             "pilots": len(t.get("pilots", [])),
@@ -107,7 +117,7 @@ def main(argv=None):
             "target_s": t_target,
         }
         row["reached"] = row["target_db"] >= args.target
-        print("%-32s own N %4s %6.2f dB %6.2f s | target N %4s %-8s %6.2f dB (low %s) %6.2f s | raytrace %6.2f s" % (
+        print("%-32s own N %4s %6.2f dB %6.2f s | target N %4s %-22s %6.2f dB (low %s) %6.2f s | raytrace %6.2f s" % (
             name, own_n, row["own_db"], t_own, row["chosen_n"], row["points"], row["target_db"],
             "-" if row["predicted_db_low"] is None else "%.2f" % row["predicted_db_low"], t_target, t_ray),
             flush=True)
@@ -141,7 +151,7 @@ def main(argv=None):
                         args.seed, args.target, args.hard, args.flat, args.race, args.size, args.cube_res,
                         args.threads))
             f.write("\n".join("- " + s for s in summary) + "\n\n")
-            f.write("| scene | triangles | own N | own dB | own s | chosen N | points | predicted low | "
+            f.write("| scene | triangles | own N | own dB | own s | chosen N | plan | predicted low | "
                     "target dB | target s | raytrace s |\n|" + "---|" * 11 + "\n")
             for r in rows:
                 f.write("| %s | %d | %s | %.2f | %.2f | %s | %s | %s | %.2f | %.2f | %.2f |\n" % (

@@ -215,11 +215,11 @@ class MapRender {
     // What the points' lights gave (SHADOW EDGES) and their secondary rays found (SECONDARY EDGES).
     PrimaryLights* const record = edges_ || secondary ? direct : nullptr;
     if (q.count <= 1) {
+      glm::dvec3 c = shade_at(f, x, y, fragment_point(camera_, *scene_.triangles, f, x, y), f.mask, record, s);
       if (secondary && force_secondary) {
         ++s->secondary_edge_fragments;
-        return shade_samples(f, x, y, f.mask, worker, s);
+        c += secondary_samples(f, x, y, f.mask, s) - direct[0].secondary;
       }
-      glm::dvec3 c = shade_at(f, x, y, fragment_point(camera_, *scene_.triangles, f, x, y), f.mask, record, s);
       if (secondary && !trails_.empty()) trails_.note_point(at, direct[0].trail);
       if (edges_ && force) {
         refine_shadow_edges(scene_, camera_, f, x, y, q.mask, 1, direct, force, &c, on_surface, shader_, s,
@@ -248,16 +248,20 @@ class MapRender {
       for (int k = 0; k < q.count; ++k) trails_.note_point(at, direct[k].trail);
     }
     if (refined) {
-      // SECONDARY EDGES (map_shading.hpp): each sample shaded at its own point, its own
-      // shadows with it; the trails its samples found on each side of the pixel noted.
+      // SECONDARY EDGES (map_shading.hpp): each quarter's kr and kt terms the mean of its
+      // samples', each searched from its own point; the trails its samples found on each side
+      // of the pixel noted.
       SideTrails sides;
-      for (int k = 0; k < q.count; ++k) colour[k] = shade_samples(f, x, y, q.mask[k], worker, s, &sides);
+      for (int k = 0; k < q.count; ++k) {
+        colour[k] += secondary_samples(f, x, y, q.mask[k], s, &sides) - direct[k].secondary;
+      }
       ++s->secondary_edge_fragments;
       if (!trails_.empty()) {
         trails_.note_several(at);
         trails_.note_sides(at, worker, sides);
       }
-    } else if (edges_ && split) {
+    }
+    if (edges_ && split) {
       refine_shadow_edges(scene_, camera_, f, x, y, q.mask, q.count, direct, force, colour, on_surface, shader_, s,
                           &seen_.sides[at]);
     }
@@ -274,21 +278,21 @@ class MapRender {
     return shader_.secondary_edges() && scene_.render.max_depth > 0 && (m.reflect > 0.0 || m.transmit > 0.0);
   }
 
-  // The mean colour of the covered samples `mask` of fragment f, each shaded at its own point
-  // of the fragment's plane (its texture lookup that sample's alone); `sides` (optional)
-  // gains the trails of the samples on each side of the pixel.
-  glm::dvec3 shade_samples(const Fragment& f, int x, int y, CoverageMask mask, int worker, MapShadingStats* s,
-                           SideTrails* sides = nullptr) {
-    PrimaryLights* const record = &worker_direct_[static_cast<size_t>(worker)][4];
+  // The mean of the kr and kt terms of the covered samples `mask` of fragment f, each
+  // searched from its own point of the fragment's plane (moved onto the mesh as the shading
+  // points are); `sides` (optional) gains the trails of the samples on each side of the pixel.
+  glm::dvec3 secondary_samples(const Fragment& f, int x, int y, CoverageMask mask, MapShadingStats* s,
+                               SideTrails* sides = nullptr) const {
     glm::dvec3 sum(0.0);
     for (CoverageMask m = mask; m; m &= m - 1) {
       const int b = __builtin_ctz(m);
       const glm::dvec3 p =
           point_on_triangle_plane(camera_.view, *scene_.triangles, f.triangle(), x + sample_dx(b), y + sample_dy(b));
-      sum += shade_at(f, x, y, p, CoverageMask{1} << b, record, s);
+      uint64_t trail = 0;
+      sum += shader_.secondary(surface_at(f, x, y, p), glm::normalize(p - scene_.camera.position), s, &trail);
       ++s->secondary_edge_samples;
       for (int side = 0; sides && side < 4; ++side) {
-        if (sample_sides(b) & (1 << side)) (*sides)[static_cast<size_t>(side)].add(record->trail);
+        if (sample_sides(b) & (1 << side)) (*sides)[static_cast<size_t>(side)].add(trail);
       }
     }
     return sum / double(mask_count(mask));
@@ -351,8 +355,7 @@ class MapRender {
   std::vector<uint8_t> widened_;
   std::vector<uint64_t> forced_;  // per pixel, the lights whose edge the second pass searches
   std::vector<MapShadingStats> per_worker_;
-  // Per worker: the records of a fragment's four points, and of one sample (shade_samples).
-  std::vector<std::array<PrimaryLights, 5>> worker_direct_;
+  std::vector<std::array<PrimaryLights, 4>> worker_direct_;
   bool trails_on_ = false;
   PixelTrails trails_;
   std::vector<uint8_t> forced_secondary_;  // per pixel, 1: its secondary fragments shaded at their samples

@@ -106,6 +106,33 @@ glm::dvec3 MapShader::shade(const SurfacePoint& sp, const glm::dvec3& dir, int d
                direct ? &direct->trail : nullptr);
 }
 
+glm::dvec3 MapShader::secondary(const SurfacePoint& sp, const glm::dvec3& dir, MapShadingStats* stats,
+                                uint64_t* trail) const {
+  const MediumCrossing c{sp.triangle, !(glm::dot(sp.geometric_normal, dir) < 0.0), 0.0};
+  if (trail) *trail = 0;
+  const Terms t =
+      secondary_terms(Crossed{sp, sp.point, ctx_->media().resolve(MediumStack{}, &c, 1)}, dir, 0, true, stats, trail);
+  return t.reflected + t.transmitted;
+}
+
+// kr times the reflected ray's colour, kt times the transmitted one's (THE RULES).
+MapShader::Terms MapShader::secondary_terms(const Crossed& cr, const glm::dvec3& dir, int depth, bool primary,
+                                            MapShadingStats* stats, uint64_t* trail) const {
+  const SurfacePoint& sp = cr.sp;
+  const SecondaryWeights w =
+      secondary_weights(scene_.materials[sp.material], scene_.render.fresnel, dir,
+                        transmission_between(dir, sp.geometric_normal, sp.shading_normal, cr.itf.n_from, cr.itf.n_to),
+                        sp.geometric_normal);
+  Terms t;
+  if (depth < scene_.render.max_depth && w.reflect > 0.0) {
+    t.reflected = w.reflect * reflected(sp, dir, depth, primary, cr.itf.before, stats, trail);
+  }
+  if (depth < scene_.render.max_depth && w.transmit > 0.0) {
+    t.transmitted = w.transmit * transmitted(cr, dir, depth, stats, trail);
+  }
+  return t;
+}
+
 glm::dvec3 MapShader::shade(const Crossed& cr, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats,
                             PrimaryLights* direct, uint64_t* trail) const {
   const SurfacePoint& sp = cr.sp;
@@ -121,14 +148,10 @@ glm::dvec3 MapShader::shade(const Crossed& cr, const glm::dvec3& dir, int depth,
   const glm::dvec3 n = face_forward(sp.shading_normal, v);
   const glm::dvec3 od = sp.diffuse_given ? sp.diffuse : diffuse_color_at(scene_, sp.triangle, sp.point);
   glm::dvec3 c = phong_ambient(m, scene_.ambient, od) + lights(sp, v, n, od, stats, depth == 0 ? direct : nullptr);
-  const SecondaryWeights w =
-      secondary_weights(m, scene_.render.fresnel, dir,
-                        transmission_between(dir, sp.geometric_normal, sp.shading_normal, cr.itf.n_from, cr.itf.n_to),
-                        sp.geometric_normal);
-  if (depth < scene_.render.max_depth && w.reflect > 0.0) {
-    c += w.reflect * reflected(sp, dir, depth, primary, cr.itf.before, stats, trail);
-  }
-  if (depth < scene_.render.max_depth && w.transmit > 0.0) c += w.transmit * transmitted(cr, dir, depth, stats, trail);
+  const Terms t = secondary_terms(cr, dir, depth, primary, stats, trail);
+  if (depth == 0 && direct) direct->secondary = t.reflected + t.transmitted;
+  c += t.reflected;  // in this order, term by term: the same sums as ever
+  c += t.transmitted;
   return blend ? blend_coverage(m.opacity, c, behind) : c;
 }
 

@@ -123,11 +123,13 @@ constexpr double QUARTER_SPLIT_SRGB = 1.0 / 255.0;
 // through the glass) would be decided at the points too. So every covered quarter of such a
 // fragment (a material with kr or kt, bounces left) is shaded; where their secondary rays
 // found different surfaces (PrimaryLights::trail) and their colours differ by more than
-// QUARTER_SPLIT_SRGB, each quarter's colour becomes the mean of its covered samples, each
-// shaded at its own point (its own searches, shadows and texture lookup), as the tracer's
-// 32 rays see the pixel (--secondary-edges samples; the stats' "secondary_edges"). Quarters
-// that see one surface keep their points' colours, however that surface's shading varies:
-// the cost falls on the fragments a silhouette of the secondary image crosses.
+// QUARTER_SPLIT_SRGB, each quarter's kr and kt terms become the mean of its covered
+// samples', each searched from the sample's own point, as the tracer's 32 rays see the pixel
+// (--secondary-edges samples; the stats' "secondary_edges"). The quarter keeps its own
+// light, its shadows refined as SHADOW EDGES says: the colour is the light plus those terms,
+// and only the terms change across an edge of what the mirror shows. Quarters that see one
+// surface keep their points' colours, however that surface's shading varies: the cost falls
+// on the fragments a silhouette of the secondary image crosses.
 
 // The direct light one primary point received, light by light (scene.lights' order):
 // `lit` the unshadowed term (phong_light; 0 where the light is behind the surface), `shadow`
@@ -138,6 +140,8 @@ struct PrimaryLights {
   // transparency, at every depth; 0 for a miss), hashed in the order they were found: two
   // points whose trails differ see different surfaces in a mirror or through glass.
   uint64_t trail = 0;
+  // The point's kr and kt terms: its colour less its own light (SECONDARY EDGES).
+  glm::dvec3 secondary{0.0};
 };
 
 struct SurfacePoint {
@@ -168,6 +172,9 @@ class MapShader {
   // `direct` (optional) receives what the point's own lights gave it (depth 0 only).
   glm::dvec3 shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats,
                    PrimaryLights* direct = nullptr) const;
+  // A camera fragment's point's kr and kt terms alone (what `shade` adds to its own light),
+  // `trail` (optional) receiving PrimaryLights::trail.
+  glm::dvec3 secondary(const SurfacePoint& sp, const glm::dvec3& dir, MapShadingStats* stats, uint64_t* trail) const;
   // S_l of `light` at `p`: the shadow search's transmittance (thesis 8.3).
   glm::dvec3 visibility(const glm::dvec3& p, const PointLight& light, MapShadingStats* stats) const;
 
@@ -203,6 +210,11 @@ class MapShader {
   // (PrimaryLights::trail).
   glm::dvec3 shade(const Crossed& c, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats,
                    PrimaryLights* direct, uint64_t* trail) const;
+  struct Terms {
+    glm::dvec3 reflected{0.0}, transmitted{0.0};
+  };
+  Terms secondary_terms(const Crossed& c, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats,
+                        uint64_t* trail) const;
   Ray transmitted_ray(const Crossed& c, const Transmission& tr, MediumStack* stack) const;
   glm::dvec3 trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, const MediumStack& stack,
                    MapShadingStats* stats, SearchResult* found, uint64_t* trail) const;

@@ -27,7 +27,7 @@ std::vector<uint8_t> PixelTrails::across(int width, int height, const std::vecto
     for (int x = 0; x < width; ++x) {
       const size_t p = at(x, y);
       if ((only && !(*only)[p]) || points_[p].state != TrailSet::ONE) continue;
-      const uint64_t mine = points_[p].trail;
+      const uint32_t mine = points_[p].trail;
       // q: a 4-neighbour; side: q's side that faces this pixel.
       const auto differs = [&](size_t q, uint8_t side) {
         const TrailSet& t = points_[q];
