@@ -124,12 +124,15 @@ uint64_t mix64(uint64_t x) {
 // For items 0..n-1: the smallest index of an item equal to each (its own when it is the
 // first), or NO_PARTNER for an item skip(i) leaves out. An open-addressing hash table of
 // item indices (linear probing, kept at most 3/4 full, doubled as it fills): 4 bytes an
-// item for the answer and 5 to 11 bytes a distinct key for the table, no sort.
+// item for the answer and 5 to 11 bytes a distinct key for the table, no sort. `expected`
+// distinct keys size the table from the start (each doubling re-hashes every key).
 template <class Hash, class Equal, class Skip>
-std::vector<uint32_t> first_equal(size_t n, Hash&& hash, Equal&& equal, Skip&& skip) {
+std::vector<uint32_t> first_equal(size_t n, size_t expected, Hash&& hash, Equal&& equal, Skip&& skip) {
   constexpr uint32_t EMPTY = NO_PARTNER;
   std::vector<uint32_t> first(n, NO_PARTNER);
-  std::vector<uint32_t> table(1024, EMPTY);
+  size_t slots = 1024;
+  while (4 * (expected + 1) > 3 * slots) slots *= 2;
+  std::vector<uint32_t> table(slots, EMPTY);
   size_t used = 0;
   for (uint32_t i = 0; i < n; ++i) {
     if (skip(i)) continue;
@@ -397,8 +400,9 @@ std::vector<uint32_t> edge_partners(const TriangleSoup& soup, size_t first, size
     return mix64((uint64_t{k.bits[0]} << 32 | k.bits[1]) ^ mix64(uint64_t{k.bits[2]} << 32 | object[c / 3]));
   };
   const auto same_vertex = [&](uint32_t a, uint32_t b) { return vertex_key(p[a]) == vertex_key(p[b]); };
+  // Two half-edges an edge on a closed mesh, a few more edges on an open one's border.
   std::vector<uint32_t> partner = first_equal(
-      3 * count,
+      3 * count, 3 * count / 2 + 3 * count / 64,
       [&](uint32_t h) {
         const uint64_t a = vertex_hash(h), b = vertex_hash(next_corner(h));
         return mix64(std::min(a, b) ^ mix64(std::max(a, b)));
@@ -429,8 +433,34 @@ std::vector<uint32_t> edge_partners(const TriangleSoup& soup, size_t first, size
   return partner;
 }
 
+namespace {
+
+// Whether triangles [first, first + count) may be closed: the sum of (b - a) x (c - a) over a
+// closed, consistently oriented surface is exactly zero (each edge u -> v's u x v meets its
+// v x u), so a sum larger than its rounding can reach rules a closed surface out. In double,
+// each term is within 7 unit roundoffs (2^-53) of |b - a| |c - a| (two subtractions, two
+// products, their difference) and the running sum adds at most `count` more of the sum of
+// those: the threshold, (count + 8) 2^-52 of it, is twice that. Open meshes (terrains,
+// scans, planes) are ruled out here, in one pass over their positions with no table.
+bool may_be_closed(const TriangleSoup& soup, size_t first, size_t count) {
+  glm::dvec3 sum(0.0);
+  double bound = 0.0;
+  for (size_t t = first; t < first + count; ++t) {
+    const glm::dvec3 a(soup.positions[3 * t]);
+    const glm::dvec3 u = glm::dvec3(soup.positions[3 * t + 1]) - a;
+    const glm::dvec3 v = glm::dvec3(soup.positions[3 * t + 2]) - a;
+    sum += glm::cross(u, v);
+    bound += glm::length(u) * glm::length(v);
+  }
+  const double ulp = std::ldexp(1.0, -52);
+  const double slack = (static_cast<double>(count) + 8.0) * ulp * bound;
+  return std::fabs(sum.x) <= slack && std::fabs(sum.y) <= slack && std::fabs(sum.z) <= slack;
+}
+
+}  // namespace
+
 bool is_closed_surface(const TriangleSoup& soup, size_t first, size_t count) {
-  if (count == 0) return false;
+  if (count == 0 || !may_be_closed(soup, first, count)) return false;
   const std::vector<uint32_t> partner = edge_partners(soup, first, count);
   const glm::vec3* p = soup.positions.data() + 3 * first;
   for (uint32_t h = 0; h < partner.size(); ++h) {

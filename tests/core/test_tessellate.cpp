@@ -1,6 +1,9 @@
 // The primitives' tessellation and the object transform (cpu_core/scene/tessellate.cpp),
 // through the loader: known answers for boxes, spheres and transforms, and the closed-surface
 // test.
+#include <cstdio>
+#include <random>
+
 #include "scene_load_fixtures.hpp"
 
 namespace abcube {
@@ -134,6 +137,58 @@ TEST(Tessellate, ClosedSurfaceNeedsConsistentOrientation) {
   EXPECT_FALSE(is_closed_surface(*s.triangles, 0, 11));                         // a hole
   std::swap(s.triangles.edit().positions[1], s.triangles.edit().positions[2]);  // one face turned over
   EXPECT_FALSE(is_closed_surface(*s.triangles, 0, 12));
+}
+
+// The closed-surface test rules open meshes out by their summed (b - a) x (c - a) before it
+// pairs edges: that sum's rounding must never rule a closed one out. Boxes and spheres from
+// seeds, far from the origin, at sizes from 1e-4 to 1e4 and turned every way, stay closed
+// exactly where the independent edge count says so; and a tube, open at both ends but
+// summing to zero, is still found open by its edges.
+TEST(Tessellate, ClosedSurfacesStayClosedFarAwayAndAtAnyScale) {
+  std::mt19937 rng(20261127);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int closed = 0;
+  for (int k = 0; k < 40; ++k) {
+    const double scale = std::pow(10.0, -4.0 + 8.0 * unit(rng));
+    const double far = std::pow(10.0, 7.0 * unit(rng));
+    char shape[128], object[512];
+    if (k % 2) {
+      std::snprintf(shape, sizeof shape, R"("type": "box", "min": [0,0,0], "max": [1,%g,%g])", 0.01 + unit(rng),
+                    1 + 50 * unit(rng));
+    } else {
+      std::snprintf(shape, sizeof shape, R"("type": "sphere", "center": [0,0,0], "radius": 1, "segments": %d)", 3 + k);
+    }
+    std::snprintf(object, sizeof object,
+                  R"([{%s, "transform": {"scale": %g, "rotate_deg": [%g,%g,%g], "translate": [%g,%g,%g]}}])", shape,
+                  scale, 360 * unit(rng), 360 * unit(rng), 360 * unit(rng), far * (unit(rng) - 0.5),
+                  far * (unit(rng) - 0.5), far * (unit(rng) - 0.5));
+    const std::string text = object;
+    SCOPED_TRACE(text);
+    const SceneData s = load_text(with_objects(text).str());
+    ASSERT_EQ(s.objects.size(), 1u);
+    EXPECT_EQ(s.objects[0].closed, edges_shared_twice(s, s.objects[0]));
+    EXPECT_EQ(is_closed_surface(*s.triangles, 0, s.objects[0].triangle_count), edges_shared_twice(s, s.objects[0]));
+    closed += s.objects[0].closed ? 1 : 0;
+  }
+  EXPECT_GE(closed, 30);  // float positions far away may merge corners: most stay closed
+  // A box without its two end faces: every (b - a) x (c - a) meets its opposite.
+  const SceneData box = load_text(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1]}])").str());
+  ASSERT_EQ(box.triangles->triangle_count(), 12u);
+  SceneData tube = box;
+  TriangleSoup& soup = tube.triangles.edit();
+  std::vector<size_t> keep;
+  for (size_t t = 0; t < 12; ++t) {
+    const glm::vec3 g = glm::cross(soup.positions[3 * t + 1] - soup.positions[3 * t],
+                                   soup.positions[3 * t + 2] - soup.positions[3 * t]);
+    if (g.y == 0.0f) keep.push_back(t);  // the four sides
+  }
+  ASSERT_EQ(keep.size(), 8u);
+  TriangleSoup sides;
+  for (const size_t t : keep) {
+    for (int c = 0; c < 3; ++c) sides.positions.push_back(soup.positions[3 * t + static_cast<size_t>(c)]);
+    sides.object_id.push_back(0);
+  }
+  EXPECT_FALSE(is_closed_surface(sides, 0, 8));
 }
 
 }  // namespace
