@@ -84,10 +84,22 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
     walker = nb;
   }
   if (!start_near) return a;
-  // Then every triangle near the ray, breadth-first.
+  // Then every triangle near the ray, breadth-first. `seen` in the order found, and the same
+  // triangles in a set (open addressing, at most half full): one look-up a neighbour, where
+  // a scan of `seen` would cost up to REFINE_MAX_TRIANGLES.
   std::array<uint32_t, REFINE_MAX_TRIANGLES> seen{};
+  constexpr size_t SLOTS = 2 * REFINE_MAX_TRIANGLES;
+  static_assert((SLOTS & (SLOTS - 1)) == 0, "a power of two");
+  std::array<uint32_t, SLOTS> slots;
+  slots.fill(SearchContext::NO_NEIGHBOUR);
+  const auto slot_of = [&slots](uint32_t tri) {  // tri's slot, or the empty one it would take
+    size_t h = (tri * 2654435761u) & (SLOTS - 1);
+    while (slots[h] != tri && slots[h] != SearchContext::NO_NEIGHBOUR) h = (h + 1) & (SLOTS - 1);
+    return h;
+  };
   size_t count = 0, next = 0;
   seen[count++] = start;
+  slots[slot_of(start)] = start;
   bool overflow = false;
   while (next < count) {
     const uint32_t tri = seen[next++];
@@ -99,14 +111,15 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
     }
     for (int k = 0; k < 3; ++k) {
       const uint32_t nb = ctx.neighbour(tri, k);
-      const auto seen_end = seen.begin() + static_cast<std::ptrdiff_t>(count);
-      if (nb == SearchContext::NO_NEIGHBOUR || std::find(seen.begin(), seen_end, nb) != seen_end) continue;
-      if (!near_ray(ctx.bounding_sphere(nb), q, l_lo, l_hi, radius)) continue;
+      if (nb == SearchContext::NO_NEIGHBOUR) continue;
+      const size_t slot = slot_of(nb);
+      if (slots[slot] == nb || !near_ray(ctx.bounding_sphere(nb), q, l_lo, l_hi, radius)) continue;
       if (count == seen.size()) {
         overflow = true;
         continue;
       }
       seen[count++] = nb;
+      slots[slot] = nb;
     }
   }
   if (a.l < INF)
