@@ -78,8 +78,7 @@ SurfacePoint surface_point(const SceneData& scene, uint32_t triangle, const glm:
 MapShader::MapShader(const SceneData& scene, const CubeABuffer& cube, const MapShadingOptions& options,
                      const RayTracer* reference, const SceneCache* cache)
     : scene_(scene), cube_(cube), options_(options), reference_(reference) {
-  options_.search.layers = options.method == Method::zbuffer ? SearchLayers::nearest : SearchLayers::all;
-  ctx_ = std::make_unique<SearchContext>(scene, cube, [cache]() -> std::shared_ptr<const MeshNeighbours> {
+  ctx_ = std::make_shared<SearchContext>(scene, cube, [cache]() -> std::shared_ptr<const MeshNeighbours> {
     return cache ? cache->neighbours() : nullptr;  // asked for once the side structure is built
   });
   lens_of_object_.assign(scene.objects.size(), -1);
@@ -89,10 +88,28 @@ MapShader::MapShader(const SceneData& scene, const CubeABuffer& cube, const MapS
       if (lenses_[i].valid) lens_of_object_[lenses_[i].object] = static_cast<int>(i);
     }
   }
+  set_method_state();
+}
+
+MapShader::MapShader(const MapShader& base, const MapShadingOptions& options, const RayTracer* reference)
+    : scene_(base.scene_),
+      cube_(base.cube_),
+      options_(options),
+      reference_(reference),
+      ctx_(base.ctx_),
+      lenses_(base.lenses_),
+      lens_of_object_(base.lens_of_object_) {
+  ABCUBE_CHECK(options.method == base.options_.method && options.refraction == base.options_.refraction,
+               "a shader over another's map keeps its method and refraction");
+  set_method_state();
+}
+
+void MapShader::set_method_state() {
+  options_.search.layers = options_.method == Method::zbuffer ? SearchLayers::nearest : SearchLayers::all;
   if (options_.method == Method::envmap) {
-    env_colour_ = CubeImage(cube.n, 3);
+    env_colour_ = CubeImage(cube_.n, 3);
     texel_state_ =
-        std::make_unique<std::atomic<uint8_t>[]>(6 * static_cast<size_t>(cube.n) * static_cast<size_t>(cube.n));
+        std::make_unique<std::atomic<uint8_t>[]>(6 * static_cast<size_t>(cube_.n) * static_cast<size_t>(cube_.n));
   }
 }
 

@@ -164,6 +164,10 @@ class MapShader {
   // for every render of the scene; without it they are built here.
   MapShader(const SceneData& scene, const CubeABuffer& cube, const MapShadingOptions& options,
             const RayTracer* reference = nullptr, const SceneCache* cache = nullptr);
+  // A shader with other options over `base`'s map, sharing its search structures (its
+  // SearchContext, built once per map) and copying its lens fits: another shading plan on
+  // the same map. The options' method and refraction must be base's.
+  MapShader(const MapShader& base, const MapShadingOptions& options, const RayTracer* reference = nullptr);
   ~MapShader();
 
   // The colour of surface point `sp` seen along unit `dir` at bounce `depth`. `primary`
@@ -234,7 +238,9 @@ class MapShader {
   const CubeABuffer& cube_;
   MapShadingOptions options_;
   const RayTracer* reference_;
-  std::unique_ptr<SearchContext> ctx_;
+  void set_method_state();  // the search layers and envmap's texel cache, from options_.method
+
+  std::shared_ptr<SearchContext> ctx_;
   std::vector<LensFit> lenses_;
   std::vector<int> lens_of_object_;  // index into lenses_, -1 if none
   // envmap: the resolved colour of each texel looked up so far (envmap_at).

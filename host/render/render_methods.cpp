@@ -282,14 +282,15 @@ MapShadingOptions map_shading_options(const MethodContext& mc) {
   return options;
 }
 
-CubeMap build_cube_map(const MethodContext& mc, int n, const ABufferOptions& options, const RayTracer* reference) {
+CubeMap build_cube_map(const MethodContext& mc, int n, const ABufferOptions& options, const RayTracer* reference,
+                       const MapShadingOptions& shading) {
   CubeMap m;
   m.n = n;
   Clock::time_point t0 = Clock::now();
   m.cube = std::make_unique<CubeABuffer>(build_cube_abuffer(mc.scene, mc.scene.camera.position, n, options, &m.stats));
   m.build_ms = ms_since(t0);
   t0 = Clock::now();
-  m.shader = std::make_unique<MapShader>(mc.scene, *m.cube, map_shading_options(mc), reference, &mc.cache);
+  m.shader = std::make_unique<MapShader>(mc.scene, *m.cube, shading, reference, &mc.cache);
   m.setup_ms = ms_since(t0);
   return m;
 }
@@ -331,7 +332,7 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
     cube_options.reserved_bytes += as.bytes_total;
     map = cube_map_for_target(mc, *camera, cube_options, reference.get());
   } else {
-    map = build_cube_map(mc, scene.render.cube_resolution, r.abuffer, reference.get());
+    map = build_cube_map(mc, scene.render.cube_resolution, r.abuffer, reference.get(), map_shading_options(mc));
     build_camera(map.stats.bytes_total);
   }
   stats["timings_ms"]["cube_abuffer"] = map.build_ms;

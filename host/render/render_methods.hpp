@@ -62,8 +62,10 @@ struct CubeMap {
 // The map methods' shading options for this render.
 MapShadingOptions map_shading_options(const MethodContext& mc);
 // The cube A-buffer around the camera at `n`, within `options`' memory budget, and its
-// shader. `reference` (optional): the tracer the searches' ray errors are measured against.
-CubeMap build_cube_map(const MethodContext& mc, int n, const ABufferOptions& options, const RayTracer* reference);
+// shader with `shading`. `reference` (optional): the tracer the searches' ray errors are
+// measured against.
+CubeMap build_cube_map(const MethodContext& mc, int n, const ABufferOptions& options, const RayTracer* reference,
+                       const MapShadingOptions& shading);
 
 // The hybrid method (docs/design/gpu-exact-paths.md): the GPU's exact camera pass,
 // and the abuffer method on the CPU for the pixels whose samples meet a surface the GPU

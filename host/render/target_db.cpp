@@ -76,7 +76,9 @@ PilotSample pilot_sample(MethodContext& mc) {
   s.pixels = pilot_pixels(mc.scene.camera.width, mc.scene.camera.height, &s.block);
   RaytraceOptions ro;
   ro.threads = mc.request.threads;
-  ro.bvh = mc.cache.bvh();
+  // The scene's tree when a render of it already built one; else the tracer builds one for
+  // the sample alone, freed before the cube maps are built: the peak holds no tracer's tree.
+  if (mc.cache.builds().bvh) ro.bvh = mc.cache.bvh();
   ro.only = &s.pixels;
   const Clock::time_point t0 = Clock::now();
   s.exact = render_raytrace(mc.scene, ro);
@@ -125,82 +127,141 @@ std::vector<MapShadingOptions> cheaper_plans(const MapShadingOptions& chosen) {
   return plans;
 }
 
-}  // namespace
+// The pilots' state: the sample, every pilot's stats line, and the best map found so far
+// (the highest predicted lower bound; the smaller N keeps a tie) with its plan.
+struct Pilots {
+  Pilots(MethodContext& m, const ABuffer& cam, const ABufferOptions& cube, double db)
+      : mc(m), camera(cam), cube_options(cube), target(db), sample(pilot_sample(m)) {}
 
-CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABufferOptions& cube_options,
-                            const RayTracer* reference) {
-  const SceneData& scene = mc.scene;
-  const double target = scene.render.target_db;
-  const Clock::time_point start = Clock::now();
-  const PilotSample sample = pilot_sample(mc);
-  json pilots = json::array();
+  MethodContext& mc;
+  const ABuffer& camera;
+  const ABufferOptions& cube_options;
+  const double target;
+  const PilotSample sample;
+  json lines = json::array();
   CubeMap best;
   SampledError best_error;
+  MapShadingOptions best_plan;
   bool reached = false;
-  int stalled = 0;
   std::string why;
-  for (const int n : target_ladder(scene.render.cube_resolution)) {
-    check_deadline();
-    const Clock::time_point t0 = Clock::now();
-    CubeMap m = build_cube_map(mc, n, cube_options, nullptr);
-    const SampledError e = run_pilot(mc, camera, *m.shader, sample, n, t0, &pilots);
-    const bool improved = !best.cube || e.psnr_low >= best_error.psnr_low + IMPROVEMENT_DB;
-    if (!best.cube || e.psnr_low > best_error.psnr_low) {
-      best = std::move(m);  // the smaller N keeps a tie
-      best_error = e;
+
+  // Climbs the ladder of N with `plan`, up to the first N that reaches the target, or until
+  // STALLED_PILOTS pilots in a row improve on the climb's best by less than IMPROVEMENT_DB.
+  void climb(const MapShadingOptions& plan) {
+    int stalled = 0;
+    double climb_best = -std::numeric_limits<double>::infinity();
+    why.clear();
+    for (const int n : target_ladder(mc.scene.render.cube_resolution)) {
+      check_deadline();
+      const Clock::time_point t0 = Clock::now();
+      CubeMap m;
+      if (best.cube && best.n == n) {  // an earlier climb's map at this N: only the plan differs
+        m.n = n;
+        m.stats = best.stats;
+        m.build_ms = best.build_ms;
+        m.shader = std::make_unique<MapShader>(*best.shader, plan);
+      } else {
+        m = build_cube_map(mc, n, cube_options, nullptr, plan);
+      }
+      const SampledError e = run_pilot(mc, camera, *m.shader, sample, n, t0, &lines);
+      const bool improved = e.psnr_low >= climb_best + IMPROVEMENT_DB;
+      climb_best = std::max(climb_best, e.psnr_low);
+      if (!best.shader || e.psnr_low > best_error.psnr_low) {
+        if (!m.cube) m.cube = std::move(best.cube);  // the shared map moves with its new shader
+        best = std::move(m);
+        best_error = e;
+        best_plan = plan;
+      }
+      if (e.psnr_low >= target) {
+        reached = true;
+        why = "the smallest N on the ladder whose predicted PSNR reaches the target";
+        return;
+      }
+      stalled = improved ? 0 : stalled + 1;
+      if (stalled >= STALLED_PILOTS) {
+        why = "the error stopped improving with N before the target: the best N found";
+        return;
+      }
     }
-    if (e.psnr_low >= target) {
-      reached = true;
-      why = "the smallest N on the ladder whose predicted PSNR reaches the target";
-      break;
-    }
-    stalled = improved ? 0 : stalled + 1;
-    if (stalled >= STALLED_PILOTS) {
-      why = "the error stopped improving with N before the target: the best N found";
-      break;
+    why = "the ladder's largest N did not reach the target: the best N found";
+  }
+
+  // At the chosen N, the first of `plans` (cheapest first) that still reaches the target.
+  void cheapen(const std::vector<MapShadingOptions>& plans) {
+    for (const MapShadingOptions& plan : plans) {
+      const Clock::time_point t0 = Clock::now();
+      auto shader = std::make_unique<MapShader>(*best.shader, plan);
+      const SampledError e = run_pilot(mc, camera, *shader, sample, best.n, t0, &lines);
+      if (e.psnr_low >= target) {
+        best_plan = plan;
+        best.shader = std::move(shader);
+        best_error = e;
+        return;
+      }
     }
   }
-  if (why.empty()) why = "the ladder's largest N did not reach the target: the best N found";
-  // At the chosen N, the cheapest shading plan that still reaches the target.
-  MapShadingOptions chosen = map_shading_options(mc);
-  for (const MapShadingOptions& plan : reached ? cheaper_plans(chosen) : std::vector<MapShadingOptions>{}) {
-    const Clock::time_point t0 = Clock::now();
-    auto shader = std::make_unique<MapShader>(scene, *best.cube, plan, nullptr, &mc.cache);
-    const SampledError e = run_pilot(mc, camera, *shader, sample, best.n, t0, &pilots);
-    if (e.psnr_low >= target) {
-      chosen = plan;
-      best.shader = std::move(shader);
-      best_error = e;
-      break;
-    }
-  }
-  if (reference) {  // the searches' ray errors, measured on the final render only
-    const Clock::time_point t0 = Clock::now();
-    best.shader = std::make_unique<MapShader>(scene, *best.cube, chosen, reference, &mc.cache);
-    best.setup_ms = ms_since(t0);
-  }
-  json& stats = mc.stats;
-  stats["size"]["cube_resolution"] = best.n;
+};
+
+// The choice into the render's stats: its size, method_options and target_db.
+void write_stats(const Pilots& p, json* out) {
+  json& stats = *out;
+  const MapShadingOptions& chosen = p.best_plan;
+  stats["size"]["cube_resolution"] = p.best.n;
   const char* shadow_edges = chosen.shadow_edges && !chosen.one_point ? "samples" : "points";
   const char* secondary_edges = chosen.secondary_edges && !chosen.one_point ? "samples" : "points";
   stats["method_options"]["shading_points"] = chosen.one_point ? "one" : "quarters";
   stats["method_options"]["shadow_edges"] = shadow_edges;
   stats["method_options"]["secondary_edges"] = secondary_edges;
   stats["target_db"] = {
-      {"target", target},
-      {"cube_resolution", best.n},
+      {"target", p.target},
+      {"cube_resolution", p.best.n},
       {"shading_points", chosen.one_point ? "one" : "quarters"},
       {"shadow_edges", shadow_edges},
       {"secondary_edges", secondary_edges},
-      {"scene_cube_resolution", scene.render.cube_resolution},
-      {"reached", reached},
-      {"why", why},
-      {"predicted_psnr_db", number_or_null(best_error.psnr)},
-      {"predicted_psnr_db_low", number_or_null(best_error.psnr_low)},
-      {"sample", {{"pixels", best_error.pixels}, {"block", sample.block}, {"exact_trace_ms", sample.trace_ms}}},
-      {"pilots", pilots}};
-  stats["timings_ms"]["target_pilots"] = ms_since(start);
-  return best;
+      {"scene_cube_resolution", p.mc.scene.render.cube_resolution},
+      {"reached", p.reached},
+      {"why", p.why},
+      {"predicted_psnr_db", number_or_null(p.best_error.psnr)},
+      {"predicted_psnr_db_low", number_or_null(p.best_error.psnr_low)},
+      {"sample", {{"pixels", p.best_error.pixels}, {"block", p.sample.block}, {"exact_trace_ms", p.sample.trace_ms}}},
+      {"pilots", p.lines}};
+}
+
+bool same_plan(const MapShadingOptions& a, const MapShadingOptions& b) {
+  return a.one_point == b.one_point && a.shadow_edges == b.shadow_edges && a.secondary_edges == b.secondary_edges;
+}
+
+}  // namespace
+
+CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABufferOptions& cube_options,
+                            const RayTracer* reference) {
+  const Clock::time_point start = Clock::now();
+  Pilots p(mc, camera, cube_options, mc.scene.render.target_db);
+  // The ladder is climbed with the quarters unrefined at the samples first: their pilots
+  // cost a fraction of the refined ones', and they reach most targets. Only when they stop
+  // short is it climbed again with the plan asked for, whose edges refined at the samples
+  // lift the error's floor.
+  const MapShadingOptions asked = map_shading_options(mc);
+  MapShadingOptions plain = asked;
+  plain.shadow_edges = plain.secondary_edges = false;
+  p.climb(plain);
+  if (!p.reached && !same_plan(plain, asked)) p.climb(asked);
+  if (p.reached) {
+    // The plain plan was piloted at this N on its climb, or stopped short below it.
+    std::vector<MapShadingOptions> plans;
+    for (const MapShadingOptions& plan : cheaper_plans(p.best_plan)) {
+      if (!same_plan(plan, plain) || same_plan(p.best_plan, plain)) plans.push_back(plan);
+    }
+    p.cheapen(plans);
+  }
+  if (reference) {  // the searches' ray errors, measured on the final render only
+    const Clock::time_point t0 = Clock::now();
+    p.best.shader = std::make_unique<MapShader>(*p.best.shader, p.best_plan, reference);
+    p.best.setup_ms = ms_since(t0);
+  }
+  write_stats(p, &mc.stats);
+  mc.stats["timings_ms"]["target_pilots"] = ms_since(start);
+  return std::move(p.best);
 }
 
 }  // namespace abcube
