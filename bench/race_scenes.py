@@ -139,6 +139,25 @@ def write(folder, template, seed):
     return path
 
 
+def generated_sample(folder, seed, hard, flat, size, cube_res):
+    """The hard-case and flat-mirror templates' scenes drawn from seed: `hard` scenes cycling
+    tools/hard_scenes.py's templates and `flat` cycling tools/flat_mirror_scenes.py's, at
+    `size` ("WxH") with N = cube_res, written into folder/hard and folder/flat. Returns their
+    paths, sorted within each generator."""
+    import subprocess
+    tools = os.path.join(HERE, "..", "tools")
+    paths = []
+    for tool, count, sub in (("hard_scenes.py", hard, "hard"), ("flat_mirror_scenes.py", flat, "flat")):
+        if count <= 0:
+            continue
+        d = os.path.join(folder, sub)
+        subprocess.run(["/usr/bin/python3", os.path.join(tools, tool), "--seed", str(seed), "--count", str(count),
+                        "--out", d, "--size", size, "--cube-res", str(cube_res)], check=True,
+                       stdout=subprocess.DEVNULL)
+        paths += sorted(os.path.join(d, f) for f in os.listdir(d) if f.endswith(".json"))
+    return paths
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", required=True)

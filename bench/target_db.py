@@ -28,7 +28,6 @@ import csv
 import json
 import os
 import statistics
-import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -37,33 +36,14 @@ sys.path.insert(0, HERE)
 import race  # noqa: E402  (psnr, timed)
 import race_scenes  # noqa: E402
 
-PY = "/usr/bin/python3"
-
 
 def generate(args, out):
     """The scene files, generated into out."""
-    scenes = []
-    for tool, count, folder in (("tools/hard_scenes.py", args.hard, "hard"),
-                                ("tools/flat_mirror_scenes.py", args.flat, "flat")):
-        if count <= 0:
-            continue
-        d = os.path.join(out, folder)
-        subprocess.run([PY, os.path.join(ROOT, tool), "--seed", str(args.seed), "--count", str(count), "--out", d,
-                        "--size", args.size, "--cube-res", str(args.cube_res)], check=True,
-                       stdout=subprocess.DEVNULL)
-        scenes += sorted(os.path.join(d, f) for f in os.listdir(d) if f.endswith(".json"))
+    scenes = race_scenes.generated_sample(out, args.seed, args.hard, args.flat, args.size, args.cube_res)
     for k in range(args.race):
         template = ("room", "outdoor")[k % 2]
         scenes.append(race_scenes.write(os.path.join(out, "race"), template, args.seed + k // 2))
     return scenes
-
-
-def plan(t):
-    """The shading plan --target-db chose (its stats' target_db object), in a few words."""
-    if t.get("shading_points", "-") != "quarters":
-        return t.get("shading_points", "-")
-    edges = [name for name in ("shadow", "secondary") if t.get(name + "_edges") == "samples"]
-    return " + ".join(["quarters"] + edges)
 
 
 def main(argv=None):
@@ -107,7 +87,7 @@ def main(argv=None):
             "own_n": own_n,
             "own_db": race.psnr(abcube, own, ref),
             "chosen_n": t.get("cube_resolution", "-"),
-            "points": plan(t),
+            "points": race.plan_words(t),
             "predicted_db_low": t.get("predicted_psnr_db_low"),
             "target_db": race.psnr(abcube, target, ref),
             "pilots": len(t.get("pilots", [])),
