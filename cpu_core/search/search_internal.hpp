@@ -63,11 +63,16 @@ struct Candidate {
 // times 1/sin(corner angle / 2)).
 struct PlaneCrossing {
   double l = INF;
+  // -1: on the triangle (within ON_TRIANGLE_TEXELS); 0 to 2: the edge it lies furthest
+  // outside of; NOT_TESTED: l outside the range asked, the edges not looked at.
   int outside_edge = -1;
+  static constexpr int NOT_TESTED = 3;
 };
 
-// The crossing of the ray with triangle `tri`'s plane (search_refine.cpp).
-PlaneCrossing plane_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri);
+// The crossing of the ray with triangle `tri`'s plane (search_refine.cpp); where it is on
+// the triangle only when l lies in [l_lo, l_hi].
+PlaneCrossing plane_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri, double l_lo = -INF,
+                             double l_hi = INF);
 
 // MESH REFINEMENT (crossing mode; docs/design/search.md). The answer of the mesh around a
 // fragment's triangle when the ray does not cross that triangle itself.

@@ -8,12 +8,16 @@
 namespace abcube {
 namespace detail {
 
-PlaneCrossing plane_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri) {
+PlaneCrossing plane_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri, double l_lo, double l_hi) {
   PlaneCrossing c;
   const SearchContext::EdgePlanes e = ctx.edge_planes(tri);
   const double den = glm::dot(e.plane.normal, q.d);
   if (den == 0.0) return c;  // parallel, or degenerate (a zero normal)
   c.l = (e.plane.offset - glm::dot(e.plane.normal, q.w)) / den;
+  if (!(c.l >= l_lo && c.l <= l_hi)) {
+    c.outside_edge = PlaneCrossing::NOT_TESTED;
+    return c;
+  }
   const glm::dvec3 x = q.w + c.l * q.d;
   double outside[3];
   for (size_t k = 0; k < 3; ++k) outside[k] = glm::dot(e.edge_normal[k], x) - e.edge_offset[k];
@@ -34,8 +38,9 @@ namespace {
 // The exact crossing of the ray with triangle `tri` (on the triangle, l in [self, l_max]):
 // its parameter l, or INF.
 double exact_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri) {
-  const PlaneCrossing c = plane_crossing(ctx, q, tri);
-  return c.outside_edge < 0 && c.l >= q.self && c.l <= q.l_max ? c.l : INF;
+  // The range first: most planes of a flood are crossed behind the ray or before `self`.
+  const PlaneCrossing c = plane_crossing(ctx, q, tri, q.self, q.l_max);
+  return c.outside_edge < 0 ? c.l : INF;
 }
 
 // Does a triangle's bounding sphere come within `radius` of the ray's stretch [l_lo, l_hi]?
