@@ -67,10 +67,14 @@ float round_up(double z) {
   return static_cast<double>(f) < z ? step_bits(f, +1) : f;
 }
 
-void bin_view(const TriangleSoup& soup, ViewBuild* vb) {
+// `views` (optional, one byte a triangle): bit `view_bit` clear where the view is known to
+// cover none of the triangle's samples (cube_faces_of), which is then culled unset up.
+// Degenerate and edge-on triangles keep every bit, so that each view counts them.
+void bin_view(const TriangleSoup& soup, const uint8_t* views, int view_bit, ViewBuild* vb) {
   TriangleSetup s;
   const uint32_t count = static_cast<uint32_t>(soup.triangle_count());
   for (uint32_t t = 0; t < count; ++t) {
+    if (views && !((views[t] >> view_bit) & 1u)) continue;
     switch (setup_triangle(vb->view, soup, t, &s)) {
       case SetupResult::visible:
         vb->bins.push_back({t, s.y0, s.y1});
@@ -263,7 +267,8 @@ ABufferStats summarise(const std::vector<ViewBuild>& views, const std::vector<AB
 }
 
 std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView> rasters, const char* what,
-                                 const ABufferOptions& options, ABufferStats* stats) {
+                                 const ABufferOptions& options, ABufferStats* stats,
+                                 const std::vector<uint8_t>* views_of_triangle = nullptr) {
   const Clock::time_point start = Clock::now();
   const TriangleSoup& soup = *scene.triangles;
   std::vector<ViewBuild> views(rasters.size());
@@ -279,7 +284,8 @@ std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView>
   check_budget(what, index_bytes, "its per-pixel index alone", options, budget);
   const int threads = thread_count(options.threads, bands.size());
 
-  parallel_for(views.size(), threads, [&](size_t v, int) { bin_view(soup, &views[v]); });
+  const uint8_t* masks = views_of_triangle ? views_of_triangle->data() : nullptr;
+  parallel_for(views.size(), threads, [&](size_t v, int) { bin_view(soup, masks, static_cast<int>(v), &views[v]); });
   for (ViewBuild& vb : views) vb.offsets.assign(vb.view.pixel_count() + 1, 0);
   const uint64_t raw = count_views(soup, &views, bands, threads);
   const double count_ms = ms_since(start);
@@ -334,7 +340,21 @@ CubeABuffer build_cube_abuffer(const SceneData& scene, const glm::dvec3& centre,
   const double near = near_for(scene, centre, options);
   std::vector<RasterView> rasters;
   for (int f = 0; f < CUBE_FACES; ++f) rasters.push_back(cube_face_view(f, centre, n, near));
-  std::vector<ABuffer> faces = build_views(scene, std::move(rasters), "cube A-buffer", options, stats);
+  // Each triangle's faces first (one byte a triangle, for the build): most triangles lie in
+  // one face's pyramid, and the five other faces then skip them unset up.
+  const TriangleSoup& soup = *scene.triangles;
+  std::vector<uint8_t> faces_of(soup.triangle_count());
+  constexpr size_t CHUNK = 1 << 14;
+  parallel_for((faces_of.size() + CHUNK - 1) / CHUNK, thread_count(options.threads, CUBE_FACES), [&](size_t c, int) {
+    const size_t end = std::min(faces_of.size(), (c + 1) * CHUNK);
+    for (size_t t = c * CHUNK; t < end; ++t) {
+      const uint32_t k = static_cast<uint32_t>(t);
+      faces_of[t] = triangle_shape(centre, soup, k) == SetupResult::visible ? cube_faces_of(centre, soup, k)
+                                                                            : uint8_t{(1u << CUBE_FACES) - 1};
+    }
+  });
+  std::vector<ABuffer> faces = build_views(scene, std::move(rasters), "cube A-buffer", options, stats, &faces_of);
+  faces_of = std::vector<uint8_t>();
   // The build's bins and its workers' small blocks, freed in their threads' heaps: handed
   // back before the searches' own structures are built, so that they do not stay resident
   // through the render's peak (bench/memory.py measures it).

@@ -126,13 +126,15 @@ RasterView camera_view(const CameraFrame& f, double near_distance) {
                    to_direction, f.width, f.height, near_distance);
 }
 
-SetupResult setup_triangle(const RasterView& view, const TriangleSoup& soup, uint32_t index, TriangleSetup* s) {
-  s->triangle = index;
+namespace {
+
+// The corners relative to `centre` into r, their plane (normal, offset, distance) into s, and
+// whether the triangle is degenerate or edge-on: setup_triangle's first part, view-free.
+SetupResult shape(const glm::dvec3& centre, const TriangleSoup& soup, uint32_t index, TriangleSetup* s) {
   const size_t base = 3 * static_cast<size_t>(index);
   double farthest = 0.0;
   for (size_t k = 0; k < 3; ++k) {
-    s->r[k] = glm::dvec3(soup.positions[base + k]) - view.centre;
-    s->normal[k] = glm::dvec3(soup.normals[base + k]);
+    s->r[k] = glm::dvec3(soup.positions[base + k]) - centre;
     if (!finite(s->r[k])) return SetupResult::degenerate;
     farthest = std::max(farthest, glm::length(s->r[k]));
   }
@@ -142,6 +144,40 @@ SetupResult setup_triangle(const RasterView& view, const TriangleSoup& soup, uin
   s->plane_offset = glm::dot(s->plane_normal, s->r[0]);  // = det(r0, r1, r2)
   s->plane_distance = std::fabs(s->plane_offset) / area2;
   if (!(s->plane_distance > EDGE_ON_REL * farthest)) return SetupResult::edge_on;
+  return SetupResult::visible;
+}
+
+}  // namespace
+
+SetupResult triangle_shape(const glm::dvec3& centre, const TriangleSoup& soup, uint32_t index) {
+  TriangleSetup s;
+  return shape(centre, soup, index, &s);
+}
+
+uint8_t cube_faces_of(const glm::dvec3& centre, const TriangleSoup& soup, uint32_t index) {
+  constexpr uint8_t ALL = (1u << CUBE_FACES) - 1;
+  uint8_t faces = ALL;
+  for (size_t k = 0; k < 3 && faces != 0; ++k) {
+    const glm::dvec3 r = glm::dvec3(soup.positions[3 * static_cast<size_t>(index) + k]) - centre;
+    uint8_t in = 0;
+    for (int f = 0; f < CUBE_FACES; ++f) {
+      const CubeFaceBasis& b = cube_face_basis(f);
+      const double ahead = glm::dot(r, b.forward);
+      if (ahead >= std::fabs(glm::dot(r, b.s_axis)) && ahead >= std::fabs(glm::dot(r, b.t_axis))) {
+        in = static_cast<uint8_t>(in | (1u << f));
+      }
+    }
+    faces &= in;
+  }
+  return faces != 0 ? faces : ALL;
+}
+
+SetupResult setup_triangle(const RasterView& view, const TriangleSoup& soup, uint32_t index, TriangleSetup* s) {
+  s->triangle = index;
+  const size_t base = 3 * static_cast<size_t>(index);
+  const SetupResult shaped = shape(view.centre, soup, index, s);
+  if (shaped != SetupResult::visible) return shaped;
+  for (size_t k = 0; k < 3; ++k) s->normal[k] = glm::dvec3(soup.normals[base + k]);
 
   // The part in front of the near plane (thesis: "clipping" before the raster).
   std::array<double, 3> w{};

@@ -66,6 +66,17 @@ struct TriangleSetup {
 // Prepares triangle `index` of `soup` for `view`; `setup` is valid only for `visible`.
 SetupResult setup_triangle(const RasterView& view, const TriangleSoup& soup, uint32_t index, TriangleSetup* setup);
 
+// What setup_triangle answers for triangle `index` before it looks at a view's direction:
+// degenerate (not finite, or no area), edge_on (its plane through `centre`, by the raster's
+// rule), or visible (the view decides). The same for every view of one centre.
+SetupResult triangle_shape(const glm::dvec3& centre, const TriangleSoup& soup, uint32_t index);
+
+// The cube faces (bit f for face f of cube_face_basis) a triangle's samples may lie in, seen
+// from `centre`: one face (or the faces sharing a seam) when its three corners lie in that
+// face's closed pyramid, which holds the whole triangle (the pyramid is convex), else all six.
+// Every sample of a face lies strictly inside its pyramid, so a face left out would cover none.
+uint8_t cube_faces_of(const glm::dvec3& centre, const TriangleSoup& soup, uint32_t index);
+
 // Columns [*x_begin, *x_end) of row y that may hold covered samples (a conservative span
 // inside the setup's bounds); empty when *x_begin >= *x_end.
 void row_span(const TriangleSetup& setup, int y, int* x_begin, int* x_end);

@@ -65,10 +65,8 @@ SearchContext::SearchContext(const SceneData& scene, const CubeABuffer& cube, co
   const TriangleSoup& soup = *scene.triangles;
   const uint32_t count = static_cast<uint32_t>(soup.triangle_count());
   // The raster's own rule decides which triangles the map cannot hold (raster.hpp).
-  const RasterView view = cube_face_view(0, cube.centre, std::max(cube.n, 1), cube.near_distance);
-  TriangleSetup setup;
   for (uint32_t k = 0; k < count; ++k) {
-    if (setup_triangle(view, soup, k, &setup) == SetupResult::edge_on) zero_area_.push_back(k);
+    if (triangle_shape(cube.centre, soup, k) == SetupResult::edge_on) zero_area_.push_back(k);
   }
   // Where each face holds fragments, row by row (empty_ahead), BLOCK BOUNDS, and which
   // triangles have a fragment (THE SIDE STRUCTURE).

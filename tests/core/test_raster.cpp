@@ -119,6 +119,48 @@ TEST(Raster, ClosedMeshesAroundTheCentreCoverEverySampleOnce) {
   }
 }
 
+// The cube build skips, for each triangle, the faces cube_faces_of leaves out: none of those
+// may hold a covered sample. Seeded triangles of every size, many of them with corners on or
+// a hair from the seams between faces (|s| = 1) and at the cube's corners, rasterised on
+// all six faces without the skip.
+TEST(Raster, FacesLeftOutOfATriangleCoverNoneOfItsSamples) {
+  std::mt19937 rng(20261128);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const dvec3 centre(0.25, -0.5, 1.5);
+  const int n = 16;
+  SceneData s = empty_scene(centre, {0, 0, -1}, 90, 8, 8);
+  begin_object(s, "triangles", add_material(s, Material{}), false);
+  for (int k = 0; k < 3000; ++k) {
+    // A corner on a seam or a cube corner, nudged by 0 or a few ulps, then two more nearby.
+    const int face = k % CUBE_FACES;
+    const CubeFaceBasis& b = cube_face_basis(face);
+    const double a = k % 3 == 0 ? 1.0 : (k % 3 == 1 ? u(rng) : 1.0 - 1e-15 * (k % 7));
+    const double c = k % 5 == 0 ? 1.0 : u(rng);
+    const dvec3 corner = b.forward + a * b.s_axis + c * b.t_axis;
+    const double size = std::pow(10.0, -3.0 + 3.0 * (0.5 + 0.5 * u(rng)));
+    const double far = 0.5 + 5.0 * (0.5 + 0.5 * u(rng));
+    const dvec3 p0 = centre + far * corner;
+    const dvec3 p1 = p0 + size * dvec3(u(rng), u(rng), u(rng));
+    const dvec3 p2 = p0 + size * dvec3(u(rng), u(rng), u(rng));
+    add_flat_triangle(s, p0, p1, p2);
+  }
+  const TriangleSoup& soup = *s.triangles;
+  int single = 0;
+  for (uint32_t t = 0; t < soup.triangle_count(); ++t) {
+    const uint8_t faces = cube_faces_of(centre, soup, t);
+    single += (faces & (faces - 1)) == 0 ? 1 : 0;
+    for (int f = 0; f < CUBE_FACES; ++f) {
+      if ((faces >> f) & 1) continue;
+      TriangleSetup setup;
+      if (setup_triangle(cube_face_view(f, centre, n, 1e-3), soup, t, &setup) != SetupResult::visible) continue;
+      int covered = 0;
+      rasterize_rows(setup, 0, n, [&](int, int, CoverageMask mask) { covered += mask != 0; });
+      EXPECT_EQ(covered, 0) << "triangle " << t << " face " << f;
+    }
+  }
+  EXPECT_GT(single, 1000);  // the skip is exercised: most of them lie in one face
+}
+
 // A grid of triangles on face +Z whose vertices sit exactly on sample positions, so edges
 // run through samples (ties). Winding alternates; each sample strictly inside the grid
 // must be covered exactly once, samples outside never.
