@@ -248,6 +248,7 @@ struct SearchResult {
   uint32_t nodes_skipped = 0;     // pyramid nodes it stepped over (HIERARCHICAL SKIP)
   uint32_t fragments_tested = 0;  // z-interval tests
   uint32_t candidates = 0;        // fragments refined (z overlap, not own surface)
+  uint32_t mesh_triangles = 0;    // triangles MESH REFINEMENT tested for a crossing (walks and floods)
 };
 
 struct ShadowResult {
@@ -262,6 +263,7 @@ struct ShadowResult {
   uint32_t nodes_skipped = 0;
   uint32_t fragments_tested = 0;
   uint32_t candidates = 0;
+  uint32_t mesh_triangles = 0;
   uint32_t threshold_rejections = 0;  // candidates refused by the tolerance / theta_max
 };
 
@@ -307,6 +309,7 @@ struct SearchKindStats {
   uint64_t nodes = 0;                   // pyramid nodes stepped over (HIERARCHICAL SKIP)
   uint64_t fragments = 0;               // z-interval tests
   uint64_t candidates = 0;              // fragments refined
+  uint64_t mesh_triangles = 0;          // triangles MESH REFINEMENT tested for a crossing
   uint64_t hits = 0;                    // shadows: rays with a blocker
   uint64_t misses = 0;                  // every miss, whatever the reason; shadows: unblocked
   uint64_t threshold_rejections = 0;    // misses whose best candidate failed the threshold

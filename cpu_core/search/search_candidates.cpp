@@ -54,10 +54,9 @@ SearchResult make_result(const SearchContext& ctx, const SearchRay& q, const Can
 // Crossing mode (docs/design/search.md): the ray meets the fragment's triangle plane at X(l');
 // refined on the mesh around that triangle unless the ray crosses the triangle itself there.
 Candidate crossing_candidate(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o, const WalkTexel& t,
-                             const Fragment& f) {
+                             const Fragment& f, const SearchContext::Plane& p) {
   Candidate c;
   const uint32_t tri = f.triangle();
-  const SearchContext::Plane& p = ctx.plane(tri);
   const double den = glm::dot(p.normal, q.d);
   const double l = den == 0.0 ? INF : (p.offset - glm::dot(p.normal, q.w)) / den;
   // The map's evidence: the point lies in the texel holding the fragment (to rounding).
@@ -79,6 +78,7 @@ Candidate crossing_candidate(const SearchContext& ctx, const SearchRay& q, const
     const double l_ref = std::isinf(t.l1) ? t.l0 : 0.5 * (t.l0 + t.l1);
     const double radius = std::max(o.tolerance_texels, 1.0) * texel_size_at(q.w + l_ref * q.d, ctx.cube().n);
     const MeshAnswer m = refine_on_mesh(ctx, q, tri, t.l0 - radius, t.l1 + radius, radius);
+    c.mesh_triangles = m.tested;
     if (m.result == Refined::hit) {
       c.x = q.w + m.l * q.d;
       c.l = m.l;
@@ -95,7 +95,11 @@ Candidate crossing_candidate(const SearchContext& ctx, const SearchRay& q, const
       return c;
     }
   }
-  if (!c.tested) return Candidate{};
+  if (!c.tested) {
+    Candidate none;
+    none.mesh_triangles = c.mesh_triangles;
+    return none;
+  }
   c.valid = c.outside <= o.tolerance_texels && (c.exact || l >= q.self_tolerance);
   c.triangle = tri;
   c.back_face = f.back_face();
@@ -104,9 +108,8 @@ Candidate crossing_candidate(const SearchContext& ctx, const SearchRay& q, const
 
 // Thesis mode (thesis 7.4.1, 9.3.4): the point a V of the texel centre on the fragment's plane.
 Candidate thesis_candidate(const SearchContext& ctx, const SearchRay& q, const WalkTexel& t, const Fragment& f,
-                           const glm::dvec3& v) {
+                           const glm::dvec3& v, const SearchContext::Plane& p) {
   Candidate c;
-  const SearchContext::Plane& p = ctx.plane(f.triangle());
   const double den = glm::dot(p.normal, v);
   if (den == 0.0) return c;
   const double a = p.offset / den;
@@ -212,6 +215,7 @@ SearchResult finish(const SearchContext& ctx, const SearchRay& q, const Candidat
   r.nodes_skipped = counts.nodes;
   r.fragments_tested = counts.fragments;
   r.candidates = counts.candidates;
+  r.mesh_triangles = counts.mesh_triangles;
   return r;
 }
 

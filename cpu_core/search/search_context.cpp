@@ -27,9 +27,13 @@ template <class Value>
 struct Memo {
   static constexpr int BITS = 12;
   static constexpr uint32_t NONE = 0xffffffffu;
+  // A slot's triangle beside its value: one look-up reads one place, not two arrays.
+  struct Slot {
+    uint32_t triangle;
+    Value value;
+  };
   uint64_t context = 0;
-  std::array<uint32_t, size_t{1} << BITS> triangle{};
-  std::array<Value, size_t{1} << BITS> value{};
+  std::array<Slot, size_t{1} << BITS> slots;
 };
 
 template <class Value, class Compute>
@@ -38,14 +42,15 @@ Value remembered(uint64_t context, uint32_t triangle, Compute&& compute) {
   if (!memo) memo = std::make_unique<Memo<Value>>();
   if (memo->context != context) {
     memo->context = context;
-    memo->triangle.fill(Memo<Value>::NONE);
+    for (auto& slot : memo->slots) slot.triangle = Memo<Value>::NONE;
   }
-  const size_t slot = (triangle * 2654435761u) >> (32 - Memo<Value>::BITS);  // Knuth's multiplicative hash
-  if (memo->triangle[slot] != triangle) {
-    memo->value[slot] = compute();
-    memo->triangle[slot] = triangle;
+  const size_t index = (triangle * 2654435761u) >> (32 - Memo<Value>::BITS);  // Knuth's multiplicative hash
+  typename Memo<Value>::Slot& slot = memo->slots[index];
+  if (slot.triangle != triangle) {
+    slot.value = compute();
+    slot.triangle = triangle;
   }
-  return memo->value[slot];
+  return slot.value;
 }
 
 std::atomic<uint64_t> next_memo_id{1};

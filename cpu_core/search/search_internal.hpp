@@ -38,7 +38,8 @@ inline bool allowed(const SearchContext& ctx, const SearchRay& q, uint32_t objec
 // What the walk over the map saw of one ray.
 struct ScanCounts {
   uint32_t texels = 0, fragments = 0, candidates = 0;
-  uint32_t nodes = 0;  // pyramid nodes stepped over (HIERARCHICAL SKIP)
+  uint32_t mesh_triangles = 0;  // MESH REFINEMENT's crossing tests (counted by the search)
+  uint32_t nodes = 0;           // pyramid nodes stepped over (HIERARCHICAL SKIP)
   bool aborted = false;
 };
 
@@ -55,6 +56,7 @@ struct Candidate {
   uint32_t triangle = 0;   // the surface found: the fragment's triangle or, refined on the mesh, the one crossed
   bool back_face = false;  // its facing as seen from the centre (abuffer.hpp)
   CubeTexel texel{0, 0, 0};
+  uint32_t mesh_triangles = 0;  // MESH REFINEMENT's crossing tests for it
 };
 
 // Where the ray meets triangle `tri`'s plane: l (INF when parallel or degenerate) and the
@@ -81,6 +83,7 @@ struct MeshAnswer {
   Refined result = Refined::unknown;
   uint32_t triangle = 0;
   double l = INF;
+  uint32_t tested = 0;  // triangles tested for a crossing (the walk's steps and the flood's)
 };
 
 // MESH REFINEMENT: the crossing of the ray with the mesh around `start` (search_refine.cpp).
@@ -88,11 +91,12 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
                           double radius);
 
 // A fragment's candidate in crossing mode (MODE crossing, docs/design/search.md) and in thesis
-// mode (thesis 7.4.1, 9.3.4) (search_candidates.cpp).
+// mode (thesis 7.4.1, 9.3.4) (search_candidates.cpp); `p` is its triangle's plane (the walk
+// computed it for the own-surface test).
 Candidate crossing_candidate(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o, const WalkTexel& t,
-                             const Fragment& f);
+                             const Fragment& f, const SearchContext::Plane& p);
 Candidate thesis_candidate(const SearchContext& ctx, const SearchRay& q, const WalkTexel& t, const Fragment& f,
-                           const glm::dvec3& v);
+                           const glm::dvec3& v, const SearchContext::Plane& p);
 
 // Does the exact ray meet a triangle the map cannot hold before parameter l_end?
 bool meets_zero_area(const SearchContext& ctx, const SearchRay& q, double l_end);

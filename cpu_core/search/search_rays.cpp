@@ -17,8 +17,11 @@ SearchResult search_crossing(const SearchContext& ctx, const SearchRay& q, const
   Candidate exact, near;
   bool rejected = false;
   int64_t first = -1;
-  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3&) {
-    const Candidate c = crossing_candidate(ctx, q, o, t, f);
+  uint32_t mesh_triangles = 0;
+  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3&,
+                               const SearchContext::Plane& p) {
+    const Candidate c = crossing_candidate(ctx, q, o, t, f, p);
+    mesh_triangles += c.mesh_triangles;
     if (!c.valid) {
       rejected = rejected || (c.tested && c.outside > o.tolerance_texels);
       return;
@@ -34,7 +37,8 @@ SearchResult search_crossing(const SearchContext& ctx, const SearchRay& q, const
     if (first < 0) first = index;
     return index < first + CROSSING_WINDOW_TEXELS || t.l1 <= best_l;
   };
-  const ScanCounts counts = scan(ctx, q, o, on_fragment, after_texel, [&] { return first < 0; });
+  ScanCounts counts = scan(ctx, q, o, on_fragment, after_texel, [&] { return first < 0; });
+  counts.mesh_triangles = mesh_triangles;
   const Candidate& best = exact.fragment ? exact : near;
   return finish(ctx, q, best.fragment ? &best : nullptr,
                 rejected ? MissReason::threshold_rejection : MissReason::no_crossing, counts);
@@ -45,8 +49,9 @@ SearchResult search_crossing(const SearchContext& ctx, const SearchRay& q, const
 SearchResult search_thesis(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o) {
   Candidate best;
   int64_t first = -1;
-  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v) {
-    const Candidate c = thesis_candidate(ctx, q, t, f, v);
+  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v,
+                               const SearchContext::Plane& p) {
+    const Candidate c = thesis_candidate(ctx, q, t, f, v, p);
     if (c.valid && c.angle < best.angle) best = c;
   };
   const auto after_texel = [&](const WalkTexel&, uint32_t index) {
@@ -154,10 +159,12 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
   SearchRay q = make_query(ctx, p, seg / len, options);
   q.l_max = len;
   std::vector<ShadowCrossing> counted;
-  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v) {
+  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v,
+                               const SearchContext::Plane& p) {
     if (res.blocked) return;
-    const Candidate c = options.mode == SearchMode::thesis ? thesis_candidate(ctx, q, t, f, v)
-                                                           : crossing_candidate(ctx, q, options, t, f);
+    const Candidate c = options.mode == SearchMode::thesis ? thesis_candidate(ctx, q, t, f, v, p)
+                                                           : crossing_candidate(ctx, q, options, t, f, p);
+    res.mesh_triangles += c.mesh_triangles;
     const bool accepted = options.mode == SearchMode::thesis ? c.valid && c.angle <= options.theta_max : c.valid;
     if (!accepted || !(c.l < len)) {
       if (c.l < len && (options.mode == SearchMode::thesis ? c.valid : c.tested)) {

@@ -73,6 +73,7 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
   uint32_t walker = start;
   for (size_t step = 0; step < REFINE_MAX_STEPS; ++step) {
     const PlaneCrossing c = plane_crossing(ctx, q, walker);
+    ++a.tested;
     if (c.l == INF) break;
     if (c.outside_edge < 0) {  // on this triangle
       if (c.l >= q.self && c.l <= q.l_max && (start_near || (c.l >= l_lo && c.l <= l_hi))) {
@@ -109,6 +110,7 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
   while (next < count) {
     const uint32_t tri = seen[next++];
     const double l = exact_crossing(ctx, q, tri);
+    ++a.tested;
     if (l < a.l) {
       a.l = l;
       a.triangle = tri;

@@ -128,7 +128,8 @@ inline bool skip_node(const SearchContext& ctx, CubeWalk& walk, const WalkTexel&
   return false;
 }
 
-// Walks the ray's texels; for each texel calls on_fragment(texel, fragment, v) for every
+// Walks the ray's texels; for each texel calls on_fragment(texel, fragment, v, plane) (the
+// fragment's triangle's SearchContext::plane) for every
 // fragment that passes the layer choice, the object restriction, the z-interval test
 // (thesis 7.5) and the own-surface test, then after_texel(texel, index) -> keep walking?
 //
@@ -182,7 +183,7 @@ ScanCounts scan(const SearchContext& ctx, const SearchRay& q, const SearchOption
         const SearchContext::Plane& p = ctx.plane(f.triangle());
         if (own_surface(p, q)) continue;
         ++counts.candidates;
-        on_fragment(t, f, v);
+        on_fragment(t, f, v, p);
       }
     }
     if (!after_texel(t, counts.texels - 1)) break;

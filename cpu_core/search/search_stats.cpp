@@ -72,6 +72,7 @@ void add_walk(SearchKindStats* s, const Result& r) {
   s->nodes += r.nodes_skipped;
   s->fragments += r.fragments_tested;
   s->candidates += r.candidates;
+  s->mesh_triangles += r.mesh_triangles;
 }
 
 }  // namespace
@@ -108,6 +109,7 @@ void SearchKindStats::merge(const SearchKindStats& o) {
   nodes += o.nodes;
   fragments += o.fragments;
   candidates += o.candidates;
+  mesh_triangles += o.mesh_triangles;
   hits += o.hits;
   misses += o.misses;
   threshold_rejections += o.threshold_rejections;

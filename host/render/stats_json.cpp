@@ -13,6 +13,7 @@ json search_kind_json(const SearchKindStats& s) {
           {"nodes_mean", s.mean_nodes()},
           {"fragments_tested", s.fragments},
           {"candidates", s.candidates},
+          {"mesh_triangles", s.mesh_triangles},
           {"hits", s.hits},
           {"misses", s.misses},
           {"threshold_rejections", s.threshold_rejections},
