@@ -24,6 +24,23 @@ constexpr double SAMPLES_WANTED = 4096;
 constexpr double IMPROVEMENT_DB = 0.2;
 constexpr int STALLED_PILOTS = 2;
 
+// THE COST MODEL (docs/performance.md "Choosing N by cost"). A render's shading time is close
+// to NS_PER_RAY a search ray, NS_PER_FRAGMENT a fragment's z-interval test and
+// NS_PER_MESH_TRIANGLE a triangle MESH REFINEMENT tests for a crossing; a cube A-buffer's
+// build to NS_PER_TRIANGLE a scene triangle and NS_PER_RAW_FRAGMENT a triangle-texel pair.
+// Fitted on the 2-core machine (two threads) over the race's and the generated scenes at
+// five N and both shading points: only their ratios decide. As N grows by x, the fragments
+// tested grow about as x^FRAGMENTS_POWER and the mesh triangles fall as x^MESH_POWER (the
+// texels shrink under the triangles), the raw fragments grow at most as x^2.
+constexpr double NS_PER_RAY = 539, NS_PER_FRAGMENT = 13.3, NS_PER_MESH_TRIANGLE = 24.3;
+constexpr double NS_PER_TRIANGLE = 1007, NS_PER_RAW_FRAGMENT = 117;
+constexpr double FRAGMENTS_POWER = 0.5, MESH_POWER = -1.4;
+// A larger N is piloted only when the model expects it to shade at most PROBE_SHARE of the
+// current N's time, with a saving over the whole image of at least PROBE_COST_FACTOR times
+// the pilot's modelled cost (its build and its shading): a pilot's wall time runs 1.2 to 3.5
+// times the model's (scattered pixels, its passes over the whole image).
+constexpr double PROBE_SHARE = 0.9, PROBE_COST_FACTOR = 2;
+
 uint64_t mix(uint64_t x) {  // splitmix64's finaliser: a fixed, well-spread hash
   x += 0x9E3779B97F4A7C15ull;
   x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
@@ -86,22 +103,44 @@ PilotSample pilot_sample(MethodContext& mc) {
   return s;
 }
 
+// A pilot's outcome: the sample's error, and the counts of THE COST MODEL.
+struct Pilot {
+  SampledError error;
+  double rays = 0, fragments = 0, mesh_triangles = 0;
+  // The model's shading time of the sampled pixels, ns.
+  double shading_ns() const {
+    return NS_PER_RAY * rays + NS_PER_FRAGMENT * fragments + NS_PER_MESH_TRIANGLE * mesh_triangles;
+  }
+  // The same at N grown by x.
+  double shading_ns_at(double x) const {
+    return NS_PER_RAY * rays + NS_PER_FRAGMENT * fragments * std::pow(x, FRAGMENTS_POWER) +
+           NS_PER_MESH_TRIANGLE * mesh_triangles * std::pow(x, MESH_POWER);
+  }
+};
+
 // A pilot: the sampled pixels rendered by `shader`, their error against the tracer's, and a
 // line of the stats' "pilots" (its time counted from `t0`, its cube map's build included).
-SampledError run_pilot(MethodContext& mc, const ABuffer& camera, const MapShader& shader, const PilotSample& sample,
-                       int n, Clock::time_point t0, json* pilots) {
+Pilot run_pilot(MethodContext& mc, const ABuffer& camera, const MapShader& shader, const PilotSample& sample, int n,
+                Clock::time_point t0, json* pilots) {
   MapShadingStats ms;
-  const Image pilot =
+  const Image image =
       render_with_map(mc.scene, camera, shader, mc.request.threads, &ms, nullptr, &sample.pixels, false);
-  const SampledError e = sampled_error(pilot, sample.exact, sample.pixels);
+  Pilot p;
+  const SampledError& e = p.error = sampled_error(image, sample.exact, sample.pixels);
+  for (const SearchKindStats* k : {&ms.searches.reflection, &ms.searches.refraction_exit, &ms.searches.shadow}) {
+    p.rays += static_cast<double>(k->rays);
+    p.fragments += static_cast<double>(k->fragments);
+    p.mesh_triangles += static_cast<double>(k->mesh_triangles);
+  }
   pilots->push_back({{"cube_resolution", n},
                      {"shading_points", shader.one_point() ? "one" : "quarters"},
                      {"shadow_edges", shader.shadow_edges() ? "samples" : "points"},
                      {"secondary_edges", shader.secondary_edges() ? "samples" : "points"},
                      {"psnr_db", number_or_null(e.psnr)},
                      {"psnr_db_low", number_or_null(e.psnr_low)},
+                     {"model_shading_ms", p.shading_ns() * 1e-6},
                      {"ms", ms_since(t0)}});
-  return e;
+  return p;
 }
 
 // The shading plans cheaper than `chosen`, cheapest first: one shading point per fragment
@@ -127,6 +166,10 @@ std::vector<MapShadingOptions> cheaper_plans(const MapShadingOptions& chosen) {
   return plans;
 }
 
+bool same_plan(const MapShadingOptions& a, const MapShadingOptions& b) {
+  return a.one_point == b.one_point && a.shadow_edges == b.shadow_edges && a.secondary_edges == b.secondary_edges;
+}
+
 // The pilots' state: the sample, every pilot's stats line, and the best map found so far
 // (the highest predicted lower bound; the smaller N keeps a tie) with its plan.
 struct Pilots {
@@ -140,10 +183,42 @@ struct Pilots {
   const PilotSample sample;
   json lines = json::array();
   CubeMap best;
-  SampledError best_error;
+  Pilot best_pilot;
   MapShadingOptions best_plan;
   bool reached = false;
   std::string why;
+  std::vector<std::pair<int, MapShadingOptions>> short_of_target;  // (N, plan) piloted short
+
+  // A pilot of `plan` at N = n, on the best map when it is at that N (only the plan
+  // differs), else on a map built for it; the map is kept as the best when the pilot's lower
+  // bound is the highest so far.
+  Pilot pilot(int n, const MapShadingOptions& plan) {
+    check_deadline();
+    const Clock::time_point t0 = Clock::now();
+    CubeMap m;
+    if (best.cube && best.n == n) {
+      m.n = n;
+      m.stats = best.stats;
+      m.build_ms = best.build_ms;
+      m.shader = std::make_unique<MapShader>(*best.shader, plan);
+    } else {
+      m = build_cube_map(mc, n, cube_options, nullptr, plan);
+    }
+    const Pilot p = run_pilot(mc, camera, *m.shader, sample, n, t0, &lines);
+    if (!best.shader || p.error.psnr_low > best_pilot.error.psnr_low) {
+      if (!m.cube) m.cube = std::move(best.cube);  // the shared map moves with its new shader
+      best = std::move(m);
+      best_pilot = p;
+      best_plan = plan;
+    }
+    if (p.error.psnr_low < target) short_of_target.emplace_back(n, plan);
+    return p;
+  }
+
+  bool fell_short(int n, const MapShadingOptions& plan) const {
+    return std::any_of(short_of_target.begin(), short_of_target.end(),
+                       [&](const auto& s) { return s.first == n && same_plan(s.second, plan); });
+  }
 
   // Climbs the ladder of N with `plan`, up to the first N that reaches the target, or until
   // STALLED_PILOTS pilots in a row improve on the climb's best by less than IMPROVEMENT_DB.
@@ -152,26 +227,9 @@ struct Pilots {
     double climb_best = -std::numeric_limits<double>::infinity();
     why.clear();
     for (const int n : target_ladder(mc.scene.render.cube_resolution)) {
-      check_deadline();
-      const Clock::time_point t0 = Clock::now();
-      CubeMap m;
-      if (best.cube && best.n == n) {  // an earlier climb's map at this N: only the plan differs
-        m.n = n;
-        m.stats = best.stats;
-        m.build_ms = best.build_ms;
-        m.shader = std::make_unique<MapShader>(*best.shader, plan);
-      } else {
-        m = build_cube_map(mc, n, cube_options, nullptr, plan);
-      }
-      const SampledError e = run_pilot(mc, camera, *m.shader, sample, n, t0, &lines);
+      const SampledError e = pilot(n, plan).error;
       const bool improved = e.psnr_low >= climb_best + IMPROVEMENT_DB;
       climb_best = std::max(climb_best, e.psnr_low);
-      if (!best.shader || e.psnr_low > best_error.psnr_low) {
-        if (!m.cube) m.cube = std::move(best.cube);  // the shared map moves with its new shader
-        best = std::move(m);
-        best_error = e;
-        best_plan = plan;
-      }
       if (e.psnr_low >= target) {
         reached = true;
         why = "the smallest N on the ladder whose predicted PSNR reaches the target";
@@ -186,18 +244,49 @@ struct Pilots {
     why = "the ladder's largest N did not reach the target: the best N found";
   }
 
-  // At the chosen N, the first of `plans` (cheapest first) that still reaches the target.
+  // At the chosen N, the first of `plans` (cheapest first) that still reaches the target;
+  // a plan already piloted short of it there is not tried again.
   void cheapen(const std::vector<MapShadingOptions>& plans) {
     for (const MapShadingOptions& plan : plans) {
+      if (fell_short(best.n, plan)) continue;
       const Clock::time_point t0 = Clock::now();
       auto shader = std::make_unique<MapShader>(*best.shader, plan);
-      const SampledError e = run_pilot(mc, camera, *shader, sample, best.n, t0, &lines);
-      if (e.psnr_low >= target) {
+      const Pilot p = run_pilot(mc, camera, *shader, sample, best.n, t0, &lines);
+      if (p.error.psnr_low >= target) {
         best_plan = plan;
         best.shader = std::move(shader);
-        best_error = e;
+        best_pilot = p;
         return;
       }
+      short_of_target.emplace_back(best.n, plan);
+    }
+  }
+
+  // THE COST MODEL. Above the chosen N, the next rung is piloted with the chosen plan when
+  // the model expects its shading to cost at most PROBE_SHARE of the chosen N's, with a
+  // saving over the whole image worth the pilot (PROBE_COST_FACTOR); it becomes the choice when it reaches the target
+  // and its counts say it shades for less. MESH REFINEMENT's floods shrink with the texels, so a scene whose meshes are
+  // finer than the texels may render faster at a larger N.
+  void grow() {
+    const std::vector<int> ladder = target_ladder(mc.scene.render.cube_resolution);
+    const double pixels = static_cast<double>(mc.scene.camera.width) * static_cast<double>(mc.scene.camera.height);
+    const double triangles = static_cast<double>(mc.scene.triangles->triangle_count());
+    for (const int n : ladder) {
+      if (n <= best.n) continue;
+      const double x = static_cast<double>(n) / static_cast<double>(best.n);
+      const double scale = pixels / static_cast<double>(std::max<uint64_t>(best_pilot.error.pixels, 1));
+      const double now = best_pilot.shading_ns(), then = best_pilot.shading_ns_at(x);
+      const double build =
+          NS_PER_TRIANGLE * triangles + NS_PER_RAW_FRAGMENT * static_cast<double>(best.stats.raw_fragments) * x * x;
+      if (!(then <= PROBE_SHARE * now && (now - then) * scale >= PROBE_COST_FACTOR * (build + then))) break;
+      check_deadline();
+      const Clock::time_point t0 = Clock::now();
+      CubeMap m = build_cube_map(mc, n, cube_options, nullptr, best_plan);
+      const Pilot p = run_pilot(mc, camera, *m.shader, sample, n, t0, &lines);
+      if (!(p.error.psnr_low >= target && p.shading_ns() < now)) break;
+      best = std::move(m);
+      best_pilot = p;
+      why = "a larger N than the smallest reaching the target: the cost model says it shades for less";
     }
   }
 };
@@ -221,14 +310,11 @@ void write_stats(const Pilots& p, json* out) {
       {"scene_cube_resolution", p.mc.scene.render.cube_resolution},
       {"reached", p.reached},
       {"why", p.why},
-      {"predicted_psnr_db", number_or_null(p.best_error.psnr)},
-      {"predicted_psnr_db_low", number_or_null(p.best_error.psnr_low)},
-      {"sample", {{"pixels", p.best_error.pixels}, {"block", p.sample.block}, {"exact_trace_ms", p.sample.trace_ms}}},
+      {"predicted_psnr_db", number_or_null(p.best_pilot.error.psnr)},
+      {"predicted_psnr_db_low", number_or_null(p.best_pilot.error.psnr_low)},
+      {"sample",
+       {{"pixels", p.best_pilot.error.pixels}, {"block", p.sample.block}, {"exact_trace_ms", p.sample.trace_ms}}},
       {"pilots", p.lines}};
-}
-
-bool same_plan(const MapShadingOptions& a, const MapShadingOptions& b) {
-  return a.one_point == b.one_point && a.shadow_edges == b.shadow_edges && a.secondary_edges == b.secondary_edges;
 }
 
 }  // namespace
@@ -253,6 +339,9 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
       if (!same_plan(plan, plain) || same_plan(p.best_plan, plain)) plans.push_back(plan);
     }
     p.cheapen(plans);
+    // Then the cost: a plan cheaper than the one kept fell short at this N, and is not
+    // expected to reach the target at a larger one.
+    p.grow();
   }
   if (reference) {  // the searches' ray errors, measured on the final render only
     const Clock::time_point t0 = Clock::now();

@@ -11,6 +11,10 @@
 // more pilots try cheaper shading, cheapest first, and keep the first that still reaches
 // the target: one shading point per fragment instead of the quarters; the quarters without
 // the shadow and secondary edges' refinement at the samples; without the secondary edges'.
+// Then THE COST MODEL (target_db.cpp): from a pilot's counts of search rays, fragment tests
+// and mesh refinement's triangles, the next N up is piloted where the model expects it to
+// shade for enough less to pay for the pilot, and chosen when it reaches the target and
+// its counts say it does (meshes finer than the texels cost less at a larger N).
 #pragma once
 #include <cstdint>
 #include <vector>

@@ -1,6 +1,7 @@
 // --target-db (render/target_db.hpp): the pilots' sample, the plan the stats report being
 // the plan rendered, the target reached against the exact tracer, and the options that
 // contradict it refused.
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -61,15 +62,19 @@ RenderOptions target_options(int width, int height, double target) {
   return o;
 }
 
+// `scene` rendered so, measured against the exact tracer (stats.psnr_db).
+RenderResult render_measured(const Scene& scene, int width, int height, double target) {
+  RenderOptions o = target_options(width, height, target);
+  o.reference = true;
+  return Renderer().render(scene, o);
+}
+
 // The N and the shading points the stats report give, rendered directly, the very image
 // --target-db rendered; that image reaches the target against the exact tracer; every
 // pilot is in the stats.
 TEST(TargetDb, TheChosenPlanIsTheImageAndReachesTheTarget) {
   const Scene scene = Scene::load(scene_path("cornell.json"));
-  Renderer renderer;
-  RenderOptions o = target_options(96, 72, 36);
-  o.reference = true;
-  const RenderResult r = renderer.render(scene, o);
+  const RenderResult r = render_measured(scene, 96, 72, 36);
   const json s = json::parse(r.stats.json);
   ASSERT_TRUE(s.contains("target_db")) << r.stats.json;
   const json& t = s["target_db"];
@@ -90,7 +95,7 @@ TEST(TargetDb, TheChosenPlanIsTheImageAndReachesTheTarget) {
   direct.shading_points = t["shading_points"].get<std::string>();
   direct.shadow_edges = t["shadow_edges"].get<std::string>();
   direct.secondary_edges = t["secondary_edges"].get<std::string>();
-  EXPECT_TRUE(images_equal(renderer.render(scene, direct).image, r.image));
+  EXPECT_TRUE(images_equal(Renderer().render(scene, direct).image, r.image));
 }
 
 // A target no N reaches stops where the error stops improving, keeps the best N found,
@@ -111,6 +116,34 @@ TEST(TargetDb, AnUnreachableTargetKeepsTheBestAndSaysSo) {
   }
   EXPECT_EQ(t["cube_resolution"].get<int>(), best_n);
   EXPECT_LT(t["pilots"].size(), target_ladder(scene.cube_resolution()).size() + 1) << "climbed past the stall";
+}
+
+// THE COST MODEL (target_db.cpp): on default.json, whose spheres are finer than the texels
+// of the smallest N reaching the target, the choice moves up the ladder; every move is to a
+// pilot that reaches the target and that the model says shades for less than the one
+// before, and the image still reaches the target against the exact tracer.
+TEST(TargetDb, FinerMeshesThanTheTexelsMoveNUpWhereItShadesForLess) {
+  const RenderResult r = render_measured(Scene::load(scene_path("default.json")), 512, 384, 40);
+  const json t = json::parse(r.stats.json)["target_db"];
+  ASSERT_TRUE(t["reached"].get<bool>()) << t.dump(1);
+  int smallest = 0;  // the smallest N whose pilot reached the target
+  for (const json& p : t["pilots"]) {
+    if (p["psnr_db_low"].get<double>() >= 40.0 && (smallest == 0 || p["cube_resolution"].get<int>() < smallest))
+      smallest = p["cube_resolution"].get<int>();
+  }
+  const int chosen = t["cube_resolution"].get<int>();
+  EXPECT_GT(chosen, smallest) << t.dump(1);
+  EXPECT_NE(t["why"].get<std::string>().find("cost model"), std::string::npos) << t["why"];
+  double previous = std::numeric_limits<double>::infinity();
+  for (const json& p : t["pilots"]) {
+    const int n = p["cube_resolution"].get<int>();
+    if (n < smallest || p["shading_points"] != t["shading_points"]) continue;
+    if (n > smallest) EXPECT_GE(p["psnr_db_low"].get<double>(), 40.0) << "moved to a pilot short of the target";
+    EXPECT_LT(p["model_shading_ms"].get<double>(), previous) << "N = " << n;
+    previous = p["model_shading_ms"].get<double>();
+  }
+  ASSERT_TRUE(r.stats.psnr_db.has_value());
+  EXPECT_GE(*r.stats.psnr_db, 40.0);
 }
 
 TEST(TargetDb, OptionsThatAlsoSetNAreRefused) {
