@@ -160,10 +160,10 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
   q.l_max = len;
   std::vector<ShadowCrossing> counted;
   const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v,
-                               const SearchContext::Plane& p) {
+                               const SearchContext::Plane& plane) {
     if (res.blocked) return;
-    const Candidate c = options.mode == SearchMode::thesis ? thesis_candidate(ctx, q, t, f, v, p)
-                                                           : crossing_candidate(ctx, q, options, t, f, p);
+    const Candidate c = options.mode == SearchMode::thesis ? thesis_candidate(ctx, q, t, f, v, plane)
+                                                           : crossing_candidate(ctx, q, options, t, f, plane);
     res.mesh_triangles += c.mesh_triangles;
     const bool accepted = options.mode == SearchMode::thesis ? c.valid && c.angle <= options.theta_max : c.valid;
     if (!accepted || !(c.l < len)) {

@@ -187,7 +187,6 @@ struct Pilots {
   MapShadingOptions best_plan;
   bool reached = false;
   std::string why;
-  std::vector<std::pair<int, MapShadingOptions>> short_of_target;  // (N, plan) piloted short
 
   // A pilot of `plan` at N = n, on the best map when it is at that N (only the plan
   // differs), else on a map built for it; the map is kept as the best when the pilot's lower
@@ -211,13 +210,7 @@ struct Pilots {
       best_pilot = p;
       best_plan = plan;
     }
-    if (p.error.psnr_low < target) short_of_target.emplace_back(n, plan);
     return p;
-  }
-
-  bool fell_short(int n, const MapShadingOptions& plan) const {
-    return std::any_of(short_of_target.begin(), short_of_target.end(),
-                       [&](const auto& s) { return s.first == n && same_plan(s.second, plan); });
   }
 
   // Climbs the ladder of N with `plan`, up to the first N that reaches the target, or until
@@ -244,11 +237,9 @@ struct Pilots {
     why = "the ladder's largest N did not reach the target: the best N found";
   }
 
-  // At the chosen N, the first of `plans` (cheapest first) that still reaches the target;
-  // a plan already piloted short of it there is not tried again.
+  // At the chosen N, the first of `plans` (cheapest first) that still reaches the target.
   void cheapen(const std::vector<MapShadingOptions>& plans) {
     for (const MapShadingOptions& plan : plans) {
-      if (fell_short(best.n, plan)) continue;
       const Clock::time_point t0 = Clock::now();
       auto shader = std::make_unique<MapShader>(*best.shader, plan);
       const Pilot p = run_pilot(mc, camera, *shader, sample, best.n, t0, &lines);
@@ -258,15 +249,15 @@ struct Pilots {
         best_pilot = p;
         return;
       }
-      short_of_target.emplace_back(best.n, plan);
     }
   }
 
   // THE COST MODEL. Above the chosen N, the next rung is piloted with the chosen plan when
   // the model expects its shading to cost at most PROBE_SHARE of the chosen N's, with a
-  // saving over the whole image worth the pilot (PROBE_COST_FACTOR); it becomes the choice when it reaches the target
-  // and its counts say it shades for less. MESH REFINEMENT's floods shrink with the texels, so a scene whose meshes are
-  // finer than the texels may render faster at a larger N.
+  // saving over the whole image worth the pilot (PROBE_COST_FACTOR); it becomes the choice
+  // when it reaches the target and its counts say it shades for less. MESH REFINEMENT's
+  // floods shrink with the texels, so a scene whose meshes are finer than the texels may
+  // render faster at a larger N.
   void grow() {
     const std::vector<int> ladder = target_ladder(mc.scene.render.cube_resolution);
     const double pixels = static_cast<double>(mc.scene.camera.width) * static_cast<double>(mc.scene.camera.height);
