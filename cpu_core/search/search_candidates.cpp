@@ -107,8 +107,8 @@ Candidate crossing_candidate(const SearchContext& ctx, const SearchRay& q, const
 }
 
 // Thesis mode (thesis 7.4.1, 9.3.4): the point a V of the texel centre on the fragment's plane.
-Candidate thesis_candidate(const SearchContext& ctx, const SearchRay& q, const WalkTexel& t, const Fragment& f,
-                           const glm::dvec3& v, const SearchContext::Plane& p) {
+Candidate thesis_candidate(const SearchRay& q, const WalkTexel& t, const Fragment& f, const glm::dvec3& v,
+                           const SearchContext::Plane& p) {
   Candidate c;
   const double den = glm::dot(p.normal, v);
   if (den == 0.0) return c;

@@ -95,8 +95,8 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
 // computed it for the own-surface test).
 Candidate crossing_candidate(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o, const WalkTexel& t,
                              const Fragment& f, const SearchContext::Plane& p);
-Candidate thesis_candidate(const SearchContext& ctx, const SearchRay& q, const WalkTexel& t, const Fragment& f,
-                           const glm::dvec3& v, const SearchContext::Plane& p);
+Candidate thesis_candidate(const SearchRay& q, const WalkTexel& t, const Fragment& f, const glm::dvec3& v,
+                           const SearchContext::Plane& p);
 
 // Does the exact ray meet a triangle the map cannot hold before parameter l_end?
 bool meets_zero_area(const SearchContext& ctx, const SearchRay& q, double l_end);

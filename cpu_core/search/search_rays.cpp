@@ -51,7 +51,7 @@ SearchResult search_thesis(const SearchContext& ctx, const SearchRay& q, const S
   int64_t first = -1;
   const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v,
                                const SearchContext::Plane& p) {
-    const Candidate c = thesis_candidate(ctx, q, t, f, v, p);
+    const Candidate c = thesis_candidate(q, t, f, v, p);
     if (c.valid && c.angle < best.angle) best = c;
   };
   const auto after_texel = [&](const WalkTexel&, uint32_t index) {
@@ -162,7 +162,7 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
   const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v,
                                const SearchContext::Plane& plane) {
     if (res.blocked) return;
-    const Candidate c = options.mode == SearchMode::thesis ? thesis_candidate(ctx, q, t, f, v, plane)
+    const Candidate c = options.mode == SearchMode::thesis ? thesis_candidate(q, t, f, v, plane)
                                                            : crossing_candidate(ctx, q, options, t, f, plane);
     res.mesh_triangles += c.mesh_triangles;
     const bool accepted = options.mode == SearchMode::thesis ? c.valid && c.angle <= options.theta_max : c.valid;
