@@ -142,15 +142,16 @@ def write(folder, template, seed):
 def generated_sample(folder, seed, hard, flat, size, cube_res):
     """The hard-case and flat-mirror templates' scenes drawn from seed: `hard` scenes cycling
     tools/hard_scenes.py's templates and `flat` cycling tools/flat_mirror_scenes.py's, at
-    `size` ("WxH") with N = cube_res, written into folder/hard and folder/flat. Returns their
-    paths, sorted within each generator."""
+    `size` ("WxH") with N = cube_res, written into folder/hard_SEED and folder/flat_SEED (a
+    folder per seed: another seed's scenes left in the same --out are not swept in). Returns
+    their paths, sorted within each generator."""
     import subprocess
     tools = os.path.join(HERE, "..", "tools")
     paths = []
     for tool, count, sub in (("hard_scenes.py", hard, "hard"), ("flat_mirror_scenes.py", flat, "flat")):
         if count <= 0:
             continue
-        d = os.path.join(folder, sub)
+        d = os.path.join(folder, "%s_%d" % (sub, seed))
         subprocess.run(["/usr/bin/python3", os.path.join(tools, tool), "--seed", str(seed), "--count", str(count),
                         "--out", d, "--size", size, "--cube-res", str(cube_res)], check=True,
                        stdout=subprocess.DEVNULL)
