@@ -70,6 +70,7 @@ struct SearchOptions {
   uint32_t max_texels = 0;                   // walk cap; 0 = CubeWalk's default
   bool side_structure = true;                // THE SIDE STRUCTURE answers what the map cannot hold
   bool hierarchy = true;                     // HIERARCHICAL SKIP (search_scan.hpp); off: the plain walk (same answers)
+  bool known_blockers = true;                // KNOWN BLOCKER (shadow_search); off: every segment walked
 };
 
 // The self offset `options` gives, in texels at W (its own, or the mode's default).
@@ -251,11 +252,18 @@ struct SearchResult {
   uint32_t mesh_triangles = 0;    // triangles MESH REFINEMENT tested for a crossing (walks and floods)
 };
 
+// No triangle (ShadowResult::opaque_blocker, shadow_search's known blocker).
+constexpr uint32_t NO_TRIANGLE = 0xffffffffu;
+
 struct ShadowResult {
   glm::dvec3 transmittance{1.0};  // S_l: product of blocker_transmittance over blockers
   bool blocked = false;           // an opaque blocker stopped the walk
-  uint32_t blockers = 0;          // distinct crossings counted
-  uint32_t first_blocker = 0;     // triangle of the nearest counted blocker (if blockers > 0)
+  // The blocker, opaque on its own (blocker_transmittance 0), that stopped the segment;
+  // NO_TRIANGLE when none did. What a nearby point's search may take as its known blocker.
+  uint32_t opaque_blocker = NO_TRIANGLE;
+  bool known_blocker = false;  // answered by the known blocker: the map was not walked
+  uint32_t blockers = 0;       // distinct crossings counted
+  uint32_t first_blocker = 0;  // triangle of the nearest counted blocker (if blockers > 0)
   bool aborted = false;
   bool zero_area = false;      // the segment meets a zero-area surface and no side structure answered
   uint32_t side_blockers = 0;  // blockers found by THE SIDE STRUCTURE
@@ -294,8 +302,19 @@ void coincident_crossings(const SearchContext& ctx, const glm::dvec3& w, const g
                           double l_hit, double tolerance, const std::function<void(uint32_t, double)>& visit);
 
 // Visibility of point light `light_position` from surface point p (world space).
+//
+// KNOWN BLOCKER. `known_blocker` (or NO_TRIANGLE) names a triangle expected to block the
+// segment: the opaque one that stopped a nearby point's segment to the same light
+// (ShadowResult::opaque_blocker). Before the walk it is tested exactly, by THE SIDE
+// STRUCTURE's rules: the watertight test (reference/triangle_test.hpp) between p and the
+// light, beyond the self offset, not p's own surface, its plane not through the light. When
+// it passes, the segment is blocked (transmittance 0) and the map is not walked: an opaque
+// triangle the segment crosses blocks it whatever else lies on it, so that answer is the
+// exact one, and the walk's differs from it only where the walk would have missed that
+// triangle. Crossing mode over all layers only (SearchOptions::known_blockers): the thesis
+// mode and the Z-buffer keep the answers of the methods they reproduce.
 ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const glm::dvec3& light_position,
-                           const SearchOptions& options = {});
+                           const SearchOptions& options = {}, uint32_t known_blocker = NO_TRIANGLE);
 
 // Whether two searches gave the same answer bit for bit: every field but the walk's counts
 // of texels and nodes (HIERARCHICAL SKIP: on and off must agree).
@@ -315,6 +334,7 @@ struct SearchKindStats {
   uint64_t threshold_rejections = 0;    // misses whose best candidate failed the threshold
   uint64_t zero_area = 0;               // misses on a surface through the centre (map only)
   uint64_t side_hits = 0;               // answered by THE SIDE STRUCTURE; shadows: rays with a side blocker
+  uint64_t known_blockers = 0;          // shadows: answered by their KNOWN BLOCKER, the map not walked
   uint64_t aborted = 0;                 // walks stopped by the cap
   double mean_texels() const { return rays ? static_cast<double>(texels) / static_cast<double>(rays) : 0.0; }
   double mean_nodes() const { return rays ? static_cast<double>(nodes) / static_cast<double>(rays) : 0.0; }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "reference/triangle_test.hpp"
 #include "search/search_scan.hpp"
 #include "material/shading.hpp"
 
@@ -129,10 +130,22 @@ void add_side_blockers(const SearchContext& ctx, const SearchRay& q, const Searc
     if (already_counted(*counted, ctx, o, c)) continue;
     counted->push_back({s.triangle, soup.object_id[s.triangle], s.back_face, c.x, s.l, true});
     ++res->side_blockers;
-    res->transmittance *= blocker_transmittance(ctx.scene().materials[soup.material_id[s.triangle]]);  // thesis 8.3
+    const glm::dvec3 kt = blocker_transmittance(ctx.scene().materials[soup.material_id[s.triangle]]);  // thesis 8.3
+    res->transmittance *= kt;
     res->blocked = res->transmittance == glm::dvec3(0.0);
+    if (kt == glm::dvec3(0.0)) res->opaque_blocker = s.triangle;
     if (res->blocked) return;
   }
+}
+
+// KNOWN BLOCKER (search.hpp): does opaque triangle `tri` block the segment q, by THE SIDE
+// STRUCTURE's rules?
+bool blocks(const SearchContext& ctx, const SearchRay& q, uint32_t tri, const glm::dvec3& light) {
+  const TriangleSoup& soup = *ctx.scene().triangles;
+  if (blocker_transmittance(ctx.scene().materials[soup.material_id[tri]]) != glm::dvec3(0.0)) return false;
+  TriangleHit hit;
+  return intersect_triangle(RayQuery(ctx.cube().centre + q.w, q.d), soup, tri, q.l_max, &hit) &&
+         side_crossing_counts(ctx, q, tri, hit.t) && !plane_holds_light(soup, tri, light);
 }
 
 }  // namespace
@@ -151,13 +164,21 @@ SearchResult refraction_exit_search(const SearchContext& ctx, const glm::dvec3& 
 }
 
 ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const glm::dvec3& light_position,
-                           const SearchOptions& options) {
+                           const SearchOptions& options, uint32_t known_blocker) {
   ShadowResult res;
   const glm::dvec3 seg = light_position - p;
   const double len = glm::length(seg);
   if (!(len > 0.0)) return res;
   SearchRay q = make_query(ctx, p, seg / len, options);
   q.l_max = len;
+  if (known_blocker != NO_TRIANGLE && options.known_blockers && options.mode == SearchMode::crossing &&
+      options.layers == SearchLayers::all && blocks(ctx, q, known_blocker, light_position)) {
+    res.transmittance = glm::dvec3(0.0);
+    res.blocked = res.known_blocker = true;
+    res.blockers = 1;
+    res.first_blocker = res.opaque_blocker = known_blocker;
+    return res;
+  }
   std::vector<ShadowCrossing> counted;
   const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v,
                                const SearchContext::Plane& plane) {
@@ -178,8 +199,10 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
     counted.push_back({tri, ctx.scene().triangles->object_id[tri], c.back_face, c.x, c.l,
                        options.mode == SearchMode::crossing && c.exact});
     // thesis 8.3; rule "shadows" (shading.hpp): S_l is the product over the blockers.
-    res.transmittance *= blocker_transmittance(ctx.scene().materials[ctx.scene().triangles->material_id[tri]]);
+    const glm::dvec3 kt = blocker_transmittance(ctx.scene().materials[ctx.scene().triangles->material_id[tri]]);
+    res.transmittance *= kt;
     res.blocked = res.transmittance == glm::dvec3(0.0);
+    if (kt == glm::dvec3(0.0)) res.opaque_blocker = tri;
   };
   const auto after_texel = [&](const WalkTexel&, uint32_t) { return !res.blocked; };
   const ScanCounts counts = scan(ctx, q, options, on_fragment, after_texel, [] { return true; });

@@ -57,7 +57,8 @@ bool same_answer(const SearchResult& a, const SearchResult& b) {
 bool same_answer(const ShadowResult& a, const ShadowResult& b) {
   return same_bits(a.transmittance, b.transmittance) && a.blocked == b.blocked && a.blockers == b.blockers &&
          a.first_blocker == b.first_blocker && a.aborted == b.aborted && a.zero_area == b.zero_area &&
-         a.side_blockers == b.side_blockers && a.fragments_tested == b.fragments_tested &&
+         a.side_blockers == b.side_blockers && a.opaque_blocker == b.opaque_blocker &&
+         a.known_blocker == b.known_blocker && a.fragments_tested == b.fragments_tested &&
          a.candidates == b.candidates && a.threshold_rejections == b.threshold_rejections;
 }
 
@@ -99,6 +100,7 @@ void SearchKindStats::add(const ShadowResult& r) {
   threshold_rejections += r.blockers == 0 && r.threshold_rejections > 0;
   zero_area += r.zero_area;
   side_hits += r.side_blockers > 0;
+  known_blockers += r.known_blocker;
   aborted += r.aborted;
 }
 
@@ -115,6 +117,7 @@ void SearchKindStats::merge(const SearchKindStats& o) {
   threshold_rejections += o.threshold_rejections;
   zero_area += o.zero_area;
   side_hits += o.side_hits;
+  known_blockers += o.known_blockers;
   aborted += o.aborted;
 }
 

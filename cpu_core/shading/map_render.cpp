@@ -113,6 +113,7 @@ class MapRender {
     // of the points' lights too, reused fragment after fragment (their vectors keep their room).
     const size_t workers = static_cast<size_t>(resolve_workers(camera_, ro));
     per_worker_.assign(workers, MapShadingStats{});
+    known_.assign(workers, Known{});
     worker_direct_.resize(workers);
     if (trails_on_) trails_ = PixelTrails(pixels_, workers);
     const WorkerPixelShader shade = [this](const Fragment& f, int x, int y, int worker) {
@@ -137,14 +138,19 @@ class MapRender {
   // The fragment shaded at its covered quarters, adaptively (header, QUARTER_SPLIT_SRGB).
   ShadedFragment shade_fragment(const Fragment& f, int x, int y, int worker) {
     MapShadingStats* s = &per_worker_[static_cast<size_t>(worker)];
+    Known& known = known_[static_cast<size_t>(worker)];
+    if (known.row != y) {  // KNOWN BLOCKERS (map_shading.hpp): none carried from another row
+      known.row = y;
+      known.blockers.clear();
+    }
     const size_t at = static_cast<size_t>(y) * static_cast<size_t>(camera_.width()) + static_cast<size_t>(x);
     const std::pair<uint64_t, uint64_t> before =
         fallback_ ? searches_and_failures(*s) : std::pair<uint64_t, uint64_t>{};
     glm::dvec3 c;
     if (shader_.one_point()) {
-      c = shade_at(f, x, y, fragment_point(camera_, *scene_.triangles, f, x, y), f.mask, nullptr, s);
+      c = shade_at(f, x, y, fragment_point(camera_, *scene_.triangles, f, x, y), f.mask, nullptr, s, &known.blockers);
     } else {
-      c = shade_quarters(f, x, y, at, worker, s);
+      c = shade_quarters(f, x, y, at, worker, s, &known.blockers);
     }
     if (fallback_) {
       const std::pair<uint64_t, uint64_t> after = searches_and_failures(*s);
@@ -177,13 +183,13 @@ class MapRender {
   // a textured surface takes its base colour averaged over those samples, as the exact
   // tracer's 32 rays a pixel see it; the light, shadows and secondary rays are the point's.
   glm::dvec3 shade_at(const Fragment& f, int x, int y, const glm::dvec3& p, CoverageMask mask, PrimaryLights* direct,
-                      MapShadingStats* s) const {
+                      MapShadingStats* s, KnownBlockers* known) const {
     const glm::dvec3 eye = scene_.camera.position;
     SurfacePoint sp = surface_at(f, x, y, p);
     if (shader_.texture_samples() && sp.material == scene_.triangles->material_id[f.triangle()]) {
       sp.diffuse_given = mean_diffuse_color(scene_, camera_.view, f.triangle(), x, y, mask, &sp.diffuse);
     }
-    return shader_.shade(sp, glm::normalize(p - eye), 0, true, s, direct);
+    return shader_.shade(sp, glm::normalize(p - eye), 0, true, s, direct, known);
   }
 
   Quarters quarters(const Fragment& f, int x, int y) const {
@@ -203,7 +209,8 @@ class MapRender {
 
   // The fragment's two end quarters shaded, the ones between too where the ends differ (or
   // a shadow edge is forced), each quarter's samples searched again along a shadow's edge.
-  glm::dvec3 shade_quarters(const Fragment& f, int x, int y, size_t at, int worker, MapShadingStats* s) {
+  glm::dvec3 shade_quarters(const Fragment& f, int x, int y, size_t at, int worker, MapShadingStats* s,
+                            KnownBlockers* known) {
     const uint64_t force = forced_.empty() ? 0 : forced_[at];
     const bool force_secondary = !forced_secondary_.empty() && forced_secondary_[at];
     const std::function<glm::dvec3(const glm::dvec3&)> on_surface = [&](const glm::dvec3& p) {
@@ -215,14 +222,14 @@ class MapRender {
     // What the points' lights gave (SHADOW EDGES) and their secondary rays found (SECONDARY EDGES).
     PrimaryLights* const record = edges_ || secondary ? direct : nullptr;
     if (q.count <= 1) {
-      glm::dvec3 c = shade_at(f, x, y, fragment_point(camera_, *scene_.triangles, f, x, y), f.mask, record, s);
+      glm::dvec3 c = shade_at(f, x, y, fragment_point(camera_, *scene_.triangles, f, x, y), f.mask, record, s, known);
       if (secondary && force_secondary) {
         ++s->secondary_edge_fragments;
-        c += secondary_samples(f, x, y, f.mask, s) - direct[0].secondary;
+        c += secondary_samples(f, x, y, f.mask, s, known) - direct[0].secondary;
       }
       if (secondary && !trails_.empty()) trails_.note_point(at, direct[0].trail);
       if (edges_ && force) {
-        refine_shadow_edges(scene_, camera_, f, x, y, q.mask, 1, direct, force, &c, on_surface, shader_, s,
+        refine_shadow_edges(scene_, camera_, f, x, y, q.mask, 1, direct, force, &c, on_surface, shader_, s, known,
                             &seen_.sides[at]);
       }
       if (edges_) seen_.note(at, scene_, direct, 1, true);
@@ -231,15 +238,15 @@ class MapRender {
     ++s->multi_point_fragments;
     const int last = q.count - 1;
     glm::dvec3 colour[4];
-    colour[0] = shade_at(f, x, y, q.point[0], q.mask[0], record ? &direct[0] : nullptr, s);
-    colour[last] = shade_at(f, x, y, q.point[last], q.mask[last], record ? &direct[last] : nullptr, s);
+    colour[0] = shade_at(f, x, y, q.point[0], q.mask[0], record ? &direct[0] : nullptr, s, known);
+    colour[last] = shade_at(f, x, y, q.point[last], q.mask[last], record ? &direct[last] : nullptr, s, known);
     const bool ends_differ = edges_ && direct[0].shadow != direct[last].shadow;
     // A texture may differ between quarters whose ends agree: each of them is shaded with
     // its own samples' base colour (--texture-lookups samples). A mirror's or glass's quarters
     // are all shaded, so that SECONDARY EDGES compares them all.
     const bool split = force != 0 || ends_differ || differ(colour[0], colour[last]) || textured(f) || secondary;
     for (int k = 1; k < last; ++k) {
-      colour[k] = split ? shade_at(f, x, y, q.point[k], q.mask[k], record ? &direct[k] : nullptr, s)
+      colour[k] = split ? shade_at(f, x, y, q.point[k], q.mask[k], record ? &direct[k] : nullptr, s, known)
                         : 0.5 * (colour[0] + colour[last]);
     }
     const bool refined =
@@ -253,7 +260,7 @@ class MapRender {
       // of the pixel noted.
       SideTrails sides;
       for (int k = 0; k < q.count; ++k) {
-        colour[k] += secondary_samples(f, x, y, q.mask[k], s, &sides) - direct[k].secondary;
+        colour[k] += secondary_samples(f, x, y, q.mask[k], s, known, &sides) - direct[k].secondary;
       }
       ++s->secondary_edge_fragments;
       if (!trails_.empty()) {
@@ -263,7 +270,7 @@ class MapRender {
     }
     if (edges_ && split) {
       refine_shadow_edges(scene_, camera_, f, x, y, q.mask, q.count, direct, force, colour, on_surface, shader_, s,
-                          &seen_.sides[at]);
+                          known, &seen_.sides[at]);
     }
     if (edges_) seen_.note(at, scene_, direct, q.count, split);
     glm::dvec3 c = q.weight[0] * colour[0] + q.weight[last] * colour[last];
@@ -282,14 +289,14 @@ class MapRender {
   // searched from its own point of the fragment's plane (moved onto the mesh as the shading
   // points are); `sides` (optional) gains the trails of the samples on each side of the pixel.
   glm::dvec3 secondary_samples(const Fragment& f, int x, int y, CoverageMask mask, MapShadingStats* s,
-                               SideTrails* sides = nullptr) const {
+                               KnownBlockers* known, SideTrails* sides = nullptr) const {
     glm::dvec3 sum(0.0);
     for (CoverageMask m = mask; m; m &= m - 1) {
       const int b = __builtin_ctz(m);
       const glm::dvec3 p =
           point_on_triangle_plane(camera_.view, *scene_.triangles, f.triangle(), x + sample_dx(b), y + sample_dy(b));
       uint64_t trail = 0;
-      sum += shader_.secondary(surface_at(f, x, y, p), glm::normalize(p - scene_.camera.position), s, &trail);
+      sum += shader_.secondary(surface_at(f, x, y, p), glm::normalize(p - scene_.camera.position), s, &trail, known);
       ++s->secondary_edge_samples;
       for (int side = 0; sides && side < 4; ++side) {
         if (sample_sides(b) & (1 << side)) (*sides)[static_cast<size_t>(side)].add(trail);
@@ -330,6 +337,7 @@ class MapRender {
       }
     }
     if (flagged + flagged_secondary > 0) {
+      for (Known& k : known_) k.row = -1;  // each row starts afresh in this pass too
       ResolveOptions second = ro;
       second.only = &again;
       const Image redone = resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, second);
@@ -355,6 +363,12 @@ class MapRender {
   std::vector<uint8_t> widened_;
   std::vector<uint64_t> forced_;  // per pixel, the lights whose edge the second pass searches
   std::vector<MapShadingStats> per_worker_;
+  // Per worker: its KNOWN BLOCKERS (map_shading.hpp) and the row they were found in.
+  struct Known {
+    int row = -1;
+    KnownBlockers blockers;
+  };
+  std::vector<Known> known_;
   std::vector<std::array<PrimaryLights, 4>> worker_direct_;
   bool trails_on_ = false;
   PixelTrails trails_;

@@ -116,25 +116,25 @@ void MapShader::set_method_state() {
 MapShader::~MapShader() = default;
 
 glm::dvec3 MapShader::shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
-                            MapShadingStats* stats, PrimaryLights* direct) const {
+                            MapShadingStats* stats, PrimaryLights* direct, KnownBlockers* known) const {
   const MediumCrossing c{sp.triangle, !(glm::dot(sp.geometric_normal, dir) < 0.0), 0.0};
   if (direct) direct->trail = 0;
-  return shade(Crossed{sp, sp.point, ctx_->media().resolve(MediumStack{}, &c, 1)}, dir, depth, primary, stats, direct,
-               direct ? &direct->trail : nullptr);
+  return shade(Crossed{sp, sp.point, ctx_->media().resolve(MediumStack{}, &c, 1)}, dir, depth, primary, stats, known,
+               direct, direct ? &direct->trail : nullptr);
 }
 
-glm::dvec3 MapShader::secondary(const SurfacePoint& sp, const glm::dvec3& dir, MapShadingStats* stats,
-                                uint64_t* trail) const {
+glm::dvec3 MapShader::secondary(const SurfacePoint& sp, const glm::dvec3& dir, MapShadingStats* stats, uint64_t* trail,
+                                KnownBlockers* known) const {
   const MediumCrossing c{sp.triangle, !(glm::dot(sp.geometric_normal, dir) < 0.0), 0.0};
   if (trail) *trail = 0;
-  const Terms t =
-      secondary_terms(Crossed{sp, sp.point, ctx_->media().resolve(MediumStack{}, &c, 1)}, dir, 0, true, stats, trail);
+  const Terms t = secondary_terms(Crossed{sp, sp.point, ctx_->media().resolve(MediumStack{}, &c, 1)}, dir, 0, true,
+                                  stats, known, trail);
   return t.reflected + t.transmitted;
 }
 
 // kr times the reflected ray's colour, kt times the transmitted one's (THE RULES).
 MapShader::Terms MapShader::secondary_terms(const Crossed& cr, const glm::dvec3& dir, int depth, bool primary,
-                                            MapShadingStats* stats, uint64_t* trail) const {
+                                            MapShadingStats* stats, KnownBlockers* known, uint64_t* trail) const {
   const SurfacePoint& sp = cr.sp;
   const SecondaryWeights w =
       secondary_weights(scene_.materials[sp.material], scene_.render.fresnel, dir,
@@ -142,30 +142,31 @@ MapShader::Terms MapShader::secondary_terms(const Crossed& cr, const glm::dvec3&
                         sp.geometric_normal);
   Terms t;
   if (depth < scene_.render.max_depth && w.reflect > 0.0) {
-    t.reflected = w.reflect * reflected(sp, dir, depth, primary, cr.itf.before, stats, trail);
+    t.reflected = w.reflect * reflected(sp, dir, depth, primary, cr.itf.before, stats, known, trail);
   }
   if (depth < scene_.render.max_depth && w.transmit > 0.0) {
-    t.transmitted = w.transmit * transmitted(cr, dir, depth, stats, trail);
+    t.transmitted = w.transmit * transmitted(cr, dir, depth, stats, known, trail);
   }
   return t;
 }
 
 glm::dvec3 MapShader::shade(const Crossed& cr, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats,
-                            PrimaryLights* direct, uint64_t* trail) const {
+                            KnownBlockers* known, PrimaryLights* direct, uint64_t* trail) const {
   const SurfacePoint& sp = cr.sp;
   const Material& m = scene_.materials[sp.material];
   // Coverage transparency of a found surface: the ray goes on behind it, same depth.
   glm::dvec3 behind(0.0);
   const bool blend = !primary && m.opacity < 1.0;
   if (blend) {
-    behind = trace(cr.far, dir, depth, cr.itf.after, stats, nullptr, trail);
+    behind = trace(cr.far, dir, depth, cr.itf.after, stats, known, nullptr, trail);
     if (m.opacity <= 0.0) return behind;
   }
   const glm::dvec3 v = -dir;
   const glm::dvec3 n = face_forward(sp.shading_normal, v);
   const glm::dvec3 od = sp.diffuse_given ? sp.diffuse : diffuse_color_at(scene_, sp.triangle, sp.point);
-  glm::dvec3 c = phong_ambient(m, scene_.ambient, od) + lights(sp, v, n, od, stats, depth == 0 ? direct : nullptr);
-  const Terms t = secondary_terms(cr, dir, depth, primary, stats, trail);
+  glm::dvec3 c =
+      phong_ambient(m, scene_.ambient, od) + lights(sp, v, n, od, stats, known, depth == 0 ? direct : nullptr);
+  const Terms t = secondary_terms(cr, dir, depth, primary, stats, known, trail);
   if (depth == 0 && direct) direct->secondary = t.reflected + t.transmitted;
   c += t.reflected;  // in this order, term by term: the same sums as ever
   c += t.transmitted;
@@ -173,14 +174,17 @@ glm::dvec3 MapShader::shade(const Crossed& cr, const glm::dvec3& dir, int depth,
 }
 
 // sum_l S_l phong_light, S_l from the shadow search (thesis 8.3).
-glm::dvec3 MapShader::visibility(const glm::dvec3& p, const PointLight& light, MapShadingStats* stats) const {
-  const ShadowResult s = shadow_search(*ctx_, p, light.position, options_.search);
+glm::dvec3 MapShader::visibility(const glm::dvec3& p, size_t light, MapShadingStats* stats,
+                                 KnownBlockers* known) const {
+  const ShadowResult s =
+      shadow_search(*ctx_, p, scene_.lights[light].position, options_.search, known ? known->of(light) : NO_TRIANGLE);
+  if (known) known->note(light, s.opaque_blocker);
   if (stats) stats->searches.shadow.add(s);
   return s.transmittance;
 }
 
 glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n, const glm::dvec3& od,
-                             MapShadingStats* stats, PrimaryLights* direct) const {
+                             MapShadingStats* stats, KnownBlockers* known, PrimaryLights* direct) const {
   const Material& m = scene_.materials[sp.material];
   if (direct) {
     direct->lit.assign(scene_.lights.size(), glm::dvec3(0.0));
@@ -202,7 +206,7 @@ glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const 
       c += lit;
       continue;
     }
-    const glm::dvec3 shadow = visibility(sp.point, light, stats);
+    const glm::dvec3 shadow = visibility(sp.point, l, stats, known);
     if (direct) direct->shadow[l] = shadow;
     c += lit * shadow;
   }
@@ -246,7 +250,7 @@ MapShader::Crossed MapShader::crossing_set(const glm::dvec3& w, const glm::dvec3
 
 // What a ray from w along dir finds in the map, shaded one bounce deeper (or background).
 glm::dvec3 MapShader::trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, const MediumStack& stack,
-                            MapShadingStats* stats, SearchResult* found, uint64_t* trail) const {
+                            MapShadingStats* stats, KnownBlockers* known, SearchResult* found, uint64_t* trail) const {
   const SearchResult r = search(w, dir, stack, stats);
   if (found) *found = r;
   if (trail) {  // an order-dependent mix of the object found (0: none)
@@ -257,13 +261,14 @@ glm::dvec3 MapShader::trace(const glm::dvec3& w, const glm::dvec3& dir, int dept
   const Crossed c = crossing_set(w, dir, r, stack);
   if (c.itf.pass) {  // no interface: the same ray goes on from the crossing
     if (c.itf.after.passes > MEDIA_MAX_PASSES) return scene_.background;
-    return trace(c.far, dir, depth, c.itf.after, stats, nullptr, trail);
+    return trace(c.far, dir, depth, c.itf.after, stats, known, nullptr, trail);
   }
-  return shade(c, dir, depth, false, stats, nullptr, trail);
+  return shade(c, dir, depth, false, stats, known, nullptr, trail);
 }
 
 glm::dvec3 MapShader::reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary,
-                                const MediumStack& stack, MapShadingStats* stats, uint64_t* trail) const {
+                                const MediumStack& stack, MapShadingStats* stats, KnownBlockers* known,
+                                uint64_t* trail) const {
   const glm::dvec3 r = glm::normalize(reflect_dir(dir, sp.shading_normal));
   if (options_.method == Method::envmap) {
     if (stats) ++stats->envmap_lookups;
@@ -272,7 +277,7 @@ glm::dvec3 MapShader::reflected(const SurfacePoint& sp, const glm::dvec3& dir, i
     return envmap_at(lookup);
   }
   SearchResult found;
-  const glm::dvec3 c = trace(sp.point, r, depth + 1, stack, stats, &found, trail);
+  const glm::dvec3 c = trace(sp.point, r, depth + 1, stack, stats, known, &found, trail);
   if (primary && reference_ && stats) measure(sp.point, r, &found, nullptr, stats);
   return c;
 }
@@ -285,7 +290,7 @@ Ray MapShader::transmitted_ray(const Crossed& c, const Transmission& tr, MediumS
 }
 
 glm::dvec3 MapShader::transmitted(const Crossed& c, const glm::dvec3& dir, int depth, MapShadingStats* stats,
-                                  uint64_t* trail) const {
+                                  KnownBlockers* known, uint64_t* trail) const {
   const SurfacePoint& sp = c.sp;
   const Transmission tr = transmission_between(dir, sp.geometric_normal, sp.shading_normal, c.itf.n_from, c.itf.n_to);
   if (options_.method == Method::envmap) {
@@ -298,13 +303,13 @@ glm::dvec3 MapShader::transmitted(const Crossed& c, const glm::dvec3& dir, int d
     LensRay out;
     if (lens_transfer(lenses_[static_cast<size_t>(lens)], options_.refraction, sp.point, dir, &out)) {
       if (stats) ++stats->lens_transfers;
-      return trace(out.point, out.dir, depth + 1, MediumStack{}, stats, nullptr, trail);
+      return trace(out.point, out.dir, depth + 1, MediumStack{}, stats, known, nullptr, trail);
     }
     if (stats) ++stats->lens_fallbacks;
   }
   MediumStack stack;
   const Ray ray = transmitted_ray(c, tr, &stack);
-  return trace(ray.origin, ray.dir, depth + 1, stack, stats, nullptr, trail);
+  return trace(ray.origin, ray.dir, depth + 1, stack, stats, known, nullptr, trail);
 }
 
 std::vector<Ray> MapShader::transmitted_path(const glm::dvec3& origin, const glm::dvec3& dir, int max_rays) const {
@@ -377,7 +382,8 @@ glm::dvec3 MapShader::envmap_texel(int face, int i, int j) const {
     const glm::dvec3 v = glm::normalize(cube_.centre - p);
     const glm::dvec3 nn = face_forward(sp.shading_normal, v);
     const glm::dvec3 od = diffuse_color_at(scene_, sp.triangle, p);
-    return ShadedFragment{phong_ambient(m, scene_.ambient, od) + lights(sp, v, nn, od, nullptr, nullptr), m.opacity};
+    return ShadedFragment{phong_ambient(m, scene_.ambient, od) + lights(sp, v, nn, od, nullptr, nullptr, nullptr),
+                          m.opacity};
   };
   const SampleDepth depth{&buffer.view, &*scene_.triangles, i, j};
   return pack_under_mask(buffer.list(i, j), FULL_MASK, shade_fragment, *scene_.triangles, scene_.background, nullptr,

@@ -144,6 +144,22 @@ struct PrimaryLights {
   glm::dvec3 secondary{0.0};
 };
 
+// KNOWN BLOCKERS (search.hpp shadow_search): per light, the opaque triangle that stopped the
+// last shadow segment one worker searched to it (NO_TRIANGLE when none), tried first by its
+// next search to that light: neighbouring points' segments to one light are mostly stopped by
+// the same triangle (docs/design/map-shading.md, "Known blockers"). A render
+// keeps one per worker and clears it when the worker starts a row, so that a pixel's shadows
+// depend only on the pixels before it in its row, whatever the threads.
+struct KnownBlockers {
+  std::vector<uint32_t> triangle;  // by light index; empty: none known
+  uint32_t of(size_t light) const { return light < triangle.size() ? triangle[light] : NO_TRIANGLE; }
+  void note(size_t light, uint32_t blocker) {
+    if (triangle.size() <= light) triangle.resize(light + 1, NO_TRIANGLE);
+    triangle[light] = blocker;
+  }
+  void clear() { triangle.clear(); }
+};
+
 struct SurfacePoint {
   glm::dvec3 point{0.0};
   glm::dvec3 geometric_normal{0.0};  // unit, cross(b-a, c-a)
@@ -174,13 +190,16 @@ class MapShader {
   // marks a camera fragment: its coverage transparency is the resolve's business, and
   // its reflection rays are the ones measured against the reference.
   // `direct` (optional) receives what the point's own lights gave it (depth 0 only).
+  // `known` (optional): the caller's KNOWN BLOCKERS, used and updated by every shadow search.
   glm::dvec3 shade(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats,
-                   PrimaryLights* direct = nullptr) const;
+                   PrimaryLights* direct = nullptr, KnownBlockers* known = nullptr) const;
   // A camera fragment's point's kr and kt terms alone (what `shade` adds to its own light),
   // `trail` (optional) receiving PrimaryLights::trail.
-  glm::dvec3 secondary(const SurfacePoint& sp, const glm::dvec3& dir, MapShadingStats* stats, uint64_t* trail) const;
-  // S_l of `light` at `p`: the shadow search's transmittance (thesis 8.3).
-  glm::dvec3 visibility(const glm::dvec3& p, const PointLight& light, MapShadingStats* stats) const;
+  glm::dvec3 secondary(const SurfacePoint& sp, const glm::dvec3& dir, MapShadingStats* stats, uint64_t* trail,
+                       KnownBlockers* known = nullptr) const;
+  // S_l of light number `light` at `p`: the shadow search's transmittance (thesis 8.3).
+  glm::dvec3 visibility(const glm::dvec3& p, size_t light, MapShadingStats* stats,
+                        KnownBlockers* known = nullptr) const;
 
   // The path of the transmitted weight alone from `origin` (in air, not a surface) along
   // `dir`, answered by the searches: the ray after each interface, as
@@ -213,21 +232,21 @@ class MapShader {
   // `trail` (optional): the surfaces every search below this one found, hashed in order
   // (PrimaryLights::trail).
   glm::dvec3 shade(const Crossed& c, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats,
-                   PrimaryLights* direct, uint64_t* trail) const;
+                   KnownBlockers* known, PrimaryLights* direct, uint64_t* trail) const;
   struct Terms {
     glm::dvec3 reflected{0.0}, transmitted{0.0};
   };
   Terms secondary_terms(const Crossed& c, const glm::dvec3& dir, int depth, bool primary, MapShadingStats* stats,
-                        uint64_t* trail) const;
+                        KnownBlockers* known, uint64_t* trail) const;
   Ray transmitted_ray(const Crossed& c, const Transmission& tr, MediumStack* stack) const;
   glm::dvec3 trace(const glm::dvec3& w, const glm::dvec3& dir, int depth, const MediumStack& stack,
-                   MapShadingStats* stats, SearchResult* found, uint64_t* trail) const;
+                   MapShadingStats* stats, KnownBlockers* known, SearchResult* found, uint64_t* trail) const;
   glm::dvec3 lights(const SurfacePoint& sp, const glm::dvec3& v, const glm::dvec3& n, const glm::dvec3& od,
-                    MapShadingStats* stats, PrimaryLights* direct) const;
+                    MapShadingStats* stats, KnownBlockers* known, PrimaryLights* direct) const;
   glm::dvec3 reflected(const SurfacePoint& sp, const glm::dvec3& dir, int depth, bool primary, const MediumStack& stack,
-                       MapShadingStats* stats, uint64_t* trail) const;
+                       MapShadingStats* stats, KnownBlockers* known, uint64_t* trail) const;
   glm::dvec3 transmitted(const Crossed& c, const glm::dvec3& dir, int depth, MapShadingStats* stats,
-                         uint64_t* trail) const;
+                         KnownBlockers* known, uint64_t* trail) const;
   glm::dvec3 envmap_direction(const glm::dvec3& w, const glm::dvec3& r) const;
   glm::dvec3 envmap_at(const glm::dvec3& direction) const;
   void measure(const glm::dvec3& w, const glm::dvec3& r, const SearchResult* found, const glm::dvec3* lookup,

@@ -18,7 +18,7 @@ size_t pixel_index(int width, int x, int y) {
 void refine_shadow_edges(const SceneData& scene, const ABuffer& camera, const Fragment& f, int x, int y,
                          const CoverageMask* quarter, int count, const PrimaryLights* direct, uint64_t forced,
                          glm::dvec3* colour, const std::function<glm::dvec3(const glm::dvec3&)>& on_surface,
-                         const MapShader& shader, MapShadingStats* stats, uint8_t* sides) {
+                         const MapShader& shader, MapShadingStats* stats, KnownBlockers* known, uint8_t* sides) {
   bool any = false;
   for (size_t l = 0; l < scene.lights.size(); ++l) {
     bool refine = l < 64 && ((forced >> l) & 1u) != 0;
@@ -32,7 +32,7 @@ void refine_shadow_edges(const SceneData& scene, const ABuffer& camera, const Fr
         const int b = __builtin_ctz(m);
         const glm::dvec3 p =
             point_on_triangle_plane(camera.view, *scene.triangles, f.triangle(), x + sample_dx(b), y + sample_dy(b));
-        const glm::dvec3 v = shader.visibility(on_surface(p), scene.lights[l], stats);
+        const glm::dvec3 v = shader.visibility(on_surface(p), l, stats, known);
         sum += v;
         ++stats->shadow_edge_samples;
         if (sides)

@@ -26,7 +26,8 @@ namespace abcube {
 void refine_shadow_edges(const SceneData& scene, const ABuffer& camera, const Fragment& f, int x, int y,
                          const CoverageMask* quarter, int count, const PrimaryLights* direct, uint64_t forced,
                          glm::dvec3* colour, const std::function<glm::dvec3(const glm::dvec3&)>& on_surface,
-                         const MapShader& shader, MapShadingStats* stats, uint8_t* sides = nullptr);
+                         const MapShader& shader, MapShadingStats* stats, KnownBlockers* known,
+                         uint8_t* sides = nullptr);
 
 // Per pixel, the lights (the first 64) that its shaded points saw wholly lit, and those they
 // saw shadowed. A resolve worker owns a row at a time: no two threads write one pixel.

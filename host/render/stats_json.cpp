@@ -19,6 +19,7 @@ json search_kind_json(const SearchKindStats& s) {
           {"threshold_rejections", s.threshold_rejections},
           {"zero_area_misses", s.zero_area},
           {"side_hits", s.side_hits},
+          {"known_blockers", s.known_blockers},
           {"aborted", s.aborted}};
 }
 

@@ -44,6 +44,36 @@ Rendered render_method(const SceneData& s, Method method, const RayTracer* refer
   return r;
 }
 
+// KNOWN BLOCKERS (map_shading.hpp) in a whole render: most shadow walks of the shadows scene
+// end at the blocker its row's previous search found. The image is the one every segment
+// walked gives, bit for bit (here the walk misses no blocker the known one answers), and it
+// does not depend on the threads (a worker clears them at each row).
+TEST(MapShading, KnownBlockersSpareShadowWalksAndChangeNothing) {
+  const SceneData s = small_scene("shadows.json", 160, 128);
+  const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, s.render.cube_resolution);
+  const ABuffer camera = build_camera_abuffer(s);
+  const auto render = [&](bool known, int threads, MapShadingStats* stats) {
+    MapShadingOptions o;
+    o.search.known_blockers = known;
+    const MapShader shader(s, cube, o);
+    return render_with_map(s, camera, shader, threads, stats);
+  };
+  MapShadingStats walked, known, one_thread;
+  const Image a = render(false, 2, &walked), b = render(true, 2, &known), c = render(true, 1, &one_thread);
+  std::printf("[ known    ] %llu of %llu shadow searches; fragments tested %llu -> %llu\n",
+              static_cast<unsigned long long>(known.searches.shadow.known_blockers),
+              static_cast<unsigned long long>(known.searches.shadow.rays),
+              static_cast<unsigned long long>(walked.searches.shadow.fragments),
+              static_cast<unsigned long long>(known.searches.shadow.fragments));
+  EXPECT_EQ(walked.searches.shadow.known_blockers, 0u);
+  EXPECT_EQ(known.searches.shadow.rays, walked.searches.shadow.rays);
+  EXPECT_GT(known.searches.shadow.known_blockers, walked.searches.shadow.hits / 2);
+  EXPECT_LT(known.searches.shadow.fragments, walked.searches.shadow.fragments);
+  EXPECT_EQ(a.data, b.data);
+  EXPECT_EQ(b.data, c.data);
+  EXPECT_EQ(one_thread.searches.shadow.known_blockers, known.searches.shadow.known_blockers);
+}
+
 // Thesis 7.4.2 and figures 11.3-11.5: in the mirror pixels whose exact reflected ray meets
 // the part of the green triangle hidden from the camera by the red one, the A-buffered map
 // shows green and the one-layer Z-buffered map does not. The pixel set comes from the

@@ -416,6 +416,79 @@ TEST(Search, ShadowsMatchExactVisibility) {
   EXPECT_EQ(agree, points);
 }
 
+// KNOWN BLOCKER (search.hpp): along each row of floor points, every point takes the opaque
+// blocker of the point before it. What the known blocker answers is blocked for the exact
+// tracer too; every other answer is the walk's, bit for bit.
+TEST(Search, AKnownBlockerAnswersOnlyWhereTheExactSegmentIsBlocked) {
+  const auto world = make_world(shadow_scene(), 96);
+  const PointLight& light = world->scene.lights[0];
+  int known = 0, blocked = 0;
+  for (int iz = 0; iz < 40; ++iz) {
+    uint32_t previous = NO_TRIANGLE;
+    for (int ix = 0; ix < 60; ++ix) {
+      const dvec3 p(-3.0 + 6.0 * (ix + 0.5) / 60, 0.0, -2.0 + 4.0 * (iz + 0.5) / 40);
+      const ShadowResult walked = shadow_search(*world->ctx, p, light.position);
+      const ShadowResult r = shadow_search(*world->ctx, p, light.position, {}, previous);
+      Hit h;
+      ASSERT_TRUE(world->tracer->intersect(p + dvec3(0, 1e-4, 0), {0, -1, 0}, &h));
+      const dvec3 exact = world->tracer->light_visibility(h, light, nullptr);
+      blocked += exact == dvec3(0.0);
+      if (r.known_blocker) {
+        ++known;
+        EXPECT_EQ(exact, dvec3(0.0)) << p.x << " " << p.z;
+        EXPECT_EQ(r.transmittance, dvec3(0.0));
+        EXPECT_TRUE(r.blocked);
+        EXPECT_EQ(r.opaque_blocker, previous);
+        EXPECT_EQ(r.fragments_tested, 0u);
+      } else {
+        EXPECT_TRUE(same_answer(r, walked)) << p.x << " " << p.z;
+      }
+      previous = r.opaque_blocker;
+    }
+  }
+  std::printf("known blockers: %d of %d blocked points\n", known, blocked);
+  EXPECT_GT(blocked, 100);
+  EXPECT_GT(known, blocked * 3 / 4);  // all but the first point of each row's shadow
+}
+
+// A known blocker answers only an opaque crossing beyond the point's own surface, and only in
+// crossing mode over all layers.
+TEST(Search, AKnownBlockerIsIgnoredWhereItCannotAnswer) {
+  const auto world = make_world(shadow_scene(), 96);
+  const PointLight& light = world->scene.lights[0];
+  const dvec3 under_opaque(-1.0, 0.0, 0.0), under_glass(1.0, 0.0, 0.0);
+  const ShadowResult opaque = shadow_search(*world->ctx, under_opaque, light.position);
+  ASSERT_TRUE(opaque.blocked);
+  ASSERT_NE(opaque.opaque_blocker, NO_TRIANGLE);
+  EXPECT_TRUE(shadow_search(*world->ctx, under_opaque, light.position, {}, opaque.opaque_blocker).known_blocker);
+  // Off, in thesis mode, or over the nearest layer only: the walk, as without it.
+  SearchOptions off, thesis, nearest;
+  off.known_blockers = false;
+  thesis.mode = SearchMode::thesis;
+  nearest.layers = SearchLayers::nearest;
+  for (const SearchOptions& o : {off, thesis, nearest}) {
+    const ShadowResult r = shadow_search(*world->ctx, under_opaque, light.position, o, opaque.opaque_blocker);
+    EXPECT_FALSE(r.known_blocker);
+    EXPECT_TRUE(same_answer(r, shadow_search(*world->ctx, under_opaque, light.position, o)));
+  }
+  // Glass is no known blocker, whichever of its triangles: the walk counts its two crossings.
+  const ShadowResult glass = shadow_search(*world->ctx, under_glass, light.position);
+  ASSERT_EQ(glass.blockers, 2u);
+  ASSERT_EQ(glass.opaque_blocker, NO_TRIANGLE);
+  const TriangleSoup& soup = *world->scene.triangles;
+  for (uint32_t t = 0; t < soup.triangle_count(); ++t) {
+    if (world->scene.materials[soup.material_id[t]].transmit <= 0.0) continue;
+    EXPECT_TRUE(same_answer(shadow_search(*world->ctx, under_glass, light.position, {}, t), glass)) << t;
+  }
+  // The floor under a lit point: its own surface, never crossed.
+  const dvec3 lit(-2.5, 0.0, 1.5);
+  const ShadowResult open = shadow_search(*world->ctx, lit, light.position);
+  ASSERT_FALSE(open.blocked);
+  for (uint32_t floor : {0u, 1u}) {
+    EXPECT_TRUE(same_answer(shadow_search(*world->ctx, lit, light.position, {}, floor), open)) << floor;
+  }
+}
+
 TEST(Search, OwnSurfaceNeverShadowsGrazingLight) {
   // Lights just above the floor's plane, seen from floor points away from the slabs: the
   // floor is P's own surface (its plane contains P) and must not block.
