@@ -15,7 +15,7 @@ using nlohmann::json;
 
 namespace {
 
-// About 4096 sampled pixels (at most one in 4, at least one in 64): per-pixel error is
+// About 4096 sampled pixels (b rounded; at most one in 4, at least one in 64): per-pixel error is
 // heavy-tailed (edges, mirrors), and the lower bound's width follows from the sample; the
 // pilots' cost, the exact tracer's above all, follows from the sample's size.
 constexpr double SAMPLES_WANTED = 4096;
@@ -64,7 +64,7 @@ std::vector<int> target_ladder(int scene_n) {
 
 std::vector<uint8_t> pilot_pixels(int width, int height, int* block) {
   const double pixels = static_cast<double>(width) * static_cast<double>(height);
-  const int b = std::clamp(static_cast<int>(std::floor(std::sqrt(pixels / SAMPLES_WANTED))), 2, 8);
+  const int b = std::clamp(static_cast<int>(std::lround(std::sqrt(pixels / SAMPLES_WANTED))), 2, 8);
   *block = b;
   std::vector<uint8_t> only(static_cast<size_t>(width) * static_cast<size_t>(height), 0);
   for (int by = 0; by < height; by += b) {
@@ -128,7 +128,7 @@ Pilot run_pilot(MethodContext& mc, const ABuffer& camera, const MapShader& shade
   Pilot p;
   const SampledError& e = p.error = sampled_error(image, sample.exact, sample.pixels);
   for (const SearchKindStats* k : {&ms.searches.reflection, &ms.searches.refraction_exit, &ms.searches.shadow}) {
-    p.rays += static_cast<double>(k->rays);
+    p.rays += static_cast<double>(k->rays - k->known_blockers);  // a known blocker's answer walks no map
     p.fragments += static_cast<double>(k->fragments);
     p.mesh_triangles += static_cast<double>(k->mesh_triangles);
   }
@@ -321,13 +321,26 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
   const MapShadingOptions asked = map_shading_options(mc);
   MapShadingOptions plain = asked;
   plain.shadow_edges = plain.secondary_edges = false;
-  p.climb(plain);
+  // Before them, the cheapest plan at the ladder's first N: one shading point a fragment
+  // reaches most targets on open scenes, and its pilot costs a fraction of the quarters'.
+  MapShadingOptions one = plain;
+  one.one_point = true;
+  const int first_n = target_ladder(mc.scene.render.cube_resolution).front();
+  const bool one_first = !plain.one_point;
+  if (one_first && p.pilot(first_n, one).error.psnr_low >= p.target) {
+    p.reached = true;
+    p.why = "one shading point a fragment reaches the target at the ladder's smallest N";
+  }
+  if (!p.reached) p.climb(plain);
   if (!p.reached && !same_plan(plain, asked)) p.climb(asked);
   if (p.reached) {
-    // The plain plan was piloted at this N on its climb, or stopped short below it.
+    // The plain plan was piloted at this N on its climb, or stopped short below it; one
+    // point, at the first N.
     std::vector<MapShadingOptions> plans;
     for (const MapShadingOptions& plan : cheaper_plans(p.best_plan)) {
-      if (!same_plan(plan, plain) || same_plan(p.best_plan, plain)) plans.push_back(plan);
+      if (same_plan(plan, plain) && !same_plan(p.best_plan, plain)) continue;
+      if (one_first && same_plan(plan, one) && p.best.n == first_n) continue;
+      plans.push_back(plan);
     }
     p.cheapen(plans);
     // Then the cost: a plan cheaper than the one kept fell short at this N, and is not

@@ -5,9 +5,11 @@
 // lower bound of the sample's estimate, io/metrics.hpp sampled_error) reaches the target.
 // When the error stops improving first, the best N found is kept and the stats say the
 // target was not reached. The sample is one pixel in each b x b block (b from 2 to 8 as
-// the image grows), chosen by a fixed hash: the same pixels every run. The ladder is first
-// climbed with the quarters unrefined at the samples (the cheapest pilots that shade every
-// quarter), and again with the plan asked for only when that stops short. At the N chosen,
+// the image grows), chosen by a fixed hash: the same pixels every run. One shading point a
+// fragment at the ladder's first N is piloted first: where it reaches the target it is the
+// choice. Else the ladder is climbed with the quarters unrefined at the samples (the
+// cheapest pilots that shade every quarter), and again with the plan asked for only when
+// that stops short. At the N chosen,
 // more pilots try cheaper shading, cheapest first, and keep the first that still reaches
 // the target: one shading point per fragment instead of the quarters; the quarters without
 // the shadow and secondary edges' refinement at the samples; without the secondary edges'.

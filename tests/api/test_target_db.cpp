@@ -98,6 +98,23 @@ TEST(TargetDb, TheChosenPlanIsTheImageAndReachesTheTarget) {
   EXPECT_TRUE(images_equal(Renderer().render(scene, direct).image, r.image));
 }
 
+// One shading point a fragment is piloted first, at the ladder's smallest N: where it
+// reaches the target, that is the choice, and no quarters pilot is paid for.
+TEST(TargetDb, OnePointReachingAtTheSmallestNIsChosenWithoutQuartersPilots) {
+  const Scene scene = Scene::load(scene_path("cornell.json"));
+  const RenderResult r = render_measured(scene, 96, 72, 30);
+  const json t = json::parse(r.stats.json)["target_db"];
+  ASSERT_TRUE(t["reached"].get<bool>()) << t.dump(1);
+  const int smallest = target_ladder(scene.cube_resolution()).front();
+  ASSERT_GE(t["pilots"].size(), 1u);
+  EXPECT_EQ(t["pilots"][0]["cube_resolution"].get<int>(), smallest);
+  EXPECT_EQ(t["pilots"][0]["shading_points"], "one");
+  EXPECT_EQ(t["shading_points"], "one");
+  for (const json& p : t["pilots"]) EXPECT_EQ(p["shading_points"], "one") << t.dump(1);
+  ASSERT_TRUE(r.stats.psnr_db.has_value());
+  EXPECT_GE(*r.stats.psnr_db, 30.0);
+}
+
 // A target no N reaches stops where the error stops improving, keeps the best N found,
 // and says so.
 TEST(TargetDb, AnUnreachableTargetKeepsTheBestAndSaysSo) {
