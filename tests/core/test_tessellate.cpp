@@ -191,5 +191,48 @@ TEST(Tessellate, ClosedSurfacesStayClosedFarAwayAndAtAnyScale) {
   EXPECT_FALSE(is_closed_surface(sides, 0, 8));
 }
 
+// EdgePairing: a grid of quads large enough for the pairing's two partitions (tessellate.cpp
+// first_equal), two triangles a quad, as two objects side by side: every half-edge's partner
+// is the one the grid says (the other triangle of its quad, or the quad across), none across
+// the objects' seam or on the border, whichever thread found it.
+TEST(EdgePairing, AGridLargerThanOnePartitionPairsAsItsTopologySays) {
+  constexpr int W = 180, H = 80;  // 28,800 triangles, 86,400 half-edges
+  TriangleSoup soup;
+  const auto at = [](int i, int j) {
+    return glm::vec3(0.25f * static_cast<float>(i), 0.0f, 0.5f * static_cast<float>(j));
+  };
+  // Quad (i, j): triangle A = (i,j) (i+1,j) (i+1,j+1), B = (i,j) (i+1,j+1) (i,j+1); the
+  // objects meet between columns W / 2 - 1 and W / 2.
+  for (int j = 0; j < H; ++j) {
+    for (int i = 0; i < W; ++i) {
+      const uint32_t object = i < W / 2 ? 0u : 1u;
+      for (const glm::vec3& p : {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)})
+        soup.positions.push_back(p);
+      soup.object_id.push_back(object);
+      soup.object_id.push_back(object);
+    }
+  }
+  const auto half = [](int i, int j, int tri, int edge) {
+    return static_cast<uint32_t>(3 * (2 * (j * W + i) + tri) + edge);
+  };
+  const std::vector<uint32_t> partner = edge_partners(soup, 0, soup.triangle_count());
+  ASSERT_EQ(partner.size(), 3u * soup.triangle_count());
+  for (int j = 0; j < H; ++j) {
+    for (int i = 0; i < W; ++i) {
+      const bool seam_right = i + 1 == W / 2, seam_left = i == W / 2;
+      // A's edges: 0 the bottom (the top of the quad below, its B's edge 1), 1 the right side
+      // (the left of the quad to the right, its B's edge 2), 2 the diagonal (B's edge 0).
+      EXPECT_EQ(partner[half(i, j, 0, 0)], j > 0 ? half(i, j - 1, 1, 1) : NO_PARTNER) << i << " " << j;
+      EXPECT_EQ(partner[half(i, j, 0, 1)], i + 1 < W && !seam_right ? half(i + 1, j, 1, 2) : NO_PARTNER)
+          << i << " " << j;
+      EXPECT_EQ(partner[half(i, j, 0, 2)], half(i, j, 1, 0)) << i << " " << j;
+      EXPECT_EQ(partner[half(i, j, 1, 0)], half(i, j, 0, 2)) << i << " " << j;
+      EXPECT_EQ(partner[half(i, j, 1, 1)], j + 1 < H ? half(i, j + 1, 0, 0) : NO_PARTNER) << i << " " << j;
+      EXPECT_EQ(partner[half(i, j, 1, 2)], i > 0 && !seam_left ? half(i - 1, j, 0, 1) : NO_PARTNER) << i << " " << j;
+      if (HasFailure()) return;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace abcube
