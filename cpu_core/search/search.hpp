@@ -311,8 +311,9 @@ void coincident_crossings(const SearchContext& ctx, const glm::dvec3& w, const g
 // it passes, the segment is blocked (transmittance 0) and the map is not walked: an opaque
 // triangle the segment crosses blocks it whatever else lies on it, so that answer is the
 // exact one, and the walk's differs from it only where the walk would have missed that
-// triangle. Crossing mode over all layers only (SearchOptions::known_blockers): the thesis
-// mode and the Z-buffer keep the answers of the methods they reproduce.
+// triangle. Crossing mode over all layers, with THE SIDE STRUCTURE, only
+// (SearchOptions::known_blockers): the thesis mode and the Z-buffer keep the answers of the
+// methods they reproduce, and a search of the map alone (--map-only) sees only the map.
 ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const glm::dvec3& light_position,
                            const SearchOptions& options = {}, uint32_t known_blocker = NO_TRIANGLE);
 

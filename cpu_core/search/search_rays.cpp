@@ -171,8 +171,9 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
   if (!(len > 0.0)) return res;
   SearchRay q = make_query(ctx, p, seg / len, options);
   q.l_max = len;
-  if (known_blocker != NO_TRIANGLE && options.known_blockers && options.mode == SearchMode::crossing &&
-      options.layers == SearchLayers::all && blocks(ctx, q, known_blocker, light_position)) {
+  if (known_blocker != NO_TRIANGLE && options.known_blockers && options.side_structure &&
+      options.mode == SearchMode::crossing && options.layers == SearchLayers::all &&
+      blocks(ctx, q, known_blocker, light_position)) {
     res.transmittance = glm::dvec3(0.0);
     res.blocked = res.known_blocker = true;
     res.blockers = 1;

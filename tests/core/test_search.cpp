@@ -461,12 +461,13 @@ TEST(Search, AKnownBlockerIsIgnoredWhereItCannotAnswer) {
   ASSERT_TRUE(opaque.blocked);
   ASSERT_NE(opaque.opaque_blocker, NO_TRIANGLE);
   EXPECT_TRUE(shadow_search(*world->ctx, under_opaque, light.position, {}, opaque.opaque_blocker).known_blocker);
-  // Off, in thesis mode, or over the nearest layer only: the walk, as without it.
-  SearchOptions off, thesis, nearest;
+  // Off, in thesis mode, over the nearest layer only, or the map alone: the walk, as without it.
+  SearchOptions off, thesis, nearest, map_only;
   off.known_blockers = false;
   thesis.mode = SearchMode::thesis;
   nearest.layers = SearchLayers::nearest;
-  for (const SearchOptions& o : {off, thesis, nearest}) {
+  map_only.side_structure = false;
+  for (const SearchOptions& o : {off, thesis, nearest, map_only}) {
     const ShadowResult r = shadow_search(*world->ctx, under_opaque, light.position, o, opaque.opaque_blocker);
     EXPECT_FALSE(r.known_blocker);
     EXPECT_TRUE(same_answer(r, shadow_search(*world->ctx, under_opaque, light.position, o)));
