@@ -325,11 +325,6 @@ void CubeWalk::jump(const SquareExit& exit) {
   next_crossing(1);
 }
 
-double texel_size_at(const glm::dvec3& x, int n) {
-  const double m = std::max({std::fabs(x.x), std::fabs(x.y), std::fabs(x.z)});
-  return 2.0 * m / n;
-}
-
 glm::dvec2 ray_distance_range(const glm::dvec3& w, const glm::dvec3& d, double l0, double l1) {
   const double lc = std::clamp(-glm::dot(w, d), l0, l1);
   const double dmin = glm::length(w + lc * d);

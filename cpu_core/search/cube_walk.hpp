@@ -7,6 +7,8 @@
 // exact interval [l0, l1] the ray spends in its frustum; consecutive intervals meet except
 // across a gap. docs/design/cube-walk.md has the whole argument, rule by rule.
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -113,7 +115,11 @@ class CubeWalk {
 // the exact width of a texel in the plane through x perpendicular to its face's axis
 // (|x|_inf = F . x). At a face centre it is 2 |x| / n (the thesis 9.3.4 texel, the largest);
 // at a face corner 2 |x| / (sqrt(3) n). Tolerances and offsets in texel units use it.
-double texel_size_at(const glm::dvec3& x, int n);
+// Inline: the mesh refinement asks for it once a triangle it tests.
+inline double texel_size_at(const glm::dvec3& x, int n) {
+  const double m = std::max({std::fabs(x.x), std::fabs(x.y), std::fabs(x.z)});
+  return 2.0 * m / n;
+}
 
 // [min, max] of |W + l D| over l in [l0, l1] (D unit; l1 may be +inf).
 glm::dvec2 ray_distance_range(const glm::dvec3& w, const glm::dvec3& d, double l0, double l1);

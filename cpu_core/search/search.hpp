@@ -151,12 +151,15 @@ class SearchContext {
     std::array<glm::dvec3, 3> edge_normal{};
     std::array<double, 3> edge_offset{};
   };
-  EdgePlanes edge_planes(uint32_t triangle) const;
+  EdgePlanes compute_edge_planes(uint32_t triangle) const;
   struct Sphere {
     glm::dvec3 centroid{0.0};
     double radius = 0;
   };
-  Sphere bounding_sphere(uint32_t triangle) const;
+  Sphere compute_bounding_sphere(uint32_t triangle) const;
+  // Names this context's triangles in the threads' MEMO (search_internal.hpp), which the
+  // refinement asks instead of computing each value again; never reused.
+  uint64_t memo_id() const { return memo_id_; }
   // The vertices of a triangle relative to the centre.
   glm::dvec3 vertex(uint32_t triangle, int k) const {
     return glm::dvec3(positions_[3 * static_cast<size_t>(triangle) + static_cast<size_t>(k)]) - cube_->centre;
@@ -200,13 +203,11 @@ class SearchContext {
   size_t block_bounds_bytes() const;
 
  private:
-  EdgePlanes compute_edge_planes(uint32_t triangle) const;
-  Sphere compute_bounding_sphere(uint32_t triangle) const;
   const SceneData* scene_;
   const CubeABuffer* cube_;
   Media media_;
   const glm::vec3* positions_;  // the soup's, 3 per triangle
-  uint64_t memo_id_;            // names this context's triangles in the threads' MEMO (search_context.cpp)
+  uint64_t memo_id_;            // memo_id()
   std::vector<uint32_t> zero_area_;
   std::shared_ptr<const Bvh> side_bvh_;  // over the side triangles (the scene's soup, not copied)
   std::vector<uint32_t> no_triangles_;

@@ -16,43 +16,6 @@ namespace abcube {
 
 namespace {
 
-// MEMO. The refinement asks for the same triangles' geometry again and again: neighbouring
-// rays refine on the same patch, and a flood meets each triangle from up to three sides, so
-// nearly every ask is for a triangle among the last few thousand its own thread asked for.
-// Each thread keeps the values it computed last, for one context at a time
-// (SearchContext::memo_id_, never reused), in 4096 slots by a hash of the triangle: the
-// values are the functions' own, so every answer is the same bit for bit, for any thread
-// count. The slots are a fixed cost a thread that searches, whatever the scene's size.
-template <class Value>
-struct Memo {
-  static constexpr int BITS = 12;
-  static constexpr uint32_t NONE = 0xffffffffu;
-  // A slot's triangle beside its value: one look-up reads one place, not two arrays.
-  struct Slot {
-    uint32_t triangle;
-    Value value;
-  };
-  uint64_t context = 0;
-  std::array<Slot, size_t{1} << BITS> slots;
-};
-
-template <class Value, class Compute>
-Value remembered(uint64_t context, uint32_t triangle, Compute&& compute) {
-  thread_local std::unique_ptr<Memo<Value>> memo;
-  if (!memo) memo = std::make_unique<Memo<Value>>();
-  if (memo->context != context) {
-    memo->context = context;
-    for (auto& slot : memo->slots) slot.triangle = Memo<Value>::NONE;
-  }
-  const size_t index = (triangle * 2654435761u) >> (32 - Memo<Value>::BITS);  // Knuth's multiplicative hash
-  typename Memo<Value>::Slot& slot = memo->slots[index];
-  if (slot.triangle != triangle) {
-    slot.value = compute();
-    slot.triangle = triangle;
-  }
-  return slot.value;
-}
-
 std::atomic<uint64_t> next_memo_id{1};
 
 }  // namespace
@@ -204,14 +167,6 @@ bool SearchContext::empty_ahead(int face, int i, int j, int step_i, int step_j) 
   if (step_i > 0) return hi < i;
   if (step_i < 0) return lo > i;
   return hi < i || lo > i;  // column i only
-}
-
-SearchContext::EdgePlanes SearchContext::edge_planes(uint32_t triangle) const {
-  return remembered<EdgePlanes>(memo_id_, triangle, [&] { return compute_edge_planes(triangle); });
-}
-
-SearchContext::Sphere SearchContext::bounding_sphere(uint32_t triangle) const {
-  return remembered<Sphere>(memo_id_, triangle, [&] { return compute_bounding_sphere(triangle); });
 }
 
 // The plane as plane() computes it, the same expressions on the same vertices.

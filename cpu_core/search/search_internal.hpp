@@ -2,8 +2,10 @@
 // the walk's counts, one fragment's answer (a candidate), the mesh refinement's answer, and
 // the functions one file defines for the others. Not part of the stage's API.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <limits>
+#include <memory>
 
 #include <glm/glm.hpp>
 
@@ -16,6 +18,61 @@ namespace abcube::detail {
 constexpr double INF = std::numeric_limits<double>::infinity();
 // A refined point this close to its triangle (in texels) is on it: rounding, not tolerance.
 constexpr double ON_TRIANGLE_TEXELS = 1e-6;
+
+// MEMO. The refinement asks for the same triangles' geometry again and again: neighbouring
+// rays refine on the same patch, and a flood meets each triangle from up to three sides, so
+// nearly every ask is for a triangle among the last few thousand its own thread asked for.
+// Each thread keeps the values it computed last, for one context at a time
+// (SearchContext::memo_id, never reused), in 4096 slots by a hash of the triangle: the
+// values are the functions' own, so every answer is the same bit for bit, for any thread
+// count. The slots are a fixed cost a thread that searches, whatever the scene's size.
+// Inline: a flood asks several times a triangle it tests.
+template <class Value>
+class Memo {
+ public:
+  // This thread's memo of Values for ctx's triangles.
+  static Memo& of(const SearchContext& ctx) {
+    thread_local std::unique_ptr<Memo> memo;
+    if (!memo) memo = std::make_unique<Memo>();
+    if (memo->context_ != ctx.memo_id()) {
+      memo->context_ = ctx.memo_id();
+      for (Slot& slot : memo->slots_) slot.triangle = NONE;
+    }
+    return *memo;
+  }
+  // The value of `triangle`, compute() where the slot holds another's. It stays in its slot
+  // until this thread's next ask.
+  template <class Compute>
+  const Value& get(uint32_t triangle, Compute&& compute) {
+    Slot& slot = slots_[(triangle * 2654435761u) >> (32 - BITS)];  // Knuth's multiplicative hash
+    if (slot.triangle != triangle) {
+      slot.value = compute();
+      slot.triangle = triangle;
+    }
+    return slot.value;
+  }
+
+ private:
+  static constexpr int BITS = 12;
+  static constexpr uint32_t NONE = 0xffffffffu;
+  // A slot's triangle beside its value: one look-up reads one place, not two arrays.
+  struct Slot {
+    uint32_t triangle;
+    Value value;
+  };
+  uint64_t context_ = 0;
+  std::array<Slot, size_t{1} << BITS> slots_;
+};
+
+// A triangle's edge planes and bounding sphere (SearchContext::compute_edge_planes,
+// compute_bounding_sphere) from this thread's MEMO.
+inline const SearchContext::EdgePlanes& edge_planes(const SearchContext& ctx, uint32_t tri) {
+  return Memo<SearchContext::EdgePlanes>::of(ctx).get(tri, [&] { return ctx.compute_edge_planes(tri); });
+}
+inline const SearchContext::Sphere& bounding_sphere(Memo<SearchContext::Sphere>& spheres, const SearchContext& ctx,
+                                                    uint32_t tri) {
+  return spheres.get(tri, [&] { return ctx.compute_bounding_sphere(tri); });
+}
 
 // One search's ray, relative to the cube centre.
 struct SearchRay {

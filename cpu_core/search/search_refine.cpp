@@ -10,7 +10,7 @@ namespace detail {
 
 PlaneCrossing plane_crossing(const SearchContext& ctx, const SearchRay& q, uint32_t tri, double l_lo, double l_hi) {
   PlaneCrossing c;
-  const SearchContext::EdgePlanes e = ctx.edge_planes(tri);
+  const SearchContext::EdgePlanes& e = edge_planes(ctx, tri);
   const double den = glm::dot(e.plane.normal, q.d);
   if (den == 0.0) return c;  // parallel, or degenerate (a zero normal)
   c.l = (e.plane.offset - glm::dot(e.plane.normal, q.w)) / den;
@@ -21,15 +21,23 @@ PlaneCrossing plane_crossing(const SearchContext& ctx, const SearchRay& q, uint3
   const glm::dvec3 x = q.w + c.l * q.d;
   double outside[3];
   for (size_t k = 0; k < 3; ++k) outside[k] = glm::dot(e.edge_normal[k], x) - e.edge_offset[k];
-  // Inside every edge's line: on the triangle, whatever the tolerance (it is not negative).
-  if (!(outside[0] < 0.0 || outside[1] < 0.0 || outside[2] < 0.0)) return c;
-  double worst = -ON_TRIANGLE_TEXELS * texel_size_at(x, ctx.cube().n);
+  // The edge whose line the point lies furthest outside of (the first, at equal distances).
+  double worst = 0.0;
+  int edge = -1;
   for (int k = 0; k < 3; ++k) {
     if (outside[k] < worst) {
       worst = outside[k];
-      c.outside_edge = k;
+      edge = k;
     }
   }
+  // Inside every edge's line: on the triangle, whatever the tolerance (it is not negative).
+  if (edge < 0) return c;
+  // Outside it by more than ON_TRIANGLE_TEXELS texels? The texel's width, 2 |x|_inf / n, is
+  // at most 2 |x|_inf: far outside (nearly every triangle a flood tests) is decided without
+  // its division; near the bound, by the tolerance itself.
+  const double m = std::max({std::fabs(x.x), std::fabs(x.y), std::fabs(x.z)});
+  if (worst < -2.000001 * ON_TRIANGLE_TEXELS * m || worst < -ON_TRIANGLE_TEXELS * texel_size_at(x, ctx.cube().n))
+    c.outside_edge = edge;
   return c;
 }
 
@@ -51,6 +59,47 @@ bool near_ray(const SearchContext::Sphere& b, const SearchRay& q, double l_lo, d
   return glm::dot(off, off) <= reach * reach;
 }
 
+// The flood's table: what it knows of a triangle (TAKEN into the flood, found AWAY from the
+// ray or past the flood's size, or NEW), by open addressing in a table kept by each thread across floods. Every
+// flood starts from an empty table: the slots it used are reset when it ends (`used`), so a
+// flood of a few triangles does not pay for clearing the whole table. A flood takes at
+// most REFINE_MAX_TRIANGLES triangles and each slot it finds NEW it sets at once, so it holds
+// at most the start and three neighbours of each taken triangle: the table is never more
+// than a fifth full.
+class FloodTable {
+ public:
+  static constexpr uint8_t NEW = 0, TAKEN = 1, AWAY = 2;
+  // The state of `tri`, a place the caller may set (the slot is kept as tri's).
+  uint8_t* find(uint32_t tri) {
+    size_t h = (tri * 2654435761u) & (SLOTS - 1);
+    while (state_[h] != NEW && triangle_[h] != tri) h = (h + 1) & (SLOTS - 1);
+    if (state_[h] == NEW) {
+      triangle_[h] = tri;
+      used_[used_count_++] = static_cast<uint16_t>(h);
+    }
+    return &state_[h];
+  }
+  void mark(uint32_t tri, uint8_t state) { *find(tri) = state; }
+  void clear() {
+    for (size_t k = 0; k < used_count_; ++k) state_[used_[k]] = NEW;
+    used_count_ = 0;
+  }
+
+ private:
+  static constexpr size_t MOST = REFINE_MAX_TRIANGLES * 4;  // taken, and their neighbours
+  static constexpr size_t SLOTS = 4 * MOST;
+  static_assert((SLOTS & (SLOTS - 1)) == 0, "a power of two");
+  std::array<uint32_t, SLOTS> triangle_{};
+  std::array<uint8_t, SLOTS> state_{};
+  std::array<uint16_t, MOST> used_{};
+  size_t used_count_ = 0;
+};
+
+FloodTable& flood_table() {
+  thread_local FloodTable table;
+  return table;
+}
+
 }  // namespace
 
 // Floods the edge-connected triangles of `start` that come within `radius` of the ray's
@@ -66,7 +115,8 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
   // otherwise the flood cannot say. (Such fragments must still be refined: a glass ball's
   // exit crossing seen only in a texel of a merged fragment would otherwise be lost,
   // speckles in its shadow on scenes/cornell.json.)
-  const bool start_near = near_ray(ctx.bounding_sphere(start), q, l_lo, l_hi, radius);
+  Memo<SearchContext::Sphere>& spheres = Memo<SearchContext::Sphere>::of(ctx);
+  const bool start_near = near_ray(bounding_sphere(spheres, ctx, start), q, l_lo, l_hi, radius);
   // First the straight way: from triangle to triangle across the edge the ray's crossing
   // of the current plane lies furthest outside of, while the next is near the ray. On a
   // smooth patch this reaches the triangle crossed in a few steps.
@@ -85,27 +135,20 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
       break;
     }
     const uint32_t nb = ctx.neighbour(walker, c.outside_edge);
-    if (nb == SearchContext::NO_NEIGHBOUR || (start_near && !near_ray(ctx.bounding_sphere(nb), q, l_lo, l_hi, radius)))
+    if (nb == SearchContext::NO_NEIGHBOUR ||
+        (start_near && !near_ray(bounding_sphere(spheres, ctx, nb), q, l_lo, l_hi, radius)))
       break;
     walker = nb;
   }
   if (!start_near) return a;
-  // Then every triangle near the ray, breadth-first. `seen` in the order found, and the same
-  // triangles in a set (open addressing, at most half full): one look-up a neighbour, where
-  // a scan of `seen` would cost up to REFINE_MAX_TRIANGLES.
-  std::array<uint32_t, REFINE_MAX_TRIANGLES> seen{};
-  constexpr size_t SLOTS = 2 * REFINE_MAX_TRIANGLES;
-  static_assert((SLOTS & (SLOTS - 1)) == 0, "a power of two");
-  std::array<uint32_t, SLOTS> slots;
-  slots.fill(SearchContext::NO_NEIGHBOUR);
-  const auto slot_of = [&slots](uint32_t tri) {  // tri's slot, or the empty one it would take
-    size_t h = (tri * 2654435761u) & (SLOTS - 1);
-    while (slots[h] != tri && slots[h] != SearchContext::NO_NEIGHBOUR) h = (h + 1) & (SLOTS - 1);
-    return h;
-  };
+  // Then every triangle near the ray, breadth-first, in the order found (`seen`). The flood's
+  // table (FloodTable) remembers both the triangles taken and those found away from the ray,
+  // so a triangle on the flood's border is tested once, not once from each neighbour taken.
+  std::array<uint32_t, REFINE_MAX_TRIANGLES> seen;  // only [0, count) is read
+  FloodTable& table = flood_table();
   size_t count = 0, next = 0;
   seen[count++] = start;
-  slots[slot_of(start)] = start;
+  table.mark(start, FloodTable::TAKEN);
   bool overflow = false;
   while (next < count) {
     const uint32_t tri = seen[next++];
@@ -119,16 +162,22 @@ MeshAnswer refine_on_mesh(const SearchContext& ctx, const SearchRay& q, uint32_t
     for (int k = 0; k < 3; ++k) {
       const uint32_t nb = ctx.neighbour(tri, k);
       if (nb == SearchContext::NO_NEIGHBOUR) continue;
-      const size_t slot = slot_of(nb);
-      if (slots[slot] == nb || !near_ray(ctx.bounding_sphere(nb), q, l_lo, l_hi, radius)) continue;
-      if (count == seen.size()) {
+      uint8_t* state = table.find(nb);
+      if (*state == FloodTable::TAKEN || *state == FloodTable::AWAY) continue;
+      if (!near_ray(bounding_sphere(spheres, ctx, nb), q, l_lo, l_hi, radius)) {
+        *state = FloodTable::AWAY;
+        continue;
+      }
+      if (count == seen.size()) {  // not taken; met again, it would only say this again
         overflow = true;
+        *state = FloodTable::AWAY;
         continue;
       }
       seen[count++] = nb;
-      slots[slot] = nb;
+      *state = FloodTable::TAKEN;
     }
   }
+  table.clear();
   if (a.l < INF)
     a.result = Refined::hit;
   else
