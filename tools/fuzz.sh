@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs the libFuzzer harnesses of tests/fuzz (docs/robustness.md) for SECONDS each
-# (default 60), one after the other, each on one core.
+# (default 60), each on one core, as many side by side as there are cores.
 #   tools/fuzz.sh [SECONDS] [HARNESS[:SECONDS]...]   HARNESS: scene_json obj gltf batch_jobs (default
 #                                                    all), each for its own SECONDS where given
 # Builds build-fuzz with clang-14 (address and undefined-behaviour checks, ABCUBE_FUZZ=ON),
@@ -87,41 +87,68 @@ seeds() {  # HARNESS FOLDER: fills FOLDER with the inputs gathered from installe
 export ASAN_OPTIONS=${ASAN_OPTIONS:-abort_on_error=1:detect_leaks=1:new_delete_type_mismatch=0}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/tools/sanitizers/lsan.supp:print_suppressions=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-status=0
-summary=()
-for harness in "${HARNESSES[@]}"; do
-  name=${harness%%:*}
-  seconds=$SECONDS_EACH
-  [[ $harness == *:* ]] && seconds=${harness#*:}
-  corpus=$BUILD/corpus/$name
-  artifacts=$BUILD/artifacts/$name
+# One harness's run: its seeds, then libFuzzer on one core for its seconds; its summary line
+# goes to $BUILD/fuzz_NAME.summary, its failure report to the output, and the exit status
+# says whether it failed.
+run_harness() {  # NAME SECONDS
+  local name=$1 seconds=$2 corpus=$BUILD/corpus/$1 artifacts=$BUILD/artifacts/$1 log=$BUILD/fuzz_$1.log
+  local rc=0 runs corpus_size first unwind="" inputs
   mkdir -p "$corpus" "$artifacts"
   seeds "$name" "$BUILD/seeds/$name"
   inputs=("$corpus" tests/fuzz/corpus/$name "$BUILD/seeds/$name")
   [[ -d tests/fuzz/regressions/$name ]] && inputs+=(tests/fuzz/regressions/$name)
-  log=$BUILD/fuzz_$name.log
   echo "fuzz: $name for ${seconds} s (log $log)"
-  rc=0
   # gltf decodes images through OpenImageIO: whole stacks for LeakSanitizer
   # (fast_unwind_on_malloc=0, 6x slower), which libstdc++ (no frame pointers) otherwise cuts
   # at two frames, too few for the PNG reader's entry in tools/sanitizers/lsan.supp to match.
-  unwind=""
   [[ $name == gltf ]] && unwind=":fast_unwind_on_malloc=0"
   ASAN_OPTIONS="$ASAN_OPTIONS$unwind" "$BUILD/tests/fuzz/fuzz_$name" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 -max_len=65536 \
     -print_final_stats=1 -artifact_prefix="$artifacts/" "${inputs[@]}" > "$log" 2>&1 || rc=$?
   runs=$(sed -n 's/^stat::number_of_executed_units:[[:space:]]*//p' "$log" | tail -1)
   corpus_size=$(find "$corpus" -type f | wc -l)
   if [[ $rc -ne 0 ]]; then
-    status=1
-    # The report's head (its kind and the innermost frames), then the log's end.
-    first=$(grep -n -m1 -E '==ERROR:|runtime error:|ERROR: libFuzzer' "$log" | cut -d: -f1 || true)
-    [[ -n $first ]] && sed -n "${first},$((first + 40))p" "$log" && echo "..."
-    tail -n 15 "$log"
-    echo "fuzz: $name FAILED (exit $rc); input: $(ls -t "$artifacts" | head -1 | sed "s|^|$artifacts/|")"
-    summary+=("$name: FAILED after ${runs:-?} inputs")
-  else
-    summary+=("$name: ${runs:-?} inputs in ${seconds} s, no failure; corpus $corpus_size files")
+    # The report's head (its kind and the innermost frames), then the log's end, in one write
+    # so that a harness beside it does not interleave.
+    {
+      first=$(grep -n -m1 -E '==ERROR:|runtime error:|ERROR: libFuzzer' "$log" | cut -d: -f1 || true)
+      [[ -n $first ]] && sed -n "${first},$((first + 40))p" "$log" && echo "..."
+      tail -n 15 "$log"
+      echo "fuzz: $name FAILED (exit $rc); input: $(ls -t "$artifacts" | head -1 | sed "s|^|$artifacts/|")"
+    } > "$log.report"
+    cat "$log.report"
+    echo "$name: FAILED after ${runs:-?} inputs" > "$BUILD/fuzz_$name.summary"
+    return 1
   fi
+  echo "$name: ${runs:-?} inputs in ${seconds} s, no failure; corpus $corpus_size files" > "$BUILD/fuzz_$name.summary"
+}
+
+# The harnesses run side by side, each on one core (libFuzzer's own process, one thread),
+# ABCUBE_FUZZ_JOBS at once (default: the cores, at most the harnesses), the longest first so
+# that the wall time is close to the total over the cores. Each keeps its own seconds.
+jobs=${ABCUBE_FUZZ_JOBS:-$(nproc)}
+order=()
+for harness in "${HARNESSES[@]}"; do
+  seconds=$SECONDS_EACH
+  [[ $harness == *:* ]] && seconds=${harness#*:}
+  order+=("$seconds ${harness%%:*}")
 done
-printf 'fuzz: %s\n' "${summary[@]}"
+mapfile -t order < <(printf '%s\n' "${order[@]}" | sort -s -k1,1nr)
+status=0
+running=0
+for entry in "${order[@]}"; do
+  if [[ $running -ge $jobs ]]; then
+    wait -n || status=1
+    running=$((running - 1))
+  fi
+  rm -f "$BUILD/fuzz_${entry#* }.summary"
+  run_harness "${entry#* }" "${entry%% *}" &
+  running=$((running + 1))
+done
+while [[ $running -gt 0 ]]; do
+  wait -n || status=1
+  running=$((running - 1))
+done
+for harness in "${HARNESSES[@]}"; do
+  cat "$BUILD/fuzz_${harness%%:*}.summary" 2>/dev/null | sed 's/^/fuzz: /' || echo "fuzz: ${harness%%:*}: no summary"
+done
 exit $status
