@@ -92,19 +92,6 @@ CubeWalk::CubeWalk(const glm::dvec3& w, const glm::dvec3& d, int n, double l_max
   }
 }
 
-double CubeWalk::denominator(int axis, int boundary) const {
-  return n_ * axis_d_[axis] - (2.0 * boundary - n_) * forward_d_;
-}
-
-double CubeWalk::raw_crossing(int axis, int boundary) const {
-  // Plane n (A . X) - (2k - n) (F . X) = 0 through the centre: s or t = k / n on this face.
-  const double u = 2.0 * boundary - n_;
-  const double num = n_ * axis_w_[axis] - u * forward_w_;
-  const double den = denominator(axis, boundary);
-  if (!(den * step_[axis] > 0.0)) return INF;  // moving away from (or along) this plane
-  return -num / den;
-}
-
 double CubeWalk::crossing(int axis, int boundary) const { return std::max(l_, raw_crossing(axis, boundary)); }
 
 void CubeWalk::next_crossing(int axis) {

@@ -80,8 +80,18 @@ class CubeWalk {
   bool on_face();                                 // a face segment started (the current or the next); false at the end
   void start_texel_on_face();                     // entry texel and first crossings of the face segment
   double crossing(int axis, int boundary) const;  // l where the ray crosses a boundary plane
-  double raw_crossing(int axis, int boundary) const;  // the same, not clamped to l_ (INF: never)
-  double denominator(int axis, int boundary) const;   // of raw_crossing: its sign says if the ray gets there
+  // The same, not clamped to l_ (INF: never). Inline, as denominator(): a walk asks for a few
+  // of them a texel, and the hierarchy's square exits for more.
+  double raw_crossing(int axis, int boundary) const {
+    // Plane n (A . X) - (2k - n) (F . X) = 0 through the centre: s or t = k / n on this face.
+    const double u = 2.0 * boundary - n_;
+    const double num = n_ * axis_w_[axis] - u * forward_w_;
+    const double den = denominator(axis, boundary);
+    if (!(den * step_[axis] > 0.0)) return std::numeric_limits<double>::infinity();  // moving away (or along)
+    return -num / den;
+  }
+  // Of raw_crossing: its sign says if the ray gets there.
+  double denominator(int axis, int boundary) const { return n_ * axis_d_[axis] - (2.0 * boundary - n_) * forward_d_; }
   struct AxisRun;
   bool axis_run(int axis, int lo, int hi, AxisRun* run) const;
   int crossed_before(int axis, const AxisRun& run, double l) const;
