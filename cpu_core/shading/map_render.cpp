@@ -26,12 +26,12 @@ namespace {
 // The quarters of the 4x8 mask (samples.hpp): columns 0-3 / 4-7 of rows 0-1 / 2-3.
 constexpr CoverageMask QUARTERS[4] = {0x00000f0fu, 0x0000f0f0u, 0x0f0f0000u, 0xf0f00000u};
 
-// Is the sRGB-encoded difference of two colours above QUARTER_SPLIT_SRGB in any channel?
-bool differ(const glm::dvec3& a, const glm::dvec3& b) {
+// Is the sRGB-encoded difference of two colours above `threshold` in any channel?
+bool differ(const glm::dvec3& a, const glm::dvec3& b, double threshold = QUARTER_SPLIT_SRGB) {
   for (int k = 0; k < 3; ++k) {
     const double ea = srgb_encode(static_cast<float>(std::clamp(a[k], 0.0, 1.0)));
     const double eb = srgb_encode(static_cast<float>(std::clamp(b[k], 0.0, 1.0)));
-    if (std::fabs(ea - eb) > QUARTER_SPLIT_SRGB) return true;
+    if (std::fabs(ea - eb) > threshold) return true;
   }
   return false;
 }
@@ -93,6 +93,7 @@ class MapRender {
       seen_.dark.assign(pixels_, 0);
       seen_.sides.assign(pixels_, 0);
     }
+    sparse_ = shader.one_point() && shader.quarters_at_edges();
     trails_on_ = shader.secondary_edges() && !shader.one_point() && scene.render.max_depth > 0 &&
                  std::any_of(scene.materials.begin(), scene.materials.end(),
                              [](const Material& m) { return m.reflect > 0.0 || m.transmit > 0.0; });
@@ -105,7 +106,7 @@ class MapRender {
     ro.only = only_;
     // SHADOW EDGES and SECONDARY EDGES (header): what each pixel's points saw, and in the
     // second pass the pixels an edge runs between whose points and their neighbour's.
-    if ((edges_ || trails_on_) && only_ && neighbours) {
+    if ((edges_ || trails_on_ || sparse_) && only_ && neighbours) {
       widened_ = with_neighbours(*only_, camera_.width(), camera_.height());
       ro.only = &widened_;
     }
@@ -121,6 +122,7 @@ class MapRender {
     };
     Image image = resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, ro);
     if (edges_ || trails_on_) second_pass(shade, ro, &image);
+    if (sparse_) sparse_pass(shade, ro, &image);
     if (stats) {
       for (const MapShadingStats& s : per_worker_) stats->merge(s);
     }
@@ -147,7 +149,8 @@ class MapRender {
     const std::pair<uint64_t, uint64_t> before =
         fallback_ ? searches_and_failures(*s) : std::pair<uint64_t, uint64_t>{};
     glm::dvec3 c;
-    if (shader_.one_point()) {
+    // SPARSE (header): one point, the quarters in the sparse pass.
+    if (shader_.one_point() && !sparse_again_) {
       c = shade_at(f, x, y, fragment_point(camera_, *scene_.triangles, f, x, y), f.mask, nullptr, s, &known.blockers);
     } else {
       c = shade_quarters(f, x, y, at, worker, s, &known.blockers);
@@ -326,28 +329,62 @@ class MapRender {
       again[p] = 1;
       flagged += light ? 1 : 0;
       flagged_secondary += secondary ? 1 : 0;
-      if (fallback_) pixel_searches_[p] = {0, 0};
     }
-    const size_t channels = static_cast<size_t>(image->channels);
-    if (!widened_.empty()) {  // the neighbours shaded for their points: black again, as `only` says
-      for (size_t p = 0; p < pixels_; ++p) {
-        if ((*only_)[p]) continue;
-        std::fill_n(image->data.begin() + static_cast<std::ptrdiff_t>(p * channels), image->channels, 0.f);
-        if (fallback_) pixel_searches_[p] = {0, 0};
-      }
-    }
-    if (flagged + flagged_secondary > 0) {
-      for (Known& k : known_) k.row = -1;  // each row starts afresh in this pass too
-      ResolveOptions second = ro;
-      second.only = &again;
-      const Image redone = resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, second);
-      for (size_t p = 0; p < pixels_; ++p) {
-        if (!again[p]) continue;
-        for (size_t ch = 0; ch < channels; ++ch) image->data[p * channels + ch] = redone.data[p * channels + ch];
-      }
-    }
+    shade_again(shade, ro, again, flagged + flagged_secondary, image);
     per_worker_[0].shadow_edge_pixels += flagged;
     per_worker_[0].secondary_edge_pixels += flagged_secondary;
+  }
+
+  // SPARSE (map_shading.hpp): the pixels whose colour differs from a 4-neighbour's by more
+  // than SPARSE_SPLIT_SRGB, shaded again at their quarters.
+  void sparse_pass(const WorkerPixelShader& shade, const ResolveOptions& ro, Image* image) {
+    const int width = camera_.width(), height = camera_.height();
+    const size_t channels = static_cast<size_t>(image->channels);
+    const auto colour = [&](size_t p) {
+      const float* c = image->data.data() + p * channels;
+      return glm::dvec3(c[0], c[1], c[2]);
+    };
+    const auto apart = [&](const glm::dvec3& c, size_t q) { return differ(c, colour(q), SPARSE_SPLIT_SRGB); };
+    std::vector<uint8_t> again(pixels_, 0);
+    uint64_t flagged = 0;
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const size_t p = static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
+        if (only_ && !(*only_)[p]) continue;
+        const glm::dvec3 c = colour(p);
+        const size_t row = static_cast<size_t>(width);
+        if ((x > 0 && apart(c, p - 1)) || (x + 1 < width && apart(c, p + 1)) || (y > 0 && apart(c, p - row)) ||
+            (y + 1 < height && apart(c, p + row))) {
+          again[p] = 1;
+          ++flagged;
+        }
+      }
+    }
+    sparse_again_ = true;  // shade_fragment: the quarters
+    shade_again(shade, ro, again, flagged, image);
+    sparse_again_ = false;
+    per_worker_[0].sparse_pixels += flagged;
+  }
+
+  // The pixels `again` (`count` of them) resolved once more, their searches counted afresh;
+  // the neighbours a pass shaded beside `only` (widened_) black again, as `only` says.
+  void shade_again(const WorkerPixelShader& shade, const ResolveOptions& ro, const std::vector<uint8_t>& again,
+                   uint64_t count, Image* image) {
+    const size_t channels = static_cast<size_t>(image->channels);
+    for (size_t p = 0; p < pixels_; ++p) {
+      const bool outside = !widened_.empty() && !(*only_)[p];
+      if (outside) std::fill_n(image->data.begin() + static_cast<std::ptrdiff_t>(p * channels), image->channels, 0.f);
+      if (fallback_ && (outside || again[p])) pixel_searches_[p] = {0, 0};
+    }
+    if (count == 0) return;
+    for (Known& k : known_) k.row = -1;  // each row starts afresh in this pass too
+    ResolveOptions second = ro;
+    second.only = &again;
+    const Image redone = resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, second);
+    for (size_t p = 0; p < pixels_; ++p) {
+      if (!again[p]) continue;
+      for (size_t ch = 0; ch < channels; ++ch) image->data[p * channels + ch] = redone.data[p * channels + ch];
+    }
   }
 
   const SceneData& scene_;
@@ -357,6 +394,8 @@ class MapRender {
   const std::vector<uint8_t>* const only_;
   const size_t pixels_;
   bool edges_ = false;
+  bool sparse_ = false;        // --shading-points sparse
+  bool sparse_again_ = false;  // in its pass: the quarters
   // Per pixel: secondary searches and failures (one resolve worker owns a row at a time).
   std::vector<std::pair<uint64_t, uint64_t>> pixel_searches_;
   PixelShadows seen_;

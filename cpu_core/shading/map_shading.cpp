@@ -52,6 +52,7 @@ void MapShadingStats::merge(const MapShadingStats& o) {
   secondary_edge_fragments += o.secondary_edge_fragments;
   secondary_edge_samples += o.secondary_edge_samples;
   secondary_edge_pixels += o.secondary_edge_pixels;
+  sparse_pixels += o.sparse_pixels;
   errors.merge(o.errors);
 }
 
@@ -73,6 +74,10 @@ SurfacePoint surface_point(const SceneData& scene, uint32_t triangle, const glm:
   const double len = glm::length(n);
   sp.shading_normal = len > 0.0 && std::isfinite(len) ? n / len : sp.geometric_normal;
   return sp;
+}
+
+const char* shading_points_name(const MapShadingOptions& o) {
+  return !o.one_point ? "quarters" : (o.quarters_at_edges ? "sparse" : "one");
 }
 
 MapShader::MapShader(const SceneData& scene, const CubeABuffer& cube, const MapShadingOptions& options,

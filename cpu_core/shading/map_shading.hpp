@@ -33,6 +33,10 @@ enum class EnvmapLookup { reflected, bisector, position };  // R, [[R + [[W]]]],
 const char* envmap_lookup_name(EnvmapLookup l);
 bool parse_envmap_lookup(const std::string& s, EnvmapLookup* out);  // "R" | "bisector" | "position"
 
+struct MapShadingOptions;
+// --shading-points of a plan as it shades: "quarters", "sparse" or "one".
+const char* shading_points_name(const MapShadingOptions& o);
+
 struct MapShadingOptions {
   Method method = Method::abuffer;  // abuffer, zbuffer or envmap
   SearchOptions search;             // layers are set from the method
@@ -50,6 +54,9 @@ struct MapShadingOptions {
   // covered pixel; an edge of a shadow or a reflection inside the pixel is then all or
   // nothing).
   bool one_point = false;
+  // With one_point, --shading-points sparse (SPARSE, below): the pixels whose colour
+  // differs from a neighbour's are shaded again at their quarters.
+  bool quarters_at_edges = false;
   // SHADOW EDGES (below): where a camera fragment's shading points disagree about a light,
   // each covered sample gets its own shadow answer. Off: the points' answers stand.
   bool shadow_edges = true;
@@ -81,6 +88,8 @@ struct MapShadingStats {
   // Camera fragments with a secondary term shaded at each covered sample (SECONDARY EDGES),
   // the samples shaded, and the pixels shaded a second time for an edge beside them.
   uint64_t secondary_edge_fragments = 0, secondary_edge_samples = 0, secondary_edge_pixels = 0;
+  // --shading-points sparse: the pixels shaded again at their quarters (SPARSE).
+  uint64_t sparse_pixels = 0;
   RayErrors errors;  // filled only when a reference tracer is given
   void merge(const MapShadingStats& o);
 };
@@ -96,6 +105,15 @@ struct MapShadingStats {
 // channel) are the others shaded too, else they take the mean of the two.
 // docs/design/map-shading.md says where this matters.
 constexpr double QUARTER_SPLIT_SRGB = 1.0 / 255.0;
+//
+// SPARSE (--shading-points sparse). Each fragment shaded at one point first; then the pixels
+// whose colour differs from a 4-neighbour's by more than SPARSE_SPLIT_SRGB (sRGB-encoded, any
+// channel: an edge of a shadow, of a silhouette, of what a mirror or glass shows) are shaded
+// again, their fragments at the adaptive quarters. Elsewhere the pixel is smooth, and one
+// point stands for it as well as the quarters would. Measured at the N --target-db 40 takes
+// on the race's scenes, it renders within 0.05 dB of the quarters in about 0.7 of their
+// shading time (docs/performance.md). There is no SHADOW EDGES or SECONDARY EDGES pass.
+constexpr double SPARSE_SPLIT_SRGB = 16.0 / 255.0;
 //
 // SHADOW EDGES (shadow_edges.hpp). A shadow's edge through a fragment would still be
 // decided at those points: a step a pixel where the tracer's 32 samples make a ramp. The
@@ -213,7 +231,9 @@ class MapShader {
   // mode).
   bool refines_on_mesh() const { return options_.search.refine == SearchRefine::mesh; }
   bool exact_priority() const { return options_.exact_priority; }
+  const MapShadingOptions& options() const { return options_; }
   bool one_point() const { return options_.one_point; }
+  bool quarters_at_edges() const { return options_.quarters_at_edges; }
   bool shadow_edges() const { return options_.shadow_edges; }
   bool texture_samples() const { return options_.texture_samples; }
   bool secondary_edges() const { return options_.secondary_edges; }

@@ -275,9 +275,11 @@ void add_map_methods(Table& t) {
        "the environment map's lookup direction", {}},
       [](RenderSetup& s, const json& v) { s.render.envmap_lookup = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.envmap_lookup, d.envmap_lookup); });
-  add(t, {"shading_points", "--shading-points", OptionKind::choice, OptionScope::job, {"quarters", "one"}, 0, 0,
-       d.shading_points, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
-       "shading points per camera fragment: quarters (2 to 4, more where they differ) | one (its centroid)", {}},
+  add(t, {"shading_points", "--shading-points", OptionKind::choice, OptionScope::job, {"quarters", "sparse", "one"},
+       0, 0, d.shading_points, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
+       "shading points per camera fragment: quarters (2 to 4, more where they differ) | sparse (one, the quarters "
+       "where a shadow's edge runs beside the pixel) | one (its centroid)",
+       {}},
       [](RenderSetup& s, const json& v) { s.render.shading_points = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.shading_points, d.shading_points); });
   add(t, {"shadow_edges", "--shadow-edges", OptionKind::choice, OptionScope::job, {"samples", "points"}, 0, 0,

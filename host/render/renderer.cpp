@@ -121,7 +121,8 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   r.map.refraction = parse_checked(o.refraction, parse_refraction_mode);
   r.map.lookup = parse_checked(o.envmap_lookup, parse_envmap_lookup);
   r.map.exact_priority = o.resolve == "exact";
-  r.map.one_point = o.shading_points == "one";
+  r.map.one_point = o.shading_points == "one" || o.shading_points == "sparse";
+  r.map.quarters_at_edges = o.shading_points == "sparse";
   r.map.shadow_edges = o.shadow_edges == "samples";
   r.map.texture_samples = o.texture_lookups == "samples";
   r.map.secondary_edges = o.secondary_edges == "samples";
@@ -172,7 +173,7 @@ json request_stats(const SceneData& view, const RenderRequest& request) {
                              {"refraction", refraction_mode_name(request.map.refraction)},
                              {"envmap_lookup", envmap_lookup_name(request.map.lookup)},
                              {"resolve", request.map.exact_priority ? "exact" : "thesis"},
-                             {"shading_points", request.map.one_point ? "one" : "quarters"},
+                             {"shading_points", shading_points_name(request.map)},
                              {"shadow_edges", request.map.shadow_edges ? "samples" : "points"},
                              {"texture_lookups", request.map.texture_samples ? "samples" : "points"},
                              {"secondary_edges", request.map.secondary_edges ? "samples" : "points"},

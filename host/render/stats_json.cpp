@@ -42,7 +42,8 @@ json map_shading_json(const MapShadingStats& ms) {
         {"share",
          ms.multi_point_fragments ? double(ms.secondary_edge_fragments) / double(ms.multi_point_fragments) : 0.0},
         {"samples_shaded", ms.secondary_edge_samples},
-        {"pixels_shaded_again", ms.secondary_edge_pixels}}}};
+        {"pixels_shaded_again", ms.secondary_edge_pixels}}},
+      {"sparse", {{"pixels_shaded_again", ms.sparse_pixels}}}};
 }
 
 json error_stats_json(const ErrorStats& e) {

@@ -133,7 +133,7 @@ Pilot run_pilot(MethodContext& mc, const ABuffer& camera, const MapShader& shade
     p.mesh_triangles += static_cast<double>(k->mesh_triangles);
   }
   pilots->push_back({{"cube_resolution", n},
-                     {"shading_points", shader.one_point() ? "one" : "quarters"},
+                     {"shading_points", shading_points_name(shader.options())},
                      {"shadow_edges", shader.shadow_edges() ? "samples" : "points"},
                      {"secondary_edges", shader.secondary_edges() ? "samples" : "points"},
                      {"psnr_db", number_or_null(e.psnr)},
@@ -143,16 +143,24 @@ Pilot run_pilot(MethodContext& mc, const ABuffer& camera, const MapShader& shade
   return p;
 }
 
-// The shading plans cheaper than `chosen`, cheapest first: one shading point per fragment
-// (about half the shading of a covered pixel, and no edges refined at the samples), then the
-// quarters with neither SHADOW EDGES nor SECONDARY EDGES, then without SECONDARY EDGES
-// alone (map_shading.hpp: each costs where its edges are).
+// The shading plans cheaper than `chosen` (quarters), cheapest first: one shading point per
+// fragment (about half the shading of a covered pixel, and no edges refined at the samples);
+// one point with the quarters beside a shadow's edge (--shading-points sparse, where the
+// plan `asked` for refines shadow edges: where the quarters' gain is at the shadows' edges,
+// most of it for little more than one point's cost); the quarters with neither SHADOW EDGES
+// nor SECONDARY EDGES; then without SECONDARY EDGES alone (map_shading.hpp: each costs
+// where its edges are). Below sparse, only one point.
 std::vector<MapShadingOptions> cheaper_plans(const MapShadingOptions& chosen) {
   std::vector<MapShadingOptions> plans;
-  if (chosen.one_point) return plans;
+  if (chosen.one_point && !chosen.quarters_at_edges) return plans;
   MapShadingOptions one = chosen;
   one.one_point = true;
+  one.quarters_at_edges = false;
   plans.push_back(one);
+  if (chosen.one_point) return plans;
+  MapShadingOptions sparse = one;
+  sparse.quarters_at_edges = true;
+  plans.push_back(sparse);
   if (chosen.shadow_edges && chosen.secondary_edges) {
     MapShadingOptions neither = chosen;
     neither.shadow_edges = neither.secondary_edges = false;
@@ -167,7 +175,8 @@ std::vector<MapShadingOptions> cheaper_plans(const MapShadingOptions& chosen) {
 }
 
 bool same_plan(const MapShadingOptions& a, const MapShadingOptions& b) {
-  return a.one_point == b.one_point && a.shadow_edges == b.shadow_edges && a.secondary_edges == b.secondary_edges;
+  return a.one_point == b.one_point && a.quarters_at_edges == b.quarters_at_edges && a.shadow_edges == b.shadow_edges &&
+         a.secondary_edges == b.secondary_edges;
 }
 
 // The pilots' state: the sample, every pilot's stats line, and the best map found so far
@@ -289,13 +298,13 @@ void write_stats(const Pilots& p, json* out) {
   stats["size"]["cube_resolution"] = p.best.n;
   const char* shadow_edges = chosen.shadow_edges && !chosen.one_point ? "samples" : "points";
   const char* secondary_edges = chosen.secondary_edges && !chosen.one_point ? "samples" : "points";
-  stats["method_options"]["shading_points"] = chosen.one_point ? "one" : "quarters";
+  stats["method_options"]["shading_points"] = shading_points_name(chosen);
   stats["method_options"]["shadow_edges"] = shadow_edges;
   stats["method_options"]["secondary_edges"] = secondary_edges;
   stats["target_db"] = {
       {"target", p.target},
       {"cube_resolution", p.best.n},
-      {"shading_points", chosen.one_point ? "one" : "quarters"},
+      {"shading_points", shading_points_name(chosen)},
       {"shadow_edges", shadow_edges},
       {"secondary_edges", secondary_edges},
       {"scene_cube_resolution", p.mc.scene.render.cube_resolution},

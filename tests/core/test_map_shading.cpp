@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ostream>
+#include <utility>
 
 #include "raster/abuffer.hpp"
 #include "scene/camera.hpp"
@@ -44,19 +45,31 @@ Rendered render_method(const SceneData& s, Method method, const RayTracer* refer
   return r;
 }
 
+// A small scene's maps, built once, rendered with several shading options.
+struct Maps {
+  explicit Maps(SceneData scene)
+      : s(std::move(scene)),
+        cube(build_cube_abuffer(s, s.camera.position, s.render.cube_resolution)),
+        camera(build_camera_abuffer(s)) {}
+  Image render(const MapShadingOptions& o, int threads, MapShadingStats* stats) const {
+    const MapShader shader(s, cube, o);
+    return render_with_map(s, camera, shader, threads, stats);
+  }
+  const SceneData s;
+  const CubeABuffer cube;
+  const ABuffer camera;
+};
+
 // KNOWN BLOCKERS (map_shading.hpp) in a whole render: most shadow walks of the shadows scene
 // end at the blocker its row's previous search found. The image is the one every segment
 // walked gives, bit for bit (here the walk misses no blocker the known one answers), and it
 // does not depend on the threads (a worker clears them at each row).
 TEST(MapShading, KnownBlockersSpareShadowWalksAndChangeNothing) {
-  const SceneData s = small_scene("shadows.json", 160, 128);
-  const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, s.render.cube_resolution);
-  const ABuffer camera = build_camera_abuffer(s);
+  const Maps maps(small_scene("shadows.json", 160, 128));
   const auto render = [&](bool known, int threads, MapShadingStats* stats) {
     MapShadingOptions o;
     o.search.known_blockers = known;
-    const MapShader shader(s, cube, o);
-    return render_with_map(s, camera, shader, threads, stats);
+    return maps.render(o, threads, stats);
   };
   MapShadingStats walked, known, one_thread;
   const Image a = render(false, 2, &walked), b = render(true, 2, &known), c = render(true, 1, &one_thread);
@@ -72,6 +85,53 @@ TEST(MapShading, KnownBlockersSpareShadowWalksAndChangeNothing) {
   EXPECT_EQ(a.data, b.data);
   EXPECT_EQ(b.data, c.data);
   EXPECT_EQ(one_thread.searches.shadow.known_blockers, known.searches.shadow.known_blockers);
+}
+
+// SPARSE (map_shading.hpp), on cornell (mirror and glass spheres, shadows) at 128 pixels
+// wide: a pixel the sparse pass leaves is the one-point image's, bit for bit; one it shades
+// again is the quarters image's (KNOWN BLOCKERS off, so that no answer depends on the order
+// of the pixels); the pass takes a minority of the pixels, and the image is as close to the
+// exact tracer's as the quarters' and closer than one point's.
+TEST(MapShading, SparseShadesTheQuartersOnlyWhereNeighboursDiffer) {
+  const Maps maps(small_scene("cornell.json", 128, 96));
+  const SceneData& s = maps.s;
+  const auto render = [&](bool one, bool sparse, MapShadingStats* stats) {
+    MapShadingOptions o;
+    o.search.known_blockers = false;
+    o.one_point = one;
+    o.quarters_at_edges = sparse;
+    o.shadow_edges = o.secondary_edges = false;
+    return maps.render(o, 2, stats);
+  };
+  MapShadingStats one_stats, sparse_stats, quarters_stats;
+  const Image one = render(true, false, &one_stats), sparse = render(true, true, &sparse_stats),
+              quarters = render(false, false, &quarters_stats);
+  EXPECT_EQ(shading_points_name(MapShadingOptions{}), std::string("quarters"));
+  const size_t pixels = static_cast<size_t>(s.camera.width) * static_cast<size_t>(s.camera.height);
+  size_t as_one = 0, as_quarters = 0;
+  for (size_t p = 0; p < pixels; ++p) {
+    const auto same = [&](const Image& a) {
+      for (size_t c = 0; c < 3; ++c) {
+        if (a.data[3 * p + c] != sparse.data[3 * p + c]) return false;
+      }
+      return true;
+    };
+    if (same(one)) ++as_one;
+    if (same(quarters)) ++as_quarters;
+    EXPECT_TRUE(same(one) || same(quarters)) << "pixel " << p;
+  }
+  std::printf("[ sparse   ] %llu of %zu pixels shaded again; %zu as one point, %zu as the quarters\n",
+              static_cast<unsigned long long>(sparse_stats.sparse_pixels), pixels, as_one, as_quarters);
+  EXPECT_GT(sparse_stats.sparse_pixels, pixels / 50);
+  EXPECT_LT(sparse_stats.sparse_pixels, pixels / 2);
+  EXPECT_EQ(one_stats.sparse_pixels, 0u);
+  EXPECT_LT(sparse_stats.multi_point_fragments, quarters_stats.multi_point_fragments / 2);
+  const Image exact = render_raytrace(s);
+  const double e_one = image_error(one, exact).psnr, e_sparse = image_error(sparse, exact).psnr,
+               e_quarters = image_error(quarters, exact).psnr;
+  std::printf("[ sparse   ] PSNR one %.2f, sparse %.2f, quarters %.2f dB\n", e_one, e_sparse, e_quarters);
+  EXPECT_GT(e_sparse, e_one + 2.0);
+  EXPECT_GT(e_sparse, e_quarters - 0.3);
 }
 
 // Thesis 7.4.2 and figures 11.3-11.5: in the mirror pixels whose exact reflected ray meets
