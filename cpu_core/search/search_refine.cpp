@@ -60,12 +60,12 @@ bool near_ray(const SearchContext::Sphere& b, const SearchRay& q, double l_lo, d
 }
 
 // The flood's table: what it knows of a triangle (TAKEN into the flood, found AWAY from the
-// ray or past the flood's size, or NEW), by open addressing in a table kept by each thread across floods. Every
-// flood starts from an empty table: the slots it used are reset when it ends (`used`), so a
-// flood of a few triangles does not pay for clearing the whole table. A flood takes at
-// most REFINE_MAX_TRIANGLES triangles and each slot it finds NEW it sets at once, so it holds
-// at most the start and three neighbours of each taken triangle: the table is never more
-// than a fifth full.
+// ray or past the flood's size, or NEW), by open addressing in a table each thread keeps
+// across floods. Every flood starts from an empty table: the slots it used are reset when it
+// ends (`used`), so a flood of a few triangles does not pay for clearing the whole table. A
+// flood takes at most REFINE_MAX_TRIANGLES triangles and sets each slot it finds NEW at once,
+// so it holds at most the start and three neighbours of each taken triangle: the table is
+// never more than a fifth full.
 class FloodTable {
  public:
   static constexpr uint8_t NEW = 0, TAKEN = 1, AWAY = 2;

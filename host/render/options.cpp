@@ -278,7 +278,7 @@ void add_map_methods(Table& t) {
   add(t, {"shading_points", "--shading-points", OptionKind::choice, OptionScope::job, {"quarters", "sparse", "one"},
        0, 0, d.shading_points, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
        "shading points per camera fragment: quarters (2 to 4, more where they differ) | sparse (one, the quarters "
-       "where a shadow's edge runs beside the pixel) | one (its centroid)",
+       "in the pixels whose colour differs from a neighbour's) | one (its centroid)",
        {}},
       [](RenderSetup& s, const json& v) { s.render.shading_points = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.shading_points, d.shading_points); });

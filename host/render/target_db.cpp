@@ -145,11 +145,10 @@ Pilot run_pilot(MethodContext& mc, const ABuffer& camera, const MapShader& shade
 
 // The shading plans cheaper than `chosen` (quarters), cheapest first: one shading point per
 // fragment (about half the shading of a covered pixel, and no edges refined at the samples);
-// one point with the quarters beside a shadow's edge (--shading-points sparse, where the
-// plan `asked` for refines shadow edges: where the quarters' gain is at the shadows' edges,
-// most of it for little more than one point's cost); the quarters with neither SHADOW EDGES
-// nor SECONDARY EDGES; then without SECONDARY EDGES alone (map_shading.hpp: each costs
-// where its edges are). Below sparse, only one point.
+// one point with the quarters where neighbouring pixels differ (SPARSE, map_shading.hpp:
+// the quarters' error where their gain is at edges, for little more than one point's cost);
+// the quarters with neither SHADOW EDGES nor SECONDARY EDGES; then without SECONDARY EDGES
+// alone (map_shading.hpp: each costs where its edges are). Below sparse, only one point.
 std::vector<MapShadingOptions> cheaper_plans(const MapShadingOptions& chosen) {
   std::vector<MapShadingOptions> plans;
   if (chosen.one_point && !chosen.quarters_at_edges) return plans;
