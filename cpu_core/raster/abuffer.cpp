@@ -188,7 +188,11 @@ BandResult fill_band(const TriangleSoup& soup, const ABufferOptions& options, Vi
 }
 
 // Moves the kept part of every list to the front: final offsets, no gaps.
+// Closes the gaps the merges left, and hands back what the build alone used: the bins,
+// the cursors, and the raw fragments' room (on a large mesh's cube the raw fragments are
+// several times the kept ones, and would otherwise stay resident through the render).
 void compact(ViewBuild* vb) {
+  vb->bins = std::vector<BinEntry>();
   const size_t pixels = vb->view.pixel_count();
   uint32_t write = 0;
   for (size_t p = 0; p < pixels; ++p) {
@@ -198,7 +202,9 @@ void compact(ViewBuild* vb) {
     write += n;
   }
   vb->offsets[pixels] = write;
+  vb->cursor = std::vector<uint32_t>();
   vb->fragments.resize(write);
+  vb->fragments.shrink_to_fit();
 }
 
 std::string mib(uint64_t bytes) { return std::to_string((bytes + MIB - 1) / MIB); }
@@ -240,20 +246,27 @@ uint64_t count_views(const TriangleSoup& soup, std::vector<ViewBuild>* views, co
   return total;
 }
 
+// The triangles no view binned: culled, degenerate or edge-on (read before compact()
+// frees the bins).
+uint64_t unbinned_triangles(const std::vector<ViewBuild>& views, size_t triangles) {
+  std::vector<unsigned char> seen(triangles, 0);
+  for (const ViewBuild& vb : views) {
+    for (const BinEntry& b : vb.bins) seen[b.triangle] = 1;
+  }
+  return static_cast<uint64_t>(std::count(seen.begin(), seen.end(), 0));
+}
+
 // The counters of ABufferStats from the finished build.
 ABufferStats summarise(const std::vector<ViewBuild>& views, const std::vector<ABuffer>& out,
-                       const std::vector<BandResult>& results, size_t triangles) {
+                       const std::vector<BandResult>& results, uint64_t unbinned) {
   ABufferStats st;
-  std::vector<unsigned char> seen(triangles, 0);
   for (const ViewBuild& vb : views) {
     st.triangle_views += vb.triangle_views;
     st.triangles_clipped += vb.clipped;
-    for (const BinEntry& b : vb.bins) seen[b.triangle] = 1;
   }
   st.triangles_degenerate = views.front().degenerate;  // the same in every view of one centre
   st.triangles_edge_on = views.front().edge_on;
-  st.triangles_culled =
-      static_cast<uint64_t>(std::count(seen.begin(), seen.end(), 0)) - st.triangles_degenerate - st.triangles_edge_on;
+  st.triangles_culled = unbinned - st.triangles_degenerate - st.triangles_edge_on;
   for (const BandResult& r : results) {
     st.dropped_by_cap += r.dropped;
     st.max_list_length = std::max(st.max_list_length, r.max_list);
@@ -302,6 +315,7 @@ std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView>
   std::vector<BandResult> results(bands.size());
   parallel_for(bands.size(), threads,
                [&](size_t i, int) { results[i] = fill_band(soup, options, &views[bands[i].view], bands[i]); });
+  const uint64_t unbinned = stats ? unbinned_triangles(views, soup.triangle_count()) : 0;
   parallel_for(views.size(), threads, [&](size_t v, int) { compact(&views[v]); });
 
   std::vector<ABuffer> out(views.size());
@@ -311,7 +325,7 @@ std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView>
     out[v].fragments = std::move(views[v].fragments);
   }
   if (stats) {
-    *stats = summarise(views, out, results, soup.triangle_count());
+    *stats = summarise(views, out, results, unbinned);
     stats->raw_fragments = raw;
     stats->estimated_bytes = estimate;
     stats->budget_bytes = budget;

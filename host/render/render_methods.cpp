@@ -314,34 +314,27 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   }
   std::unique_ptr<RayTracer> reference;
   if (r.reference) reference = std::make_unique<RayTracer>(scene, mc.cache.bvh());
-  // Each A-buffer is budgeted with the other one held.
-  std::optional<ABuffer> camera;
+  // The camera's A-buffer first, then the cube's, budgeted with the camera's held: the
+  // camera build's per-triangle bins are gone before the cube's A-buffer, its mesh
+  // neighbours and its side structure are made (peak memory), and every pilot of
+  // --target-db shades the same camera fragments.
   ABufferStats as;
-  double camera_ms = 0;
-  const auto build_camera = [&](uint64_t reserved) {
-    const Clock::time_point t0 = Clock::now();
-    ABufferOptions camera_options = r.abuffer;
-    camera_options.reserved_bytes += reserved;
-    camera.emplace(build_camera_abuffer(scene, camera_options, &as));
-    camera_ms = ms_since(t0);
-  };
-  CubeMap map;
-  if (scene.render.method == Method::abuffer && scene.render.target_db > 0) {
-    build_camera(0);  // first: every pilot shades it
-    ABufferOptions cube_options = r.abuffer;
-    cube_options.reserved_bytes += as.bytes_total;
-    map = cube_map_for_target(mc, *camera, cube_options, reference.get());
-  } else {
-    map = build_cube_map(mc, scene.render.cube_resolution, r.abuffer, reference.get(), map_shading_options(mc));
-    build_camera(map.stats.bytes_total);
-  }
+  const Clock::time_point camera_start = Clock::now();
+  const ABuffer camera = build_camera_abuffer(scene, r.abuffer, &as);
+  const double camera_ms = ms_since(camera_start);
+  ABufferOptions cube_options = r.abuffer;
+  cube_options.reserved_bytes += as.bytes_total;
+  const CubeMap map =
+      scene.render.method == Method::abuffer && scene.render.target_db > 0
+          ? cube_map_for_target(mc, camera, cube_options, reference.get())
+          : build_cube_map(mc, scene.render.cube_resolution, cube_options, reference.get(), map_shading_options(mc));
   stats["timings_ms"]["cube_abuffer"] = map.build_ms;
   stats["cube_abuffer"] = cube_abuffer_json(map.stats);
   stats["timings_ms"]["map_setup"] = map.setup_ms;
   stats["timings_ms"]["camera_abuffer"] = camera_ms;
   const Clock::time_point t0 = Clock::now();
   MapShadingStats ms;
-  Image image = render_with_map(scene, *camera, *map.shader, r.threads, &ms, mc.fallback, only);
+  Image image = render_with_map(scene, camera, *map.shader, r.threads, &ms, mc.fallback, only);
   stats["timings_ms"]["shade_and_resolve"] = ms_since(t0);
   stats["abuffer"] = abuffer_json(as, false);
   stats["searches"] = map_shading_json(ms);
