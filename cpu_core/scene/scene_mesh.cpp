@@ -1,12 +1,14 @@
 // Mesh objects: triangles from a Wavefront OBJ file, materials from the MTL files it
 // names, and the confinement of both to LoadLimits::root.
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <utility>
 
@@ -15,6 +17,8 @@
 #include "base/error.hpp"
 #include "base/input_file.hpp"
 #include "base/memory.hpp"
+#include "base/parallel.hpp"
+#include "scene/obj_text.hpp"
 #include "scene/scene_load_state.hpp"
 #include "scene/tessellate.hpp"
 
@@ -112,12 +116,6 @@ std::vector<std::string> find_lines(const std::string& text, const char* needle)
   return lines;
 }
 
-// First line of a tinyobjloader message that contains `needle`, or "".
-std::string find_line(const std::string& text, const char* needle) {
-  const std::vector<std::string> lines = find_lines(text, needle);
-  return lines.empty() ? "" : lines.front();
-}
-
 // tinyobjloader's warning of a material it did not find, the name it holds quoted:
 // "material [ 'NAME' ] not found in .mtl" (usemtl) and "Material file [ NAME ] not found
 // in a path : DIR" (mtllib). Other lines are shown as they are, cut short.
@@ -131,28 +129,6 @@ std::string missing_material_message(const std::string& line) {
   std::string m = between("material [ '", "' ] not found", "usemtl: material");
   if (m.empty()) m = between("Material file [ ", " ] not found", "mtllib: material file");
   return m.empty() ? printable(line) : m;
-}
-
-// Appends one OBJ face (already validated) to `out` (indexed, positions, normals and
-// texture coordinates already copied from the file's), triangulating polygons.
-void add_obj_face(const tinyobj::index_t* corners, size_t n, int material, LocalMesh* out) {
-  std::vector<glm::dvec3> p(n);
-  bool smooth = true;
-  for (size_t k = 0; k < n; ++k) {
-    p[k] = out->positions[static_cast<size_t>(corners[k].vertex_index)];
-    smooth = smooth && corners[k].normal_index >= 0;
-  }
-  for (const auto& t : triangulate_polygon(p)) {
-    for (int k : t) {
-      const tinyobj::index_t& c = corners[static_cast<size_t>(k)];
-      out->position_index.push_back(static_cast<uint32_t>(c.vertex_index));
-      out->normal_index.push_back(smooth ? static_cast<uint32_t>(c.normal_index) : LocalMesh::NO_NORMAL);  // flat
-      if (!out->uvs.empty()) {
-        out->uv_index.push_back(c.texcoord_index >= 0 ? static_cast<uint32_t>(c.texcoord_index) : LocalMesh::NO_UV);
-      }
-    }
-    out->material.push_back(material);
-  }
 }
 
 // tinyobjloader's MaterialFileReader, refusing before it is opened an MTL file outside the
@@ -204,26 +180,54 @@ class ConfinedMaterialReader final : public tinyobj::MaterialReader {
   uint64_t max_bytes_;
 };
 
-// What tinyobjloader read of one OBJ file and its MTL files.
+// What one OBJ file holds, and the MTL materials its faces use.
 struct ObjFile {
-  tinyobj::attrib_t attrib;
-  std::vector<tinyobj::shape_t> shapes;
+  ObjText text;
   std::vector<tinyobj::material_t> materials;
   std::map<std::string, std::string> mtl_file_of;  // material name -> the MTL file it came from
-  std::string warning, error;
+  // From face `first` on, the faces use materials[material] (-1: none), ascending.
+  struct Run {
+    uint64_t first;
+    int material;
+  };
+  std::vector<Run> material_runs;
+  std::string warning;  // tinyobjloader's words for a missing MTL file or material
 };
 
-// tinyobj::ObjReader::ParseFromFile (MTL files looked up in the OBJ's folder, no
-// triangulation, no vertex colours) with the MTL files confined to the root.
-ObjFile parse_obj(const LoadState& st, const std::string& path, const std::string& resolved) {
-  ObjFile obj;
-  std::ifstream in(resolved);
-  if (!in) fail(st.src, path, "cannot read mesh " + quote_path(resolved) + ": " + std::strerror(errno));
+// The file's MTL statements in order, as tinyobjloader resolved them: `mtllib` reads the
+// first of its files not read before that can be (tinyobjloader's MaterialFileReader,
+// confined to the root), `usemtl` names a material of the files read so far, or none (a
+// warning).
+void resolve_materials(const LoadState& st, const std::string& path, const std::string& resolved, ObjFile* obj) {
   const size_t slash = resolved.find_last_of("/\\");
   const std::string base_dir = slash == std::string::npos || slash == 0 ? "" : resolved.substr(0, slash) + "/";
   ConfinedMaterialReader mtl(base_dir, st.root, st.limits.max_scene_bytes);
-  const bool ok = tinyobj::LoadObj(&obj.attrib, &obj.shapes, &obj.materials, &obj.warning, &obj.error, &in, &mtl,
-                                   false /* triangulate: ear-clipped here, keeping the winding */, false);
+  std::map<std::string, int> by_name;
+  std::set<std::string> read;
+  int material = -1;
+  obj->material_runs.push_back({0, -1});
+  for (const ObjStatement& s : obj->text.statements) {
+    if (s.kind == ObjStatement::mtllib) {
+      for (const std::string& name : split_mtllib(s.text)) {
+        if (read.count(name) > 0) continue;
+        std::string warning, error;
+        const bool ok = mtl(name, &obj->materials, &by_name, &warning, &error);
+        obj->warning += warning;
+        if (ok) {
+          read.insert(name);
+          break;
+        }
+      }
+      continue;
+    }
+    const auto it = by_name.find(s.text);
+    if (it == by_name.end()) obj->warning += "material [ '" + s.text + "' ] not found in .mtl\n";
+    const int id = it == by_name.end() ? -1 : it->second;
+    if (id == material) continue;
+    material = id;
+    if (obj->material_runs.back().first == s.faces_before) obj->material_runs.pop_back();
+    obj->material_runs.push_back({s.faces_before, id});
+  }
   if (!mtl.escaped.empty()) {
     fail(st.src, path,
          "mtllib " + quote_path(mtl.escaped) + " of mesh " + quote_path(resolved) + " resolves outside --root " +
@@ -234,9 +238,23 @@ ObjFile parse_obj(const LoadState& st, const std::string& path, const std::strin
          "mtllib " + quote_path(mtl.unreadable.first) + " of mesh " + quote_path(resolved) + ": " +
              mtl.unreadable.second);
   }
-  obj.mtl_file_of = std::move(mtl.file_of);
-  if (!ok)
-    fail(st.src, path, "cannot parse mesh " + quote_path(resolved) + ": " + printable(find_line(obj.error, ""), 160));
+  obj->mtl_file_of = std::move(mtl.file_of);
+}
+
+// The OBJ file read on the hardware's threads (obj_text.hpp), its materials resolved.
+ObjFile parse_obj(const LoadState& st, const std::string& path, const std::string& resolved) {
+  ObjFile obj;
+  try {
+    obj.text = read_obj_text(resolved);
+  } catch (const std::runtime_error& e) {
+    fail(st.src, path, "cannot read mesh " + quote_path(resolved) + ": " + e.what());
+  }
+  if (!obj.text.error.empty()) {
+    fail(st.src, path,
+         "cannot parse mesh " + quote_path(resolved) + ": line " + std::to_string(obj.text.error_line) + ": " +
+             obj.text.error);
+  }
+  resolve_materials(st, path, resolved, &obj);
   return obj;
 }
 
@@ -288,9 +306,7 @@ uint64_t count_face_triangles(const std::string& resolved) {
 // Triangles the faces of an OBJ file become (ear clipping: n - 2 per polygon of n corners).
 uint64_t obj_triangle_count(const ObjFile& obj) {
   uint64_t count = 0;
-  for (const tinyobj::shape_t& shape : obj.shapes) {
-    for (const auto n : shape.mesh.num_face_vertices) count += n >= 3 ? n - 2u : 0u;
-  }
+  for (const uint32_t n : obj.text.face_sizes) count += n - 2u;
   return count;
 }
 
@@ -367,50 +383,122 @@ void check_obj_file(LoadState& st, const std::string& path, const std::string& r
   if (over_cap || over_budget) check_triangle_cap(st, path, count_face_triangles(resolved));
 }
 
+// A run of faces with the first corner and triangle of its first face: the faces of a
+// run are made into triangles by one thread, writing only the run's places.
+struct FaceRun {
+  static constexpr size_t FACES = size_t{1} << 14;
+  uint64_t face, corner, triangle;
+};
+
+std::vector<FaceRun> face_runs(const ObjText& text) {
+  std::vector<FaceRun> runs;
+  uint64_t corner = 0, triangle = 0;
+  for (size_t f = 0; f < text.face_count(); ++f) {
+    if (f % FaceRun::FACES == 0) runs.push_back({f, corner, triangle});
+    corner += text.face_sizes[f];
+    triangle += text.face_sizes[f] - 2u;
+  }
+  return runs;
+}
+
+// The scene material of each of obj's material runs (-1: the object's own, without
+// use_mtl), made here, before the faces are taken on several threads: the default
+// material is added to the scene only when a face uses it.
+std::vector<int> run_materials(LoadState& st, const ObjFile& obj, const std::vector<uint32_t>& mtl_ids, bool use_mtl) {
+  std::vector<int> out;
+  const std::vector<ObjFile::Run>& runs = obj.material_runs;
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const uint64_t end = r + 1 < runs.size() ? runs[r + 1].first : obj.text.face_count();
+    const int mtl = runs[r].material;
+    if (!use_mtl || runs[r].first >= end) {
+      out.push_back(-1);
+    } else {
+      out.push_back(mtl >= 0 && static_cast<size_t>(mtl) < mtl_ids.size()
+                        ? static_cast<int>(mtl_ids[static_cast<size_t>(mtl)])
+                        : static_cast<int>(default_material(st)));
+    }
+  }
+  return out;
+}
+
+// The faces of `run` as triangles of m (its index arrays sized), each with its run's scene
+// material; false at a face with an index out of range (its number in *bad).
+bool triangulate_run(const ObjFile& obj, const FaceRun& run, const std::vector<int>& materials, LocalMesh* out,
+                     uint64_t* bad) {
+  LocalMesh& m = *out;
+  const ObjText& text = obj.text;
+  const int64_t counts[3] = {static_cast<int64_t>(m.positions.size()), static_cast<int64_t>(m.uvs.size()),
+                             static_cast<int64_t>(m.normals.size())};
+  const auto in_range = [&](int32_t index, int field, bool optional) {
+    return (optional && index == ObjCorner::ABSENT) || (index >= 0 && index < counts[field]);
+  };
+  const uint64_t end = std::min<uint64_t>(run.face + FaceRun::FACES, text.face_count());
+  uint64_t c = run.corner, t = run.triangle;
+  size_t material_run =
+      static_cast<size_t>(std::upper_bound(obj.material_runs.begin(), obj.material_runs.end(), run.face,
+                                           [](uint64_t face, const ObjFile::Run& r) { return face < r.first; }) -
+                          obj.material_runs.begin() - 1);
+  std::vector<glm::dvec3> polygon;
+  for (uint64_t f = run.face; f < end; ++f) {
+    const ObjCorner* corners = &text.corners[c];
+    const uint32_t n = text.face_sizes[f];
+    c += n;
+    while (material_run + 1 < obj.material_runs.size() && obj.material_runs[material_run + 1].first <= f)
+      ++material_run;
+    bool smooth = true;
+    for (uint32_t k = 0; k < n; ++k) {
+      if (!in_range(corners[k].v, 0, false) || !in_range(corners[k].vt, 1, true) || !in_range(corners[k].vn, 2, true)) {
+        *bad = f;
+        return false;
+      }
+      smooth = smooth && corners[k].vn != ObjCorner::ABSENT;
+    }
+    const auto emit = [&](const std::array<int, 3>& tri) {
+      for (size_t k = 0; k < 3; ++k) {
+        const ObjCorner& q = corners[tri[k]];
+        m.position_index[3 * t + k] = static_cast<uint32_t>(q.v);
+        m.normal_index[3 * t + k] = smooth ? static_cast<uint32_t>(q.vn) : LocalMesh::NO_NORMAL;  // flat
+        if (!m.uvs.empty()) m.uv_index[3 * t + k] = q.vt >= 0 ? static_cast<uint32_t>(q.vt) : LocalMesh::NO_UV;
+      }
+      m.material[t++] = materials[material_run];
+    };
+    if (n == 3) {
+      emit({0, 1, 2});
+      continue;
+    }
+    polygon.resize(n);
+    for (uint32_t k = 0; k < n; ++k) polygon[k] = m.positions[static_cast<size_t>(corners[k].v)];
+    for (const auto& tri : triangulate_polygon(polygon)) emit(tri);
+  }
+  return true;
+}
+
 // The OBJ file's faces as triangles of `m` (its vertex arrays filled), each with its MTL
-// material when `use_mtl` (mtl_ids: per material of the file, the scene's).
+// material when `use_mtl` (mtl_ids: per material of the file, the scene's); polygons ear
+// clipped. The face runs are taken on the hardware's threads.
 void add_obj_faces(LoadState& st, const std::string& path, const std::string& resolved, const ObjFile& obj,
                    const std::vector<uint32_t>& mtl_ids, bool use_mtl, LocalMesh* out) {
   LocalMesh& m = *out;
-  const tinyobj::attrib_t& a = obj.attrib;
-  const int vertex_count = static_cast<int>(a.vertices.size() / 3);
-  const int normal_count = static_cast<int>(a.normals.size() / 3);
-  const int uv_count = static_cast<int>(a.texcoords.size() / 2);
   const uint64_t triangles = obj_triangle_count(obj);
-  m.position_index.reserve(3 * triangles);
-  m.normal_index.reserve(3 * triangles);
-  if (uv_count > 0) m.uv_index.reserve(3 * triangles);
-  m.material.reserve(triangles);
-  for (const tinyobj::shape_t& shape : obj.shapes) {
-    size_t offset = 0;
-    for (size_t face = 0; face < shape.mesh.num_face_vertices.size(); ++face) {
-      const size_t n = shape.mesh.num_face_vertices[face];
-      if (n < 3) {
-        fail(st.src, path,
-             "mesh " + quote_path(resolved) + ": face " + std::to_string(face + 1) + " of shape " + quote(shape.name) +
-                 " has " + std::to_string(n) + " corners (a face needs 3 or more)");
-      }
-      const tinyobj::index_t* corners = &shape.mesh.indices[offset];
-      offset += n;
-      for (size_t k = 0; k < n; ++k) {
-        if (corners[k].vertex_index < 0 || corners[k].vertex_index >= vertex_count ||
-            corners[k].normal_index >= normal_count || corners[k].texcoord_index >= uv_count) {
-          fail(st.src, path,
-               "mesh " + quote_path(resolved) + ": face of shape " + quote(shape.name) + " has an index out of range");
-        }
-      }
-      const int mtl = face < shape.mesh.material_ids.size() ? shape.mesh.material_ids[face] : -1;
-      int material = -1;  // the object's own
-      if (use_mtl) {
-        material = mtl >= 0 && static_cast<size_t>(mtl) < mtl_ids.size()
-                       ? static_cast<int>(mtl_ids[static_cast<size_t>(mtl)])
-                       : static_cast<int>(default_material(st));
-      }
-      add_obj_face(corners, n, material, &m);
-      if (st.scene.triangles->triangle_count() + m.triangle_count() > MAX_TRIANGLES) {
-        fail(st.src, path, "the scene would exceed " + std::to_string(MAX_TRIANGLES) + " triangles");
-      }
-    }
+  if (st.scene.triangles->triangle_count() + triangles > MAX_TRIANGLES) {
+    fail(st.src, path, "the scene would exceed " + std::to_string(MAX_TRIANGLES) + " triangles");
+  }
+  m.position_index.resize(3 * triangles);
+  m.normal_index.resize(3 * triangles);
+  if (!m.uvs.empty()) m.uv_index.resize(3 * triangles);
+  m.material.resize(triangles);
+  const std::vector<FaceRun> runs = face_runs(obj.text);
+  const std::vector<int> materials = run_materials(st, obj, mtl_ids, use_mtl);
+  std::vector<uint64_t> bad(runs.size(), UINT64_MAX);
+  parallel_for(runs.size(), thread_count(0, runs.size()),
+               [&](size_t r, int) { triangulate_run(obj, runs[r], materials, &m, &bad[r]); });
+  const uint64_t first_bad = bad.empty() ? UINT64_MAX : *std::min_element(bad.begin(), bad.end());
+  if (first_bad != UINT64_MAX) {
+    const uint64_t line = obj_face_line(resolved, first_bad);
+    fail(st.src, path,
+         "mesh " + quote_path(resolved) + (line > 0 ? ": line " + std::to_string(line) : std::string()) +
+             ": face has an index out of range (the file has " + std::to_string(m.positions.size()) + " v, " +
+             std::to_string(m.uvs.size()) + " vt and " + std::to_string(m.normals.size()) + " vn lines)");
   }
 }
 
@@ -421,29 +509,26 @@ LocalMesh read_obj(LoadState& st, const Fields& f, bool use_mtl) {
   const std::string resolved = resolve_mesh_path(st.src, file);
   check_inside_root(st, path, file, resolved);
   check_obj_file(st, path, resolved);
-  const ObjFile obj = parse_obj(st, path, resolved);
+  ObjFile obj = parse_obj(st, path, resolved);
   check_triangle_cap(st, path, obj_triangle_count(obj));  // before anything is made
   if (use_mtl) warn_missing_mtl(st, path, file, obj);
   const std::vector<uint32_t> mtl_ids =
       use_mtl ? mtl_material_ids(st, path, file, resolved, obj.materials, obj.mtl_file_of) : std::vector<uint32_t>{};
-  const tinyobj::attrib_t& a = obj.attrib;
-  const int vertex_count = static_cast<int>(a.vertices.size() / 3);
-  const int normal_count = static_cast<int>(a.normals.size() / 3);
-  const int uv_count = static_cast<int>(a.texcoords.size() / 2);
   LocalMesh m;
   m.indexed = true;
-  m.positions.reserve(static_cast<size_t>(vertex_count));
-  for (size_t v = 0; v < static_cast<size_t>(vertex_count); ++v) {
-    m.positions.emplace_back(a.vertices[3 * v], a.vertices[3 * v + 1], a.vertices[3 * v + 2]);
-  }
-  m.normals.reserve(static_cast<size_t>(normal_count));
-  for (size_t v = 0; v < static_cast<size_t>(normal_count); ++v) {
-    m.normals.emplace_back(a.normals[3 * v], a.normals[3 * v + 1], a.normals[3 * v + 2]);
-  }
-  m.uvs.reserve(static_cast<size_t>(uv_count));
-  for (size_t v = 0; v < static_cast<size_t>(uv_count); ++v) {
-    m.uvs.emplace_back(a.texcoords[2 * v], a.texcoords[2 * v + 1]);
-    if (!std::isfinite(m.uvs.back().x) || !std::isfinite(m.uvs.back().y)) {
+  // As floats in the file's text: the values any reader of it sees.
+  const auto take3 = [](std::vector<float>& from, std::vector<glm::dvec3>* to) {
+    to->reserve(from.size() / 3);
+    for (size_t k = 0; k + 3 <= from.size(); k += 3) to->emplace_back(from[k], from[k + 1], from[k + 2]);
+    from = std::vector<float>();
+  };
+  take3(obj.text.v, &m.positions);
+  take3(obj.text.vn, &m.normals);
+  m.uvs.reserve(obj.text.vt.size() / 2);
+  for (size_t k = 0; k + 2 <= obj.text.vt.size(); k += 2) m.uvs.emplace_back(obj.text.vt[k], obj.text.vt[k + 1]);
+  obj.text.vt = std::vector<float>();
+  for (size_t v = 0; v < m.uvs.size(); ++v) {
+    if (!std::isfinite(m.uvs[v].x) || !std::isfinite(m.uvs[v].y)) {
       fail(st.src, path, "mesh " + quote_path(resolved) + ": vt " + std::to_string(v + 1) + " is not finite");
     }
   }
