@@ -1,5 +1,7 @@
 // glTF accessors and primitives into triangles (scene_gltf_reader.hpp).
 #include <algorithm>
+#include <atomic>
+#include <cstdint>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -13,6 +15,7 @@
 
 #include "base/error.hpp"
 #include "base/input_file.hpp"
+#include "base/parallel.hpp"
 #include "scene/scene_gltf_reader.hpp"
 
 namespace abcube::detail::gltf {
@@ -97,6 +100,20 @@ double read_component(const unsigned char* p, int c, bool normalized) {
     }
   }
 }
+
+namespace {
+
+// visit(i) for i in [0, count), in chunks on the hardware's threads.
+template <class Visit>
+void for_chunks(size_t count, Visit&& visit) {
+  constexpr size_t CHUNK = size_t{1} << 15;
+  const size_t chunks = (count + CHUNK - 1) / CHUNK;
+  parallel_for(chunks, thread_count(0, chunks), [&](size_t c, int) {
+    for (size_t i = c * CHUNK; i < std::min(count, (c + 1) * CHUNK); ++i) visit(i);
+  });
+}
+
+}  // namespace
 
 const char* mode_name(int mode) {
   static const char* names[] = {"POINTS",    "LINES",          "LINE_LOOP",   "LINE_STRIP",
@@ -218,9 +235,8 @@ void GltfReader::apply_sparse(const tg::Accessor& a, const std::string& aat, siz
           "index " + format_number(target) + " out of range (" + std::to_string(a.count) + " elements)");
     }
     for (int k = 0; k < out.n; ++k) {
-      out.values[static_cast<size_t>(target) * static_cast<size_t>(out.n) + static_cast<size_t>(k)] =
-          read_component(vp + i * vstride + static_cast<size_t>(k) * component_bytes(a.componentType),
-                         a.componentType, a.normalized);
+      out.values[static_cast<size_t>(target) * static_cast<size_t>(out.n) + static_cast<size_t>(k)] = read_component(
+          vp + i * vstride + static_cast<size_t>(k) * component_bytes(a.componentType), a.componentType, a.normalized);
     }
   }
 }
@@ -258,19 +274,24 @@ Accessed GltfReader::read_accessor(int index, const std::string& at, std::initia
     size_t stride = 0;
     const unsigned char* p = view_bytes(a.bufferView, a.byteOffset, a.count, elem, &stride, aat);
     const size_t cb = component_bytes(a.componentType);
-    for (size_t i = 0; i < a.count; ++i) {
+    for_chunks(a.count, [&](size_t i) {
       for (int k = 0; k < out.n; ++k) {
         out.values[i * static_cast<size_t>(out.n) + static_cast<size_t>(k)] =
             read_component(p + i * stride + static_cast<size_t>(k) * cb, a.componentType, a.normalized);
       }
-    }
+    });
   }
   if (a.sparse.isSparse) apply_sparse(a, aat, elem, &out);
-  for (size_t i = 0; i < out.values.size(); ++i) {
-    if (!std::isfinite(out.values[i])) {
-      bad(aat, "element " + std::to_string(i / static_cast<size_t>(out.n)) + " is not finite (" +
-                   format_number(out.values[i]) + ")");
+  std::atomic<size_t> first_bad{SIZE_MAX};  // the first value that is not finite
+  for_chunks(out.values.size(), [&](size_t i) {
+    if (std::isfinite(out.values[i])) return;
+    size_t seen = first_bad.load();
+    while (i < seen && !first_bad.compare_exchange_weak(seen, i)) {
     }
+  });
+  if (const size_t i = first_bad.load(); i != SIZE_MAX) {
+    bad(aat, "element " + std::to_string(i / static_cast<size_t>(out.n)) + " is not finite (" +
+                 format_number(out.values[i]) + ")");
   }
   return out;
 }
@@ -360,32 +381,63 @@ std::vector<std::array<uint32_t, 3>> GltfReader::primitive_triangles(const tg::P
 
 void GltfReader::append_triangles(const std::vector<std::array<uint32_t, 3>>& tris, const Accessed& p,
                                   const Accessed& nrm, const Accessed& uv, int material, const glm::dmat4& world) {
+  // Indexed: each vertex a triangle uses transformed once (a corner's values are what
+  // transforming it at the corner would give), numbered in the accessor's order. Only the
+  // used ones: primitives may share one large accessor, each drawing a part of it.
   const glm::dmat3 linear(world);
   const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(linear));
   const bool mirrors = glm::determinant(linear) < 0;
-  const bool with_uv = !uv.values.empty();
-  if (with_uv && out_.uvs.empty()) out_.uvs.assign(out_.positions.size(), glm::dvec2(0.0));
-  for (const auto& t : tris) {
-    const uint32_t order[3] = {t[0], mirrors ? t[2] : t[1], mirrors ? t[1] : t[2]};
-    for (uint32_t v : order) {
+  const bool with_normals = !nrm.values.empty(), with_uv = !uv.values.empty();
+  constexpr uint32_t UNUSED = 0xffffffffu;
+  std::vector<uint32_t> number(p.count, UNUSED);
+  for (const auto& t : tris) number[t[0]] = number[t[1]] = number[t[2]] = 0;
+  uint32_t used = 0;
+  for (uint32_t& n : number) n = n == UNUSED ? UNUSED : used++;
+  out_.indexed = true;
+  const size_t first = out_.positions.size(), first_normal = out_.normals.size(), first_uv = out_.uvs.size();
+  const size_t corners = out_.position_index.size();
+  out_.positions.resize(first + used);
+  if (with_normals) out_.normals.resize(first_normal + used);
+  if (with_uv) {
+    if (out_.uvs.empty()) out_.uv_index.assign(corners, LocalMesh::NO_UV);  // the primitives before
+    out_.uvs.resize(first_uv + used);
+  }
+  constexpr size_t CHUNK = size_t{1} << 14;
+  parallel_for((p.count + CHUNK - 1) / CHUNK, thread_count(0, p.count / CHUNK + 1), [&](size_t c, int) {
+    for (size_t v = c * CHUNK; v < std::min(p.count, (c + 1) * CHUNK); ++v) {
+      if (number[v] == UNUSED) continue;
+      const size_t k = number[v];
       const double* q = &p.values[3 * v];
-      out_.positions.push_back(glm::dvec3(world * glm::dvec4(q[0], q[1], q[2], 1.0)));
-      glm::dvec3 n(0.0);  // flat
-      if (!nrm.values.empty()) {
+      out_.positions[first + k] = glm::dvec3(world * glm::dvec4(q[0], q[1], q[2], 1.0));
+      if (with_normals) {
         const double* m = &nrm.values[3 * v];
-        n = normal_matrix * glm::dvec3(m[0], m[1], m[2]);
+        const glm::dvec3 n = normal_matrix * glm::dvec3(m[0], m[1], m[2]);
         const double len = glm::length(n);
-        n = len > 0 && std::isfinite(len) ? n / len : glm::dvec3(0.0);
+        out_.normals[first_normal + k] = len > 0 && std::isfinite(len) ? n / len : glm::dvec3(0.0);  // 0: flat
       }
-      out_.normals.push_back(n);
-      if (with_uv) {
-        out_.uvs.emplace_back(uv.values[2 * v], 1.0 - uv.values[2 * v + 1]);  // glTF's v runs down
-      } else if (!out_.uvs.empty()) {
-        out_.uvs.emplace_back(0.0);
+      if (with_uv) out_.uvs[first_uv + k] = glm::dvec2(uv.values[2 * v], 1.0 - uv.values[2 * v + 1]);  // v runs down
+    }
+  });
+  out_.position_index.resize(corners + 3 * tris.size());
+  out_.normal_index.resize(corners + 3 * tris.size());
+  if (!out_.uvs.empty()) out_.uv_index.resize(corners + 3 * tris.size());
+  out_.material.resize(out_.material.size() + tris.size(), material);
+  parallel_for((tris.size() + CHUNK - 1) / CHUNK, thread_count(0, tris.size() / CHUNK + 1), [&](size_t c, int) {
+    for (size_t t = c * CHUNK; t < std::min(tris.size(), (c + 1) * CHUNK); ++t) {
+      const uint32_t order[3] = {tris[t][0], mirrors ? tris[t][2] : tris[t][1], mirrors ? tris[t][1] : tris[t][2]};
+      for (size_t k = 0; k < 3; ++k) {
+        const size_t at = corners + 3 * t + k;
+        const uint32_t v = number[order[k]];
+        out_.position_index[at] = static_cast<uint32_t>(first + v);
+        out_.normal_index[at] = with_normals ? static_cast<uint32_t>(first_normal + v) : LocalMesh::NO_NORMAL;
+        if (with_uv) {
+          out_.uv_index[at] = static_cast<uint32_t>(first_uv + v);
+        } else if (!out_.uvs.empty()) {
+          out_.uv_index[at] = LocalMesh::NO_UV;
+        }
       }
     }
-    out_.material.push_back(material);
-  }
+  });
 }
 
 }  // namespace abcube::detail::gltf

@@ -215,7 +215,8 @@ void GltfReader::add_light(const tg::Value& v, const std::string& at, const glm:
 // triangles (the inverse square evaluated once, where the model is).
 void GltfReader::finish_lights() {
   Bounds b;
-  for (const glm::dvec3& p : out_.positions) {
+  for (const uint32_t v : out_.position_index) {  // the vertices of triangles only
+    const glm::dvec3& p = out_.positions[v];
     if (std::isfinite(p.x + p.y + p.z)) b.extend(p);
   }
   const glm::dvec3 centre = b.empty() ? glm::dvec3(0.0) : 0.5 * (b.lo + b.hi);
