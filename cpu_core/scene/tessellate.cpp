@@ -336,6 +336,66 @@ bool is_zero_area(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
   return !(twice_area > ZERO_AREA_RELATIVE * longest2) || !std::isfinite(longest2);
 }
 
+namespace {
+
+// Local triangle t, mapped by m, written to soup place `at` (its object id already there);
+// false, nothing written, for a triangle the renderer would not see whole (not finite, or
+// of zero area). `order`: the corners' order (reversed by a mirroring map).
+bool put_triangle(const LocalMesh& local, const AffineMap& m, const int order[3], size_t t, uint32_t material,
+                  bool store_uvs, size_t at, TriangleSoup* soup) {
+  glm::vec3 f[3];
+  glm::dvec3 p[3];
+  for (int k = 0; k < 3; ++k) {
+    f[k] = to_float(m.point(local.position(3 * t + static_cast<size_t>(order[k]))));
+    p[k] = glm::dvec3(f[k]);  // judge the triangle the renderer will see
+  }
+  if (!finite3(p[0]) || !finite3(p[1]) || !finite3(p[2]) || is_zero_area(p[0], p[1], p[2])) return false;
+  const glm::dvec3 flat = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
+  glm::dvec3 n[3] = {flat, flat, flat};
+  if (!local.normals.empty()) {
+    bool smooth = true;
+    for (int k = 0; k < 3 && smooth; ++k) {
+      const glm::dvec3 w = m.normal_matrix * local.normal(3 * t + static_cast<size_t>(order[k]));
+      const double len = glm::length(w);
+      smooth = std::isfinite(len) && len > 0.0;
+      if (smooth) n[k] = w / len;
+    }
+    if (!smooth) n[0] = n[1] = n[2] = flat;
+  }
+  for (size_t k = 0; k < 3; ++k) {
+    soup->positions[3 * at + k] = f[k];
+    soup->normals[3 * at + k] = glm::vec3(n[k]);
+    if (store_uvs) soup->uvs[3 * at + k] = glm::vec2(local.uv(3 * t + static_cast<size_t>(order[k])));
+  }
+  const int mat = local.material.empty() ? -1 : local.material[t];
+  soup->material_id[at] = mat < 0 ? material : static_cast<uint32_t>(mat);
+  return true;
+}
+
+// Moves the kept triangles of places first, first + 1, ... down over the dropped ones, in
+// order, and cuts the soup after them.
+void close_up(const std::vector<uint8_t>& kept, size_t first, bool store_uvs, TriangleSoup* soup) {
+  size_t to = first;
+  for (size_t t = 0; t < kept.size(); ++t) {
+    if (!kept[t]) continue;
+    const size_t from = first + t;
+    if (to != from) {
+      std::copy_n(&soup->positions[3 * from], 3, &soup->positions[3 * to]);
+      std::copy_n(&soup->normals[3 * from], 3, &soup->normals[3 * to]);
+      if (store_uvs) std::copy_n(&soup->uvs[3 * from], 3, &soup->uvs[3 * to]);
+      soup->material_id[to] = soup->material_id[from];
+    }
+    ++to;
+  }
+  soup->positions.resize(3 * to);
+  soup->normals.resize(3 * to);
+  if (store_uvs) soup->uvs.resize(3 * to);
+  soup->object_id.resize(to);
+  soup->material_id.resize(to);
+}
+
+}  // namespace
+
 size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t object_id, uint32_t material,
                         TriangleSoup* soup) {
   // A mirroring transform reverses the winding; swapping b and c restores the sense of
@@ -356,39 +416,29 @@ size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t obj
   // (Tested on the soup's size, not its emptiness: the first object of all has no objects before it.)
   const bool store_uvs = !local.uvs.empty() || !soup->uvs.empty();
   if (store_uvs && soup->uvs.size() < soup->positions.size()) soup->uvs.resize(soup->positions.size(), glm::vec2(0.0f));
+  // Triangle t is written to place first + t, on the hardware's threads, each a run of
+  // triangles; then, if some were dropped, the kept ones close up in order: the same soup
+  // as one thread appending the kept triangles one by one.
+  const size_t first = soup->object_id.size(), count = local.triangle_count();
+  soup->positions.resize(3 * (first + count));
+  soup->normals.resize(3 * (first + count));
+  if (store_uvs) soup->uvs.resize(3 * (first + count));
+  soup->object_id.resize(first + count, object_id);
+  soup->material_id.resize(first + count);
+  std::vector<uint8_t> kept(count, 1);
+  constexpr size_t RUN = size_t{1} << 14;
+  const size_t runs = (count + RUN - 1) / RUN;
+  std::vector<size_t> dropped_in(runs, 0);
+  parallel_for(runs, thread_count(0, runs), [&](size_t r, int) {
+    for (size_t t = r * RUN; t < std::min(count, (r + 1) * RUN); ++t) {
+      if (put_triangle(local, m, order, t, material, store_uvs, first + t, soup)) continue;
+      kept[t] = 0;
+      ++dropped_in[r];
+    }
+  });
   size_t dropped = 0;
-  for (size_t t = 0; t < local.triangle_count(); ++t) {
-    glm::vec3 f[3];
-    glm::dvec3 p[3];
-    for (int k = 0; k < 3; ++k) {
-      f[k] = to_float(m.point(local.position(3 * t + static_cast<size_t>(order[k]))));
-      p[k] = glm::dvec3(f[k]);  // judge the triangle the renderer will see
-    }
-    if (!finite3(p[0]) || !finite3(p[1]) || !finite3(p[2]) || is_zero_area(p[0], p[1], p[2])) {
-      ++dropped;
-      continue;
-    }
-    const glm::dvec3 flat = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
-    glm::dvec3 n[3] = {flat, flat, flat};
-    if (!local.normals.empty()) {
-      bool smooth = true;
-      for (int k = 0; k < 3 && smooth; ++k) {
-        const glm::dvec3 w = m.normal_matrix * local.normal(3 * t + static_cast<size_t>(order[k]));
-        const double len = glm::length(w);
-        smooth = std::isfinite(len) && len > 0.0;
-        if (smooth) n[k] = w / len;
-      }
-      if (!smooth) n[0] = n[1] = n[2] = flat;
-    }
-    const int mat = local.material.empty() ? -1 : local.material[t];
-    for (int k = 0; k < 3; ++k) {
-      soup->positions.push_back(f[k]);
-      soup->normals.push_back(glm::vec3(n[k]));
-      if (store_uvs) soup->uvs.push_back(glm::vec2(local.uv(3 * t + static_cast<size_t>(order[k]))));
-    }
-    soup->object_id.push_back(object_id);
-    soup->material_id.push_back(mat < 0 ? material : static_cast<uint32_t>(mat));
-  }
+  for (const size_t d : dropped_in) dropped += d;
+  if (dropped > 0) close_up(kept, first, store_uvs, soup);
   return dropped;
 }
 
