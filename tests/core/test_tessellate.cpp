@@ -13,6 +13,48 @@ using namespace scene_test;
 
 // ---- Geometry --------------------------------------------------------------------------
 
+// Triangles are written by runs on several threads and the dropped ones closed up after:
+// across many runs, the soup holds the kept triangles in order after what it held, each
+// with its own normals, texture coordinates and material.
+TEST(SceneLoadGeometry, AppendKeepsTheKeptTrianglesInOrderAcrossRuns) {
+  LocalMesh local;
+  const size_t count = 70000;  // several runs of triangles
+  std::vector<size_t> kept;
+  for (size_t t = 0; t < count; ++t) {
+    const double x = static_cast<double>(t);
+    const bool drop = t % 7 == 3 || t % 1000 == 999;
+    const glm::dvec3 far = drop ? glm::dvec3(x + 2, 0, 0) : glm::dvec3(x, 1, 0);  // collinear when dropped
+    for (const glm::dvec3& p : {glm::dvec3(x, 0, 0), glm::dvec3(x + 1, 0, 0), far}) {
+      local.positions.push_back(p);
+      local.normals.push_back(glm::dvec3(0, 0, 1));
+      local.uvs.push_back(glm::dvec2(x, 0.5));
+    }
+    local.material.push_back(static_cast<int>(t % 5));
+    if (!drop) kept.push_back(t);
+  }
+  TriangleSoup soup;
+  soup.positions.assign(3, glm::vec3(9));
+  soup.normals.assign(3, glm::vec3(0, 1, 0));
+  soup.object_id.assign(1, 0);
+  soup.material_id.assign(1, 7);
+  const size_t dropped = append_triangles(local, make_affine_map(Transform{}), 1, 0, &soup);
+  EXPECT_EQ(dropped, count - kept.size());
+  ASSERT_EQ(soup.triangle_count(), 1 + kept.size());
+  ASSERT_EQ(soup.uvs.size(), soup.positions.size());
+  EXPECT_EQ(soup.positions[0], glm::vec3(9));
+  EXPECT_EQ(soup.uvs[0], glm::vec2(0.0f));  // the object before got (0, 0)
+  for (size_t k = 0; k < kept.size(); ++k) {
+    const size_t at = 1 + k;
+    const float x = static_cast<float>(kept[k]);
+    ASSERT_EQ(soup.positions[3 * at], glm::vec3(x, 0, 0)) << k;
+    ASSERT_EQ(soup.positions[3 * at + 2], glm::vec3(x, 1, 0)) << k;
+    ASSERT_EQ(soup.uvs[3 * at + 1], glm::vec2(x, 0.5f)) << k;
+    ASSERT_EQ(soup.normals[3 * at + 1], glm::vec3(0, 0, 1)) << k;
+    ASSERT_EQ(soup.object_id[at], 1u) << k;
+    ASSERT_EQ(soup.material_id[at], static_cast<uint32_t>(kept[k] % 5)) << k;
+  }
+}
+
 TEST(SceneLoadGeometry, ZeroAreaTrianglesAreDroppedAndCounted) {
   const SceneData s = load_text(with_objects(R"([
       {"type": "triangle", "vertices": [[0,0,0],[1,1,1],[2,2,2]]},
