@@ -10,35 +10,41 @@ namespace abcube {
 
 namespace {
 
-SceneLimits limits_arg(const py::handle& root, const py::handle& max_triangles, const py::handle& max_memory_mib) {
+SceneLimits limits_arg(const py::handle& root, const py::handle& max_triangles, const py::handle& max_memory_mib,
+                       const py::handle& threads) {
   SceneLimits limits;
   if (!root.is_none()) limits.root = path_arg(root, "root");
   limits.max_triangles = unsigned_arg(max_triangles, "max_triangles");
   limits.max_memory_mib = unsigned_arg(max_memory_mib, "max_memory_mib");
+  const uint64_t t = unsigned_arg(threads, "threads");
+  if (t > 4096) throw InputError("threads: must be in [0, 4096], got " + std::to_string(t));
+  limits.threads = static_cast<int>(t);
   return limits;
 }
 
 Scene load_scene(const py::handle& path, const py::handle& root, const py::handle& max_triangles,
-                 const py::handle& max_memory_mib, const py::handle& set) {
+                 const py::handle& max_memory_mib, const py::handle& set, const py::handle& threads) {
   const std::string file = path_arg(path, "load_scene: path");
-  const SceneLimits limits = limits_arg(root, max_triangles, max_memory_mib);
+  const SceneLimits limits = limits_arg(root, max_triangles, max_memory_mib, threads);
   const SceneOverrides overrides = overrides_arg(set);
   py::gil_scoped_release release;
   return Scene::load(file, limits, overrides);
 }
 
 Scene scene_from_json(const py::handle& text, const py::handle& name, const py::handle& base_dir,
-                      const py::handle& root, const py::handle& max_triangles, const py::handle& max_memory_mib) {
+                      const py::handle& root, const py::handle& max_triangles, const py::handle& max_memory_mib,
+                      const py::handle& threads) {
   const std::string json_text = string_arg(text, "scene_from_json: text");
   const std::string scene_name = string_arg(name, "name");
   const std::string dir = path_arg(base_dir, "base_dir");
-  const SceneLimits limits = limits_arg(root, max_triangles, max_memory_mib);
+  const SceneLimits limits = limits_arg(root, max_triangles, max_memory_mib, threads);
   py::gil_scoped_release release;
   return Scene::from_json(json_text, scene_name, dir, limits);
 }
 
 Scene scene_from_dict(const py::handle& scene, const py::handle& name, const py::handle& base_dir,
-                      const py::handle& root, const py::handle& max_triangles, const py::handle& max_memory_mib) {
+                      const py::handle& root, const py::handle& max_triangles, const py::handle& max_memory_mib,
+                      const py::handle& threads) {
   // Python's json writes the text; NaN and infinity are refused here (not JSON), the rest is
   // validated by the loader, whose messages name the field path.
   if (!py::isinstance<py::dict>(scene)) {
@@ -51,7 +57,7 @@ Scene scene_from_dict(const py::handle& scene, const py::handle& name, const py:
     if (!e.matches(PyExc_ValueError) && !e.matches(PyExc_TypeError)) throw;
     throw InputError(string_arg(name, "name") + ": not a JSON scene: " + std::string(py::str(e.value())));
   }
-  return scene_from_json(text, name, base_dir, root, max_triangles, max_memory_mib);
+  return scene_from_json(text, name, base_dir, root, max_triangles, max_memory_mib, threads);
 }
 
 std::string scene_repr(const Scene& s) {
@@ -82,23 +88,25 @@ needs it. Made by load_scene, scene_from_dict or scene_from_json.)doc")
       .def("__repr__", &scene_repr);
 
   m.def("load_scene", &load_scene, py::arg("path"), py::arg("root") = py::none(), py::arg("max_triangles") = 0,
-        py::arg("max_memory_mib") = 0, py::arg("set") = py::none(),
+        py::arg("max_memory_mib") = 0, py::arg("set") = py::none(), py::arg("threads") = 0,
         R"doc(Loads a scene file, or a model file (.gltf, .glb, .obj: the model alone, framed and
 lit, 640 x 480, its own camera if it has one; docs/models-and-textures.md). Untrusted scenes:
 `root` confines every file the scene references to that folder, `max_triangles` (> 0) caps
 its size, `max_memory_mib` (> 0, else the memory available) the memory its triangles may
 take; all are refused before anything is allocated. `set`: a dict {"camera.fov_y": 30,
 "lights[0].position": [1, 4, 2], ...} of the file's values replaced before it is read, as
-`abcube render --set`. A bad scene raises SceneError naming the place ("scene.json:12:5:
+`abcube render --set`. `threads`: the cores the load may use (0 = every core; a large OBJ or
+glTF mesh is read on them). A bad scene raises SceneError naming the place ("scene.json:12:5:
 ..." or "scene.json: objects[3].radius: ...").)doc");
   m.def("scene_from_dict", &scene_from_dict, py::arg("scene"), py::arg("name") = "<dict>", py::arg("base_dir") = ".",
         py::arg("root") = py::none(), py::arg("max_triangles") = 0, py::arg("max_memory_mib") = 0,
+        py::arg("threads") = 0,
         R"doc(A scene from a dict in the scene file's format. `name` stands for the file in
 messages ("<dict>: objects[0].radius: ..."); relative mesh paths resolve against
 `base_dir`. Raises SceneError as load_scene does.)doc");
   m.def("scene_from_json", &scene_from_json, py::arg("text"), py::arg("name") = "<json>", py::arg("base_dir") = ".",
         py::arg("root") = py::none(), py::arg("max_triangles") = 0, py::arg("max_memory_mib") = 0,
-        "A scene from JSON text; as scene_from_dict.");
+        py::arg("threads") = 0, "A scene from JSON text; as scene_from_dict.");
 }
 
 }  // namespace abcube

@@ -355,7 +355,7 @@ void read_object(LoadState& st, const Json& v, size_t index) {
   const uint32_t id = static_cast<uint32_t>(st.scene.objects.size());
   obj.first_triangle = static_cast<uint32_t>(soup.triangle_count());
   const AffineMap map = make_affine_map(transform);
-  st.scene.dropped_triangles += append_triangles(local, map, id, obj.material, &soup);
+  st.scene.dropped_triangles += append_triangles(local, map, id, obj.material, &soup, st.limits.threads);
   add_extras(st, extras, map, use_camera);
   obj.triangle_count = static_cast<uint32_t>(soup.triangle_count() - obj.first_triangle);
   const bool per_face_materials = !local.material.empty();

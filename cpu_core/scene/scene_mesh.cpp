@@ -241,11 +241,13 @@ void resolve_materials(const LoadState& st, const std::string& path, const std::
   obj->mtl_file_of = std::move(mtl.file_of);
 }
 
-// The OBJ file read on the hardware's threads (obj_text.hpp), its materials resolved.
+// The OBJ file read on the load's threads (obj_text.hpp), its materials resolved.
 ObjFile parse_obj(const LoadState& st, const std::string& path, const std::string& resolved) {
   ObjFile obj;
   try {
-    obj.text = read_obj_text(resolved);
+    ObjReading reading;
+    reading.threads = st.limits.threads;
+    obj.text = read_obj_text(resolved, reading);
   } catch (const std::runtime_error& e) {
     fail(st.src, path, "cannot read mesh " + quote_path(resolved) + ": " + e.what());
   }
@@ -475,7 +477,7 @@ bool triangulate_run(const ObjFile& obj, const FaceRun& run, const std::vector<i
 
 // The OBJ file's faces as triangles of `m` (its vertex arrays filled), each with its MTL
 // material when `use_mtl` (mtl_ids: per material of the file, the scene's); polygons ear
-// clipped. The face runs are taken on the hardware's threads.
+// clipped. The face runs are taken on the load's threads.
 void add_obj_faces(LoadState& st, const std::string& path, const std::string& resolved, const ObjFile& obj,
                    const std::vector<uint32_t>& mtl_ids, bool use_mtl, LocalMesh* out) {
   LocalMesh& m = *out;
@@ -490,7 +492,7 @@ void add_obj_faces(LoadState& st, const std::string& path, const std::string& re
   const std::vector<FaceRun> runs = face_runs(obj.text);
   const std::vector<int> materials = run_materials(st, obj, mtl_ids, use_mtl);
   std::vector<uint64_t> bad(runs.size(), UINT64_MAX);
-  parallel_for(runs.size(), thread_count(0, runs.size()),
+  parallel_for(runs.size(), thread_count(st.limits.threads, runs.size()),
                [&](size_t r, int) { triangulate_run(obj, runs[r], materials, &m, &bad[r]); });
   const uint64_t first_bad = bad.empty() ? UINT64_MAX : *std::min_element(bad.begin(), bad.end());
   if (first_bad != UINT64_MAX) {

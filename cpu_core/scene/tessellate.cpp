@@ -397,7 +397,7 @@ void close_up(const std::vector<uint8_t>& kept, size_t first, bool store_uvs, Tr
 }  // namespace
 
 size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t object_id, uint32_t material,
-                        TriangleSoup* soup) {
+                        TriangleSoup* soup, int threads) {
   // A mirroring transform reverses the winding; swapping b and c restores the sense of
   // the geometric normal.
   const int order[3] = {0, m.mirrors ? 2 : 1, m.mirrors ? 1 : 2};
@@ -416,7 +416,7 @@ size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t obj
   // (Tested on the soup's size, not its emptiness: the first object of all has no objects before it.)
   const bool store_uvs = !local.uvs.empty() || !soup->uvs.empty();
   if (store_uvs && soup->uvs.size() < soup->positions.size()) soup->uvs.resize(soup->positions.size(), glm::vec2(0.0f));
-  // Triangle t is written to place first + t, on the hardware's threads, each a run of
+  // Triangle t is written to place first + t, on up to `threads` threads, each a run of
   // triangles; then, if some were dropped, the kept ones close up in order: the same soup
   // as one thread appending the kept triangles one by one.
   const size_t first = soup->object_id.size(), count = local.triangle_count();
@@ -429,7 +429,7 @@ size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t obj
   constexpr size_t RUN = size_t{1} << 14;
   const size_t runs = (count + RUN - 1) / RUN;
   std::vector<size_t> dropped_in(runs, 0);
-  parallel_for(runs, thread_count(0, runs), [&](size_t r, int) {
+  parallel_for(runs, thread_count(threads, runs), [&](size_t r, int) {
     for (size_t t = r * RUN; t < std::min(count, (r + 1) * RUN); ++t) {
       if (put_triangle(local, m, order, t, material, store_uvs, first + t, soup)) continue;
       kept[t] = 0;

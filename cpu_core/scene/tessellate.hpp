@@ -93,9 +93,10 @@ bool is_zero_area(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
 
 // Appends `local`, moved to world space by `m`, to `soup` as object `object_id`; triangles
 // without a material entry (or with -1) get `material`. Triangles that are zero-area or
-// non-finite once stored as floats are skipped; returns how many were.
+// non-finite once stored as floats are skipped; returns how many were. On up to `threads`
+// threads (0: every core); the same soup for any number.
 size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t object_id, uint32_t material,
-                        TriangleSoup* soup);
+                        TriangleSoup* soup, int threads = 0);
 
 // The half-edges of triangles [first, first + count) of the soup: half-edge 3 i + k runs
 // from corner k to corner k + 1 of triangle first + i. A vertex is an object and a float

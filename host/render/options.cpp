@@ -345,6 +345,7 @@ void add_resources(Table& t) {
       [](RenderSetup& s, const json& v) {
         s.render.threads = v.get<int>();
         s.renderer.threads = v.get<int>();
+        s.limits.threads = v.get<int>();
       },
       [](const RenderSetup& s) { return unless(s.render.threads, 0); });
   add(t, {"timeout", "--timeout", OptionKind::number, OptionScope::job, {}, 0, 1e9, "0 (no limit)", "seconds", {}, "",

@@ -16,6 +16,8 @@ LoadLimits load_limits(const SceneLimits& limits) {
   l.max_triangles = limits.max_triangles;
   if (limits.max_memory_mib > (uint64_t{1} << 30)) throw InputError("max-memory: must be at most 2^30 MiB");
   l.max_memory_bytes = limits.max_memory_mib << 20;
+  if (limits.threads < 0) throw InputError("threads: must be >= 0, got " + std::to_string(limits.threads));
+  l.threads = limits.threads;
   return l;
 }
 

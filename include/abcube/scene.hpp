@@ -19,6 +19,9 @@ struct SceneLimits {
   // The memory budget the scene's triangles must fit, MiB (0 = the memory available, as
   // RenderOptions::max_memory_mib): refused at load, before they are made.
   uint64_t max_memory_mib = 0;
+  // Threads the load may use (parsing OBJ files, converting glTF accessors, making the
+  // triangles), 0 = every core. `--threads` sets it with the render's.
+  int threads = 0;
 };
 
 // One value of the scene file replaced before it is read (`abcube render --set KEY=VALUE`,

@@ -103,3 +103,27 @@ def test_error_then_success(tmp_path):
             abcube.scene_from_dict({"version": 1, "objects": [{"type": "nosuch"}]})
     scene = abcube.load_scene(str(write_scene(tmp_path / "ok.json", small_scene_dict())))
     assert abcube.Renderer(gl="none").render(scene, method="raytrace").shape == (24, 32, 3)
+
+
+def test_load_threads_give_the_same_scene(tmp_path):
+    # threads= is the cores the load may use: any number gives the same triangles; a count
+    # out of range names the keyword.
+    n = 130  # 33,800 triangles: the OBJ parts and the soup's runs split between threads
+    rows = ["v %d %.3f %d" % (i, 0.1 * ((i * 7 + j * 3) % 5), j) for j in range(n + 1) for i in range(n + 1)]
+    rows += ["f %d %d %d %d" % (j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 2,
+                                j * (n + 1) + i + 2) for j in range(n) for i in range(n)]
+    (tmp_path / "grid.obj").write_text("\n".join(rows) + "\n")
+    scene = small_scene_dict(method="raytrace")
+    mesh = next(i for i, o in enumerate(scene["objects"]) if o["type"] == "mesh")
+    scene["objects"][mesh]["file"] = "grid.obj"
+    scene["objects"][mesh]["transform"] = {"scale": 0.01}
+    renderer = abcube.Renderer(gl="none")
+    images = []
+    for threads in (1, 3, 0):
+        loaded = abcube.scene_from_dict(copy.deepcopy(scene), base_dir=str(tmp_path), threads=threads)
+        assert loaded.triangle_count > 2 * n * n
+        images.append(renderer.render(loaded))
+    assert (images[0] == images[1]).all() and (images[0] == images[2]).all()
+    for bad in (5000, -1):
+        with pytest.raises((abcube.SceneError, ValueError, TypeError), match="threads"):
+            abcube.scene_from_dict(copy.deepcopy(scene), base_dir=str(tmp_path), threads=bad)
