@@ -115,4 +115,16 @@ void parallel_for(size_t count, int threads, Fn&& fn) {
   }
 }
 
+// Calls fn(i) for i in [0, count), handed out `run` items at a time (the deadline and a
+// stop request checked between runs), on up to `threads` threads (0: every core). For
+// loops over many cheap items, each writing its own place.
+template <class Fn>
+void parallel_for_runs(size_t count, size_t run, int threads, Fn&& fn) {
+  const size_t runs = (count + run - 1) / run;
+  parallel_for(runs, thread_count(threads, runs), [&](size_t r, int) {
+    const size_t end = std::min(count, (r + 1) * run);
+    for (size_t i = r * run; i < end; ++i) fn(i);
+  });
+}
+
 }  // namespace abcube

@@ -358,14 +358,10 @@ CubeABuffer build_cube_abuffer(const SceneData& scene, const glm::dvec3& centre,
   // one face's pyramid, and the five other faces then skip them unset up.
   const TriangleSoup& soup = *scene.triangles;
   std::vector<uint8_t> faces_of(soup.triangle_count());
-  constexpr size_t CHUNK = 1 << 14;
-  parallel_for((faces_of.size() + CHUNK - 1) / CHUNK, thread_count(options.threads, CUBE_FACES), [&](size_t c, int) {
-    const size_t end = std::min(faces_of.size(), (c + 1) * CHUNK);
-    for (size_t t = c * CHUNK; t < end; ++t) {
-      const uint32_t k = static_cast<uint32_t>(t);
-      faces_of[t] = triangle_shape(centre, soup, k) == SetupResult::visible ? cube_faces_of(centre, soup, k)
-                                                                            : uint8_t{(1u << CUBE_FACES) - 1};
-    }
+  parallel_for_runs(faces_of.size(), size_t{1} << 14, options.threads, [&](size_t t) {
+    const uint32_t k = static_cast<uint32_t>(t);
+    faces_of[t] = triangle_shape(centre, soup, k) == SetupResult::visible ? cube_faces_of(centre, soup, k)
+                                                                          : uint8_t{(1u << CUBE_FACES) - 1};
   });
   std::vector<ABuffer> faces = build_views(scene, std::move(rasters), "cube A-buffer", options, stats, &faces_of);
   faces_of = std::vector<uint8_t>();

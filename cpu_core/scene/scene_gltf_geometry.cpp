@@ -101,19 +101,8 @@ double read_component(const unsigned char* p, int c, bool normalized) {
   }
 }
 
-namespace {
-
-// visit(i) for i in [0, count), in chunks on up to `threads` threads (0: every core).
-template <class Visit>
-void for_chunks(size_t count, int threads, Visit&& visit) {
-  constexpr size_t CHUNK = size_t{1} << 15;
-  const size_t chunks = (count + CHUNK - 1) / CHUNK;
-  parallel_for(chunks, thread_count(threads, chunks), [&](size_t c, int) {
-    for (size_t i = c * CHUNK; i < std::min(count, (c + 1) * CHUNK); ++i) visit(i);
-  });
-}
-
-}  // namespace
+// Items of an accessor or a primitive handed to a thread at a time.
+constexpr size_t ACCESSOR_RUN = size_t{1} << 15;
 
 const char* mode_name(int mode) {
   static const char* names[] = {"POINTS",    "LINES",          "LINE_LOOP",   "LINE_STRIP",
@@ -274,7 +263,7 @@ Accessed GltfReader::read_accessor(int index, const std::string& at, std::initia
     size_t stride = 0;
     const unsigned char* p = view_bytes(a.bufferView, a.byteOffset, a.count, elem, &stride, aat);
     const size_t cb = component_bytes(a.componentType);
-    for_chunks(a.count, st_.limits.threads, [&](size_t i) {
+    parallel_for_runs(a.count, ACCESSOR_RUN, st_.limits.threads, [&](size_t i) {
       for (int k = 0; k < out.n; ++k) {
         out.values[i * static_cast<size_t>(out.n) + static_cast<size_t>(k)] =
             read_component(p + i * stride + static_cast<size_t>(k) * cb, a.componentType, a.normalized);
@@ -283,7 +272,7 @@ Accessed GltfReader::read_accessor(int index, const std::string& at, std::initia
   }
   if (a.sparse.isSparse) apply_sparse(a, aat, elem, &out);
   std::atomic<size_t> first_bad{SIZE_MAX};  // the first value that is not finite
-  for_chunks(out.values.size(), st_.limits.threads, [&](size_t i) {
+  parallel_for_runs(out.values.size(), ACCESSOR_RUN, st_.limits.threads, [&](size_t i) {
     if (std::isfinite(out.values[i])) return;
     size_t seen = first_bad.load();
     while (i < seen && !first_bad.compare_exchange_weak(seen, i)) {
@@ -402,45 +391,37 @@ void GltfReader::append_triangles(const std::vector<std::array<uint32_t, 3>>& tr
     if (out_.uvs.empty()) out_.uv_index.assign(corners, LocalMesh::NO_UV);  // the primitives before
     out_.uvs.resize(first_uv + used);
   }
-  constexpr size_t CHUNK = size_t{1} << 14;
-  parallel_for(
-      (p.count + CHUNK - 1) / CHUNK, thread_count(st_.limits.threads, p.count / CHUNK + 1), [&](size_t c, int) {
-        for (size_t v = c * CHUNK; v < std::min(p.count, (c + 1) * CHUNK); ++v) {
-          if (number[v] == UNUSED) continue;
-          const size_t k = number[v];
-          const double* q = &p.values[3 * v];
-          out_.positions[first + k] = glm::dvec3(world * glm::dvec4(q[0], q[1], q[2], 1.0));
-          if (with_normals) {
-            const double* m = &nrm.values[3 * v];
-            const glm::dvec3 n = normal_matrix * glm::dvec3(m[0], m[1], m[2]);
-            const double len = glm::length(n);
-            out_.normals[first_normal + k] = len > 0 && std::isfinite(len) ? n / len : glm::dvec3(0.0);  // 0: flat
-          }
-          if (with_uv)
-            out_.uvs[first_uv + k] = glm::dvec2(uv.values[2 * v], 1.0 - uv.values[2 * v + 1]);  // v runs down
-        }
-      });
+  parallel_for_runs(p.count, ACCESSOR_RUN, st_.limits.threads, [&](size_t v) {
+    if (number[v] == UNUSED) return;
+    const size_t k = number[v];
+    const double* q = &p.values[3 * v];
+    out_.positions[first + k] = glm::dvec3(world * glm::dvec4(q[0], q[1], q[2], 1.0));
+    if (with_normals) {
+      const double* m = &nrm.values[3 * v];
+      const glm::dvec3 n = normal_matrix * glm::dvec3(m[0], m[1], m[2]);
+      const double len = glm::length(n);
+      out_.normals[first_normal + k] = len > 0 && std::isfinite(len) ? n / len : glm::dvec3(0.0);  // 0: flat
+    }
+    if (with_uv) out_.uvs[first_uv + k] = glm::dvec2(uv.values[2 * v], 1.0 - uv.values[2 * v + 1]);  // v runs down
+  });
   out_.position_index.resize(corners + 3 * tris.size());
   out_.normal_index.resize(corners + 3 * tris.size());
   if (!out_.uvs.empty()) out_.uv_index.resize(corners + 3 * tris.size());
   out_.material.resize(out_.material.size() + tris.size(), material);
-  parallel_for(
-      (tris.size() + CHUNK - 1) / CHUNK, thread_count(st_.limits.threads, tris.size() / CHUNK + 1), [&](size_t c, int) {
-        for (size_t t = c * CHUNK; t < std::min(tris.size(), (c + 1) * CHUNK); ++t) {
-          const uint32_t order[3] = {tris[t][0], mirrors ? tris[t][2] : tris[t][1], mirrors ? tris[t][1] : tris[t][2]};
-          for (size_t k = 0; k < 3; ++k) {
-            const size_t at = corners + 3 * t + k;
-            const uint32_t v = number[order[k]];
-            out_.position_index[at] = static_cast<uint32_t>(first + v);
-            out_.normal_index[at] = with_normals ? static_cast<uint32_t>(first_normal + v) : LocalMesh::NO_NORMAL;
-            if (with_uv) {
-              out_.uv_index[at] = static_cast<uint32_t>(first_uv + v);
-            } else if (!out_.uvs.empty()) {
-              out_.uv_index[at] = LocalMesh::NO_UV;
-            }
-          }
-        }
-      });
+  parallel_for_runs(tris.size(), ACCESSOR_RUN, st_.limits.threads, [&](size_t t) {
+    const uint32_t order[3] = {tris[t][0], mirrors ? tris[t][2] : tris[t][1], mirrors ? tris[t][1] : tris[t][2]};
+    for (size_t k = 0; k < 3; ++k) {
+      const size_t at = corners + 3 * t + k;
+      const uint32_t v = number[order[k]];
+      out_.position_index[at] = static_cast<uint32_t>(first + v);
+      out_.normal_index[at] = with_normals ? static_cast<uint32_t>(first_normal + v) : LocalMesh::NO_NORMAL;
+      if (with_uv) {
+        out_.uv_index[at] = static_cast<uint32_t>(first_uv + v);
+      } else if (!out_.uvs.empty()) {
+        out_.uv_index[at] = LocalMesh::NO_UV;
+      }
+    }
+  });
 }
 
 }  // namespace abcube::detail::gltf

@@ -425,19 +425,11 @@ size_t append_triangles(const LocalMesh& local, const AffineMap& m, uint32_t obj
   if (store_uvs) soup->uvs.resize(3 * (first + count));
   soup->object_id.resize(first + count, object_id);
   soup->material_id.resize(first + count);
-  std::vector<uint8_t> kept(count, 1);
-  constexpr size_t RUN = size_t{1} << 14;
-  const size_t runs = (count + RUN - 1) / RUN;
-  std::vector<size_t> dropped_in(runs, 0);
-  parallel_for(runs, thread_count(threads, runs), [&](size_t r, int) {
-    for (size_t t = r * RUN; t < std::min(count, (r + 1) * RUN); ++t) {
-      if (put_triangle(local, m, order, t, material, store_uvs, first + t, soup)) continue;
-      kept[t] = 0;
-      ++dropped_in[r];
-    }
+  std::vector<uint8_t> kept(count);
+  parallel_for_runs(count, size_t{1} << 14, threads, [&](size_t t) {
+    kept[t] = put_triangle(local, m, order, t, material, store_uvs, first + t, soup) ? 1 : 0;
   });
-  size_t dropped = 0;
-  for (const size_t d : dropped_in) dropped += d;
+  const size_t dropped = static_cast<size_t>(std::count(kept.begin(), kept.end(), 0));
   if (dropped > 0) close_up(kept, first, store_uvs, soup);
   return dropped;
 }
