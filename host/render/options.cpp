@@ -341,7 +341,7 @@ void add_gpu_camera(Table& t) {
 void add_resources(Table& t) {
   const RendererOptions rd;
   add(t, {"threads", "--threads", OptionKind::integer, OptionScope::job, {}, 0, 4096, "0 (every core)", "threads", {}, "",
-       "worker threads, 0 = every core", {}},
+       "worker threads, for the render and for loading the scene, 0 = every core", {}},
       [](RenderSetup& s, const json& v) {
         s.render.threads = v.get<int>();
         s.renderer.threads = v.get<int>();
