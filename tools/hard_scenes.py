@@ -211,8 +211,9 @@ def t_coplanar(rng, ctx):
 
 def t_plane_through_camera(rng, ctx):
     """A wide plane at exactly the camera's height (its plane contains the camera), seen in
-    a tilted mirror in front of the camera."""
-    h = rng.uniform(0.8, 1.6)
+    a tilted mirror in front of the camera. The height is a multiple of 1/64, exact in float
+    and double alike: the camera lies on the plane exactly, not a rounding away from it."""
+    h = round(rng.uniform(0.8, 1.6) * 64) / 64
     mats = {"floor": diffuse(rng), "shelf": diffuse(rng, specular=0.2), "mirror": mirror_material(rng)}
     side = rng.choice([-1, 1])
     # the shelf: y = h exactly, beside the camera (x from 0.6 to 4.6 on one side), long in z

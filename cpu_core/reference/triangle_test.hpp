@@ -7,7 +7,16 @@
 // edge functions decide. A ray through a shared edge or vertex of a closed mesh hits at
 // least one of the triangles around it, never slips through (two triangles sharing an edge
 // compute its edge function from the same two vertices, so the signs cannot both exclude).
+//
+// THE ORIGIN RULE: a hit counts only where t > 0 beyond the rounding of its computation
+// (t_error_bound below). A triangle whose plane passes through the ray's origin, a camera on
+// a floor or a ray started on its own surface, is never hit by that ray: exactly as the
+// cube map gives such a plane no area. Without the bound, the sign of a t that is exactly 0
+// is the sign of the rounding, and such a plane is hit by some rays and missed by their
+// neighbours (streaks).
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <utility>
 
@@ -45,7 +54,31 @@ struct TriangleHit {
   double b0 = 0, b1 = 0, b2 = 0;
 };
 
-// Whether the ray meets triangle `triangle` of `soup` at 0 < t < tmax; fills *hit if so.
+// gamma(n) = n u / (1 - n u), u the unit roundoff of double: the relative error of n
+// rounded operations (Higham, "Accuracy and Stability of Numerical Algorithms", 3.1).
+constexpr double rounding_gamma(int n) {
+  constexpr double u = 0x1p-53;
+  return n * u / (1.0 - n * u);
+}
+
+// A bound on the rounding of s = u az + v bz + w cz in intersect_triangle (t = s sz / det),
+// from the magnitudes of the sheared coordinates x, y, z of the three vertices and of the
+// edge functions e = (u, v, w), each error bounded by the error of its inputs plus its own
+// operations: the vertices are exact doubles, each relative coordinate one subtraction off
+// (z), the shear two operations more with |sx|, |sy| <= 1 (x, y); an edge function two
+// products and a difference of them; s three products and two sums. Each gamma carries one
+// operation more than it counts, for the second-order terms. The exact s is zero exactly when
+// the origin lies on the triangle's plane (s is the triple product of the relative vertices,
+// which the shear keeps), so |s| <= this bound is that case within rounding.
+inline double s_error_bound(double x, double y, double z, double e) {
+  const double dz = rounding_gamma(2) * z;
+  const double dx = rounding_gamma(4) * (x + 2.0 * z), dy = rounding_gamma(4) * (y + 2.0 * z);
+  const double de = 2.0 * (rounding_gamma(3) * x * y + x * dy + y * dx);
+  return 3.0 * (rounding_gamma(4) * e * z + e * dz + z * de);
+}
+
+// Whether the ray meets triangle `triangle` of `soup` at 0 < t < tmax, t positive beyond its
+// rounding (THE ORIGIN RULE); fills *hit if so.
 inline bool intersect_triangle(const RayQuery& ray, const TriangleSoup& soup, uint32_t triangle, double tmax,
                                TriangleHit* hit) {
   const glm::vec3* p = &soup.positions[3 * static_cast<size_t>(triangle)];
@@ -61,10 +94,18 @@ inline bool intersect_triangle(const RayQuery& ray, const TriangleSoup& soup, ui
   if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) return false;
   const double det = u + v + w;
   if (det == 0.0) return false;
-  const double t_scaled = ray.sz * (u * a[ray.kz] + v * b[ray.kz] + w * c[ray.kz]);
+  const double s = u * a[ray.kz] + v * b[ray.kz] + w * c[ray.kz];
+  const double t_scaled = ray.sz * s;
   if (det > 0.0 ? (t_scaled <= 0.0 || t_scaled >= tmax * det) : (t_scaled >= 0.0 || t_scaled <= tmax * det)) {
     return false;
   }
+  // THE ORIGIN RULE, on the few tests that reach here: s of the sign of det, and zero within
+  // its rounding, is the origin on the plane.
+  const double z = std::max({std::fabs(a[ray.kz]), std::fabs(b[ray.kz]), std::fabs(c[ray.kz])});
+  const double x = std::max({std::fabs(ax), std::fabs(bx), std::fabs(cx)});
+  const double y = std::max({std::fabs(ay), std::fabs(by), std::fabs(cy)});
+  const double e = std::max({std::fabs(u), std::fabs(v), std::fabs(w)});
+  if (std::fabs(s) <= s_error_bound(x, y, z, e)) return false;
   const double inv_det = 1.0 / det;
   hit->t = t_scaled * inv_det;
   hit->triangle = triangle;

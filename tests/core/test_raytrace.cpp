@@ -484,6 +484,108 @@ TEST(Raytrace, HitCarriesExactGeometry) {
   EXPECT_FALSE(h.front_face);
 }
 
+// THE ORIGIN RULE (triangle_test.hpp): a ray never meets a triangle whose plane passes
+// through its origin. Origins exactly on the plane (vertices, edge midpoints, interior points
+// with power-of-two weights: exact in double), at scales 1e-3 to 1e4, in every direction,
+// grazing ones too: no hit, where the sign of a rounded t = 0 would hit about half of them.
+TEST(Raytrace, NoHitFromAnOriginOnTheTrianglesPlane) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  TriangleSoup soup;
+  int rays = 0, hits = 0;
+  for (int k = 0; k < 200; ++k) {
+    const double scale = std::pow(10.0, -3.0 + 7.0 * (k % 8) / 7.0);
+    const dvec3 shift = scale * 3.0 * dvec3(unit(rng), unit(rng), unit(rng));
+    glm::vec3 p[3];
+    for (glm::vec3& v : p) v = glm::vec3(shift + scale * dvec3(unit(rng), unit(rng), unit(rng)));
+    soup.positions.assign(p, p + 3);
+    const dvec3 a(p[0]), b(p[1]), c(p[2]);
+    const dvec3 n = glm::normalize(glm::cross(b - a, c - a));
+    for (const dvec3& origin : {a, (a + b) * 0.5, (b + c) * 0.5, (a + b + 2.0 * c) * 0.25, (a + 2.0 * b + c) * 0.25}) {
+      for (int j = 0; j < 50; ++j) {
+        dvec3 d = glm::normalize(dvec3(unit(rng), unit(rng), unit(rng)));
+        if (j % 5 == 0) d = glm::normalize(d - glm::dot(d, n) * n + 1e-6 * unit(rng) * n);  // grazing
+        TriangleHit h;
+        ++rays;
+        if (intersect_triangle(RayQuery(origin, d), soup, 0, INFINITY, &h)) ++hits;
+      }
+    }
+  }
+  EXPECT_EQ(rays, 200 * 5 * 50);
+  EXPECT_EQ(hits, 0);
+}
+
+// The rule costs no real hit: from 1e-9 of the scene off the plane (where secondary rays
+// start, shading.hpp), every ray towards the triangle's inside meets it, at scales 1e-3 to 1e4.
+TEST(Raytrace, OriginRuleKeepsHitsFromTheSecondaryRaysOffset) {
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), weight(0.1, 1.0);
+  TriangleSoup soup;
+  int misses = 0;
+  for (int k = 0; k < 400; ++k) {
+    const double scale = std::pow(10.0, -3.0 + 7.0 * (k % 8) / 7.0);
+    glm::vec3 p[3];
+    for (glm::vec3& v : p) v = glm::vec3(scale * dvec3(unit(rng), unit(rng), unit(rng)));
+    soup.positions.assign(p, p + 3);
+    const dvec3 a(p[0]), b(p[1]), c(p[2]);
+    const dvec3 n = glm::normalize(glm::cross(b - a, c - a));
+    const double wa = weight(rng), wb = weight(rng), wc = weight(rng);
+    const dvec3 inside = (wa * a + wb * b + wc * c) / (wa + wb + wc);
+    const double offset = self_intersection_offset(inside, 2.0 * scale);
+    const dvec3 origin = inside + offset * n;
+    dvec3 d = glm::normalize(-n + 0.5 * dvec3(unit(rng), unit(rng), unit(rng)));
+    if (glm::dot(d, n) > -0.05) d = -n;
+    TriangleHit h;
+    if (!intersect_triangle(RayQuery(origin, d), soup, 0, INFINITY, &h)) ++misses;
+  }
+  EXPECT_EQ(misses, 0);
+}
+
+// A camera exactly on a plane sees none of it: every camera ray starts on the plane, so every
+// pixel is the background, as the cube map, which gives the plane no area, sees it.
+TEST(Raytrace, CameraOnAPlaneSeesNoneOfIt) {
+  SceneData s = empty_scene({0.375, 1.25, 2.0}, {-4.0, 0.2, -20.0}, 70, 48, 36);
+  s.background = {0.2, 0.3, 0.4};
+  begin_object(s, "quad", add_material(s, emissive({0.9, 0.1, 0.1})), false);
+  // A plane through the eye, tilted, its vertices exact in float: the eye is on it exactly.
+  const dvec3 eye = s.camera.position, u(1.0, 0.25, 0.0), v(0.0, 0.5, 1.0);
+  add_flat_triangle(s, eye - 40.0 * u - 40.0 * v, eye + 40.0 * u - 40.0 * v, eye + 40.0 * u + 40.0 * v);
+  add_flat_triangle(s, eye - 40.0 * u - 40.0 * v, eye + 40.0 * u + 40.0 * v, eye - 40.0 * u + 40.0 * v);
+  for (const glm::vec3& p : s.triangles->positions) {
+    ASSERT_EQ(glm::dot(glm::dvec3(p) - eye, glm::cross(u, v)), 0.0);  // exactly on the plane
+  }
+  RaytraceOptions o;
+  o.threads = 2;
+  const Image img = render_raytrace(s, o);
+  int plane_pixels = 0;
+  for (int y = 0; y < img.height; ++y) {
+    for (int x = 0; x < img.width; ++x) plane_pixels += pixel(img, x, y) != dvec3(glm::vec3(s.background));
+  }
+  EXPECT_EQ(plane_pixels, 0);
+}
+
+// A shadow ray, or any ray, started on its own surface towards the light does not meet that
+// surface: the light is unblocked.
+TEST(Raytrace, RayFromItsOwnSurfaceDoesNotMeetIt) {
+  SceneData s = empty_scene({0, 5, 5}, {0, 0, 0}, 60, 8, 8);
+  const uint32_t m = add_material(s, Material{});
+  begin_object(s, "triangle", m, false);
+  const dvec3 a(-3.1, 0.2, -2.9), b(2.7, -0.3, -3.3), c(0.1, 0.4, 3.7);
+  add_flat_triangle(s, a, b, c);
+  const RayTracer tracer(s);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  int hits = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const dvec3 pa(s.triangles->positions[0]), pb(s.triangles->positions[1]), pc(s.triangles->positions[2]);
+    const dvec3 origin = k % 2 ? (pa + pb + 2.0 * pc) * 0.25 : (pb + pc) * 0.5;
+    const dvec3 light(unit(rng) * 10, 5 + unit(rng) * 4, unit(rng) * 10);
+    Hit h;
+    hits += tracer.intersect(origin, light - origin, 1.0, &h);
+  }
+  EXPECT_EQ(hits, 0);
+}
+
 TEST(Raytrace, MirrorAt45SendsMarkerToComputedPixel) {
   // Camera at the origin looking down -z; a mirror in the plane x + z = -5 (45 degrees);
   // a red square at x = 3, out of the camera's view, seen only in the mirror.
