@@ -278,12 +278,12 @@ glm::dvec3 MapShader::reflected(const SurfacePoint& sp, const glm::dvec3& dir, i
   if (options_.method == Method::envmap) {
     if (stats) ++stats->envmap_lookups;
     const glm::dvec3 lookup = envmap_direction(sp.point, r);
-    if (primary && reference_ && stats) measure(sp.point, r, nullptr, &lookup, stats);
+    if (primary && reference_ && stats) measure(sp, r, nullptr, &lookup, stats);
     return envmap_at(lookup);
   }
   SearchResult found;
   const glm::dvec3 c = trace(sp.point, r, depth + 1, stack, stats, known, &found, trail);
-  if (primary && reference_ && stats) measure(sp.point, r, &found, nullptr, stats);
+  if (primary && reference_ && stats) measure(sp, r, &found, nullptr, stats);
   return c;
 }
 
@@ -396,10 +396,14 @@ glm::dvec3 MapShader::envmap_texel(int face, int i, int j) const {
 }
 
 // Error_CP and Error_Parallax of one reflection ray against the exact tracer (thesis 9).
-void MapShader::measure(const glm::dvec3& w, const glm::dvec3& r, const SearchResult* found, const glm::dvec3* lookup,
-                        MapShadingStats* stats) const {
+// The exact ray leaves the surface as every secondary ray of the tracer does (shading.hpp
+// offset_origin), so that what it meets first is what the tracer's reflection meets.
+void MapShader::measure(const SurfacePoint& sp, const glm::dvec3& r, const SearchResult* found,
+                        const glm::dvec3* lookup, MapShadingStats* stats) const {
   RayErrors& e = stats->errors;
-  const glm::dvec3 origin = w + r * (1e-9 * reference_->scene_scale());
+  const glm::dvec3& w = sp.point;
+  const glm::dvec3 origin =
+      offset_origin(w, sp.geometric_normal, r, self_intersection_offset(w, reference_->scene_scale()));
   Hit exact;
   const bool exact_hit = reference_->intersect(origin, r, &exact);
   const glm::dvec3 c = cube_.centre;

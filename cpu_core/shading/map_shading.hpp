@@ -269,7 +269,7 @@ class MapShader {
                          KnownBlockers* known, uint64_t* trail) const;
   glm::dvec3 envmap_direction(const glm::dvec3& w, const glm::dvec3& r) const;
   glm::dvec3 envmap_at(const glm::dvec3& direction) const;
-  void measure(const glm::dvec3& w, const glm::dvec3& r, const SearchResult* found, const glm::dvec3* lookup,
+  void measure(const SurfacePoint& sp, const glm::dvec3& r, const SearchResult* found, const glm::dvec3* lookup,
                MapShadingStats* stats) const;
   glm::dvec3 envmap_texel(int face, int i, int j) const;
 

@@ -131,6 +131,31 @@ TEST(ABuffer, MergeNeedsSameObjectMaterialFacingAndDepth) {
     EXPECT_GE(diagonal_pixels_with_two(s), 8);
   }
   {
+    // One object, same material and facing, normals 6 degrees apart (within the merge's
+    // crease bound), crossing at x = 0: in the two columns that touch x = 0 their depth
+    // ranges share the crossing's, and each covers the whole pixel. Overlapping masks never
+    // merge (thesis 5.2): two fragments.
+    SceneData s = base;
+    begin_object(s, "mesh", m0, false);
+    add_flat_triangle(s, 1.2 * a, 1.2 * b, 1.2 * c);
+    const auto tilt = [](const dvec3& p) { return dvec3(p.x, p.y, p.z + 0.1 * p.x); };
+    add_flat_triangle(s, tilt(1.2 * a), tilt(1.2 * b), tilt(1.2 * c));
+    const ABuffer buf = build_camera_abuffer(s, test_options(true));
+    int crossing = 0, two = 0;
+    for (int y = 0; y < buf.height(); ++y) {
+      for (int x = 0; x < buf.width(); ++x) {
+        const FragmentList l = buf.list(x, y);
+        bool full_overlap = false;
+        for (const Fragment& f : l) full_overlap = full_overlap || f.mask == FULL_MASK;
+        if (l.size() == 0 || !full_overlap || (x != buf.width() / 2 - 1 && x != buf.width() / 2)) continue;
+        ++crossing;
+        two += l.size() == 2 && (l[0].mask & l[1].mask) != 0 && l[1].zmin <= l[0].zmax;
+      }
+    }
+    EXPECT_GE(crossing, 8);
+    EXPECT_EQ(two, crossing);
+  }
+  {
     SceneData s = base;  // one object, same facing, disjoint depths: two layers everywhere
     begin_object(s, "mesh", m0, false);
     add_flat_triangle(s, a, b, c);

@@ -2,6 +2,7 @@
 // and each method's image against the exact tracer on the repository scenes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ostream>
@@ -13,6 +14,15 @@
 #include "io/metrics.hpp"
 #include "reference/raytrace.hpp"
 #include "scene/scene_load.hpp"
+
+// Scene builders, defined in test_raytrace.cpp.
+namespace abcube::testkit {
+SceneData empty_scene(const glm::dvec3& eye, const glm::dvec3& look_at, double fov_y_deg, int width, int height);
+uint32_t add_material(SceneData& s, const Material& m);
+uint32_t add_quad(SceneData& s, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& d,
+                  uint32_t material);
+uint32_t add_box(SceneData& s, const glm::dvec3& lo, const glm::dvec3& hi, uint32_t material);
+}  // namespace abcube::testkit
 
 namespace abcube {
 namespace {
@@ -184,6 +194,71 @@ TEST(MapShading, HiddenPointIsFoundOnlyWithAllLayers) {
   EXPECT_GT(judged, 50);
   EXPECT_EQ(ab_green, judged);
   EXPECT_EQ(zb_green, 0);
+}
+
+// A box standing on a floor 2 km wide, lit from straight above: the floor is in shadow
+// exactly where the segment to the light crosses the box, max(|x|, |z|) <= 0.75 here (the
+// box's top face projected from the light), lit beyond. Every pixel whose footprint lies
+// clear inside the ring of contact shadow or clear outside it has the closed-form colour, in
+// the exact tracer and in abuffer: a shadow ray starts a hair off the floor (shading.hpp
+// SELF_INTERSECTION_REL), never as far as the box's height, however wide the scene.
+TEST(MapShading, ContactShadowOfABoxOnAWideFloorIsExact) {
+  using namespace testkit;
+  SceneData s = empty_scene({0.0, 3.0, 2.6}, {0.0, 0.0, 0.2}, 50, 96, 72);
+  s.ambient = glm::dvec3(0.2);
+  s.background = glm::dvec3(0.0);
+  PointLight light;
+  light.position = {0, 3, 0};
+  s.lights.push_back(light);
+  Material floor;
+  floor.color = glm::dvec3(0.8);
+  const uint32_t floor_m = add_material(s, floor);
+  add_quad(s, {-1000, 0, 1000}, {1000, 0, 1000}, {1000, 0, -1000}, {-1000, 0, -1000}, floor_m);
+  add_box(s, {-0.5, 0.0, -0.5}, {0.5, 1.0, 0.5}, add_material(s, Material{}));
+  s.render.cube_resolution = 256;
+  const CameraFrame f = make_camera_frame(s.camera);
+  // The floor point seen at image point (x, y), and its class: 1 in the shadow ring, 2 lit;
+  // -1 not judged (within `margin` of a boundary, beside or behind the box, or far).
+  const auto floor_at = [&](double x, double y) {
+    const glm::dvec3 d = f.direction(x, y);
+    return f.eye + (-f.eye.y / d.y) * d;
+  };
+  const double margin = 0.02;
+  const auto classify = [&](const glm::dvec3& p) {
+    const double m = std::max(std::fabs(p.x), std::fabs(p.z));
+    if (p.z < 0.5 + margin) return -1;  // beside or behind the box: not judged
+    if (std::fabs(m - 0.75) < margin || m > 3.0) return -1;  // at the ring's edge, or far (wide footprints)
+    return m < 0.75 ? 1 : 2;
+  };
+  struct Case {
+    const char* name;
+    Image image;
+  };
+  const RayTracer rt(s);
+  RaytraceOptions ro;
+  ro.threads = 2;
+  for (const Case& c : {Case{"raytrace", render_raytrace(s, ro)}, Case{"abuffer", render_method(s, Method::abuffer).image}}) {
+    int ring = 0, lit = 0, wrong = 0;
+    for (int y = 0; y < c.image.height; ++y) {
+      for (int x = 0; x < c.image.width; ++x) {
+        const int k = classify(floor_at(x, y));
+        bool same = k > 0;
+        for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}})
+          same = same && classify(floor_at(x + dx, y + dy)) == k;
+        if (!same) continue;
+        const glm::dvec3 p = floor_at(x + 0.5, y + 0.5);
+        const double ndotl = 3.0 / glm::length(light.position - p);
+        // Lambert varies across the pixel: 1e-3 covers it at this footprint.
+        const glm::dvec3 want = k == 1 ? 0.2 * floor.color : 0.2 * floor.color + ndotl * floor.color;
+        (k == 1 ? ring : lit) += 1;
+        if (glm::length(glm::dvec3(c.image.rgb(x, y)) - want) > 1e-3) ++wrong;
+      }
+    }
+    std::printf("[ contact  ] %s: %d ring pixels, %d lit, %d off the closed form\n", c.name, ring, lit, wrong);
+    EXPECT_GE(ring, 20) << c.name;
+    EXPECT_GE(lit, 200) << c.name;
+    EXPECT_EQ(wrong, 0) << c.name;
+  }
 }
 
 // Each method against the exact tracer on the scenes with hidden points and near
