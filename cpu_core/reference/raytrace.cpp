@@ -282,28 +282,46 @@ std::vector<Ray> RayTracer::transmitted_path(const glm::dvec3& origin, const glm
 
 namespace {
 
-// One row of the image: every pixel the mean of its camera samples (box filter).
+// One row of the image: every pixel the mean of its camera samples (box filter). At 32
+// samples they are summed in their own order, at a lower rung in the ladder's; the rungs of a
+// pilot are the ladder's prefixes of the same colours, summed as a render at that rung sums.
 void render_row(const RayTracer& tracer, const CameraFrame& frame, int spp, int y, Image* image, RayCounts* counts,
-                const std::vector<uint8_t>* only) {
+                const std::vector<uint8_t>* only, std::array<Image, LOWER_RUNGS>* rungs) {
+  glm::dvec3 colour[MASK_SAMPLES];
   for (int x = 0; x < frame.width; ++x) {
     if (only && !(*only)[static_cast<size_t>(y) * static_cast<size_t>(frame.width) + static_cast<size_t>(x)]) continue;
+    const auto sample = [&](double sx, double sy) { return tracer.trace(frame.eye, frame.direction(x + sx, y + sy), 0, counts); };
     glm::dvec3 sum(0.0);
-    for (int k = 0; k < spp; ++k) {
-      const double sx = spp == 1 ? 0.5 : sample_dx(k);
-      const double sy = spp == 1 ? 0.5 : sample_dy(k);
-      sum += tracer.trace(frame.eye, frame.direction(x + sx, y + sy), 0, counts);
+    if (spp == 1) {
+      sum = sample(0.5, 0.5);
+    } else if (spp < MASK_SAMPLES) {
+      for (int i = 0; i < spp; ++i) sum += sample(sample_dx(SAMPLE_LADDER[i]), sample_dy(SAMPLE_LADDER[i]));
+    } else {
+      for (int k = 0; k < MASK_SAMPLES; ++k) sum += colour[k] = sample(sample_dx(k), sample_dy(k));
     }
     counts->primary += static_cast<uint64_t>(spp);
     image->set_rgb(x, y, glm::vec3(sum / static_cast<double>(spp)));
+    if (!rungs) continue;
+    (*rungs)[0].set_rgb(x, y, glm::vec3(sample(0.5, 0.5)));
+    ++counts->primary;
+    glm::dvec3 prefix(0.0);
+    for (int i = 0, rung = 1; rung < LOWER_RUNGS; ++rung) {
+      const int s = 1 << rung;
+      for (; i < s; ++i) prefix += colour[SAMPLE_LADDER[i]];
+      (*rungs)[static_cast<size_t>(rung)].set_rgb(x, y, glm::vec3(prefix / static_cast<double>(s)));
+    }
   }
 }
 
 }  // namespace
 
 Image render_raytrace(const SceneData& scene, const RaytraceOptions& options, RaytraceStats* stats) {
-  if (options.samples_per_pixel != 1 && options.samples_per_pixel != MASK_SAMPLES) {
-    throw InputError("raytrace: samples per pixel must be 1 or " + std::to_string(MASK_SAMPLES) + ", got " +
+  if (!is_sample_rung(options.samples_per_pixel)) {
+    throw InputError("raytrace: samples per pixel must be 1, 2, 4, 8, 16 or 32, got " +
                      std::to_string(options.samples_per_pixel));
+  }
+  if (options.rungs && options.samples_per_pixel != MASK_SAMPLES) {
+    throw InputError("raytrace: the ladder's rungs need 32 samples a pixel");
   }
   if (options.threads < 0) throw InputError("raytrace: threads must be >= 0, got " + std::to_string(options.threads));
   ABCUBE_CHECK(!options.only || options.only->size() ==
@@ -312,6 +330,9 @@ Image render_raytrace(const SceneData& scene, const RaytraceOptions& options, Ra
   const RayTracer tracer(scene, options.bvh);
   const CameraFrame frame = make_camera_frame(scene.camera);
   Image image(frame.width, frame.height, 3);
+  if (options.rungs) {
+    for (Image& rung : *options.rungs) rung = Image(frame.width, frame.height, 3);
+  }
   const int threads = thread_count(options.threads, static_cast<size_t>(frame.height));
 
   const Clock::time_point start = Clock::now();
@@ -320,7 +341,7 @@ Image render_raytrace(const SceneData& scene, const RaytraceOptions& options, Ra
   double reported = 0;  // written by worker 0 only, which is the calling thread
   parallel_for(static_cast<size_t>(frame.height), threads, [&](size_t row, int worker) {
     render_row(tracer, frame, options.samples_per_pixel, static_cast<int>(row), &image,
-               &counts[static_cast<size_t>(worker)], options.only);
+               &counts[static_cast<size_t>(worker)], options.only, options.rungs);
     const int done = ++rows_done;
     if (worker == 0 && options.progress) options.progress(reported = static_cast<double>(done) / frame.height);
   });

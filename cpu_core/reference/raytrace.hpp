@@ -7,6 +7,7 @@
 // watertight double test through Embree's BVH (bvh.hpp), and the image is bit-identical for
 // any number of threads. docs/design/raytrace.md has the rules in full.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -21,9 +22,17 @@
 
 namespace abcube {
 
+// The ladder's rungs below 32 samples (samples.hpp THE SAMPLE LADDER): 1, 2, 4, 8, 16.
+constexpr int LOWER_RUNGS = 5;
+
 struct RaytraceOptions {
-  int threads = 0;             // 0 = std::thread::hardware_concurrency()
-  int samples_per_pixel = 32;  // 32 (the 4x8 A-buffer samples) or 1 (pixel centre)
+  int threads = 0;  // 0 = std::thread::hardware_concurrency()
+  // A rung of THE SAMPLE LADDER (samples.hpp): 32 (the 4x8 A-buffer samples, the reference),
+  // 16, 8, 4, 2 (the ladder's first samples) or 1 (the pixel's centre).
+  int samples_per_pixel = 32;
+  // For pilots: with 32 samples a pixel, each traced pixel also gets, in (*rungs)[i], the value
+  // it has at 2^i samples a pixel (the same bits a render at that rung gives it).
+  std::array<Image, LOWER_RUNGS>* rungs = nullptr;
   // Called now and then on the calling thread with the share of rows done, in [0, 1].
   std::function<void(double)> progress;
   // The scene's BVH when already built (SceneCache); null: built for this render.
@@ -131,7 +140,7 @@ class RayTracer {
 };
 
 // Renders the scene's camera view with THE RULES. Throws InputError for a bad
-// option (samples_per_pixel not 1 or 32, negative threads).
+// option (samples_per_pixel not a rung, rungs without 32 samples, negative threads).
 Image render_raytrace(const SceneData& scene, const RaytraceOptions& options = {}, RaytraceStats* stats = nullptr);
 
 }  // namespace abcube

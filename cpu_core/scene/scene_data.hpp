@@ -109,10 +109,13 @@ struct RenderSettings {
   int max_depth = 4;
   bool fresnel = false;     // Schlick weights for kr/kt (shading.hpp secondary_weights); off = thesis
   double error_target = 0;  // > 0: choose cube_resolution from the Error_Parallax bound (plan.hpp)
-  // > 0: the abuffer method chooses cube_resolution by pilot renders so that the image
-  // reaches this PSNR (dB) against the exact tracer (host/render/target_db.hpp). It
-  // overrides cube_resolution and error_target.
+  // > 0: the image reaches this PSNR (dB) against the exact tracer, by pilot renders
+  // (host/render/target_db.hpp): the abuffer method chooses cube_resolution (overriding it and
+  // error_target), the raytrace method its samples a pixel (overriding samples).
   double target_db = 0;
+  // The raytrace method's camera samples a pixel: a rung of THE SAMPLE LADDER (samples.hpp).
+  // The other methods shade the 32 samples of the A-buffer's masks, and the reference is 32.
+  int samples = 32;
 };
 // The range a target PSNR may take, in dB: 8-bit images one code apart everywhere are 48 dB.
 constexpr double MIN_TARGET_DB = 1, MAX_TARGET_DB = 100;

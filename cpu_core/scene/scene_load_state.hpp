@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "scene/framing.hpp"
 #include "scene/scene_data.hpp"
 #include "scene/scene_json.hpp"
 #include "scene/scene_load.hpp"
@@ -36,6 +37,24 @@ struct LoadState {
   // memory_budget_bytes(limits.max_memory_bytes), read once when loading starts.
   uint64_t memory_budget = 0;
 };
+
+// ---- The sections (scene_sections.cpp) ----
+
+// The camera section; with "frame": "all" its position and look_at are placed once the
+// objects are loaded (frame_camera), along "direction".
+struct CameraSection {
+  Camera camera;
+  bool frame = false;
+  glm::dvec3 direction = DEFAULT_FRAME_DIRECTION;
+};
+CameraSection read_camera(const Fields& f);
+PointLight read_light(const Fields& f);
+// Phong material with the format's defaults (docs/scene-format.md "materials").
+Material read_material(const Fields& f, const std::string& name);
+RenderSettings read_render(const Fields& f);
+Transform read_transform(const Fields& f);
+
+// ---- The objects ----
 
 uint32_t add_material(LoadState& st, Material m);
 // The material "(default)", made on first use.

@@ -14,6 +14,7 @@
 
 #include "base/error.hpp"
 #include "base/nearest_name.hpp"
+#include "base/samples.hpp"
 #include "scene/scene_data.hpp"
 
 namespace abcube {
@@ -160,11 +161,18 @@ void add_what_to_render(Table& t) {
       [](RenderSetup& s, const json& v) { s.render.error_target = v.get<double>(); },
       [](const RenderSetup& s) { return s.render.error_target < 0 ? json() : json(s.render.error_target); });
   add(t, {"target_db", "--target-db", OptionKind::number, OptionScope::job, {}, MIN_TARGET_DB, MAX_TARGET_DB,
-       "the scene's render.target_db", "dB", {"abuffer"}, "only abuffer chooses its cube map's N from pilot renders",
-       "PSNR to reach against the exact tracer: abuffer picks the cube map's N from pilot renders checked against "
-       "exact rays (overrides the scene's cube_resolution)", {}},
+       "the scene's render.target_db", "dB", {"abuffer", "raytrace"},
+       "only abuffer and raytrace choose their cost from pilot renders",
+       "PSNR to reach against the exact tracer, from pilot renders checked against exact pixels: abuffer picks the "
+       "cube map's N and shading (overrides cube_resolution), raytrace its samples a pixel (overrides samples)", {}},
       [](RenderSetup& s, const json& v) { s.render.target_db = v.get<double>(); },
       [](const RenderSetup& s) { return s.render.target_db < 0 ? json() : json(s.render.target_db); });
+  add(t, {"samples", "--samples", OptionKind::integer, OptionScope::job, {}, 1, 32, "the scene's render.samples",
+       "samples a pixel", {"raytrace"}, "the other methods shade the 32 samples of the A-buffer's masks",
+       "the exact tracer's camera samples a pixel: 1 (the centre), 2, 4, 8, 16 (the first of the 32, evenly "
+       "spread) or 32 (the reference)", {}},
+      [](RenderSetup& s, const json& v) { s.render.samples = v.get<int>(); },
+      [](const RenderSetup& s) { return unless(s.render.samples, 0); });
   add(t, {"fresnel", "--fresnel", OptionKind::flag, OptionScope::job, {}, 0, 0, "the scene's render.fresnel", "", {}, "",
        "Schlick weights for reflect and transmit", {}},
       [](RenderSetup& s, const json& v) { s.render.fresnel = v.get<bool>(); },
@@ -514,7 +522,13 @@ void check_render_options(const RenderOptions& options) {
     const json v = e.read(setup);
     if (!v.is_null()) check_value(e.spec, v);
   }
+  if (options.samples != 0 && !is_sample_rung(options.samples)) {
+    throw OptionError("samples", "must be 1, 2, 4, 8, 16 or 32, got " + std::to_string(options.samples));
+  }
   // Options that contradict one another.
+  if (options.target_db > 0 && options.samples != 0) {
+    throw OptionError("target_db", "chooses the tracer's samples, and so does samples (--samples): give one");
+  }
   if (options.target_db > 0 && (options.cube_resolution != 0 || options.error_target >= 0)) {
     const OptionSpec& other = *find_render_option(options.cube_resolution != 0 ? "cube_res" : "error_target");
     throw OptionError("target_db",
@@ -543,6 +557,7 @@ RenderOptions without_unused_options(const RenderOptions& options, const std::st
       {"cube_res", [](RenderOptions& o, const RenderOptions& x) { o.cube_resolution = x.cube_resolution; }},
       {"error_target", [](RenderOptions& o, const RenderOptions& x) { o.error_target = x.error_target; }},
       {"target_db", [](RenderOptions& o, const RenderOptions& x) { o.target_db = x.target_db; }},
+      {"samples", [](RenderOptions& o, const RenderOptions& x) { o.samples = x.samples; }},
       {"plan", [](RenderOptions& o, const RenderOptions& x) { o.plan_everything = x.plan_everything; }},
       {"search", [](RenderOptions& o, const RenderOptions& x) { o.search = x.search; }},
       {"refine", [](RenderOptions& o, const RenderOptions& x) { o.refine = x.refine; }},

@@ -263,6 +263,14 @@ Image render_hybrid(MethodContext& mc) {
 Image render_reference(MethodContext& mc, const char* key) {
   RaytraceOptions options;
   options.threads = mc.request.threads;
+  // The raytrace method at its rung of THE SAMPLE LADDER; the reference of the other methods
+  // always at all 32.
+  if (std::string(key) == "raytrace") {
+    if (mc.scene.render.target_db > 0) return raytrace_for_target(mc);
+    options.samples_per_pixel = mc.scene.render.samples;
+    mc.stats["counts"]["camera_samples_per_pixel"] = options.samples_per_pixel;
+    mc.stats["method_options"]["samples"] = options.samples_per_pixel;
+  }
   if (mc.progress) {
     const std::string stage = key;
     options.progress = [&mc, stage](double done) { mc.progress(stage, done); };
@@ -363,7 +371,10 @@ double add_reference_error(MethodContext& mc, const Image& image) {
     }
     stats["reference"]["image"] = r.reference_image;
   } else {
-    ref = mc.scene.render.method == Method::raytrace ? image : render_reference(mc, "reference");
+    // The tracer's own image is the reference only at the reference's 32 samples.
+    const bool reference_itself = mc.scene.render.method == Method::raytrace && mc.scene.render.target_db <= 0 &&
+                                  mc.scene.render.samples == MASK_SAMPLES;
+    ref = reference_itself ? image : render_reference(mc, "reference");
   }
   const ImageError e = image_error(image, ref);
   stats["reference"]["image_error"] = image_error_json(e);

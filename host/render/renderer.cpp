@@ -84,8 +84,10 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
     rs.method = parse_checked(o.method, parse_method);
   }
   if (o.target_db > 0) rs.target_db = o.target_db;
-  // An N the render asks for, or a bound that gives one, wins over the scene's target.
-  if (o.cube_resolution != 0 || o.error_target >= 0) rs.target_db = 0;
+  // An N or samples the render asks for, or a bound that gives an N, wins over the scene's
+  // target; the scene's target wins over its own samples (as over its own N).
+  if (o.cube_resolution != 0 || o.error_target >= 0 || o.samples != 0) rs.target_db = 0;
+  if (o.samples != 0) rs.samples = o.samples;
   if (o.error_target >= 0) rs.error_target = o.error_target;
   if (rs.target_db > 0) rs.error_target = 0;  // the scene's target wins over its bound
   if (rs.error_target > 0 && o.cube_resolution == 0) {
@@ -152,9 +154,10 @@ json request_stats(const SceneData& view, const RenderRequest& request) {
                      {"dropped_triangles", view.dropped_triangles},
                      {"objects", view.objects.size()},
                      {"lights", view.lights.size()}};
-  if (view.render.target_db > 0 && view.render.method != Method::abuffer) {
+  if (view.render.target_db > 0 && view.render.method != Method::abuffer && view.render.method != Method::raytrace) {
     stats["target_db"] = {{"target", view.render.target_db},
-                          {"why", std::string("not used: only abuffer chooses its N from a target, the method is ") +
+                          {"why", std::string("not used: only abuffer and raytrace choose their cost from a target, "
+                                              "the method is ") +
                                       method_name(view.render.method)}};
   }
   if (view.render.error_target > 0) {

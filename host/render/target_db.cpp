@@ -5,9 +5,11 @@
 #include <limits>
 
 #include "base/parallel.hpp"
+#include "base/samples.hpp"
 #include "base/timer.hpp"
 #include "io/metrics.hpp"
 #include "reference/raytrace.hpp"
+#include "render/stats_json.hpp"
 
 namespace abcube {
 
@@ -317,6 +319,73 @@ void write_stats(const Pilots& p, json* out) {
 }
 
 }  // namespace
+
+Image raytrace_for_target(MethodContext& mc) {
+  const Clock::time_point start = Clock::now();
+  const SceneData& scene = mc.scene;
+  const double target = scene.render.target_db;
+  int block = 0;
+  const std::vector<uint8_t> pixels = pilot_pixels(scene.camera.width, scene.camera.height, &block);
+  RaytraceOptions ro;
+  ro.threads = mc.request.threads;
+  ro.bvh = mc.cache.bvh();
+  ro.only = &pixels;
+  std::array<Image, LOWER_RUNGS> rungs;
+  ro.rungs = &rungs;
+  RaytraceStats pilot_stats;
+  const Image exact = render_raytrace(scene, ro, &pilot_stats);
+  // The smallest rung whose lower bound reaches the target; 32 samples are the reference.
+  int samples = MASK_SAMPLES;
+  const Image* chosen = &exact;
+  SampledError chosen_error;
+  chosen_error.pixels = 0;
+  chosen_error.psnr = chosen_error.psnr_low = std::numeric_limits<double>::infinity();
+  json lines = json::array();
+  for (int i = 0; i < LOWER_RUNGS; ++i) {
+    const SampledError e = sampled_error(rungs[static_cast<size_t>(i)], exact, pixels);
+    lines.push_back({{"samples", 1 << i}, {"psnr_db", number_or_null(e.psnr)}, {"psnr_db_low", number_or_null(e.psnr_low)}});
+    if (samples == MASK_SAMPLES && e.psnr_low >= target) {
+      samples = 1 << i;
+      chosen = &rungs[static_cast<size_t>(i)];
+      chosen_error = e;
+    }
+  }
+  const double pilot_ms = ms_since(start);
+  // The image at that rung: the pilot's pixels from the pilot, the others traced now.
+  std::vector<uint8_t> rest(pixels.size());
+  for (size_t k = 0; k < pixels.size(); ++k) rest[k] = pixels[k] ? 0 : 1;
+  ro.rungs = nullptr;
+  ro.only = &rest;
+  ro.samples_per_pixel = samples;
+  if (mc.progress) ro.progress = [&mc](double done) { mc.progress("raytrace", done); };
+  RaytraceStats rs;
+  Image image = render_raytrace(scene, ro, &rs);
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      if (pixels[static_cast<size_t>(y) * static_cast<size_t>(image.width) + static_cast<size_t>(x)])
+        image.set_rgb(x, y, chosen->rgb(x, y));
+    }
+  }
+  rs.primary_rays += pilot_stats.primary_rays;
+  rs.secondary_rays += pilot_stats.secondary_rays;
+  rs.shadow_rays += pilot_stats.shadow_rays;
+  mc.stats["raytrace"].update(raytrace_json(rs));
+  mc.stats["counts"]["camera_samples_per_pixel"] = samples;
+  mc.stats["method_options"]["samples"] = samples;
+  mc.stats["target_db"] = {
+      {"target", target},
+      {"samples", samples},
+      {"reached", true},
+      {"why", samples == MASK_SAMPLES ? "no rung below 32 samples is predicted to reach the target: the reference's 32"
+                                      : "the smallest rung of the sample ladder whose predicted PSNR reaches the target"},
+      {"predicted_psnr_db", number_or_null(chosen_error.psnr)},
+      {"predicted_psnr_db_low", number_or_null(chosen_error.psnr_low)},
+      {"sample",
+       {{"pixels", std::count(pixels.begin(), pixels.end(), uint8_t{1})}, {"block", block}, {"exact_trace_ms", pilot_ms}}},
+      {"rungs", lines}};
+  mc.stats["timings_ms"]["target_pilots"] = pilot_ms;
+  return image;
+}
 
 CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABufferOptions& cube_options,
                             const RayTracer* reference) {

@@ -25,6 +25,14 @@
 
 namespace abcube {
 
+// The raytrace method at a target: the smallest rung of THE SAMPLE LADDER (samples.hpp) whose
+// predicted PSNR against the 32 samples reaches it. One pilot traces the sampled pixels
+// (pilot_pixels) at the 32 samples and the pixel's centre: every lower rung is a prefix of
+// them, so one pilot judges them all. The image is then traced at that rung, the pilot's
+// pixels taken from the pilot (the same bits). Writes stats["target_db"] and
+// timings_ms["target_pilots"]; the stats' raytrace entry is the whole image's.
+Image raytrace_for_target(MethodContext& mc);
+
 // The ladder of N the pilots climb, up to max(1024, the scene's own N).
 std::vector<int> target_ladder(int scene_n);
 

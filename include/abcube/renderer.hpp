@@ -61,7 +61,9 @@ struct RenderOptions {
   int cube_resolution = 0;            // N texels per face edge (0 = render.cube_resolution, or error_target's)
   int max_depth = -1;                 // bounces (< 0 = render.max_depth)
   double error_target = -1;           // > 0: N from the Error_Parallax bound 1/(2 N^2) (< 0 = the scene's)
-  double target_db = -1;              // > 0: abuffer picks N to reach this PSNR against the tracer (< 0 = the scene's)
+  double target_db = -1;              // > 0: the PSNR to reach against the tracer: abuffer picks N, raytrace
+                                      // its samples (< 0 = the scene's)
+  int samples = 0;                    // raytrace: camera samples a pixel, 1, 2, 4, 8, 16 or 32 (0 = the scene's)
   std::optional<bool> fresnel;        // Schlick weights for kr and kt (unset = the scene's)
   int threads = 0;                    // 0 = the Renderer's (RendererOptions::threads)
   bool reference = false;             // also trace the exact reference: error figures in the stats

@@ -163,6 +163,66 @@ TEST(TargetDb, FinerMeshesThanTheTexelsMoveNUpWhereItShadesForLess) {
   EXPECT_GE(*r.stats.psnr_db, 40.0);
 }
 
+// raytrace --target-db: the rung the stats report, rendered with --samples, is the very
+// image; it reaches the target against the 32 samples; a rung below the chosen one was
+// predicted short of it; a target only 32 samples reach gives the reference itself.
+TEST(TargetDb, TheTracersRungIsTheImageAndReachesTheTarget) {
+  const Scene scene = Scene::load(scene_path("cornell.json"));
+  Renderer renderer;
+  RenderOptions o = small_options("raytrace", 96, 72, 0);
+  o.target_db = 38;
+  o.reference = true;
+  const RenderResult r = renderer.render(scene, o);
+  const json t = json::parse(r.stats.json)["target_db"];
+  const int samples = t["samples"].get<int>();
+  EXPECT_LT(samples, 32) << t.dump(1);
+  ASSERT_EQ(t["rungs"].size(), 5u);
+  for (const json& rung : t["rungs"]) {
+    if (rung["samples"].get<int>() < samples) EXPECT_LT(rung["psnr_db_low"].get<double>(), 38.0) << t.dump(1);
+  }
+  ASSERT_TRUE(r.stats.psnr_db.has_value());
+  EXPECT_GE(*r.stats.psnr_db, 38.0);
+  RenderOptions direct = small_options("raytrace", 96, 72, 0);
+  direct.samples = samples;
+  EXPECT_TRUE(images_equal(renderer.render(scene, direct).image, r.image));
+
+  o.target_db = 99;  // no lower rung predicted there: the 32 samples
+  o.reference = false;
+  const RenderResult all = renderer.render(scene, o);
+  EXPECT_EQ(json::parse(all.stats.json)["target_db"]["samples"].get<int>(), 32);
+  EXPECT_TRUE(images_equal(all.image, renderer.render(scene, small_options("raytrace", 96, 72, 0)).image));
+}
+
+// Each rung is the image at that many samples: nearer the 32 samples' as it grows, and the
+// pilot's rung images are the bits a render at that rung gives the same pixels.
+TEST(TargetDb, EveryRungOfTheLadderRenders) {
+  const Scene scene = Scene::load(scene_path("cornell.json"));
+  Renderer renderer;
+  RenderOptions o = small_options("raytrace", 64, 48, 0);
+  o.reference = true;
+  double previous = 0;
+  for (int s : {1, 2, 4, 8, 16}) {
+    o.samples = s;
+    const RenderResult r = renderer.render(scene, o);
+    ASSERT_TRUE(r.stats.psnr_db.has_value());
+    EXPECT_GT(*r.stats.psnr_db, previous) << s;
+    previous = *r.stats.psnr_db;
+    EXPECT_EQ(json::parse(r.stats.json)["counts"]["camera_samples_per_pixel"].get<int>(), s);
+  }
+  for (int bad : {3, -1, 33, 64}) {
+    o.samples = bad;
+    EXPECT_THROW(renderer.render(scene, o), InputError) << bad;
+  }
+  o.samples = 4;
+  o.target_db = 40;
+  try {
+    renderer.render(scene, o);
+    FAIL() << "--target-db with --samples rendered";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "target_db: chooses the tracer's samples, and so does samples (--samples): give one");
+  }
+}
+
 TEST(TargetDb, OptionsThatAlsoSetNAreRefused) {
   const Scene scene = Scene::load(scene_path("cornell.json"));
   Renderer renderer;

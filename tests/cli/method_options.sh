@@ -40,7 +40,8 @@ refused() {
 }
 refused raytrace cube-res --cube-res 64
 refused raytrace error-target --error-target 0.001
-for m in raytrace zbuffer envmap gpu hybrid; do refused $m target-db --target-db 40; done
+for m in zbuffer envmap gpu hybrid; do refused $m target-db --target-db 40; done
+for m in abuffer zbuffer envmap gpu hybrid; do refused $m samples --samples 4; done
 refused raytrace plan --plan everything
 for m in raytrace gpu; do
   refused $m search --search thesis

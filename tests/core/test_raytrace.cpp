@@ -1052,8 +1052,15 @@ TEST(Raytrace, EmbreeTracerMatchesThePreEmbreeImagesOnEveryRepositoryScene) {
 TEST(Raytrace, RejectsBadOptions) {
   const SceneData s = mixed_scene(4, 4);
   RaytraceOptions opt;
-  opt.samples_per_pixel = 4;
+  opt.samples_per_pixel = 3;  // not a rung of the ladder
   EXPECT_THROW(render_raytrace(s, opt), InputError);
+  opt.samples_per_pixel = 64;
+  EXPECT_THROW(render_raytrace(s, opt), InputError);
+  std::array<Image, LOWER_RUNGS> rungs;
+  opt.samples_per_pixel = 16;
+  opt.rungs = &rungs;  // the rungs are prefixes of the 32
+  EXPECT_THROW(render_raytrace(s, opt), InputError);
+  opt.rungs = nullptr;
   opt.samples_per_pixel = 1;
   opt.threads = -1;
   EXPECT_THROW(render_raytrace(s, opt), InputError);

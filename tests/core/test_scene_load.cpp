@@ -132,8 +132,8 @@ TEST(SceneLoadErrors, UnknownFieldsAnywhere) {
   s.lights = R"([{"type": "point", "position": [0, 1, 0], "intensity": 2}])";
   EXPECT_ERROR(s.str(), "scene.json: lights[0].intensity: unknown field");
   s = SceneText();
-  s.render = R"({"samples": 4})";
-  EXPECT_ERROR(s.str(), "scene.json: render.samples: unknown field");
+  s.render = R"({"spp": 4})";
+  EXPECT_ERROR(s.str(), "scene.json: render.spp: unknown field");
   EXPECT_ERROR(with_objects(R"([{"type": "box", "min": [0,0,0], "max": [1,1,1]},
                                 {"type": "sphere", "center": [0,0,0], "radus": 1}])")
                    .str(),

@@ -241,7 +241,14 @@ def test_target_db(renderer, scene):
     with pytest.raises(abcube.SceneError, match="and so does cube_res"):
         renderer.render(scene, target_db=40, cube_res=64)
     with pytest.raises(abcube.SceneError, match="target_db"):
-        renderer.render(scene, method="raytrace", target_db=40)
+        renderer.render(scene, method="zbuffer", target_db=40)
+    # raytrace: its samples a pixel chosen for the target, the same image as that rung.
+    res = renderer.render(scene, method="raytrace", target_db=30, stats=True)
+    samples = res.stats["target_db"]["samples"]
+    assert samples in (1, 2, 4, 8, 16, 32)
+    assert np.array_equal(res.image, renderer.render(scene, method="raytrace", samples=samples))
+    with pytest.raises(abcube.SceneError, match="samples"):
+        renderer.render(scene, method="abuffer", samples=4)
 
 
 def find_key(tree, key):
