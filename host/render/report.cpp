@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -145,7 +146,9 @@ class Report {
     {
       Renderer renderer(o_.renderer);
       render_reference(renderer);
+      render_ladder(renderer);
       for (const std::string& m : o_.methods) render_method(renderer, m);
+      match_rungs();
       render_sweep(renderer);
       j_["context"]["gl_path"] = renderer.gl_path();
       j_["context"]["gl_renderer"] = renderer.gl_renderer();
@@ -199,6 +202,8 @@ class Report {
   void render_reference(Renderer& renderer) {
     say("rendering the reference (raytrace)");
     RenderOptions options = without_unused_options(o_.render, "raytrace");
+    options.samples = 0;  // the reference: 32 samples a pixel
+    options.target_db = -1;
     options.aovs = {"object_id", "shadowed"};
     options.reference = false;
     options.reference_image.clear();
@@ -214,6 +219,79 @@ class Report {
                        {"stats", "stats/raytrace.json"},
                        {"total_ms", r.stats.total_ms},
                        {"timings_ms", timings(r.stats.timings_ms)}};
+  }
+
+  // The exact tracer's rivals: the same tracer at 1, 2, 4, 8 and 16 samples a pixel (THE
+  // SAMPLE LADDER), each timed and measured against the reference; with the reference's own
+  // time (its AOVs' pass left out) as the rung of 32. The chart's curve and the figures each
+  // method's time is held to.
+  void render_ladder(Renderer& renderer) {
+    json rungs = json::array();
+    for (int s : {1, 2, 4, 8, 16}) {
+      say("rendering raytrace at " + std::to_string(s) + (s == 1 ? " sample" : " samples") + " a pixel");
+      RenderOptions options = without_unused_options(o_.render, "raytrace");
+      options.samples = s;
+      options.target_db = -1;
+      options.aovs.clear();
+      options.reference = false;
+      options.reference_image.clear();
+      const RenderResult r = render(renderer, options, "raytrace_" + std::to_string(s));
+      rungs.push_back({{"samples", s},
+                       {"total_ms", r.stats.total_ms},
+                       {"error", image_error_json(image_error(r.image, reference_))},
+                       {"stats", "stats/raytrace_" + std::to_string(s) + ".json"}});
+    }
+    const json& t = j_["reference"]["timings_ms"];
+    rungs.push_back({{"samples", 32},
+                     {"total_ms", j_["reference"]["total_ms"].get<double>() - t.value("aovs", 0.0)},
+                     {"error", {{"psnr_db", "inf"}}},
+                     {"stats", "stats/raytrace.json"}});
+    j_["ladder"] = rungs;
+  }
+
+  // Each method's matched rung: the fastest rung of the ladder at least as close to the
+  // reference as the method, its time and the ratio to it (above 1: the tracer at that many
+  // samples was faster at this error); and the Pareto front of every point, methods and
+  // rungs: those no other point beats in time and error both.
+  void match_rungs() {
+    const auto psnr = [](const json& error) {
+      const json& v = error["psnr_db"];
+      return v.is_number() ? v.get<double>() : std::numeric_limits<double>::infinity();
+    };
+    for (const std::string& m : o_.methods) {
+      json& x = j_["methods"][m];
+      if (x.contains("failed")) continue;
+      const double db = psnr(x["error"]);
+      const json* best = nullptr;
+      for (const json& rung : j_["ladder"]) {
+        if (psnr(rung["error"]) >= db && (!best || rung["total_ms"].get<double>() < (*best)["total_ms"].get<double>()))
+          best = &rung;
+      }
+      const double ms = (*best)["total_ms"].get<double>();
+      x["matched_rung"] = {{"samples", (*best)["samples"]}, {"total_ms", ms},
+                           {"time_ratio", x["total_ms"].get<double>() / ms}};
+    }
+    struct Point {
+      std::string name;
+      double ms, db;
+    };
+    std::vector<Point> points;
+    for (const json& rung : j_["ladder"]) {
+      points.push_back({"raytrace " + rung["samples"].dump(), rung["total_ms"].get<double>(), psnr(rung["error"])});
+    }
+    for (const std::string& m : o_.methods) {
+      const json& x = j_["methods"][m];
+      if (!x.contains("failed")) points.push_back({m, x["total_ms"].get<double>(), psnr(x["error"])});
+    }
+    json front = json::array();
+    for (const Point& p : points) {
+      bool beaten = false;
+      for (const Point& q : points) {
+        beaten = beaten || (q.ms <= p.ms && q.db >= p.db && (q.ms < p.ms || q.db > p.db));
+      }
+      if (!beaten) front.push_back(p.name);
+    }
+    j_["front"] = front;
   }
 
   void render_method(Renderer& renderer, const std::string& method) {

@@ -75,7 +75,31 @@ struct Plot {
   std::vector<std::pair<double, double>> curve;
   std::string curve_name;
   bool log_y = false, log_x = false;
+  std::vector<std::string> curve_labels;  // beside the curve's points, drawn as dots when given
+  std::vector<bool> front, curve_front;   // points and curve points on the Pareto front, ringed and joined
+  std::string id;                         // the svg element's id
 };
+
+// The Pareto front of a plot: its points and curve points flagged, ringed and joined left to
+// right, through the plot's scales.
+template <class SX, class SY, class Finite>
+std::string front_marks(const Plot& p, SX sx, SY sy, Finite finite) {
+  std::string s, front;
+  std::vector<std::pair<double, double>> on;
+  for (const auto& [xs, flags] : {std::pair{&p.points, &p.front}, std::pair{&p.curve, &p.curve_front}}) {
+    for (size_t i = 0; i < xs->size() && i < flags->size(); ++i) {
+      if ((*flags)[i] && finite((*xs)[i].first, (*xs)[i].second)) on.push_back((*xs)[i]);
+    }
+  }
+  std::sort(on.begin(), on.end());
+  for (const auto& [x, y] : on) {
+    front += (front.empty() ? "M" : " L") + fixed(sx(x), 1) + " " + fixed(sy(y), 1);
+    s += "<circle class=\"front\" cx=\"" + fixed(sx(x), 1) + "\" cy=\"" + fixed(sy(y), 1) +
+         "\" r=\"8\" fill=\"none\" stroke=\"#2a8a2a\" stroke-width=\"2\"/>";
+  }
+  if (on.size() > 1) s += "<path d=\"" + front + "\" fill=\"none\" stroke=\"#2a8a2a\" stroke-width=\"1.5\"/>";
+  return s;
+}
 
 std::string svg(const Plot& p) {
   constexpr double W = 520, H = 300, L = 64, R = 16, T = 28, B = 44;
@@ -94,7 +118,8 @@ std::string svg(const Plot& p) {
   x0 -= dx, x1 += dx, y0 -= dy, y1 += dy;
   const auto sx = [&](double v) { return L + (tx(v) - x0) / (x1 - x0) * (W - L - R); };
   const auto sy = [&](double v) { return H - B - (ty(v) - y0) / (y1 - y0) * (H - T - B); };
-  std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + fixed(W, 0) + "\" height=\"" + fixed(H, 0) +
+  std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\"" + (p.id.empty() ? "" : " id=\"" + escape(p.id) + "\"") +
+                  " width=\"" + fixed(W, 0) + "\" height=\"" + fixed(H, 0) +
                   "\" viewBox=\"0 0 " + fixed(W, 0) + " " + fixed(H, 0) + "\" role=\"img\"><title>" + escape(p.title) +
                   "</title><rect width=\"100%\" height=\"100%\" fill=\"#fff\"/>";
   s += "<text x=\"" + fixed(W / 2, 0) + "\" y=\"18\" text-anchor=\"middle\" font-size=\"13\">" + escape(p.title) +
@@ -125,11 +150,19 @@ std::string svg(const Plot& p) {
     s += "<path d=\"" + d + "\" fill=\"none\" stroke=\"#c33\" stroke-dasharray=\"5 3\"/>";
     s += "<text x=\"" + fixed(W - R - 4, 0) + "\" y=\"" + fixed(T + 14, 0) +
          "\" text-anchor=\"end\" font-size=\"11\" fill=\"#c33\">" + escape(p.curve_name) + "</text>";
+    for (size_t i = 0; i < p.curve_labels.size() && i < p.curve.size(); ++i) {
+      const auto& [x, y] = p.curve[i];
+      s += "<circle class=\"rung\" cx=\"" + fixed(sx(x), 1) + "\" cy=\"" + fixed(sy(y), 1) + "\" r=\"3\" fill=\"#c33\"/>";
+      s += "<text x=\"" + fixed(sx(x) + 5, 1) + "\" y=\"" + fixed(sy(y) + 12, 1) + "\" font-size=\"10\" fill=\"#c33\">" +
+           escape(p.curve_labels[i]) + "</text>";
+    }
   }
+  s += front_marks(p, sx, sy, [&](double x, double y) { return std::isfinite(tx(x)) && std::isfinite(ty(y)); });
   for (size_t i = 0; i < p.points.size(); ++i) {
     const auto& [x, y] = p.points[i];
     if (!std::isfinite(tx(x)) || !std::isfinite(ty(y))) continue;
-    s += "<circle cx=\"" + fixed(sx(x), 1) + "\" cy=\"" + fixed(sy(y), 1) + "\" r=\"4\" fill=\"#1f5fbf\"/>";
+    s += "<circle class=\"point\" cx=\"" + fixed(sx(x), 1) + "\" cy=\"" + fixed(sy(y), 1) +
+         "\" r=\"4\" fill=\"#1f5fbf\"/>";
     if (i < p.labels.size()) {
       s += "<text x=\"" + fixed(sx(x) + 6, 1) + "\" y=\"" + fixed(sy(y) - 6, 1) + "\" font-size=\"11\">" +
            escape(p.labels[i]) + "</text>";
@@ -195,10 +228,9 @@ void summary(std::string& h, const json& r) {
        "triangles, 4 x 8 samples a pixel. Click a heat map below to put it in the viewer.</p>";
   h += "<table><tr><th>method</th><th>PSNR dB</th><th>RMSE (sRGB)</th><th>linear RMSE</th><th>max error /255</th>"
        "<th>at pixel</th><th>&gt; 1/255 %</th><th>&gt; 2/255 %</th><th>&gt; 8/255 %</th><th>time ms</th>"
-       "<th>time / raytrace</th></tr>";
-  const double ref_ms = r["reference"].value("total_ms", 0.0);
-  h += "<tr><td>raytrace (reference)</td><td colspan=\"8\"></td>" + figure(r, "reference.total_ms", 0) +
-       "<td>1</td></tr>";
+       "<th>matched tracer rung</th><th>its time ms</th><th>time / matched rung</th></tr>";
+  h += "<tr><td>raytrace (reference, 32 samples)</td><td colspan=\"8\"></td>" + figure(r, "reference.total_ms", 0) +
+       "<td colspan=\"3\"></td></tr>";
   for (const std::string& m : method_order(r)) {
     const json& x = r["methods"][m];
     const std::string k = "methods." + m;
@@ -214,8 +246,83 @@ void summary(std::string& h, const json& r) {
          std::to_string(w.value("x", 0)) + ", " + std::to_string(w.value("y", 0)) + ") " +
          escape(w.value("channel", std::string("?"))) + "</td>" + figure(r, k + ".error.share_over_1_255", 2, 100) +
          figure(r, k + ".error.share_over_2_255", 2, 100) + figure(r, k + ".error.share_over_8_255", 2, 100) +
-         figure(r, k + ".total_ms", 0) + "<td class=\"num\">" +
-         (ref_ms > 0 ? fixed(x.value("total_ms", 0.0) / ref_ms, 2) : "-") + "</td></tr>";
+         figure(r, k + ".total_ms", 0) + figure(r, k + ".matched_rung.samples", 0) +
+         figure(r, k + ".matched_rung.total_ms", 0) + figure(r, k + ".matched_rung.time_ratio", 2) + "</tr>";
+  }
+  h += "</table><p class=\"note\">The matched rung: the exact tracer at the fewest samples a pixel whose image is at "
+       "least as close to the reference as the method's (the ladder below). Time / matched rung above 1: that tracer "
+       "was faster at this error.</p>";
+}
+
+bool on_front(const json& r, const std::string& name) {
+  for (const json& f : r.value("front", json::array())) {
+    if (f == name) return true;
+  }
+  return false;
+}
+
+// One sentence a method: what it reached, and the fastest way to that error on this scene.
+void verdict(std::string& h, const json& r) {
+  h += "<h2 id=\"verdict\">Verdict</h2><p class=\"note\">On this scene, at this size, on this machine. The rival "
+       "of each method is the exact tracer at the fewest samples a pixel that reaches the method's error.</p><ul>";
+  for (const std::string& m : method_order(r)) {
+    const json& x = r["methods"][m];
+    const std::string k = "methods." + m;
+    if (x.contains("failed")) {
+      h += "<li><b>" + escape(m) + "</b>: not rendered.</li>";
+      continue;
+    }
+    const json& rung = x["matched_rung"];
+    const double ratio = rung.value("time_ratio", 0.0);
+    const std::string samples = rung.value("samples", 0) == 1 ? "1 sample" : rung["samples"].dump() + " samples";
+    h += "<li><b>" + escape(m) + "</b>: " + figure(r, k + ".error.psnr_db", 1, 1, "span") + " dB in " +
+         figure(r, k + ".total_ms", 0, 1, "span") + " ms. ";
+    if (ratio > 1) {
+      h += "The exact tracer at " + samples + " a pixel is as close in " +
+           figure(r, k + ".matched_rung.total_ms", 0, 1, "span") + " ms: it is faster at this error, by " +
+           figure(r, k + ".matched_rung.time_ratio", 2, 1, "span") + "x.";
+    } else {
+      h += std::string("Faster than the exact tracer at this error: it needs ") + samples + " a pixel (" +
+           figure(r, k + ".matched_rung.total_ms", 0, 1, "span") + " ms).";
+    }
+    if (on_front(r, m)) h += " On the front: nothing here is both faster and closer.";
+    h += "</li>";
+  }
+  h += "</ul>";
+}
+
+// The chart of time against error: each method, the tracer's ladder, the Pareto front.
+void front_chart(std::string& h, const json& r) {
+  Plot p;
+  p.title = "Time against error";
+  p.x_name = "time, ms (log)";
+  p.y_name = "PSNR against the reference, dB";
+  p.curve_name = "raytrace at 1 to 16 samples a pixel";
+  p.log_x = true;
+  p.id = "front-chart";
+  for (const std::string& m : method_order(r)) {
+    const json& x = r["methods"][m];
+    if (x.contains("failed") || !x["error"]["psnr_db"].is_number()) continue;
+    p.points.push_back({x.value("total_ms", 0.0), x["error"]["psnr_db"].get<double>()});
+    p.labels.push_back(m);
+    p.front.push_back(on_front(r, m));
+  }
+  for (const json& rung : r.value("ladder", json::array())) {
+    if (!rung["error"]["psnr_db"].is_number()) continue;  // 32: the reference, exact
+    p.curve.push_back({rung.value("total_ms", 0.0), rung["error"]["psnr_db"].get<double>()});
+    p.curve_labels.push_back(rung["samples"].dump());
+    p.curve_front.push_back(on_front(r, "raytrace " + rung["samples"].dump()));
+  }
+  h += "<h2 id=\"front\">Speed against error</h2>" + svg(p) +
+       "<p class=\"note\">Blue: the methods. Red: the exact tracer at 1 to 16 samples a pixel; at 32 it is the "
+       "reference itself, with no error. Green: the front, the renders no other render here beats in both time and "
+       "error.</p><table><tr><th>raytrace samples a pixel</th><th>time ms</th><th>PSNR dB</th></tr>";
+  const json& ladder = r.value("ladder", json::array());
+  for (size_t i = 0; i < ladder.size(); ++i) {
+    const std::string k = "ladder." + std::to_string(i);
+    const bool exact = !ladder[i]["error"]["psnr_db"].is_number();
+    h += "<tr><td>" + ladder[i]["samples"].dump() + "</td>" + figure(r, k + ".total_ms", 0) +
+         (exact ? "<td>the reference</td>" : figure(r, k + ".error.psnr_db", 2)) + "</tr>";
   }
   h += "</table>";
 }
@@ -305,6 +412,52 @@ void timing(std::string& h, const json& r) {
     h += "</tr>";
   }
   h += "</table>";
+}
+
+void crosscheck(std::string& h, const json& r) {
+  const json& c = r["crosscheck"];
+  h += "<h2 id=\"crosscheck\">The GPU against the CPU</h2><p><b>Covers:</b> " + escape(c.value("covers", "")) +
+       ".<br><b>Does not cover:</b> " + escape(c.value("does_not_cover", "")) + ".</p>";
+  if (c.contains("skipped")) {
+    h += "<p class=\"note\">Not run: " + escape(c["skipped"].get<std::string>()) + "</p>";
+    return;
+  }
+  const bool pass = c.value("pass", false);
+  h += std::string("<p>Verdict: <span class=\"") + (pass ? "pass\">PASS" : "fail\">FAIL") + "</span> (" +
+       escape(c.value("gl", "")) + ")" + (pass ? "" : ": " + escape(c.value("failures", ""))) + "</p>";
+  h += "<div class=\"gallery\"><figure><img class=\"px\" src=\"" + escape(c.value("samples_image", "")) +
+       "\" alt=\"camera samples where GPU and CPU differ\"><figcaption>Pixels where some of the 32 camera samples see "
+       "another object on the GPU than on the CPU, in red (yellow when all do), over the CPU image in grey: " +
+       std::to_string(c.value("pixels_with_differing_samples", 0)) + " pixels</figcaption></figure>";
+  if (c.contains("shadows_image")) {
+    h += "<figure><img class=\"px\" src=\"" + escape(c["shadows_image"].get<std::string>()) +
+         "\" alt=\"shadow samples where the GPU's volumes and the tracer differ\"><figcaption>Shadow samples where the "
+         "GPU's shadow volumes and the exact tracer differ</figcaption></figure>";
+  }
+  h += "</div>";
+}
+
+// The crosscheck's internal figures, one a row.
+void crosscheck_figures(std::string& h, const json& r) {
+  const json& c = r["crosscheck"];
+  if (c.contains("skipped")) return;
+  h += "<h3>The crosscheck's figures</h3><table><tr><th>figure</th><th>value</th></tr>";
+  for (const auto& [section, values] : c["result"].items()) {
+    if (!values.is_object()) continue;
+    for (const auto& [name, v] : values.items()) {
+      if (!v.is_number()) continue;
+      h += "<tr><td>" + escape(section + " " + name) + "</td>" +
+           figure(r, "crosscheck.result." + section + "." + name, v.is_number_integer() ? 0 : 6) + "</tr>";
+    }
+  }
+  h += "</table>";
+}
+
+// For abcube's own developers, folded: the sweep over N with the Error_Parallax plot against
+// the thesis's bound, and the crosscheck's internal figures.
+void developers(std::string& h, const json& r) {
+  h += "<h2 id=\"developers\">For abcube's developers</h2><details><summary>The sweep over N, Error_Parallax against "
+       "the thesis's bound, the crosscheck's figures</summary>";
   const json& points = r["sweep"]["points"];
   if (!points.empty()) {
     Plot speed{"abuffer: error against time, one point a cube resolution N",
@@ -337,7 +490,7 @@ void timing(std::string& h, const json& r) {
       }
       bound.curve.push_back({double(p["n"].get<int>()), p.value("bound_1_over_2n2", 0.0)});
     }
-    h += "<h3>Speed against error</h3>" + svg(speed);
+    h += "<h3>abuffer over N</h3>" + svg(speed);
     if (!bound.points.empty()) h += svg(bound);
     h += "<table><tr><th>N</th><th>time ms</th><th>PSNR dB</th><th>Error_Parallax mean</th><th>max</th>"
          "<th>bound 1/(2N^2)</th><th>within the bound %</th></tr>";
@@ -350,39 +503,8 @@ void timing(std::string& h, const json& r) {
     }
     h += "</table>";
   }
-}
-
-void crosscheck(std::string& h, const json& r) {
-  const json& c = r["crosscheck"];
-  h += "<h2 id=\"crosscheck\">The GPU against the CPU</h2><p><b>Covers:</b> " + escape(c.value("covers", "")) +
-       ".<br><b>Does not cover:</b> " + escape(c.value("does_not_cover", "")) + ".</p>";
-  if (c.contains("skipped")) {
-    h += "<p class=\"note\">Not run: " + escape(c["skipped"].get<std::string>()) + "</p>";
-    return;
-  }
-  const bool pass = c.value("pass", false);
-  h += std::string("<p>Verdict: <span class=\"") + (pass ? "pass\">PASS" : "fail\">FAIL") + "</span> (" +
-       escape(c.value("gl", "")) + ")" + (pass ? "" : ": " + escape(c.value("failures", ""))) + "</p>";
-  const json& x = c["result"];
-  h += "<table><tr><th>figure</th><th>value</th></tr>";
-  for (const auto& [section, values] : x.items()) {
-    if (!values.is_object()) continue;
-    for (const auto& [name, v] : values.items()) {
-      if (!v.is_number()) continue;
-      h += "<tr><td>" + escape(section + " " + name) + "</td>" +
-           figure(r, "crosscheck.result." + section + "." + name, v.is_number_integer() ? 0 : 6) + "</tr>";
-    }
-  }
-  h += "</table><div class=\"gallery\"><figure><img class=\"px\" src=\"" + escape(c.value("samples_image", "")) +
-       "\" alt=\"camera samples where GPU and CPU differ\"><figcaption>Pixels where some of the 32 camera samples see "
-       "another object on the GPU than on the CPU, in red (yellow when all do), over the CPU image in grey: " +
-       std::to_string(c.value("pixels_with_differing_samples", 0)) + " pixels</figcaption></figure>";
-  if (c.contains("shadows_image")) {
-    h += "<figure><img class=\"px\" src=\"" + escape(c["shadows_image"].get<std::string>()) +
-         "\" alt=\"shadow samples where the GPU's volumes and the tracer differ\"><figcaption>Shadow samples where the "
-         "GPU's shadow volumes and the exact tracer differ</figcaption></figure>";
-  }
-  h += "</div>";
+  crosscheck_figures(h, r);
+  h += "</details>";
 }
 
 void context(std::string& h, const json& r) {
@@ -420,15 +542,20 @@ std::string report_html(const json& r) {
                   escape(r.value("scene", std::string())) + "</title><style>" + STYLE + "</style></head><body>";
   h += "<h1>abcube report: " + escape(r.value("scene", std::string())) + "</h1><p class=\"note\">" +
        std::to_string(r["size"].value("width", 0)) + " x " + std::to_string(r["size"].value("height", 0)) +
-       " pixels; figures in report.json, each render's stats in stats/. <a href=\"#summary\">summary</a> | <a "
+       " pixels; figures in report.json, each render's stats in stats/. <a href=\"#verdict\">verdict</a> | <a "
+       "href=\"#summary\">summary</a> | <a href=\"#front\">speed against error</a> | <a "
        "href=\"#viewer\">side by side</a> | <a href=\"#regions\">where</a> | <a href=\"#time\">time</a> | <a "
-       "href=\"#crosscheck\">GPU against CPU</a> | <a href=\"#context\">context</a></p>";
+       "href=\"#crosscheck\">GPU against CPU</a> | <a href=\"#context\">context</a> | <a href=\"#developers\">for "
+       "developers</a></p>";
+  verdict(h, r);
   summary(h, r);
+  front_chart(h, r);
   viewer(h, r);
   regions(h, r);
   timing(h, r);
   crosscheck(h, r);
   context(h, r);
+  developers(h, r);
   return h + "<script>" + SCRIPT + "</script></body></html>\n";
 }
 

@@ -51,6 +51,21 @@ def test_files_and_figures_equal_the_stats(report):
         w = x["error"]["worst_pixel"]
         assert 0 <= w["x"] < 160 and 0 <= w["y"] < 120
     assert [p["n"] for p in j["sweep"]["points"]] == [32, 64]
+    # The tracer's ladder: 1 to 32 samples, nearer the reference as it climbs; each method held
+    # to its matched rung, the fastest rung at least as close; the front named.
+    ladder = j["ladder"]
+    assert [r["samples"] for r in ladder] == [1, 2, 4, 8, 16, 32]
+    db = [r["error"]["psnr_db"] for r in ladder[:-1]]
+    assert db == sorted(db) and ladder[-1]["error"]["psnr_db"] == "inf", db
+    for m in METHODS:
+        rung = j["methods"][m]["matched_rung"]
+        match = next(r for r in ladder if r["samples"] == rung["samples"])
+        assert match["error"]["psnr_db"] == "inf" or match["error"]["psnr_db"] >= j["methods"][m]["error"]["psnr_db"]
+        faster_and_close = [r for r in ladder if r["total_ms"] < match["total_ms"] and r["error"]["psnr_db"] != "inf"
+                            and r["error"]["psnr_db"] >= j["methods"][m]["error"]["psnr_db"]]
+        assert not faster_and_close, (m, faster_and_close)
+        assert abs(rung["time_ratio"] - j["methods"][m]["total_ms"] / rung["total_ms"]) < 1e-9
+    assert j["front"] and set(j["front"]) <= set(METHODS) | {f"raytrace {r['samples']}" for r in ladder}
     assert j["crosscheck"]["pass"] is True, j["crosscheck"].get("failures")
     assert j["context"]["gl_renderer"] and j["context"]["cores"] >= 1
 
@@ -68,11 +83,21 @@ class Page(HTMLParser):
     def __init__(self):
         super().__init__()
         self.body, self.figures, self.images, self._key = {}, [], 0, None
+        self.chart, self.in_chart, self.verdicts, self._in_verdict = {}, False, 0, False
 
     def handle_starttag(self, tag, attrs):
         a = dict(attrs)
         if tag == "body":
             self.body = a
+        if tag == "svg" and a.get("id") == "front-chart":
+            self.in_chart = True
+        if self.in_chart and tag in ("circle", "path"):
+            key = a.get("class", tag)
+            self.chart[key] = self.chart.get(key, 0) + 1
+        if tag == "h2":
+            self._in_verdict = a.get("id") == "verdict"
+        if tag == "li" and self._in_verdict:
+            self.verdicts += 1
         if tag == "img":
             self.images += 1
         if "data-key" in a:
@@ -85,6 +110,8 @@ class Page(HTMLParser):
 
     def handle_endtag(self, tag):
         self._key = None
+        if tag == "svg":
+            self.in_chart = False
 
 
 def chromium():
@@ -110,6 +137,12 @@ def test_the_page_in_a_browser(report, tmp_path):
     assert page.body.get("data-images-broken") == "0", page.body
     assert int(page.body.get("data-images-loaded", "-1")) == page.images > 10, page.body
     assert len(page.figures) > 50
+    # The chart of time against error is drawn: a dot a method, the ladder's rungs, the front
+    # ringed; one verdict a method.
+    assert page.chart.get("point", 0) == len(METHODS), page.chart
+    assert page.chart.get("rung", 0) == 5, page.chart
+    assert page.chart.get("front", 0) == len(j["front"]) - ("raytrace 32" in j["front"]), page.chart
+    assert page.verdicts == len(METHODS)
     for attrs, text in page.figures:
         value = lookup(j, attrs["data-key"])
         assert json.loads(attrs["data-value"]) == value, attrs
@@ -119,7 +152,7 @@ def test_the_page_in_a_browser(report, tmp_path):
     # the PSNR on the page is the stats file's
     for m in METHODS:
         stats = json.loads((out / j["methods"][m]["stats"]).read_text())
-        shown = [t for a, t in page.figures if a["data-key"] == f"methods.{m}.error.psnr_db"]
+        shown = [t for a, t in page.figures if a["data-key"] == f"methods.{m}.error.psnr_db" and a["data-decimals"] == "2"]
         assert shown and abs(float(shown[0]) - stats["reference"]["image_error"]["psnr_db"]) <= 0.005
 
 
