@@ -18,6 +18,7 @@
 #include "base/input_file.hpp"
 #include "base/memory.hpp"
 #include "scene/framing.hpp"
+#include "scene/radiance.hpp"
 #include "scene/scene_load_state.hpp"
 #include "scene/tessellate.hpp"
 
@@ -320,6 +321,7 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
         src, *render, "render", {"method", "cube_resolution", "max_depth", "fresnel", "error_target", "target_db", "samples"}));
   }
   load_textures(st);
+  check_radiance(scene, scene.render.max_depth, src.name + ": ");  // THE RADIANCE BOUND
   // The loaders' small blocks freed since the last object's trim (the closed-surface test's,
   // the JSON's): left resident, they would be carried by every method through its peak
   // (bench/memory.py measures it).

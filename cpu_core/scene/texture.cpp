@@ -52,7 +52,7 @@ bool decode_texture(const unsigned char* bytes, size_t size, const std::string& 
     const float* p = &img.data[t * channels];
     for (uint64_t c = 0; c < 3; ++c) {
       const float v = channels >= 3 ? p[c] : p[0];  // grey (and grey + alpha): all three
-      out->rgb[3 * t + c] = decoded.encoded ? srgb_to_linear(v) : (std::isfinite(v) ? v : 0.0f);
+      out->rgb[3 * t + c] = decoded.encoded ? srgb_to_linear(v) : (std::isfinite(v) ? std::max(v, 0.0f) : 0.0f);
     }
   }
   return true;

@@ -22,6 +22,7 @@
 #include "render/stats_json.hpp"
 #include "scene/framing.hpp"
 #include "scene/plan.hpp"
+#include "scene/radiance.hpp"
 #include "scene/scene_load.hpp"
 #include "shading/scene_cache.hpp"
 
@@ -95,7 +96,10 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
     rs.cube_resolution = resolution_for_error(rs.error_target);
   }
   if (o.cube_resolution != 0) rs.cube_resolution = o.cube_resolution;
-  if (o.max_depth >= 0) rs.max_depth = o.max_depth;
+  if (o.max_depth >= 0) {
+    rs.max_depth = o.max_depth;
+    check_radiance(*view, rs.max_depth, view->file + ": ");  // deeper bounces, a larger bound
+  }
   if (o.fresnel) rs.fresnel = *o.fresnel;
   view->camera = override_camera(view->camera, o.camera);
   // A framed camera (model files, "frame": "all") given a new size or field of view frames

@@ -1,5 +1,7 @@
 // Errors through the public API: each is the exception its kind promises (error.hpp),
 // with a message naming the place, never an exit or an abort.
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -114,6 +116,47 @@ TEST(ErrorsApi, GpuTimeoutLeavesTheGlSceneWhole) {
   const RenderResult after = renderer.render(scene, o);
   Renderer fresh;
   EXPECT_TRUE(images_equal(after.image, fresh.render(scene, o).image));
+}
+
+// THE RADIANCE BOUND (scene/radiance.hpp): a scene whose pixels could pass a float's range is
+// refused with one line naming the value to lower; one just under the bound, with a mirror
+// and glass doubling what each bounce can return, renders finite pixels with every method,
+// none above the bound. A deeper --max-depth is checked again.
+TEST(ErrorsApi, RadianceOverAFloatIsRefusedAndTheBoundRendersFinite) {
+  const auto scene_with = [](const std::string& ambient) {
+    return R"({"version": 1, "camera": {"position": [0, 1, 3], "look_at": [0, 0.5, 0], "width": 16, "height": 12},
+      "ambient": [)" + ambient + ", " + ambient + ", " + ambient + R"(],
+      "lights": [{"type": "point", "position": [1, 3, 2], "color": [1, 1, 1]}],
+      "materials": {"both": {"color": [1, 1, 1], "reflect": 1, "transmit": 1, "ior": 1.5}, "white": {}},
+      "objects": [{"type": "quad", "vertices": [[-3, 0, -3], [3, 0, -3], [3, 0, 3], [-3, 0, 3]], "material": "white"},
+                  {"type": "sphere", "center": [0, 0.6, 0], "radius": 0.5, "segments": 12, "material": "both"}],
+      "render": {"max_depth": 4}})";
+  };
+  const std::string message = input_error_of([&] { Scene::from_json(scene_with("3.4e38"), "over.json"); });
+  EXPECT_EQ(message.rfind("over.json: ambient: with this scene's lights, colours and max_depth 4, a pixel could reach ", 0),
+            0u)
+      << message;
+  EXPECT_NE(message.find("got 3.4e+38"), std::string::npos) << message;
+  // At the bound: (ambient + 2 lights) (1 + 2 + 4 + 8 + 16) <= 1e37.
+  const Scene scene = Scene::from_json(scene_with("3.2e35"), "edge.json");
+  Renderer renderer;
+  for (const char* method : {"raytrace", "abuffer", "zbuffer", "envmap", "gpu", "hybrid"}) {
+    RenderOptions o;
+    o.method = method;
+    if (std::string(method) != "raytrace") o.cube_resolution = 16;
+    const Image image = renderer.render(scene, o).image;
+    float top = 0;
+    for (const float v : image.data) {
+      ASSERT_TRUE(std::isfinite(v)) << method;
+      top = std::max(top, v);
+    }
+    EXPECT_GT(top, 1e35f) << method;
+    EXPECT_LE(top, 1e37f) << method;
+  }
+  RenderOptions deeper;
+  deeper.max_depth = 8;
+  const std::string depth = input_error_of([&] { renderer.render(scene, deeper); });
+  EXPECT_EQ(depth.rfind("edge.json: ambient: with this scene's lights, colours and max_depth 8", 0), 0u) << depth;
 }
 
 TEST(ErrorsApi, GpuWithoutGlIsInputError) {

@@ -9,6 +9,9 @@
 
 #include <abcube/error.hpp>
 
+#include "reference/raytrace.hpp"
+#include "scene/radiance.hpp"
+
 namespace abcube::fuzz {
 
 void broken(const std::string& what) {
@@ -77,6 +80,22 @@ void check_scene(const SceneData& scene) {
     }
   }
   for (const std::string& w : scene.warnings) check_message(w, scene.file);
+  // THE RADIANCE BOUND: an accepted scene cannot overflow a float; a small one is traced at
+  // 4 x 3 pixels to see it (the tracer shades as every method does).
+  const double bound = radiance_bound(scene, scene.render.max_depth);
+  if (!(bound <= MAX_RADIANCE)) broken("accepted a scene whose pixels may reach " + std::to_string(bound));
+  if (n <= 2000) {
+    SceneData small = scene;
+    small.camera.width = 4;
+    small.camera.height = 3;
+    RaytraceOptions o;
+    o.threads = 1;
+    o.samples_per_pixel = 1;
+    const Image image = render_raytrace(small, o);
+    for (const float v : image.data) {
+      if (!std::isfinite(v) || v < 0.0f || v > MAX_RADIANCE) broken("a pixel of " + std::to_string(v));
+    }
+  }
   if (verbose()) {
     std::fprintf(stderr, "loaded: %zu objects, %zu triangles, %zu materials, %zu warnings\n", scene.objects.size(), n,
                  scene.materials.size(), scene.warnings.size());

@@ -24,7 +24,8 @@ constexpr size_t MAX_MESSAGE_BYTES = 4096;
 
 // Every number finite, every index in range (triangle -> object, material; object ->
 // its triangle range), every object holding triangles or named by a warning, the camera
-// finite with a positive size, the lights and materials finite.
+// finite with a positive size, the lights and materials finite; THE RADIANCE BOUND under
+// MAX_RADIANCE, and a small scene's pixels finite (traced at 4 x 3).
 void check_scene(const SceneData& scene);
 
 // An error message: one line, at most MAX_MESSAGE_BYTES, starting with `place` (the file
