@@ -300,6 +300,7 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
   LoadState st{src, scene, limits, root, {}, {}, -1, {}, {}, memory_budget_bytes(limits.max_memory_bytes)};
   if (const Json* materials = top.find("materials")) read_materials(st, *materials);
   const Json& objects = read_array(src, top.need("objects"), "objects");
+  check_scene_triangles(st, objects);
   for (size_t i = 0; i < objects.size(); ++i) read_object(st, objects[i], i);
   if (camera.frame) {
     scene.camera = frame_camera(scene.bounds(), camera.direction, scene.camera);

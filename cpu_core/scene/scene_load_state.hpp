@@ -66,6 +66,17 @@ uint32_t default_material(LoadState& st);
 // Called before they are made.
 void check_triangle_cap(const LoadState& st, const std::string& path, uint64_t adding);
 
+// THE COUNT BEFORE THE BUILD (scene_count.cpp): the triangles the scene's `objects` will make
+// (primitives by their type and segments, OBJ files by their face lines, glTF files by their
+// accessors' counts and node instances) checked against the caps as check_triangle_cap does,
+// before any is made: a scene over them is refused, naming the object that passes the cap,
+// having built nothing. An object it cannot count (a malformed one) counts none: its own
+// load refuses it.
+void check_scene_triangles(const LoadState& st, const Json& objects);
+
+// An OBJ file's triangles, from its face lines, without parsing (scene_mesh.cpp).
+uint64_t count_face_triangles(const std::string& resolved);
+
 // The canonical form of LoadLimits::root (InputError when it is not a folder).
 std::string canonical_root(const std::string& root);
 // Whether `file` (symbolic links and ".." resolved) lies inside the canonical `root`.

@@ -260,6 +260,15 @@ ObjFile parse_obj(const LoadState& st, const std::string& path, const std::strin
   return obj;
 }
 
+// Triangles the faces of an OBJ file become (ear clipping: n - 2 per polygon of n corners).
+uint64_t obj_triangle_count(const ObjFile& obj) {
+  uint64_t count = 0;
+  for (const uint32_t n : obj.text.face_sizes) count += n - 2u;
+  return count;
+}
+
+}  // namespace
+
 // The triangles an OBJ file's face lines make (n - 2 for a line of n corners), counted
 // without parsing, so that a mesh over the caps is refused before tinyobjloader holds it
 // (its arrays take about what the triangles will). A face continued onto the next line
@@ -304,15 +313,6 @@ uint64_t count_face_triangles(const std::string& resolved) {
   if (state == in_face) end_face();
   return triangles;
 }
-
-// Triangles the faces of an OBJ file become (ear clipping: n - 2 per polygon of n corners).
-uint64_t obj_triangle_count(const ObjFile& obj) {
-  uint64_t count = 0;
-  for (const uint32_t n : obj.text.face_sizes) count += n - 2u;
-  return count;
-}
-
-}  // namespace
 
 std::string resolve_mesh_path(const Source& src, const std::string& file) {
   namespace fs = std::filesystem;
