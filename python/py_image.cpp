@@ -86,6 +86,15 @@ inputs' shape).)doc");
         R"doc(Writes a float array (H x W, H x W x C; linear values) to `path`, format by
 extension: float formats (EXR) keep the values, 8-bit ones (PNG) get sRGB-encoded values.
 Atomic: a temporary file renamed into place, never a partial file.)doc");
+  m.def(
+      "remove_stale_temporaries",
+      [](const py::handle& folder) { return remove_stale_temporaries(path_arg(folder, "folder")); }, py::arg("folder"),
+      R"doc(Removes from `folder` the temporary files of write_image (and of the abcube program)
+that processes of this host left when they were killed before renaming them into place
+(".NAME.tmpPID-HOST.EXT", their process gone), and returns how many. Temporaries of live
+processes and of other hosts stay. `abcube batch` does this for its output folders before it
+renders; a recipe that writes files from workers that may be killed calls it before its own
+writes.)doc");
 }
 
 }  // namespace abcube

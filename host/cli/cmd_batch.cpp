@@ -19,6 +19,7 @@
 #include "base/input_file.hpp"
 #include "base/parallel.hpp"
 #include "base/statistics.hpp"
+#include "base/temporary_file.hpp"
 #include "base/timer.hpp"
 #include "cli/batch_jobs.hpp"
 #include "cli/cli_common.hpp"
@@ -68,6 +69,22 @@ void draw_progress(size_t done, size_t total, size_t failed) {
   if (done == total) std::fputc('\n', stderr);
 }
 
+// Whether every output of `job` exists: its image, each AOV it asks for and its stats
+// (--skip-existing). Each lands whole, by rename: a file there is complete.
+bool outputs_exist(const Job& job, const RenderSetup& base) {
+  if (!fs::exists(job.out) || (!job.stats.empty() && !fs::exists(job.stats))) return false;
+  std::vector<std::string> aovs;
+  try {
+    aovs = job.setup(base).render.aovs;
+  } catch (const std::exception&) {
+    return false;  // the render says what is wrong
+  }
+  for (const std::string& name : aovs) {
+    if (!fs::exists(aov_path(job.out, name))) return false;
+  }
+  return true;
+}
+
 struct BatchCommand {
   std::string jobs_path, shard = "0/1";
   bool skip_existing = false;
@@ -108,6 +125,16 @@ struct BatchCommand {
         }
       }
     }
+    // What killed runs left (SIGKILL, a preempted machine): their temporaries, once their
+    // processes are gone. Every output lands whole, by rename, so what exists is complete.
+    size_t stale = 0;
+    std::set<std::string> folders;
+    for (const Job& job : jobs) {
+      for (const std::string* out : {&job.out, &job.stats}) {
+        if (!out->empty() && folders.insert(fs::path(*out).parent_path().string()).second)
+          stale += remove_stale_temporaries(fs::path(*out).parent_path().string());
+      }
+    }
     Renderer renderer(base.renderer);
     SceneShelf scenes(std::max<size_t>(scene_cache, 1), base.limits);
     const bool terminal = stderr_is_terminal();
@@ -126,7 +153,7 @@ struct BatchCommand {
         stopped();
         check_stop_request();
       }
-      if (skip_existing && fs::exists(job.out) && (job.stats.empty() || fs::exists(job.stats))) {
+      if (skip_existing && outputs_exist(job, base)) {
         ++skipped;
       } else {
         try {
@@ -165,9 +192,10 @@ struct BatchCommand {
     const double median = sorted.empty() ? 0.0 : percentile(sorted, 0.5);
     std::printf(
         "batch %s shard %zu/%zu: %zu jobs, %zu rendered, %zu failed, %zu skipped; %zu scenes loaded; "
-        "%.1f ms per render (median, with load and write), %.1f s in all\n",
+        "%.1f ms per render (median, with load and write), %.1f s in all%s\n",
         jobs_path.c_str(), shard_i, shard_n, jobs.size(), render_ms.size(), failed, skipped, scenes.loads(), median,
-        total_ms / 1000.0);
+        total_ms / 1000.0,
+        stale ? ("; " + std::to_string(stale) + " temporaries of killed runs removed").c_str() : "");
     return failed ? 1 : 0;
   }
 };

@@ -41,6 +41,11 @@ Image read_image(const std::string& path);
 // only (no time stamp), so the same render always writes the same file.
 void write_image(const std::string& path, const Image& image);
 
+// Removes from `folder` the temporaries of atomic writes (".NAME.tmpPID-HOST.EXT") that
+// processes of this host left when they were killed before their rename, their process
+// gone, and returns how many. Those of live processes and of other hosts stay.
+std::size_t remove_stale_temporaries(const std::string& folder);
+
 // Whether a writer handles this file's extension (PNG and EXR, or one of OpenImageIO's).
 bool image_format_supported(const std::string& path);
 // The extensions that have a writer ("exr", "png", ...), for messages.

@@ -12,6 +12,10 @@ process. Run it (from the repository, after the build):
 It prints the time of the batch in the cluster and in this process, checks that the images
 are equal, and with --out writes orbit/view_000.exr ... (float EXR, linear).
 
+On machines that may die mid-batch (preemptible, spot), write files from the workers
+instead (files_in_cluster, render_views_to_files): each file lands whole or not at all, a
+task run again skips what exists, and the temporaries a killed worker left are removed.
+
 How it works, and what to copy:
   - Scenes do not travel between processes: send the scene's path (or its dict); each
     worker process loads it once and keeps it (load), so the per-scene data the first
@@ -95,6 +99,29 @@ def render_views(scene_source, cameras, method="abuffer", cube_res=None, max_dep
                             camera=camera) for camera in cameras]
 
 
+def render_views_to_files(scene_source, jobs, method="abuffer", cube_res=None, max_depth=None,
+                          threads=1):
+    """Renders each (camera, out) of `jobs` into its file, the unit of work of a Dask task a
+    preemptible worker may not finish. A file that exists is whole (abcube.write_image
+    writes a temporary and renames it into place), so it is skipped: a task run again redoes
+    only what is missing. First the temporaries that killed workers of this host left in the
+    output folders are removed (abcube.remove_stale_temporaries). Returns [(out, "rendered"
+    or "skipped")]."""
+    for folder in sorted({os.path.dirname(out) or "." for _, out in jobs}):
+        abcube.remove_stale_temporaries(folder)
+    done = []
+    for camera, out in jobs:
+        if os.path.exists(out):
+            done.append((out, "skipped"))
+            continue
+        scene = load(scene_source)
+        image = renderer_for(method, threads).render(scene, method=method, cube_res=cube_res,
+                                                     max_depth=max_depth, camera=camera)
+        abcube.write_image(out, image)
+        done.append((out, "rendered"))
+    return done
+
+
 def worker_version():
     """Run on every worker before the clock starts: abcube imports there, and its version."""
     return abcube.__version__
@@ -140,6 +167,48 @@ def render_in_cluster(scene_source, cameras, method="abuffer", cube_res=None, ma
         images = [image for part in client.gather(futures) for image in part]
         batch = time.perf_counter() - begin
     return images, batch, startup
+
+
+def task_retries(client, futures):
+    """How many times a worker died while running each future's task (the scheduler's count),
+    for the futures whose task ran more than once."""
+    keys = [f.key for f in futures]
+
+    def count(dask_scheduler, keys=keys):
+        return {k: dask_scheduler.tasks[k].suspicious for k in keys if k in dask_scheduler.tasks}
+
+    counts = client.run_on_scheduler(count)
+    return {f.key: counts[f.key] for f in futures if counts.get(f.key)}
+
+
+def files_in_cluster(scene_source, cameras, out_dir, method="abuffer", cube_res=None,
+                     max_depth=None, n_workers=2, chunk=4, after_first=None):
+    """Writes out_dir/view_NNN.exr for each camera from a LocalCluster of `n_workers` worker
+    processes, `chunk` views per task. A worker that dies (killed, preempted) loses nothing:
+    the scheduler runs its task again on another, which skips the files already whole.
+    `after_first` (optional) is called with (client, cluster) once the first task is done
+    (the kill test uses it). Returns (the views rendered, the views of tasks run again)."""
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    os.environ["PYTHONPATH"] = worker_environment()
+    task = importlib.import_module("dask_orbit").render_views_to_files if __name__ == "__main__" \
+        else render_views_to_files
+    out_dir = pathlib.Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    jobs = [(camera, str(out_dir / f"view_{k:03d}.exr")) for k, camera in enumerate(cameras)]
+    with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        parts = chunks(jobs, chunk)
+        futures = [client.submit(task, scene_source, part, method, cube_res, max_depth, 1,
+                                 pure=False) for part in parts]
+        views = {f.key: [out for _, out in part] for f, part in zip(futures, parts)}
+        results = []
+        for k, done in enumerate(as_completed(futures)):
+            results += done.result()
+            if k == 0 and after_first:
+                after_first(client, cluster)
+        retried = sorted(out for key in task_retries(client, futures) for out in views[key])
+    return [out for out, what in results if what == "rendered"], retried
 
 
 def render_in_process(scene_source, cameras, method="abuffer", cube_res=None, max_depth=None,
