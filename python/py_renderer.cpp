@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <csignal>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -44,7 +45,7 @@ void set_option(RenderSetup& setup, const std::string& key, const std::string& s
 // The keywords of Renderer.render applied to a setup: every job option of the table by its
 // key, "camera" as a dict of position, look_at, up, fov_y, width, height, and the older
 // keywords plan_everything (plan="everything") and side_structure (not map_only).
-RenderSetup setup_from_kwargs(const py::kwargs& kwargs, bool* want_stats) {
+RenderSetup setup_from_kwargs(const py::kwargs& kwargs, bool* want_stats, py::object* progress) {
   RenderSetup setup;
   for (const auto& item : kwargs) {
     const std::string key = py::str(item.first);
@@ -54,6 +55,11 @@ RenderSetup setup_from_kwargs(const py::kwargs& kwargs, bool* want_stats) {
       continue;
     }
     if (value.is_none()) continue;  // the default
+    if (key == "progress") {
+      if (!PyCallable_Check(value.ptr())) throw InputError("progress: must be callable (stage, done), got " + type_name(value));
+      *progress = py::reinterpret_borrow<py::object>(value);
+      continue;
+    }
     if (key == "camera") {
       if (!py::isinstance<py::dict>(value)) {
         throw InputError("camera: must be a dict with any of position, look_at, up, fov_y, width, height, got " +
@@ -74,7 +80,7 @@ RenderSetup setup_from_kwargs(const py::kwargs& kwargs, bool* want_stats) {
     } else {
       const OptionSpec* spec = find_render_option(key);
       if (!spec || spec->flag == key) {
-        std::vector<std::string> known = {"camera", "stats", "plan_everything", "side_structure"};
+        std::vector<std::string> known = {"camera", "stats", "progress", "plan_everything", "side_structure"};
         for (const OptionSpec& o : render_option_table()) {
           if (o.scope == OptionScope::job) known.push_back(o.key);
         }
@@ -145,9 +151,25 @@ py::object render(Renderer& renderer, const py::handle& scene_object, const py::
     throw InputError("scene: must be an abcube.Scene (load_scene, scene_from_dict), got " + type_name(scene_object));
   }
   bool want_stats = false;
-  const RenderSetup setup = setup_from_kwargs(kwargs, &want_stats);
+  py::object progress;  // a callable (stage, done), or None
+  const RenderSetup setup = setup_from_kwargs(kwargs, &want_stats, &progress);
   RenderOptions options = setup.render;
   options.stats = want_stats;
+  // The callback runs on the rendering thread with the GIL taken for it; one that raises is
+  // called no more, and its exception is raised when the render returns.
+  std::optional<py::error_already_set> raised;
+  if (progress) {
+    const py::object* call = &progress;  // outlives the render; copied as a pointer, no reference count touched
+    options.progress = [call, &raised](const std::string& stage, double done) {
+      if (raised) return;
+      py::gil_scoped_acquire gil;
+      try {
+        (*call)(stage, done);
+      } catch (py::error_already_set& e) {
+        raised.emplace(std::move(e));
+      }
+    };
+  }
   const bool want_result = !options.aovs.empty() || options.stats;
   // A cheap copy sharing the loaded data; loaded again only when set= replaces values.
   const Scene scene = scene_object.cast<Scene>().with_overrides(setup.set);
@@ -170,6 +192,7 @@ py::object render(Renderer& renderer, const py::handle& scene_object, const py::
     PyErr_SetNone(PyExc_KeyboardInterrupt);
     throw py::error_already_set();
   }
+  if (raised) throw std::move(*raised);
   if (!want_result) return image_to_array(std::move(result.image));
 
   // The image, the AOVs and the stats as Python objects.
@@ -221,6 +244,10 @@ use is refused (SceneError), as it is there.
   set: a dict {"camera.fov_y": 30, "lights[0].position": [1, 4, 2], ...} of scene values
        replaced before the scene is read (the scene is loaded again from its source).
   stats: True for the stats dict.
+  progress: a callable (stage, done) called now and then on the rendering thread (the GIL
+            taken for it) with a pass's name ("shading", "cube A-buffer", "raytrace",
+            "gpu passes", ...) and its share done in [0, 1]; an exception it raises ends
+            its calls and is raised when the render returns.
   plan_everything (True: plan="everything") and side_structure (False: map_only=True) are
   taken too.
 
@@ -277,7 +304,9 @@ py::dict report(const py::handle& scene_object, const py::handle& dir, const py:
   o.renderer.gl = string_arg(gl, "gl");
   o.renderer.gl_device = int_arg(gl_device, "gl_device");
   bool want_stats = false;
-  const RenderSetup setup = setup_from_kwargs(kwargs, &want_stats);
+  py::object progress;
+  const RenderSetup setup = setup_from_kwargs(kwargs, &want_stats, &progress);
+  if (progress) throw InputError("progress: report() reports its renders itself; give it to Renderer.render");
   o.render = setup.render;
   const Scene scene = scene_object.cast<Scene>().with_overrides(setup.set);
   ReportResult r;

@@ -78,8 +78,9 @@ struct Quarters {
 class MapRender {
  public:
   MapRender(const SceneData& scene, const ABuffer& camera, const MapShader& shader, Image* fallback,
-            const std::vector<uint8_t>* only)
-      : scene_(scene),
+            const std::vector<uint8_t>* only, const std::function<void(double)>* progress)
+      : progress_(progress),
+        scene_(scene),
         camera_(camera),
         shader_(shader),
         fallback_(fallback),
@@ -104,6 +105,7 @@ class MapRender {
     ro.threads = threads;
     ro.exact_priority = shader_.exact_priority();
     ro.only = only_;
+    if (progress_ && *progress_) ro.progress = *progress_;  // the first pass: most of the shading
     // SHADOW EDGES and SECONDARY EDGES (header): what each pixel's points saw, and in the
     // second pass the pixels an edge runs between whose points and their neighbour's.
     if ((edges_ || trails_on_ || sparse_) && only_ && neighbours) {
@@ -387,6 +389,7 @@ class MapRender {
     }
   }
 
+  const std::function<void(double)>* progress_;  // the first pass's rows, when given
   const SceneData& scene_;
   const ABuffer& camera_;
   const MapShader& shader_;
@@ -417,8 +420,9 @@ class MapRender {
 }  // namespace
 
 Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
-                      MapShadingStats* stats, Image* fallback, const std::vector<uint8_t>* only, bool neighbours) {
-  MapRender render(scene, camera, shader, fallback, only);
+                      MapShadingStats* stats, Image* fallback, const std::vector<uint8_t>* only, bool neighbours,
+                      const std::function<void(double)>* progress) {
+  MapRender render(scene, camera, shader, fallback, only, progress);
   return render.render(threads, neighbours, stats);
 }
 

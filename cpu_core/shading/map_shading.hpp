@@ -9,6 +9,7 @@
 #pragma once
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -296,9 +297,10 @@ class MapShader {
 // With `only`, SHADOW EDGES between pixels need the neighbours' points too: `neighbours`
 // shades the 4-neighbours of `only`'s pixels as well (their colours are dropped); without
 // it an edge between an `only` pixel and one outside is left to the points (the pilots of
-// --target-db, single pixels apart, would pay five pixels for one).
+// --target-db, single pixels apart, would pay five pixels for one). `progress` (optional):
+// called on the calling thread with the share of the shading done.
 Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
                       MapShadingStats* stats, Image* fallback = nullptr, const std::vector<uint8_t>* only = nullptr,
-                      bool neighbours = true);
+                      bool neighbours = true, const std::function<void(double)>* progress = nullptr);
 
 }  // namespace abcube

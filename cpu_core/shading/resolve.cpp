@@ -1,6 +1,7 @@
 #include "shading/resolve.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <limits>
 
 #include "base/error.hpp"
@@ -176,8 +177,14 @@ Image resolve_image_per_worker(const ABuffer& camera, const TriangleSoup& triang
   const int threads = resolve_workers(camera, options);
   Image image(camera.width(), camera.height(), 3);
   std::vector<PackScratch> scratch(static_cast<size_t>(threads));
+  std::atomic<int> rows_done{0};
+  double reported = 0;  // written by worker 0 only, the calling thread
   parallel_for(static_cast<size_t>(camera.height()), threads, [&](size_t row, int worker) {
     const int y = static_cast<int>(row);
+    const auto report = [&] {
+      const int done = ++rows_done;
+      if (worker == 0 && options.progress) options.progress(reported = static_cast<double>(done) / camera.height());
+    };
     for (int x = 0; x < camera.width(); ++x) {
       if (options.only &&
           !(*options.only)[static_cast<size_t>(y) * static_cast<size_t>(camera.width()) + static_cast<size_t>(x)]) {
@@ -189,7 +196,9 @@ Image resolve_image_per_worker(const ABuffer& camera, const TriangleSoup& triang
                                 &scratch[static_cast<size_t>(worker)], options.exact_priority ? &depth : nullptr);
       image.set_rgb(x, y, glm::vec3(c));
     }
+    report();
   });
+  if (options.progress && reported < 1.0) options.progress(1.0);  // the other threads did the last rows
   return image;
 }
 

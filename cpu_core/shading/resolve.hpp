@@ -71,6 +71,8 @@ struct ResolveOptions {
   // When set (width x height, row 0 at the top): only the pixels whose entry is not 0 are
   // resolved; the others stay black (the hybrid method: the pixels the GPU left to the CPU).
   const std::vector<uint8_t>* only = nullptr;
+  // Called now and then on the calling thread with the share of rows resolved, in [0, 1].
+  std::function<void(double)> progress;
 };
 
 // The antialiased image (row 0 at the top): pack_under_mask(list, FULL_MASK) per pixel.

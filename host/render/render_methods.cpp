@@ -22,6 +22,11 @@ namespace abcube {
 
 using nlohmann::json;
 
+// A pass of the render starts (0) or ends (1), for the progress callback when there is one.
+void pass_progress(const MethodContext& mc, const char* pass, double done) {
+  if (mc.progress) mc.progress(pass, done);
+}
+
 json gl_json(const GlContext* ctx) {
   if (!ctx) return {{"path", "none"}, {"renderer", describe_gl(nullptr)}};
   const GlInfo& i = ctx->info();
@@ -80,7 +85,9 @@ Image render_gpu(MethodContext& mc) {
   // environment map for reflecting or refracting materials (none at max_depth 0).
   json passes = json::array(), skipped = json::array();
   const int n = scene.render.cube_resolution;
+  pass_progress(mc, "gpu passes", 0.0);
   const int maps = gl.build_shadow_maps(n);
+  pass_progress(mc, "gpu passes", 0.25);
   if (maps > 0) {
     passes.push_back("shadow_maps");
   } else {
@@ -91,6 +98,7 @@ Image render_gpu(MethodContext& mc) {
   const bool needed = mirrors && scene.render.max_depth > 0;
   if (needed || mc.request.plan_everything) {
     gl.build_environment(scene.camera.position, n);
+    pass_progress(mc, "gpu passes", 0.5);
     passes.push_back(needed ? "environment_map" : "environment_map (unused: --plan everything)");
   }
   if (!needed) {
@@ -108,6 +116,7 @@ Image render_gpu(MethodContext& mc) {
   // The camera view at the A-buffer's 4x8 sample positions, box-filtered as its resolve
   // weighs the masks: the same edges as abuffer.
   Image image = gl.camera_color(scene.camera, CameraSamples::mask_4x8);
+  pass_progress(mc, "gpu passes", 1.0);
   passes.push_back("camera_raster");
   skipped.push_back({{"pass", "cube_distance"}, {"why", "method gpu does no map search"}});
   const GpuTimings& t = gl.timings();
@@ -213,9 +222,11 @@ Image render_hybrid(MethodContext& mc) {
   const bool exact_pass = gl.exact_camera_possible();
   Image image;
   if (exact_pass) {
+    pass_progress(mc, "gpu passes", 0.0);
     gl.set_texture_level0(true);
     image = gl.camera_color(scene.camera, CameraSamples::mask_4x8);
     gl.set_texture_level0(false);
+    pass_progress(mc, "gpu passes", 1.0);
   }
   const ExactCameraStats& ex = gl.exact_camera_stats();
   std::vector<uint8_t> cpu(static_cast<size_t>(scene.camera.width) * static_cast<size_t>(scene.camera.height), 1);
@@ -318,7 +329,10 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
       stats["target_db"] = {{"target", scene.render.target_db},
                             {"why", "no cube map: nothing reflects, refracts or casts a shadow, so N is not used"}};
     }
-    return render_abuffer_local(scene, r.abuffer, &stats, r.map.exact_priority, r.map.texture_samples, only);
+    pass_progress(mc, "shading", 0.0);
+    Image image = render_abuffer_local(scene, r.abuffer, &stats, r.map.exact_priority, r.map.texture_samples, only);
+    pass_progress(mc, "shading", 1.0);
+    return image;
   }
   std::unique_ptr<RayTracer> reference;
   if (r.reference) reference = std::make_unique<RayTracer>(scene, mc.cache.bvh());
@@ -328,21 +342,28 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   // --target-db shades the same camera fragments.
   ABufferStats as;
   const Clock::time_point camera_start = Clock::now();
+  pass_progress(mc, "camera A-buffer", 0.0);
   const ABuffer camera = build_camera_abuffer(scene, r.abuffer, &as);
+  pass_progress(mc, "camera A-buffer", 1.0);
   const double camera_ms = ms_since(camera_start);
   ABufferOptions cube_options = r.abuffer;
   cube_options.reserved_bytes += as.bytes_total;
+  const bool target = scene.render.method == Method::abuffer && scene.render.target_db > 0;
+  const char* cube_pass = target ? "choosing N and the shading (pilots)" : "cube A-buffer";
+  pass_progress(mc, cube_pass, 0.0);
   const CubeMap map =
-      scene.render.method == Method::abuffer && scene.render.target_db > 0
-          ? cube_map_for_target(mc, camera, cube_options, reference.get())
-          : build_cube_map(mc, scene.render.cube_resolution, cube_options, reference.get(), map_shading_options(mc));
+      target ? cube_map_for_target(mc, camera, cube_options, reference.get())
+             : build_cube_map(mc, scene.render.cube_resolution, cube_options, reference.get(), map_shading_options(mc));
+  pass_progress(mc, cube_pass, 1.0);
   stats["timings_ms"]["cube_abuffer"] = map.build_ms;
   stats["cube_abuffer"] = cube_abuffer_json(map.stats);
   stats["timings_ms"]["map_setup"] = map.setup_ms;
   stats["timings_ms"]["camera_abuffer"] = camera_ms;
   const Clock::time_point t0 = Clock::now();
   MapShadingStats ms;
-  Image image = render_with_map(scene, camera, *map.shader, r.threads, &ms, mc.fallback, only);
+  std::function<void(double)> shading;
+  if (mc.progress) shading = [&mc](double done) { mc.progress("shading", done); };
+  Image image = render_with_map(scene, camera, *map.shader, r.threads, &ms, mc.fallback, only, true, &shading);
   stats["timings_ms"]["shade_and_resolve"] = ms_since(t0);
   stats["abuffer"] = abuffer_json(as, false);
   stats["searches"] = map_shading_json(ms);

@@ -35,6 +35,22 @@ for gl in egl osmesa egl-surfaceless auto; do
 done
 check "--gl osmesa stats say osmesa" grep -q '"path": "osmesa"' "$WORK/s_osmesa.json"
 
+# --- progress on a terminal (a pseudo-terminal from script(1)) for every method, each pass to
+# 100%; none when stderr is a file
+for m in abuffer gpu hybrid raytrace envmap; do
+  n="--cube-res 32"
+  [ $m = raytrace ] && n=""
+  script -qec "'$ABCUBE' render '$WORK/small.json' -o '$WORK/p_$m.png' --method $m $n" /dev/null \
+    > "$WORK/tty_$m" 2>&1
+  check "$m on a terminal exits 0" [ $? -eq 0 ]
+  check "$m shows its progress on a terminal ($(tr '\r' '|' < "$WORK/tty_$m" | head -c 300))" grep -q "100%" "$WORK/tty_$m"
+done
+check "abuffer's progress names its passes" grep -q "shading 100%" "$WORK/tty_abuffer"
+check "abuffer's progress names its passes" grep -q "cube A-buffer 100%" "$WORK/tty_abuffer"
+check "gpu's progress names its passes" grep -q "gpu passes 100%" "$WORK/tty_gpu"
+"$ABCUBE" render "$WORK/small.json" -o "$WORK/p_file.png" --cube-res 32 2> "$WORK/quiet"
+check "no progress when stderr is a file" [ ! -s "$WORK/quiet" ]
+
 # --- the two APIs draw the same picture
 "$ABCUBE" compare "$WORK/gpu_egl.png" "$WORK/gpu_osmesa.png" --fail 0.004 > "$WORK/cmp" 2>&1
 status=$?

@@ -268,3 +268,25 @@ def test_reference_stats(renderer, scene):
     assert psnr and all(math.isfinite(p) and p > 10 for p in psnr)
     # Without it, no reference section.
     assert "reference" not in renderer.render(scene, method="abuffer", stats=True).stats
+
+
+def test_progress(renderer, scene):
+    # python.md: progress(stage, done) on the rendering thread for every method, each pass
+    # to 1; an exception it raises comes out of render; a value that is no callable refused.
+    with_gl = abcube.Renderer(gl="auto")
+    for method in ("abuffer", "raytrace", "gpu", "hybrid"):
+        seen = []
+        with_gl.render(scene, method=method, progress=lambda stage, done: seen.append((stage, done)))
+        assert seen and all(0 <= d <= 1 for _, d in seen), (method, seen)
+        assert all(any(d == 1 for s2, d in seen if s2 == s) for s, _ in seen), (method, seen)
+    stages = []
+    renderer.render(scene, method="abuffer", progress=lambda stage, done: stages.append(stage))
+    assert "shading" in stages and "cube A-buffer" in stages, stages
+
+    def fails(stage, done):
+        raise ValueError("stop here")
+
+    with pytest.raises(ValueError, match="stop here"):
+        renderer.render(scene, method="raytrace", progress=fails)
+    with pytest.raises(abcube.SceneError, match="progress"):
+        renderer.render(scene, progress=3)
