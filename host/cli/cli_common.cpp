@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -46,8 +47,21 @@ const char* value_name(OptionKind k) {
 }
 
 void RenderFlags::add_to(CLI::App* cmd) {
+  std::vector<std::string> keys;
+  for (const OptionSpec& s : render_option_table()) keys.push_back(s.key);
+  add_to(cmd, keys);
+}
+
+const std::vector<std::string>& scene_view_keys() {
+  static const std::vector<std::string> keys = {"width", "height", "size", "fov_y", "camera_position",
+                                                "look_at", "up", "set", "max_depth"};
+  return keys;
+}
+
+void RenderFlags::add_to(CLI::App* cmd, const std::vector<std::string>& keys) {
   cmd_ = cmd;
   for (const OptionSpec& s : render_option_table()) {
+    if (std::find(keys.begin(), keys.end(), s.key) == keys.end()) continue;
     std::vector<std::string>& texts = texts_[s.key];
     if (s.kind == OptionKind::flag) {
       cmd->add_flag_function(
@@ -67,7 +81,9 @@ RenderSetup RenderFlags::setup() const {
   RenderSetup setup;
   try {
     for (const OptionSpec& s : render_option_table()) {
-      for (const std::string& t : texts_.at(s.key)) set_render_option_text(setup, s.key, t);
+      const auto given = texts_.find(s.key);
+      if (given == texts_.end()) continue;  // not a flag of this command
+      for (const std::string& t : given->second) set_render_option_text(setup, s.key, t);
     }
   } catch (const OptionError& e) {
     throw_as_flag(e);

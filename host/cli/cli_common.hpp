@@ -27,8 +27,9 @@ CommandRun add_report_command(CLI::App& app);
 // The render options of the table (<abcube/options.hpp>) as command-line flags of a
 // subcommand: their help, defaults and units from the table; their values checked by it.
 struct RenderFlags {
-  // Registers every option of the table on `cmd`.
+  // Registers every option of the table on `cmd`, or only those of `keys`.
   void add_to(CLI::App* cmd);
+  void add_to(CLI::App* cmd, const std::vector<std::string>& keys);
   // The options given, applied in the table's order (a repeated --set keeps each); an
   // InputError naming the flag for a bad value.
   RenderSetup setup() const;
@@ -37,6 +38,11 @@ struct RenderFlags {
   CLI::App* cmd_ = nullptr;
   std::map<std::string, std::vector<std::string>> texts_;  // table key -> each value given
 };
+
+// The table's keys of the scene as seen: its camera (size, field of view, placement), its
+// values replaced (--set), its bounces; for the commands that take a scene but render no
+// method (crosscheck, export-pov).
+const std::vector<std::string>& scene_view_keys();
 
 // An option the table refuses, named by its flag ("--cube-res: must be ...").
 [[noreturn]] void throw_as_flag(const OptionError& e);

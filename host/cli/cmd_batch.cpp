@@ -85,6 +85,37 @@ bool outputs_exist(const Job& job, const RenderSetup& base) {
   return true;
 }
 
+// The options a job names itself that its method does not use, refused as `render` refuses
+// them, before anything renders (exit 2), wherever the job or the command line names the
+// method; a job whose method is its scene's is checked when it renders (job_setup).
+void check_own_options(const Job& job, const RenderSetup& base, const std::string& jobs_path) {
+  const RenderSetup own = job.setup(RenderSetup{});
+  const std::string method = own.render.method.empty() ? base.render.method : own.render.method;
+  if (method.empty()) return;
+  try {
+    refuse_options_unused_by(method, own.render);
+  } catch (const OptionError& e) {
+    throw InputError(jobs_path + ":" + std::to_string(job.line) + ": \"" + e.key + "\": " + one_line(e.reason, "; "));
+  }
+}
+
+// A job's settings: the command line's defaults that its method uses, then its own keys.
+// A default its method does not use (--cube-res for a raytrace job) is left out for that job;
+// a key the job names itself that its method does not use is refused.
+RenderSetup job_setup(const Job& job, const RenderSetup& base, const Scene& scene) {
+  const std::string method = job.setup(base).render.method;
+  RenderSetup defaults = base;
+  defaults.render = without_unused_options(base.render, method.empty() ? scene.method() : method);
+  defaults.render.method = base.render.method;
+  const RenderSetup own = job.setup(RenderSetup{});
+  refuse_unused_options(scene, [&] {
+    RenderOptions o = own.render;
+    if (o.method.empty()) o.method = base.render.method;
+    return o;
+  }());
+  return job.setup(defaults);
+}
+
 struct BatchCommand {
   std::string jobs_path, shard = "0/1";
   bool skip_existing = false;
@@ -124,6 +155,7 @@ struct BatchCommand {
           throw InputError(jobs_path + ":" + std::to_string(job.line) + ": \"" + key + "\": " + e.what());
         }
       }
+      check_own_options(job, base, jobs_path);
     }
     // What killed runs left (SIGKILL, a preempted machine): their temporaries, once their
     // processes are gone. Every output lands whole, by rename, so what exists is complete.
@@ -158,9 +190,8 @@ struct BatchCommand {
       } else {
         try {
           const Clock::time_point t0 = Clock::now();
-          const RenderSetup setup = job.setup(base);
-          const Scene scene = scenes.get(job.scene, setup.set);
-          refuse_unused_options(scene, setup.render);
+          const Scene scene = scenes.get(job.scene, job.setup(base).set);
+          const RenderSetup setup = job_setup(job, base, scene);
           const RenderResult r = renderer.render(scene, setup.render);
           make_output_folders({job.out, job.stats});
           write_outputs(job.out, r);
@@ -209,15 +240,21 @@ CommandRun add_batch_command(CLI::App& app) {
       "many renders in one process: one JSON job per line, {\"scene\": ..., \"out\": ...} plus optional stats (a "
       "path), camera (an object) and any render option below by its snake_case name (cube_res, set, ...); paths "
       "relative to the jobs file");
-  cmd->add_option("JOBS", c->jobs_path, "jobs file (JSON lines)")->required();
-  cmd->add_option("--shard", c->shard, "render the jobs whose 0-based index modulo N is I")->capture_default_str();
-  cmd->add_flag("--skip-existing", c->skip_existing, "skip jobs whose output exists (resume an interrupted batch)");
-  cmd->add_option("--job-timeout", c->job_timeout_s, "stop one job past this many seconds, 0 = no limit")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e9));
-  cmd->add_option("--scene-cache", c->scene_cache, "distinct scenes kept loaded at once (least recently used dropped)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1 << 20));
+  cmd->add_option("JOBS", c->jobs_path, "jobs file (JSON lines)")->required()->type_name("PATH");
+  cmd->add_option("--shard", c->shard, "render the jobs whose 0-based index modulo N is I (default: 0/1, every job)")
+      ->type_name("I/N");
+  cmd->add_flag("--skip-existing", c->skip_existing,
+                "skip jobs whose outputs all exist: image, AOVs and stats (resume an interrupted or killed batch)");
+  cmd->add_option("--job-timeout", c->job_timeout_s,
+                  "stop one job past this many seconds, and go on with the next (seconds, 0 to 1e9; default: 0, no "
+                  "limit). --timeout, by contrast, applies to every job as a render option")
+      ->type_name("NUMBER")
+      ->check(CLI::Range(0.0, 1e9).description(""));
+  cmd->add_option("--scene-cache", c->scene_cache,
+                  "distinct scenes kept loaded at once, the least recently used dropped (scenes, 1 to 1048576; "
+                  "default: 4)")
+      ->type_name("INT")
+      ->check(CLI::Range(1, 1 << 20).description(""));
   c->flags.add_to(cmd);
   return [c] { return c->run(); };
 }

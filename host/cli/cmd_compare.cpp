@@ -54,6 +54,11 @@ struct CompareCommand {
       std::printf("%s\n", j.dump(2).c_str());
       return pass ? 0 : 1;
     }
+    // The verdict first, with the test that gave it: a bare comparison fails on one pixel
+    // over 1/255, which a reader of its last line alone would take for "far apart".
+    std::printf("%s: %.4f%% of pixels differ by more than %.4g (--fail, displayed values), %.4g%% allowed "
+                "(--failpercent)\n",
+                pass ? "PASS" : "FAIL", 100.0 * failing, fail, fail_percent);
     std::printf("RMSE        %.6g\n", e.rmse);
     if (std::isfinite(e.psnr)) {
       std::printf("PSNR        %.2f dB\n", e.psnr);
@@ -79,16 +84,20 @@ struct CompareCommand {
 CommandRun add_compare_command(CLI::App& app) {
   auto c = std::make_shared<CompareCommand>();
   CLI::App* cmd = app.add_subcommand("compare", "RMSE, PSNR, max abs error and the share of pixels over a threshold");
-  cmd->add_option("A", c->a, "first image")->required();
-  cmd->add_option("B", c->b, "second image")->required();
+  cmd->add_option("A", c->a, "first image")->required()->type_name("IMAGE");
+  cmd->add_option("B", c->b, "second image")->required()->type_name("IMAGE");
   cmd->add_option("--diff", c->diff_path,
-                  "write a per-pixel error heat map here, its legend beneath (black 0 ... red 128/255)");
-  cmd->add_option("--fail", c->fail, "a pixel fails above this difference, displayed values in [0, 1]")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--failpercent", c->fail_percent, "the comparison fails above this share of failing pixels, %")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 100.0));
+                  "write a per-pixel error heat map here, its legend beneath (black 0 ... red 128/255)")
+      ->type_name("PATH");
+  cmd->add_option("--fail", c->fail,
+                  "a pixel fails above this difference of displayed values (0 to 1; default: 1/255)")
+      ->type_name("NUMBER")
+      ->check(CLI::Range(0.0, 1.0).description(""));
+  cmd->add_option("--failpercent", c->fail_percent,
+                  "the comparison fails (exit 1) above this share of failing pixels (%, 0 to 100; default: 0, any "
+                  "failing pixel fails it; 100: the figures alone, always exit 0)")
+      ->type_name("NUMBER")
+      ->check(CLI::Range(0.0, 100.0).description(""));
   cmd->add_flag("--exact", c->exact, "pass only when every float is the same (bit for bit, before encoding)");
   cmd->add_flag("--json", c->json_output, "print every figure as one JSON object instead of the text");
   return [c] { return c->run(); };

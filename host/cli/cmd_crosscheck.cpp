@@ -12,6 +12,7 @@
 #include "base/error.hpp"
 #include "gl/gl_context.hpp"
 #include "io/image_io.hpp"
+#include "render/render_methods.hpp"
 #include "base/memory.hpp"
 #include "scene/scene_load.hpp"
 
@@ -26,6 +27,7 @@ constexpr const char* CROSSCHECK_COVERS =
 struct CrosscheckCommand {
   std::string scene_path, stats_path, samples_image, shadow_image, gl = "auto";
   int cube_res = 0, device = -1, threads = 0;
+  RenderFlags flags;  // the scene as seen: size, camera, --set, --max-depth
 
   int run() const {
     GlChoice choice = GlChoice::automatic;
@@ -34,8 +36,9 @@ struct CrosscheckCommand {
     check_output_path(stats_path, false);
     check_output_path(samples_image, true);
     check_output_path(shadow_image, true);
-    const Scene loaded = Scene::load(scene_path);
-    SceneData scene = loaded.data();  // shares the triangles
+    const RenderSetup setup = flags.setup();
+    const Scene loaded = Scene::load(scene_path, setup.limits, setup.set);
+    SceneData scene = scene_view(loaded.data(), setup.render);  // shares the triangles
     if (cube_res > 0) scene.render.cube_resolution = cube_res;
     check_render_size(scene, memory_budget_bytes(0), false);
 
@@ -104,20 +107,30 @@ CommandRun add_crosscheck_command(CLI::App& app) {
       "reflections, refractions or antialiased edges, where the methods differ by design: `abcube report` shows "
       "every method against the exact tracer");
   cmd->footer(std::string(CROSSCHECK_COVERS));
-  cmd->add_option("SCENE", c->scene_path, "scene file")->required();
-  cmd->add_option("--cube-res", c->cube_res, "face edge N, texels (default: the scene's)")->check(CLI::Range(1, 16384));
-  cmd->add_option("--gl", c->gl, "GL path: auto | egl | egl-device | egl-surfaceless | osmesa")->capture_default_str();
-  cmd->add_option("--gl-device", c->device, "EGL device index")->check(CLI::Range(0, 1024));
-  cmd->add_option("--threads", c->threads, "worker threads, 0 = every core")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 4096));
-  cmd->add_option("--stats", c->stats_path, "figures and tolerances as JSON");
+  cmd->add_option("SCENE", c->scene_path, "scene file, or a model file (.gltf, .glb, .obj)")
+      ->required()
+      ->type_name("PATH");
+  c->flags.add_to(cmd, scene_view_keys());
+  cmd->add_option("--cube-res", c->cube_res, "cube map face edge N (texels, 1 to 16384; default: the scene's)")
+      ->type_name("INT")
+      ->check(CLI::Range(1, 16384).description(""));
+  cmd->add_option("--gl", c->gl, "GL path: auto | egl | egl-device | egl-surfaceless | osmesa (default: auto)")
+      ->type_name("NAME");
+  cmd->add_option("--gl-device", c->device, "EGL device index (0 to 1024; default: ABCUBE_EGL_DEVICE, else the first GPU)")
+      ->type_name("INT")
+      ->check(CLI::Range(0, 1024).description(""));
+  cmd->add_option("--threads", c->threads, "worker threads (threads, 0 to 4096; default: 0, every core)")
+      ->type_name("INT")
+      ->check(CLI::Range(0, 4096).description(""));
+  cmd->add_option("--stats", c->stats_path, "figures and tolerances as JSON")->type_name("PATH");
   cmd->add_option("--samples-image", c->samples_image,
                   "where GPU and CPU see different objects: pixels with any of their 32 samples differing in red (to "
-                  "yellow when all do) over the CPU image in grey");
+                  "yellow when all do) over the CPU image in grey")
+      ->type_name("PATH");
   cmd->add_option("--shadow-image", c->shadow_image,
                   "per pixel of the shadow camera, the share of (sample, light) pairs where the GPU's shadow volumes "
-                  "and the exact tracer differ");
+                  "and the exact tracer differ")
+      ->type_name("PATH");
   return [c] { return c->run(); };
 }
 

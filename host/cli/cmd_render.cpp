@@ -56,9 +56,12 @@ CommandRun add_render_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("render", "render a scene into an image (PNG, EXR, TIFF, ... by extension)");
   cmd->add_option("SCENE", c->scene,
                   "scene file (docs/scene-format.md), or a model file (.gltf, .glb, .obj) rendered framed and lit")
-      ->required();
-  cmd->add_option("-o,--output", c->output, "output image, written atomically; missing folders are made");
-  cmd->add_option("--stats", c->stats_path, "stats JSON: plan, per-pass ms, counts, memory, GL path, errors");
+      ->required()
+      ->type_name("PATH");
+  cmd->add_option("-o,--output", c->output, "output image, written atomically; missing folders are made")
+      ->type_name("PATH");
+  cmd->add_option("--stats", c->stats_path, "stats JSON: plan, per-pass ms, counts, memory, GL path, errors")
+      ->type_name("PATH");
   c->flags.add_to(cmd);
   return [c] { return c->run(); };
 }

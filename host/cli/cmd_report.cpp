@@ -51,7 +51,12 @@ struct ReportCommand {
     o.crosscheck = !no_crosscheck;
     if (stderr_is_terminal()) o.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
     const Scene s = Scene::load(scene, setup.limits, setup.set);
-    const ReportResult r = write_report(s, dir, o);
+    ReportResult r;
+    try {
+      r = write_report(s, dir, o);
+    } catch (const OptionError& e) {
+      throw_as_flag(e);
+    }
     const nlohmann::json j = nlohmann::json::parse(r.json);
     std::printf("report %s: %s\n", scene.c_str(), r.index_html.c_str());
     for (const std::string& m : o.methods) {
@@ -85,12 +90,16 @@ CommandRun add_report_command(CLI::App& app) {
       "per method, per surface and object, time against error with the tracer at 1 to 32 samples a pixel and the "
       "fastest way to each method's error, time per pass and the GPU against the CPU, in DIR/index.html "
       "(self-contained, offline)");
-  cmd->add_option("SCENE", c->scene, "scene file, or a model file (.gltf, .glb, .obj)")->required();
-  cmd->add_option("-o,--output", c->dir, "output folder: index.html, report.json, images/, stats/ (made if missing)");
-  cmd->add_option("--methods", c->methods, "the methods compared with raytrace, comma-separated")
-      ->capture_default_str();
+  cmd->add_option("SCENE", c->scene, "scene file, or a model file (.gltf, .glb, .obj)")->required()->type_name("PATH");
+  cmd->add_option("-o,--output", c->dir, "output folder: index.html, report.json, images/, stats/ (made if missing)")
+      ->type_name("PATH");
+  cmd->add_option("--methods", c->methods,
+                  "the methods compared with raytrace, comma-separated (default: abuffer,gpu,hybrid,zbuffer,envmap)")
+      ->type_name("NAME,...");
   cmd->add_option("--sweep", c->sweep,
-                  "abuffer again at these cube resolutions, comma-separated (e.g. 64,128,256,512)");
+                  "abuffer again at these cube resolutions, comma-separated (e.g. 64,128,256,512), for the developers' "
+                  "section")
+      ->type_name("N,...");
   cmd->add_flag("--no-crosscheck", c->no_crosscheck, "leave out the GPU-against-CPU crosscheck");
   c->flags.add_to(cmd);
   return [c] { return c->run(); };

@@ -63,15 +63,16 @@ int main(int argc, char** argv) {
   map_large_blocks_alone();  // freed scene-sized vectors leave the resident set at once
   CLI::App app("abcube: a headless hybrid renderer (GL raster + CPU A-buffered cube map searches)", "abcube");
   app.set_version_flag("--version", version_string());
+  app.require_subcommand(1, 1);
+  const CommandRun runs[] = {add_render_command(app), add_batch_command(app),      add_compare_command(app),
+                             add_info_command(app),   add_export_pov_command(app), add_crosscheck_command(app),
+                             add_report_command(app)};
+  // Set after the commands are made, which would copy it: the citation appears once, here.
   app.footer(
       "The method: M. Eveleens and S. I. Goya, \"Calculo de Reflexiones, Refracciones y Sombras\", thesis "
       "directed by G. Rossi and G. A. Patow, Facultad de Informatica, Universidad Nacional de La Plata; the "
       "\"thesis\" modes and the error bounds named in these options are that text's (docs/methods.md cites "
       "every source). Each command's options: abcube COMMAND --help.");
-  app.require_subcommand(1, 1);
-  const CommandRun runs[] = {add_render_command(app), add_batch_command(app),      add_compare_command(app),
-                             add_info_command(app),   add_export_pov_command(app), add_crosscheck_command(app),
-                             add_report_command(app)};
   // A first word that is no option and no command is named as such (CLI11 would only say
   // that a subcommand is required).
   if (argc > 1 && argv[1][0] != '-') {

@@ -185,6 +185,17 @@ class Report {
     for (int n : o_.sweep) {
       if (n < 1 || n > 16384) throw InputError("sweep: each N must be in [1, 16384], got " + std::to_string(n));
     }
+    // Render options the report decides itself, refused rather than left unused.
+    const RenderOptions& r = o_.render;
+    if (!r.method.empty()) throw OptionError("method", "not used by report: it renders each method of methods");
+    if (!r.aovs.empty()) throw OptionError("aovs", "not used by report: it writes the images it shows, no AOVs");
+    if (r.reference || !r.reference_image.empty()) {
+      throw OptionError(r.reference_image.empty() ? "reference" : "reference_image",
+                        "not used by report: it traces its own reference, the exact image at 32 samples a pixel");
+    }
+    if (r.samples != 0) {
+      throw OptionError("samples", "not used by report: it traces the exact image at every rung of samples itself");
+    }
   }
 
   std::string path(const std::string& relative) const { return (fs::path(dir_) / relative).string(); }

@@ -98,8 +98,9 @@ check "empty mesh: exit 0, both rendered (2)" [ -s w/1.png ]
 check "empty mesh: exit 0, both rendered (3)" [ -s w/2.png ]
 check "empty mesh: one warning naming job line 1" [ "$(cat err)" = "warn.jsonl:1: empty_mesh.json: objects[0].file: warning: mesh \"empty.obj\" has no triangles" ]
 
-# --- a failing job: its line on stderr, the others rendered, exit 1
-printf '{"scene": "cornell.json", "out": "f/1.png", "method": "raytrace"}\n{"scene": "nowhere.json", "out": "f/2.png"}\n{"scene": "cornell.json", "out": "f/3.png", "method": "raytrace", "cube_res": 64}\n{"scene": "cornell.json", "out": "f/4.png", "method": "raytrace", "camera": {"position": [0, 1, 0]}}\n' > fail.jsonl
+# --- a failing job: its line on stderr, the others rendered, exit 1; a key its scene's own
+# method does not use fails that job when it renders
+printf '{"scene": "cornell.json", "out": "f/1.png", "method": "raytrace"}\n{"scene": "nowhere.json", "out": "f/2.png"}\n{"scene": "cornell.json", "out": "f/3.png", "set": {"render.method": "raytrace"}, "cube_res": 64}\n{"scene": "cornell.json", "out": "f/4.png", "method": "raytrace", "camera": {"position": [0, 1, 0]}}\n' > fail.jsonl
 "$ABCUBE" batch fail.jsonl > summary 2> err; status=$?
 check "failing jobs: exit 1" [ $status -eq 1 ]
 check "failing job 2 named by line" grep -q "fail.jsonl:2: .*nowhere.json" err
@@ -107,6 +108,23 @@ check "failing job 3 named by line" grep -q "fail.jsonl:3: \"cube_res\": not use
 check "the other jobs rendered" [ -s f/1.png ]
 check "the other jobs rendered (2)" [ -s f/4.png ]
 check "summary counts failures" grep -q "4 jobs, 2 rendered, 2 failed" summary
+
+# --- a key a job's named method does not use: exit 2 before anything renders
+printf '{"scene": "cornell.json", "out": "o/1.png"}\n{"scene": "cornell.json", "out": "o/2.png", "method": "raytrace", "cube_res": 64}\n' > own.jsonl
+"$ABCUBE" batch own.jsonl > /dev/null 2> err; status=$?
+check "a job's own unused key: exit 2 ($(cat err))" [ $status -eq 2 ]
+check "a job's own unused key: named by line" grep -q 'own.jsonl:2: "cube_res": not used by method raytrace' err
+check "a job's own unused key: nothing rendered" [ ! -e o/1.png ]
+
+# --- a command-line default a job's method does not use is left out for that job: the
+# raytrace job renders as abcube render --method raytrace, the abuffer job takes --cube-res
+printf '{"scene": "cornell.json", "out": "d/rt.png", "method": "raytrace"}\n{"scene": "cornell.json", "out": "d/ab.png"}\n' > defaults.jsonl
+"$ABCUBE" batch defaults.jsonl --cube-res 48 --width 40 --height 30 > /dev/null 2> err; status=$?
+check "defaults a method does not use: exit 0 ($(cat err))" [ $status -eq 0 ]
+"$ABCUBE" render cornell.json -o d_rt.png --method raytrace --width 40 --height 30
+"$ABCUBE" render cornell.json -o d_ab.png --cube-res 48 --width 40 --height 30
+check "the raytrace job without --cube-res" cmp -s d/rt.png d_rt.png
+check "the abuffer job with --cube-res" cmp -s d/ab.png d_ab.png
 
 # --- a bad option value is a malformed line: exit 2 before anything renders, the table's
 # message under the line's own key, with the nearest name

@@ -62,6 +62,19 @@ def test_help_and_docstrings_name_no_path_outside():
     assert not bad, bad
 
 
+def test_every_help_has_one_style():
+    """cli.md: every command's --help in the option table's style: a value's name (INT,
+    NUMBER, PATH, NAME, ...), its unit, range and default in words in its line; no raw
+    parser types (FLOAT, UINT, TEXT, INT:INT in [a - b]) or =default glued to them; the
+    citation once, in abcube --help."""
+    raw = re.compile(r"\b(FLOAT|UINT|TEXT)\b|\b[A-Z]+:[A-Z]+\b| in \[|\b(INT|NUMBER|PATH|NAME)=")
+    texts = help_texts()
+    for name, text in texts.items():
+        bad = [line for line in text.splitlines() if raw.search(line)]
+        assert not bad, (name, bad)
+        assert ("Eveleens" in text) == (name == "abcube --help"), name
+
+
 def test_readme_is_a_front_page():
     lines = (SRC / "README.md").read_text().splitlines()
     assert len(lines) < 200, len(lines)

@@ -165,3 +165,20 @@ def test_python_report(tmp_path):
     assert r["crosscheck"]["skipped"] == "not asked for"
     with pytest.raises(abcube.SceneError, match="did you mean abuffer"):
         abcube.report(scene, str(tmp_path / "bad"), methods=["abufer"])
+
+
+def test_options_the_report_decides_are_refused(tmp_path):
+    # cli.md: report refuses, with exit 2 and one line, the render options it decides itself.
+    scene = str(SRC / "scenes" / "cornell.json")
+    for args, flag in ((["--method", "envmap"], "--method"), (["--aovs", "distance"], "--aovs"),
+                       (["--reference-image", str(tmp_path / "ref.exr")], "--reference-image"),
+                       (["--samples", "4"], "--samples")):
+        out = tmp_path / flag.strip("-")
+        r = subprocess.run([BIN, "report", scene, "-o", str(out), "--width", "32", "--height", "24", *args],
+                           capture_output=True, text=True)
+        assert r.returncode == 2, (args, r.stderr)
+        assert r.stderr.count("\n") == 1 and f"{flag}: not used by report" in r.stderr, r.stderr
+        assert not out.exists(), args
+    import abcube
+    with pytest.raises(abcube.SceneError, match="method: not used by report"):
+        abcube.report(abcube.load_scene(scene), str(tmp_path / "py"), method="envmap")
