@@ -1,15 +1,19 @@
 """Builds the abcube extension module with CMake for pip (pyproject.toml).
 
-The module is the CMake target abcube_python; this script configures the project with its
-tests and benchmarks off, builds that one target for the interpreter running pip, and puts
-the module where setuptools packs it. ABCUBE_CMAKE_BUILD_DIR=DIR reuses a build folder
-configured already (the module is then rebuilt there if stale, for DIR's interpreter).
+The module is the CMake target abcube_python. A build folder the tree already has (build/,
+configured by the README's commands) is reused when its module is for this interpreter's
+ABI (the file name's suffix, cpython-311-x86_64-linux-gnu on Debian 12): only that target
+and the image module are built there, in seconds when they are current. Otherwise a fresh
+build folder is configured with the tests and benchmarks off, for the interpreter running
+pip. ABCUBE_CMAKE_BUILD_DIR=DIR reuses DIR instead; ABCUBE_CMAKE_BUILD_DIR=new builds
+afresh. pip shows the build's own output with -v.
 """
 import os
 import re
 import shutil
 import subprocess
 import sys
+import sysconfig
 from pathlib import Path
 
 from setuptools import Extension, setup
@@ -28,9 +32,29 @@ class CMakeExtension(Extension):
         super().__init__(name, sources=[])
 
 
+def reusable_build():
+    """The tree's build/ when its module is for this interpreter, else None."""
+    build = ROOT / "build"
+    suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
+    if not (build / "CMakeCache.txt").exists():
+        return None
+    cache = (build / "CMakeCache.txt").read_text(errors="replace")
+    python = re.search(r"^ABCUBE_PYTHON:\w+=(.*)$", cache, re.M)
+    if not python or not Path(python.group(1)).exists():
+        return None
+    built_for = subprocess.run([python.group(1), "-c", "import sysconfig; print(sysconfig.get_config_var('EXT_SUFFIX'))"],
+                               capture_output=True, text=True).stdout.strip()
+    return build if built_for == suffix else None
+
+
 class CMakeBuild(build_ext):
     def build_extension(self, ext):
         reuse = os.environ.get("ABCUBE_CMAKE_BUILD_DIR")
+        if reuse == "new":
+            reuse = None
+        elif not reuse and (found := reusable_build()):
+            reuse = str(found)
+            print(f"setup.py: reusing the build in {reuse} (ABCUBE_CMAKE_BUILD_DIR=new builds afresh)", flush=True)
         build = Path(reuse).resolve() if reuse else Path(self.build_temp).resolve() / "cmake"
         if not reuse:
             generator = ["-G", "Ninja"] if shutil.which("ninja") else []

@@ -10,6 +10,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "base/error.hpp"
 #include "base/parallel.hpp"
 
 namespace abcube {
@@ -117,16 +118,26 @@ bool set_index(int64_t value, uint64_t lines_of_kind, uint64_t corner, uint8_t f
   return true;
 }
 
-// One corner "v", "v/vt", "v//vn" or "v/vt/vn" at p; false on a missing or zero index.
-bool corner(const char*& p, const char* e, Part* part) {
+// One corner "v", "v/vt", "v//vn" or "v/vt/vn" at p; false on a missing or zero index,
+// *why then saying which field and what it holds.
+bool corner(const char*& p, const char* e, Part* part, std::string* why) {
   ObjText& t = part->text;
   const uint64_t at = t.corners.size();
   ObjCorner c;
   const auto field = [&](uint8_t which, int32_t* out) {
+    const char* start = p;
     bool digits = false;
     const int64_t value = index_value(p, e, &digits);
     const uint64_t lines = which == FIELD_V ? t.v.size() / 3 : which == FIELD_VT ? t.vt.size() / 2 : t.vn.size() / 3;
-    if (!digits || !set_index(value, lines, at, which, out, part)) return false;
+    if (!digits || !set_index(value, lines, at, which, out, part)) {
+      const char* end = start;
+      while (end < e && *end != '/' && !blank(*end) && *end != '\r') ++end;
+      const char* name = which == FIELD_V ? "v" : which == FIELD_VT ? "vt" : "vn";
+      *why = std::string("its ") + name + " index is " +
+             (end == start ? std::string("missing") : !digits ? "not a number: " + quote(std::string(start, end), 24)
+                                                                : std::string("0"));
+      return false;
+    }
     while (p < e && *p != '/' && !blank(*p) && *p != '\r') ++p;  // the rest of the word
     return true;
   };
@@ -172,9 +183,10 @@ bool parse_line(const char* p, const char* e, Part* part) {
     const size_t first = t.corners.size();
     const size_t first_relative = part->relative.size();
     for (p = skip_blanks(p + 2, e); p < e; p = skip_blanks(p, e)) {
-      if (!corner(p, e, part)) {
-        t.error = "f: corner " + std::to_string(t.corners.size() - first + 1) +
-                  " has index 0 or none (OBJ indices count from 1, or back from -1)";
+      std::string why;
+      if (!corner(p, e, part, &why)) {
+        t.error = "f: corner " + std::to_string(t.corners.size() - first + 1) + ": " + why +
+                  " (OBJ indices count from 1, or back from -1)";
         return false;
       }
     }

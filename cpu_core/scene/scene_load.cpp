@@ -446,8 +446,11 @@ SceneData load_model_as_scene(const std::string& path, const std::string& kind, 
   const std::string ours = path + ": objects[0].file: ", theirs = path + ": ";
   const auto rename = [&](std::string m) {
     if (m.rfind(ours, 0) == 0) m = theirs + m.substr(ours.size());
-    const std::string again = theirs + quote_path(file) + ": ";  // the glTF loader names its file
-    if (m.rfind(again, 0) == 0) m = theirs + m.substr(again.size());
+    // The loaders name their file again: the glTF one as written, the OBJ one resolved.
+    const std::string resolved = quote_path((fs::path(dir.empty() ? "." : dir) / file).lexically_normal().string());
+    for (const std::string& again : {quote_path(file), "mesh " + resolved, "cannot parse mesh " + resolved}) {
+      if (m.rfind(theirs + again + ": ", 0) == 0) m = theirs + m.substr(theirs.size() + again.size() + 2);
+    }
     return m;
   };
   try {

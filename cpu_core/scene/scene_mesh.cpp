@@ -423,10 +423,20 @@ std::vector<int> run_materials(LoadState& st, const ObjFile& obj, const std::vec
   return out;
 }
 
+// A face's corner whose index is out of range: the face's number, the corner's, which index
+// (0 v, 1 vt, 2 vn) and its value (0-based; ObjCorner::OUT_OF_RANGE past 32 bits or before
+// the first line).
+struct BadCorner {
+  uint64_t face = UINT64_MAX;
+  uint32_t corner = 0;
+  int field = 0;
+  int32_t index = 0;
+};
+
 // The faces of `run` as triangles of m (its index arrays sized), each with its run's scene
-// material; false at a face with an index out of range (its number in *bad).
+// material; false at a face with an index out of range (which, in *bad).
 bool triangulate_run(const ObjFile& obj, const FaceRun& run, const std::vector<int>& materials, LocalMesh* out,
-                     uint64_t* bad) {
+                     BadCorner* bad) {
   LocalMesh& m = *out;
   const ObjText& text = obj.text;
   const int64_t counts[3] = {static_cast<int64_t>(m.positions.size()), static_cast<int64_t>(m.uvs.size()),
@@ -449,9 +459,12 @@ bool triangulate_run(const ObjFile& obj, const FaceRun& run, const std::vector<i
       ++material_run;
     bool smooth = true;
     for (uint32_t k = 0; k < n; ++k) {
-      if (!in_range(corners[k].v, 0, false) || !in_range(corners[k].vt, 1, true) || !in_range(corners[k].vn, 2, true)) {
-        *bad = f;
-        return false;
+      const int32_t index[3] = {corners[k].v, corners[k].vt, corners[k].vn};
+      for (int field = 0; field < 3; ++field) {
+        if (!in_range(index[field], field, field > 0)) {
+          *bad = {f, k, field, index[field]};
+          return false;
+        }
       }
       smooth = smooth && corners[k].vn != ObjCorner::ABSENT;
     }
@@ -491,16 +504,23 @@ void add_obj_faces(LoadState& st, const std::string& path, const std::string& re
   m.material.resize(triangles);
   const std::vector<FaceRun> runs = face_runs(obj.text);
   const std::vector<int> materials = run_materials(st, obj, mtl_ids, use_mtl);
-  std::vector<uint64_t> bad(runs.size(), UINT64_MAX);
+  std::vector<BadCorner> bad(runs.size());
   parallel_for(runs.size(), thread_count(st.limits.threads, runs.size()),
                [&](size_t r, int) { triangulate_run(obj, runs[r], materials, &m, &bad[r]); });
-  const uint64_t first_bad = bad.empty() ? UINT64_MAX : *std::min_element(bad.begin(), bad.end());
-  if (first_bad != UINT64_MAX) {
-    const uint64_t line = obj_face_line(resolved, first_bad);
+  const BadCorner first = bad.empty() ? BadCorner{}
+                                      : *std::min_element(bad.begin(), bad.end(), [](const BadCorner& a, const BadCorner& b) {
+                                          return a.face < b.face;
+                                        });
+  if (first.face != UINT64_MAX) {
+    const uint64_t line = obj_face_line(resolved, first.face);
+    const char* name[3] = {"v", "vt", "vn"};
+    const size_t lines[3] = {m.positions.size(), m.uvs.size(), m.normals.size()};
+    const std::string value = first.index == ObjCorner::OUT_OF_RANGE ? std::string("out of range")
+                                                                      : std::to_string(int64_t{first.index} + 1);
     fail(st.src, path,
          "mesh " + quote_path(resolved) + (line > 0 ? ": line " + std::to_string(line) : std::string()) +
-             ": face has an index out of range (the file has " + std::to_string(m.positions.size()) + " v, " +
-             std::to_string(m.uvs.size()) + " vt and " + std::to_string(m.normals.size()) + " vn lines)");
+             ": f: corner " + std::to_string(first.corner + 1) + ": " + name[first.field] + " index " + value +
+             ", but the file has " + std::to_string(lines[first.field]) + " " + name[first.field] + " lines");
   }
 }
 

@@ -142,5 +142,13 @@ for case in hidden_point:23.0 cornell:11.8 default:18.5 shadows:30.8; do
     echo "FAIL gpu $scene below $floor dB: $(cat "$WORK/err")"
   fi
 done
+# A small object at a low N: too few texels for a p99, and the verdict says so and what to do.
+"$ABCUBE" crosscheck "$REPO/scenes/meshes/octahedron.obj" --cube-res 64 "${GL[@]}" --size 160x120 > "$WORK/few" 2>&1
+if [ $? -eq 1 ] && tail -n 1 "$WORK/few" | grep -q "over few texels (.* covered on both, .*): raise --cube-res"; then
+  passed=$((passed + 1))
+else
+  failed=$((failed + 1))
+  echo "FAIL crosscheck at a low N does not say why: $(tail -n 1 "$WORK/few")"
+fi
 echo "cli crosscheck_cli: $passed passed, $failed failed"
 [ $failed -eq 0 ]

@@ -115,7 +115,12 @@ TEST(ObjText, AZeroOrMissingIndexIsAnErrorOfItsLine) {
   }
   const ObjText last = parse_obj_text("v 0 0 0\nf 0 1 1");  // no line end at the end
   EXPECT_EQ(last.error_line, 2u);
-  EXPECT_EQ(last.error, "f: corner 1 has index 0 or none (OBJ indices count from 1, or back from -1)");
+  EXPECT_EQ(last.error, "f: corner 1: its v index is 0 (OBJ indices count from 1, or back from -1)");
+  // What the index holds is named: a word that is no number, a missing one.
+  EXPECT_EQ(parse_obj_text("v 0 0 0\nf 1 1 x").error,
+            "f: corner 3: its v index is not a number: \"x\" (OBJ indices count from 1, or back from -1)");
+  EXPECT_EQ(parse_obj_text("v 0 0 0\nf 1/ 1 1").error,
+            "f: corner 1: its vt index is missing (OBJ indices count from 1, or back from -1)");
 }
 
 TEST(ObjText, ALineEndsAtItsEndAndItsTextAtANul) {

@@ -3,8 +3,11 @@
 #   1. `cmake --install BUILD --prefix P`: P/bin/abcube renders every method with no
 #      variable set, and the Python module under P's site folder imports and renders;
 #   2. `pip install --no-build-isolation .` into a venv made with --system-site-packages
-#      (the build folder reused, ABCUBE_CMAKE_BUILD_DIR): `import abcube` from /tmp with no
-#      PYTHONPATH, and a render whose image is not black.
+#      (the tree's build folder reused by default, and it says so): `import abcube` from
+#      /tmp with no PYTHONPATH, and a render whose image is not black;
+#   3. `cmake --install` of a build without the Python module (the README's first command
+#      builds the program alone): exit 0, a line saying the module was skipped and how to
+#      build it, and the installed program runs.
 # Usage: install_package.sh BUILD_DIR SOURCE_DIR PYTHON
 set -euo pipefail
 BUILD=$(cd "$1" && pwd)
@@ -42,8 +45,12 @@ assert img.mean() > 0.05, img.mean()
 
 # 2. pip into a venv.
 "$PYTHON" -m venv --system-site-packages "$WORK/venv" || fail "python3 -m venv (Debian: python3-venv)"
-(cd "$SRC" && ABCUBE_CMAKE_BUILD_DIR="$BUILD" "$WORK/venv/bin/python" -m pip install --no-build-isolation --no-index \
-   --no-deps --quiet "$SRC") > "$WORK/pip.log" 2>&1 || { tail -n 30 "$WORK/pip.log"; fail "pip install"; }
+reuse=()
+[[ $BUILD == "$SRC/build" ]] || reuse=(env ABCUBE_CMAKE_BUILD_DIR="$BUILD")  # the default reuses SRC/build
+(cd "$SRC" && "${reuse[@]}" "$WORK/venv/bin/python" -m pip install --no-build-isolation --no-index \
+   --no-deps -v "$SRC") > "$WORK/pip.log" 2>&1 || { tail -n 30 "$WORK/pip.log"; fail "pip install"; }
+[[ -n ${reuse[*]} ]] || grep -q "setup.py: reusing the build in $SRC/build" "$WORK/pip.log" ||
+  { tail -n 30 "$WORK/pip.log"; fail "pip did not reuse the tree's build"; }
 cd /tmp
 env -u PYTHONPATH "$WORK/venv/bin/python" -c "
 import abcube
@@ -57,4 +64,14 @@ modules = [l.split()[-1] for l in open('/proc/self/maps') if l.rstrip().endswith
 assert modules and all(m.startswith('$WORK/venv/') for m in modules), modules
 print('pip: abcube', abcube.__version__, 'from', abcube.__file__)
 " || fail "import abcube from the venv"
+
+# 3. A build without the Python module (hidden for the install, put back on exit).
+module=$(ls "$BUILD"/python/abcube*.so | head -n 1)
+mv "$module" "$WORK/module.so"
+trap 'mv "$WORK/module.so" "$module"; rm -rf "$WORK"' EXIT
+cmake --install "$BUILD" --prefix "$WORK/prefix2" > "$WORK/install2.log" 2>&1 ||
+  { tail -n 20 "$WORK/install2.log"; fail "cmake --install without the Python module"; }
+grep -q "abcube: the Python module was not built, so it is not installed (cmake --build $BUILD --target abcube_python" \
+  "$WORK/install2.log" || fail "the skipped module is not named"
+env -i PATH="$WORK/prefix2/bin:/usr/bin:/bin" abcube --version | grep -q '^abcube ' || fail "abcube --version from prefix2"
 echo "1 passed, 0 failed"
