@@ -19,17 +19,22 @@ Per scene:
   REFERENCE  `abcube render --method raytrace` to EXR, once (kept in DIR/NAME/ref.exr).
   TIMED      per run, interleaved (so a drift in machine load hits every renderer alike):
              abuffer at the target (`--target-db T`: abcube picks N and the shading plan),
-             abuffer at the scene's own N and plan, raytrace, POV-Ray (`povray +W8W +H4H
-             -A` on `abcube export-pov`, whose pixel centres are our 32 samples per pixel;
-             box-filtered to our size untimed). Wall clock of the whole process under
-             /usr/bin/time -v, which also gives the peak RSS.
+             abuffer at the scene's own N and plan, raytrace, the tracer's ladder (`--samples`
+             1, 2, 4, 8, 16), POV-Ray (`povray +W8W +H4H -A` on `abcube export-pov`, whose
+             pixel centres are our 32 samples per pixel; box-filtered to our size untimed).
+             Wall clock of the whole process under /usr/bin/time -v, which also gives the
+             peak RSS.
+  MATCHED    each abuffer image's matched rung: the fastest rung of the ladder (1 to 32
+             samples; 32 is raytrace, the reference, infinitely close) whose image is at
+             least as close to the reference; the ratio of abuffer's time to that rung's is
+             the speed at matched error (above 1: the tracer at fewer samples is faster).
   MEMORY     bytes per triangle = (peak RSS - peak RSS of `abcube --version`) / triangles.
   GOAL       abuffer at the target: >= T dB, <= 0.5 x raytrace's time, <= 0.25 x POV-Ray's.
 
 PSNR is sRGB, `abcube compare` against the reference (the reference's own PSNR is infinite).
 POV-Ray's PSNR includes the model differences listed in cpu_core/scene/pov_export.hpp.
-The summary gives the median and the worst abuffer/raytrace and abuffer/POV-Ray ratios at
-the target, for the race scenes and for the generated sample apart.
+The summary gives the median and the worst abuffer/matched rung, abuffer/raytrace and
+abuffer/POV-Ray ratios at the target, for the race scenes and for the generated sample apart.
 Writes REPORT.md and REPORT.csv.
 """
 import argparse
@@ -99,6 +104,16 @@ def timed(cmd):
     return seconds, kib
 
 
+RUNGS = (1, 2, 4, 8, 16)  # the tracer's ladder below the reference's 32 samples
+
+
+def matched_rung(ladder, db):
+    """(samples, ms) of the fastest rung of `ladder` [(samples, ms, psnr)] at least as close
+    to the reference as `db`."""
+    spp, ms, _ = min((r for r in ladder if r[2] >= db), key=lambda r: r[1])
+    return spp, ms
+
+
 def ratio_summary(rows, key):
     v = [r[key] for r in rows if r[key] is not None]
     if not v:
@@ -155,12 +170,15 @@ def main(argv=None):
                 ("ab_own", [ab, "render", sc.path, "-o", own_png, "--method", "abuffer", "--stats",
                             own_png + ".json"] + thr),
                 ("rt", [ab, "render", sc.path, "-o", os.path.join(d, "t_rt.png"), "--method", "raytrace"] + thr)]
+        for spp in RUNGS:
+            jobs.append(("rt%d" % spp, [ab, "render", sc.path, "-o", os.path.join(d, "t_rt%d.png" % spp),
+                                        "--method", "raytrace", "--samples", str(spp)] + thr))
         if pov:
             jobs.append(("pov", ["povray", "+I" + os.path.join(d, "scene.pov"), "+O" + os.path.join(d, "pov.ppm"),
                                  "+FP16", "File_Gamma=1.0",
                                  "+W%d" % (8 * size[0]), "+H%d" % (4 * size[1]), "-A", "-D", "-P",
                                  "+WT%d" % args.threads]))
-        times = {"ab_target": [], "ab_own": [], "rt": [], "pov": []}
+        times = {k: [] for k in ["ab_target", "ab_own", "rt", "pov"] + ["rt%d" % spp for spp in RUNGS]}
         rss = {k: [] for k in times}
         for k in range(args.runs):
             print("[%s] run %d/%d" % (sc.name, k + 1, args.runs), file=sys.stderr)
@@ -202,6 +220,14 @@ def main(argv=None):
             "pilots_ms": shade.get("target_pilots"), "shade_ms": shade.get("shade_and_resolve"),
             "cube_ms": shade.get("cube_abuffer"), "camera_ms": shade.get("camera_abuffer"), "load_ms": shade.get("load"),
         }
+        ladder = [(spp, med("rt%d" % spp), psnr(ab, os.path.join(d, "t_rt%d.png" % spp), ref)) for spp in RUNGS]
+        ladder.append((32, row["raytrace_ms"], float("inf")))
+        for spp, ms, db in ladder:
+            row["rung%d_ms" % spp], row["rung%d_psnr" % spp] = ms, db
+        for key in ("target", "own"):
+            spp, ms = matched_rung(ladder, row[key + "_psnr"])
+            row[key + "_rung"], row[key + "_rung_ms"] = spp, ms
+            row[key + "_over_rung"] = row[key + "_ms"] / ms
         row["ab_over_rt"] = row["target_ms"] / row["raytrace_ms"]
         row["ab_over_pov"] = row["target_ms"] / row["pov_ms"] if row["pov_ms"] else None
         row["own_over_rt"] = row["own_ms"] / row["raytrace_ms"]
@@ -236,7 +262,9 @@ def main(argv=None):
             continue
         lines += [
             "## " + title, "",
-            "- abuffer at the target / raytrace: %s" % ratio_summary(rs, "ab_over_rt"),
+            "- abuffer at the target / the tracer at its matched rung: %s" % ratio_summary(rs, "target_over_rung"),
+            "- abuffer at the own N / the tracer at its matched rung: %s" % ratio_summary(rs, "own_over_rung"),
+            "- abuffer at the target / raytrace at 32 samples: %s" % ratio_summary(rs, "ab_over_rt"),
             "- abuffer at the target / POV-Ray: %s" % ratio_summary(rs, "ab_over_pov"),
             "- abuffer at the own N / raytrace: %s" % ratio_summary(rs, "own_over_rt"),
             "- at the target: %d of %d reach %g dB; goal met on %d" % (
@@ -254,6 +282,14 @@ def main(argv=None):
                             f(r["own_ms"], "%.0f"), f(r["own_psnr"], "%.1f"), mem(r, "own"),
                             r["raytrace_ms_range"], mem(r, "raytrace"), r["pov_ms_range"], f(r["pov_psnr"], "%.1f"),
                             f(r["ab_over_rt"], "%.2f"), f(r["ab_over_pov"], "%.2f"), r["goal"]))
+        lines += ["", "At matched error: the tracer's ladder (ms, dB) and each abuffer image's matched rung.", "",
+                  "| scene | " + " | ".join("%d spp" % spp for spp in RUNGS) + " | target dB: rung, ms, ratio | "
+                  "own dB: rung, ms, ratio |", "|---|" + "---|" * len(RUNGS) + "---|---|"]
+        for r in rs:
+            lines.append("| %s | %s | %.1f: %d, %.0f, **%.2f** | %.1f: %d, %.0f, %.2f |" % (
+                r["scene"], " | ".join("%.0f, %.1f" % (r["rung%d_ms" % spp], r["rung%d_psnr" % spp]) for spp in RUNGS),
+                r["target_psnr"], r["target_rung"], r["target_rung_ms"], r["target_over_rung"],
+                r["own_psnr"], r["own_rung"], r["own_rung_ms"], r["own_over_rung"]))
         lines += ["", "abuffer at the target, ms of the last timed run: load / pilots / cube A-buffer / "
                   "camera A-buffer / shade and resolve", ""]
         for r in rs:

@@ -46,7 +46,10 @@ MAP_METHODS = {
     "thick_lens": ["--method", "abuffer", "--refraction", "thick_lens"],
     "thin_lens": ["--method", "abuffer", "--refraction", "thin_lens"],
 }
-ALL_METHODS = list(MAP_METHODS) + ["raytrace", "povray"]
+# The exact tracer's ladder below its 32 samples a pixel (N-independent): each map method's
+# row is held to the fastest rung at least as close to the reference, its matched rung.
+LADDER = {"raytrace_%dspp" % s: ["--method", "raytrace", "--samples", str(s)] for s in (1, 2, 4, 8, 16)}
+ALL_METHODS = list(MAP_METHODS) + ["raytrace", "povray"] + list(LADDER)
 LENS_METHODS = ("thick_lens", "thin_lens")
 DEFAULT_SIZES = [64, 128, 256, 512, 1024, 2048]
 QUICK_SIZES = [64, 128, 256]
@@ -193,8 +196,10 @@ class Sweep:
             row = self.new_row(set_, scene, method, n, plan, rep)
             tag = "%s_%s_%s_%s%s" % (method, n, plan or "default", rep or 0, k)
             out_png, out_stats = os.path.join(work, tag + ".png"), os.path.join(work, tag + ".json")
-            cmd = [self.a.abcube, "render", scene, "-o", out_png, "--threads", str(self.a.threads), "--cube-res",
-                   str(n), "--reference-image", ref, "--stats", out_stats] + MAP_METHODS[method] + list(extra)
+            size = [] if method in LADDER else ["--cube-res", str(n)]
+            cmd = ([self.a.abcube, "render", scene, "-o", out_png, "--threads", str(self.a.threads)] + size +
+                   ["--reference-image", ref, "--stats", out_stats] + (LADDER.get(method) or MAP_METHODS[method]) +
+                   list(extra))
             rc, ms, _, err = run_timed(cmd, self.a.timeout)
             row["wall_ms"] = ms
             stats = None
@@ -327,6 +332,9 @@ class Sweep:
             return
         if "povray" in self.a.methods:
             self.povray(scene, ref, ref_stats, work)
+        if "raytrace" in self.a.methods:  # the rival at matched error: the tracer at fewer samples
+            for m in LADDER:
+                self.render("sweep", scene, m, "", ref, work, repeat=self.a.repeat)
         no_transmit = None  # learnt from the plan of a map method at this scene
         for n in self.a.sizes:
             for m in self.a.methods:
@@ -456,7 +464,8 @@ def write_markdown(path, sweep, args, meta):
             scenes.append(r["scene"])
     order = {m: i for i, m in enumerate(ALL_METHODS)}
     header = ("| method | N | render ms | cube frags | cam frags | refl texels mean/max | frags tested | "
-              "MiB | PSNR dB | CP mean | EP mean | EP p99 | EP max | 1/(2N^2) | within | miss |")
+              "MiB | PSNR dB | matched rung: ms, ratio | CP mean | EP mean | EP p99 | EP max | 1/(2N^2) | within | "
+              "miss |")
     for s in scenes:
         L.append("## %s" % s)
         L.append("")
@@ -464,18 +473,27 @@ def write_markdown(path, sweep, args, meta):
         L.append("|" + "---|" * (header.count("|") - 1))
         srows = sorted([r for r in rows if r["scene"] == s and r["set"] == "sweep"],
                        key=lambda r: (order.get(r["method"], 99), r["N"] or 0))
+        ladder = [(r["method"], r.get("render_ms"), r.get("psnr_db")) for r in srows
+                  if r["status"] == "ok" and (r["method"] in LADDER or r["method"] == "raytrace")]
         for r in srows:
             if r["status"] != "ok":
                 L.append("| %s | %s | %s: %s |%s" % (r["method"], r["N"], r["status"], r.get("error") or r.get("note"),
-                                                    " |" * 13))
+                                                    " |" * 14))
                 continue
+            matched = ""
+            rivals = [x for x in ladder if x[2] is not None and r.get("psnr_db") is not None and x[2] >= r["psnr_db"]
+                      and x[1]]
+            if rivals and r["method"] not in LADDER and r["method"] != "raytrace" and r.get("render_ms"):
+                name, ms, _ = min(rivals, key=lambda x: x[1])
+                matched = "%s: %.0f, %.2f" % (name.replace("raytrace_", "").replace("raytrace", "32spp"), ms,
+                                              r["render_ms"] / ms)
             texels = ("%s / %s" % (fmt(r.get("refl_texels_mean"), "f1"), fmt(r.get("refl_texels_max"), "int"))
                       if r.get("refl_rays") else "")
-            L.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            L.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
                 r["method"], r["N"], fmt(r.get("render_ms"), "ms"), fmt(r.get("cube_fragments"), "int"),
                 fmt(r.get("camera_fragments"), "int"), texels,
                 fmt(sum(r.get("%s_fragments_tested" % k) or 0 for k, _ in SEARCH_KINDS) or None, "int"),
-                fmt(r.get("peak_rss_mib"), "mib"), fmt(r.get("psnr_db"), "db"),
+                fmt(r.get("peak_rss_mib"), "mib"), fmt(r.get("psnr_db"), "db"), matched,
                 fmt(r.get("cp_mean"), "e") if r.get("par_count") is not None else "", ep(r, "par_mean"),
                 ep(r, "par_p99"), ep(r, "par_max"), fmt(r.get("bound"), "e"),
                 ep(r, "within_bound", "pct"), fmt(r.get("par_miss_share"), "pct")))
@@ -595,7 +613,7 @@ def write_markdown(path, sweep, args, meta):
 
 COLOURS = {"gpu": "#1f77b4", "envmap_R": "#ff7f0e", "envmap_bisector": "#bcbd22", "zbuffer": "#2ca02c",
            "abuffer_thesis": "#d62728", "abuffer_crossing": "#9467bd", "abuffer_plane": "#7f7f7f", "thick_lens": "#8c564b",
-           "thin_lens": "#e377c2", "raytrace": "#000000", "povray": "#17becf"}
+           "thin_lens": "#e377c2", "raytrace": "#000000", "povray": "#17becf", "ladder": "#444444"}
 SCENE_COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"]
 SUPERSCRIPT = str.maketrans("-0123456789", "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079")
 
@@ -755,7 +773,10 @@ def plot_error_vs_time(path, rows, quick, threads):
     for r in ok:
         if r["scene"] not in scenes:
             scenes.append(r["scene"])
-    methods = [m for m in ALL_METHODS if any(r["method"] == m for r in ok)]
+    # The tracer's ladder is one curve, "ladder" (its rungs labelled by their samples).
+    methods = [m for m in ALL_METHODS if m not in LADDER and any(r["method"] == m for r in ok)]
+    if any(r["method"] in LADDER for r in ok):
+        methods.append("ladder")
     cols = 2 if len(scenes) > 1 else 1
     pw, ph, mx, top = 440, 320, 90, 84 + 16 * math.ceil(len(methods) / 3)
     W = max(cols * (pw + mx) + 40, 640)
@@ -772,6 +793,8 @@ def plot_error_vs_time(path, rows, quick, threads):
             items.append(("raytrace (reference time)", COLOURS[m], "5,3", None))
         elif m == "povray":
             items.append(("povray (same size, 4x4 AA)", COLOURS[m], None, "diamond"))
+        elif m == "ladder":
+            items.append(("raytrace at 1 to 16 samples a pixel", COLOURS[m], None, "square"))
         else:
             items.append((m, COLOURS[m], None, "circle"))
     legend(body, 60, 72, items, columns=3, col_w=min(230, (W - 80) // 3))
@@ -783,6 +806,11 @@ def plot_error_vs_time(path, rows, quick, threads):
         ys = [r.get("rmse") for r in srows if r["method"] != "raytrace"]
         p = LogPanel(body, x0, y0, pw, ph, xs, ys, s, "render time (program total minus image write)", "image RMSE", "ms")
         for m in methods:
+            if m == "ladder":
+                mr = sorted([r for r in srows if r["method"] in LADDER], key=lambda r: r.get("render_ms") or 0)
+                p.polyline([(r.get("render_ms"), r.get("rmse")) for r in mr], COLOURS[m], marker="square",
+                           labels=[r["method"].replace("raytrace_", "") for r in mr])
+                continue
             mr = sorted([r for r in srows if r["method"] == m], key=lambda r: r["N"] or 0)
             if m == "raytrace":
                 for r in mr:
