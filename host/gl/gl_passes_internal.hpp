@@ -20,7 +20,7 @@ namespace abcube {
 // The camera pass renders at most this many samples a side at once (tiles beyond). 1024:
 // every tile repeats the passes and draw calls of each view, so smaller tiles cost more of
 // them; larger ones take more memory, give a mirror's scissor less to cut away, and let the
-// tile's buffers fall out of cache. docs/performance.md has the measurements.
+// tile's buffers fall out of cache. docs/design/decisions.md has the measurements.
 constexpr int CAMERA_TILE = 1024;
 // The largest of the scene's per-vertex arrays, which camera_groups.frag reads as storage
 // buffers: a position or a normal (3 floats; a vertex's ids are 2 words).
