@@ -82,64 +82,27 @@ std::vector<uint8_t> pilot_pixels(int width, int height, int* block) {
 
 namespace {
 
-// The pilots' pixels and the exact tracer's colour there, in two stages (THE FIRST QUARTER):
-// the pixels of every other block in x and in y first, a quarter of pilot_pixels' sample spread
-// as evenly; the rest only when a decision needs them. `pixels` is the sample traced so far.
+// The pilots' pixels (pilot_pixels) and the exact tracer's colour there.
 struct PilotSample {
   int block = 0;
-  std::vector<uint8_t> full, pixels;
+  std::vector<uint8_t> pixels;
   Image exact;
   double trace_ms = 0;
-  bool whole = false;  // every pixel of `full` traced
-
-  // Traces the pixels of `full` that `pixels` lacks (all of them: the whole sample).
-  void widen(MethodContext& mc);
 };
 
-// The pixels of `full` (one in each b x b block) in the blocks of even row and column.
-std::vector<uint8_t> first_quarter(const std::vector<uint8_t>& full, int width, int block) {
-  std::vector<uint8_t> q(full.size(), 0);
-  for (size_t k = 0; k < full.size(); ++k) {
-    const int x = static_cast<int>(k % static_cast<size_t>(width)), y = static_cast<int>(k / static_cast<size_t>(width));
-    q[k] = full[k] && (x / block) % 2 == 0 && (y / block) % 2 == 0;
-  }
-  return q;
-}
-
-// The exact image of the pixels of `only` (the others black).
-Image trace_pixels(MethodContext& mc, const std::vector<uint8_t>& only) {
+PilotSample pilot_sample(MethodContext& mc) {
+  PilotSample s;
+  s.pixels = pilot_pixels(mc.scene.camera.width, mc.scene.camera.height, &s.block);
   RaytraceOptions ro;
   ro.threads = mc.request.threads;
   // The scene's tree when a render of it already built one; else the tracer builds one for
   // the sample alone, freed before the cube maps are built: the peak holds no tracer's tree.
   if (mc.cache.builds().bvh) ro.bvh = mc.cache.bvh();
-  ro.only = &only;
-  return render_raytrace(mc.scene, ro);
-}
-
-PilotSample pilot_sample(MethodContext& mc) {
-  PilotSample s;
-  s.full = pilot_pixels(mc.scene.camera.width, mc.scene.camera.height, &s.block);
-  s.pixels = first_quarter(s.full, mc.scene.camera.width, s.block);
+  ro.only = &s.pixels;
   const Clock::time_point t0 = Clock::now();
-  s.exact = trace_pixels(mc, s.pixels);
+  s.exact = render_raytrace(mc.scene, ro);
   s.trace_ms = ms_since(t0);
   return s;
-}
-
-void PilotSample::widen(MethodContext& mc) {
-  if (whole) return;
-  std::vector<uint8_t> rest(full.size());
-  for (size_t k = 0; k < full.size(); ++k) rest[k] = full[k] && !pixels[k];
-  const Clock::time_point t0 = Clock::now();
-  const Image more = trace_pixels(mc, rest);
-  trace_ms += ms_since(t0);
-  const size_t c = static_cast<size_t>(exact.channels);
-  for (size_t k = 0; k < rest.size(); ++k) {
-    if (rest[k]) std::copy_n(&more.data[k * c], c, &exact.data[k * c]);
-  }
-  pixels = full;
-  whole = true;
 }
 
 // A pilot's outcome: the sample's error, and the counts of THE COST MODEL.
@@ -227,7 +190,7 @@ struct Pilots {
   const ABuffer& camera;
   const ABufferOptions& cube_options;
   const double target;
-  PilotSample sample;
+  const PilotSample sample;
   json lines = json::array();
   CubeMap best;
   Pilot best_pilot;
@@ -258,14 +221,6 @@ struct Pilots {
       best_plan = plan;
     }
     return p;
-  }
-
-  // The whole sample from here on; the best pilot so far was judged on the first quarter
-  // alone, so it is forgotten as the best (its map is kept for reuse).
-  void widen() {
-    if (sample.whole) return;
-    sample.widen(mc);
-    best_pilot.error.psnr_low = -std::numeric_limits<double>::infinity();
   }
 
   // Climbs the ladder of N with `plan`, up to the first N that reaches the target, or until
@@ -359,57 +314,8 @@ void write_stats(const Pilots& p, json* out) {
       {"predicted_psnr_db", number_or_null(p.best_pilot.error.psnr)},
       {"predicted_psnr_db_low", number_or_null(p.best_pilot.error.psnr_low)},
       {"sample",
-       {{"pixels", p.best_pilot.error.pixels},
-        {"block", p.sample.block},
-        {"whole", p.sample.whole},
-        {"exact_trace_ms", p.sample.trace_ms}}},
+       {{"pixels", p.best_pilot.error.pixels}, {"block", p.sample.block}, {"exact_trace_ms", p.sample.trace_ms}}},
       {"pilots", p.lines}};
-}
-
-}  // namespace
-
-namespace {
-
-// The tracer's pilot over `only`: the 32-sample image and each lower rung's, merged into `*exact`
-// and `*rungs` at those pixels (sized on first use).
-void trace_rungs(MethodContext& mc, const std::vector<uint8_t>& only, Image* exact,
-                 std::array<Image, LOWER_RUNGS>* rungs, RaytraceStats* stats) {
-  RaytraceOptions ro;
-  ro.threads = mc.request.threads;
-  ro.bvh = mc.cache.bvh();
-  ro.only = &only;
-  std::array<Image, LOWER_RUNGS> part;
-  ro.rungs = &part;
-  RaytraceStats rs;
-  const Image image = render_raytrace(mc.scene, ro, &rs);
-  if (exact->data.empty()) {
-    *exact = image;
-    *rungs = part;
-  } else {
-    const size_t c = static_cast<size_t>(image.channels);
-    for (size_t k = 0; k < only.size(); ++k) {
-      if (!only[k]) continue;
-      std::copy_n(&image.data[k * c], c, &exact->data[k * c]);
-      for (size_t r = 0; r < rungs->size(); ++r) std::copy_n(&part[r].data[k * c], c, &(*rungs)[r].data[k * c]);
-    }
-  }
-  stats->primary_rays += rs.primary_rays;
-  stats->secondary_rays += rs.secondary_rays;
-  stats->shadow_rays += rs.shadow_rays;
-}
-
-// The smallest rung whose lower bound reaches `target` (32: none below it), and each rung's
-// error on the pixels of `only`.
-int smallest_rung(const std::array<Image, LOWER_RUNGS>& rungs, const Image& exact, const std::vector<uint8_t>& only,
-                  double target, std::array<SampledError, LOWER_RUNGS>* errors) {
-  int samples = MASK_SAMPLES;
-  for (int i = LOWER_RUNGS - 1; i >= 0; --i) {
-    (*errors)[static_cast<size_t>(i)] = sampled_error(rungs[static_cast<size_t>(i)], exact, only);
-  }
-  for (int i = 0; i < LOWER_RUNGS; ++i) {
-    if ((*errors)[static_cast<size_t>(i)].psnr_low >= target) return samples = 1 << i;
-  }
-  return samples;
 }
 
 }  // namespace
@@ -419,52 +325,46 @@ Image raytrace_for_target(MethodContext& mc) {
   const SceneData& scene = mc.scene;
   const double target = scene.render.target_db;
   int block = 0;
-  const std::vector<uint8_t> full = pilot_pixels(scene.camera.width, scene.camera.height, &block);
-  // THE FIRST QUARTER (as abuffer's pilots): the rungs judged on a quarter of the sample; the
-  // rest traced only when the rung below the one chosen may reach the target on it (its
-  // estimate does, its wider bound does not): a smaller rung would then pay for it.
-  std::vector<uint8_t> pixels = first_quarter(full, scene.camera.width, block);
-  Image exact;
+  const std::vector<uint8_t> pixels = pilot_pixels(scene.camera.width, scene.camera.height, &block);
+  RaytraceOptions ro;
+  ro.threads = mc.request.threads;
+  ro.bvh = mc.cache.bvh();
+  ro.only = &pixels;
   std::array<Image, LOWER_RUNGS> rungs;
+  ro.rungs = &rungs;
   RaytraceStats pilot_stats;
-  trace_rungs(mc, pixels, &exact, &rungs, &pilot_stats);
-  std::array<SampledError, LOWER_RUNGS> errors;
-  int samples = smallest_rung(rungs, exact, pixels, target, &errors);
-  const int below = samples == 1 ? -1 : __builtin_ctz(static_cast<unsigned>(samples)) - 1;
-  bool whole = false;
-  if (below >= 0 && errors[static_cast<size_t>(below)].psnr >= target) {
-    std::vector<uint8_t> rest(full.size());
-    for (size_t k = 0; k < full.size(); ++k) rest[k] = full[k] && !pixels[k];
-    trace_rungs(mc, rest, &exact, &rungs, &pilot_stats);
-    pixels = full;
-    whole = true;
-    samples = smallest_rung(rungs, exact, pixels, target, &errors);
-  }
-  const size_t rung_of = static_cast<size_t>(__builtin_ctz(static_cast<unsigned>(samples)));  // samples = 2^rung
-  const Image* chosen = samples == MASK_SAMPLES ? &exact : &rungs[rung_of];
+  const Image exact = render_raytrace(scene, ro, &pilot_stats);
+  // The smallest rung whose lower bound reaches the target; 32 samples are the reference.
+  int samples = MASK_SAMPLES;
+  const Image* chosen = &exact;
+  SampledError chosen_error;
+  chosen_error.pixels = 0;
+  chosen_error.psnr = chosen_error.psnr_low = std::numeric_limits<double>::infinity();
   json lines = json::array();
   for (int i = 0; i < LOWER_RUNGS; ++i) {
-    const SampledError& e = errors[static_cast<size_t>(i)];
+    const SampledError e = sampled_error(rungs[static_cast<size_t>(i)], exact, pixels);
     lines.push_back({{"samples", 1 << i}, {"psnr_db", number_or_null(e.psnr)}, {"psnr_db_low", number_or_null(e.psnr_low)}});
+    if (samples == MASK_SAMPLES && e.psnr_low >= target) {
+      samples = 1 << i;
+      chosen = &rungs[static_cast<size_t>(i)];
+      chosen_error = e;
+    }
   }
-  SampledError chosen_error;
-  chosen_error.psnr = chosen_error.psnr_low = std::numeric_limits<double>::infinity();
-  if (samples < MASK_SAMPLES) chosen_error = errors[rung_of];
   const double pilot_ms = ms_since(start);
   // The image at that rung: the pilot's pixels from the pilot, the others traced now.
   std::vector<uint8_t> rest(pixels.size());
   for (size_t k = 0; k < pixels.size(); ++k) rest[k] = pixels[k] ? 0 : 1;
-  RaytraceOptions ro;
-  ro.threads = mc.request.threads;
-  ro.bvh = mc.cache.bvh();
+  ro.rungs = nullptr;
   ro.only = &rest;
   ro.samples_per_pixel = samples;
   if (mc.progress) ro.progress = [&mc](double done) { mc.progress("raytrace", done); };
   RaytraceStats rs;
   Image image = render_raytrace(scene, ro, &rs);
-  const size_t c = static_cast<size_t>(image.channels);
-  for (size_t k = 0; k < pixels.size(); ++k) {
-    if (pixels[k]) std::copy_n(&chosen->data[k * c], c, &image.data[k * c]);
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      if (pixels[static_cast<size_t>(y) * static_cast<size_t>(image.width) + static_cast<size_t>(x)])
+        image.set_rgb(x, y, chosen->rgb(x, y));
+    }
   }
   rs.primary_rays += pilot_stats.primary_rays;
   rs.secondary_rays += pilot_stats.secondary_rays;
@@ -481,10 +381,7 @@ Image raytrace_for_target(MethodContext& mc) {
       {"predicted_psnr_db", number_or_null(chosen_error.psnr)},
       {"predicted_psnr_db_low", number_or_null(chosen_error.psnr_low)},
       {"sample",
-       {{"pixels", std::count(pixels.begin(), pixels.end(), uint8_t{1})},
-        {"block", block},
-        {"whole", whole},
-        {"exact_trace_ms", pilot_ms}}},
+       {{"pixels", std::count(pixels.begin(), pixels.end(), uint8_t{1})}, {"block", block}, {"exact_trace_ms", pilot_ms}}},
       {"rungs", lines}};
   mc.stats["timings_ms"]["target_pilots"] = pilot_ms;
   return image;
@@ -505,29 +402,13 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
   // reaches most targets on open scenes, and its pilot costs a fraction of the quarters'.
   MapShadingOptions one = plain;
   one.one_point = true;
-  // THE FIRST QUARTER: that pilot is judged on a quarter of the sample first; where it
-  // reaches the target there (at the same 95% confidence, its bound wider), the rest is never
-  // traced. Else the whole sample: that pilot again when the quarter's estimate itself reached
-  // the target (only its bound fell short), then the climb.
   const int first_n = target_ladder(mc.scene.render.cube_resolution).front();
   const bool one_first = !plain.one_point;
-  if (one_first) {
-    const SampledError quarter = p.pilot(first_n, one).error;
-    if (quarter.psnr_low >= p.target) {
-      p.reached = true;
-      p.why = "one shading point a fragment reaches the target at the ladder's smallest N (a quarter of the sample)";
-    } else {
-      p.widen();
-      if (quarter.psnr >= p.target && p.pilot(first_n, one).error.psnr_low >= p.target) {
-        p.reached = true;
-        p.why = "one shading point a fragment reaches the target at the ladder's smallest N";
-      }
-    }
+  if (one_first && p.pilot(first_n, one).error.psnr_low >= p.target) {
+    p.reached = true;
+    p.why = "one shading point a fragment reaches the target at the ladder's smallest N";
   }
-  if (!p.reached) {
-    p.widen();
-    p.climb(plain);
-  }
+  if (!p.reached) p.climb(plain);
   if (!p.reached && !same_plan(plain, asked)) p.climb(asked);
   if (p.reached) {
     // The plain plan was piloted at this N on its climb, or stopped short below it; one

@@ -1,7 +1,6 @@
 // --target-db (render/target_db.hpp): the pilots' sample, the plan the stats report being
 // the plan rendered, the target reached against the exact tracer, and the options that
 // contradict it refused.
-#include <algorithm>
 #include <limits>
 #include <set>
 #include <utility>
@@ -114,25 +113,6 @@ TEST(TargetDb, OnePointReachingAtTheSmallestNIsChosenWithoutQuartersPilots) {
   for (const json& p : t["pilots"]) EXPECT_EQ(p["shading_points"], "one") << t.dump(1);
   ASSERT_TRUE(r.stats.psnr_db.has_value());
   EXPECT_GE(*r.stats.psnr_db, 30.0);
-}
-
-// THE FIRST QUARTER (target_db.cpp): where one shading point at the smallest N reaches the
-// target on a quarter of the sample, the rest is never traced; a target it misses there
-// traces the whole sample before the climb.
-TEST(TargetDb, AQuarterOfTheSampleDecidesWhereItReachesTheTarget) {
-  const Scene scene = Scene::load(scene_path("cornell.json"));
-  Renderer renderer;
-  int block = 0;
-  const std::vector<uint8_t> full = pilot_pixels(96, 72, &block);
-  const auto whole = static_cast<uint64_t>(std::count(full.begin(), full.end(), uint8_t{1}));
-  const json easy = json::parse(renderer.render(scene, target_options(96, 72, 30)).stats.json)["target_db"];
-  EXPECT_FALSE(easy["sample"]["whole"].get<bool>()) << easy.dump(1);
-  EXPECT_LT(easy["sample"]["pixels"].get<uint64_t>(), whole / 3);
-  EXPECT_GT(easy["sample"]["pixels"].get<uint64_t>(), whole / 6);
-  EXPECT_EQ(easy["pilots"].size(), 1u);
-  const json hard = json::parse(renderer.render(scene, target_options(96, 72, 44)).stats.json)["target_db"];
-  EXPECT_TRUE(hard["sample"]["whole"].get<bool>()) << hard.dump(1);
-  EXPECT_EQ(hard["sample"]["pixels"].get<uint64_t>(), whole);
 }
 
 // A target no N reaches stops where the error stops improving, keeps the best N found,
