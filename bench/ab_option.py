@@ -37,11 +37,8 @@ import time
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(REPO, "tools"))
 import hard_scenes  # noqa: E402  (the generator: same templates, same seeds)
-from gpu_best import psnr  # noqa: E402  (abcube compare's PSNR, as every bench reads it)
-
-
-def run(cmd):
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+sys.path.insert(0, os.path.join(REPO, "bench"))
+from common import psnr, run  # noqa: E402
 
 
 def scenes(work, args):

@@ -21,31 +21,17 @@ import csv
 import json
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import psnr, run  # noqa: E402
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 METHODS = [("abuffer", ["--method", "abuffer"]), ("gpu", ["--method", "gpu"]),
            ("gpu_maps", ["--method", "gpu", "--gpu-mirrors", "envmap", "--gpu-shadows", "maps"]),
            ("hybrid", ["--method", "hybrid"]), ("hybrid_samples", ["--method", "hybrid", "--gpu-shading", "samples"])]
-
-
-def run(cmd):
-    done = subprocess.run(cmd, capture_output=True, text=True)
-    if done.returncode != 0:
-        raise RuntimeError("%s: %s" % (" ".join(cmd), done.stderr.strip()[:300]))
-    return done.stdout
-
-
-def psnr(abcube, a, b):
-    out = subprocess.run([abcube, "compare", a, b], capture_output=True, text=True).stdout
-    for line in out.splitlines():
-        if line.startswith("PSNR"):
-            v = line.split()[1]
-            return float("inf") if v == "inf" else float(v)
-    raise RuntimeError("compare %s %s: %s" % (a, b, out))
 
 
 def render(abcube, scene, out, args, stats):

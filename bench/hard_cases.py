@@ -36,6 +36,8 @@ import tempfile
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(REPO, "tools"))
 import hard_scenes  # noqa: E402  (the generator: same templates, same seeds)
+sys.path.insert(0, os.path.join(REPO, "bench"))
+from common import psnr  # noqa: E402
 
 SEARCH_KINDS = ("reflection", "refraction_exit", "shadow")
 
@@ -61,11 +63,7 @@ def psnr_of(abcube, a, b, module):
     """PSNR dB of image a against b: through the Python module when built, else the CLI."""
     if module is not None:
         return float(module.compare(module.read_image(a), module.read_image(b))["psnr_db"])
-    out = subprocess.run([abcube, "compare", a, b], capture_output=True, text=True).stdout
-    m = re.search(r"^PSNR\s+(\S+)", out, re.M)
-    if not m:
-        raise RuntimeError("compare printed no PSNR: " + out.strip())
-    return math.inf if m.group(1).startswith("inf") else float(m.group(1))
+    return psnr(abcube, a, b)
 
 
 def side_counts(stats_path):

@@ -24,11 +24,13 @@ import datetime
 import math
 import os
 import random
-import re
 import shutil
 import subprocess
 import sys
 import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import peak_rss_kib  # noqa: E402
 
 METHODS = ["raytrace", "abuffer", "zbuffer", "envmap", "gpu", "gpu:maps"]
 # A method name, or METHOD:SHADOWS for gpu with --gpu-shadows SHADOWS (volumes, its default, or maps).
@@ -93,19 +95,6 @@ def write_terrain_scene(folder, grid, seed, size, cube_res):
 }
 """ % (size, size, os.path.basename(obj), cube_res))
     return scene, 2 * grid * grid + 2 * 2 * 48 * 23
-
-
-def peak_rss_kib(cmd):
-    """Runs cmd under /usr/bin/time -v; returns (exit status, peak RSS in KiB, wall seconds)."""
-    p = subprocess.run(["/usr/bin/time", "-v"] + cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    rss = re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr)
-    wall = re.search(r"Elapsed \(wall clock\) time \(h:mm:ss or m:ss\): (?:(\d+):)?(\d+):([\d.]+)", p.stderr)
-    seconds = 0.0
-    if wall:
-        seconds = int(wall.group(1) or 0) * 3600 + int(wall.group(2)) * 60 + float(wall.group(3))
-    if p.returncode != 0:
-        sys.stderr.write("FAILED (%d): %s\n%s\n" % (p.returncode, " ".join(cmd), p.stderr[-2000:]))
-    return p.returncode, int(rss.group(1)) if rss else 0, seconds
 
 
 def main():

@@ -41,7 +41,6 @@ import argparse
 import csv
 import datetime
 import os
-import re
 import statistics
 import subprocess
 import sys
@@ -50,26 +49,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 import race_scenes  # noqa: E402
-from memory import peak_rss_kib  # noqa: E402
+from common import peak_rss_kib, psnr, run  # noqa: E402
 
 DEFAULT_SCENES = ["scenes/bench/spheres_terrain.json", "scenes/cornell.json", "scenes/default.json"]
-
-
-def run(cmd, **kw):
-    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
-    if p.returncode != 0:
-        sys.exit("race.py: failed (%d): %s\n%s" % (p.returncode, " ".join(cmd), p.stderr[-2000:]))
-    return p.stdout
-
-
-def psnr(abcube, image, ref):
-    # compare's exit status says pass/fail at its --fail threshold; only the figure is used
-    out = subprocess.run([abcube, "compare", image, ref], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                         text=True).stdout
-    m = re.search(r"^PSNR\s+(\S+)", out, re.M)
-    if not m:
-        sys.exit("race.py: no PSNR from abcube compare %s %s" % (image, ref))
-    return float(m.group(1))
 
 
 def plan_words(t):

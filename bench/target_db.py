@@ -33,7 +33,8 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-import race  # noqa: E402  (psnr, timed)
+import race  # noqa: E402  (timed)
+from common import psnr  # noqa: E402
 import race_scenes  # noqa: E402
 
 
@@ -85,11 +86,11 @@ def main(argv=None):
             "scene": name,
             "triangles": st["counts"]["triangles"],
             "own_n": own_n,
-            "own_db": race.psnr(abcube, own, ref),
+            "own_db": psnr(abcube, own, ref),
             "chosen_n": t.get("cube_resolution", "-"),
             "points": race.plan_words(t),
             "predicted_db_low": t.get("predicted_psnr_db_low"),
-            "target_db": race.psnr(abcube, target, ref),
+            "target_db": psnr(abcube, target, ref),
             "pilots": len(t.get("pilots", [])),
             "pilot_ms": st["timings_ms"].get("target_pilots", 0.0),
             "raytrace_s": t_ray,
