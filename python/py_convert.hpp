@@ -34,7 +34,6 @@ bool bool_arg(const py::handle& value, const std::string& what);
 int int_arg(const py::handle& value, const std::string& what);
 uint64_t unsigned_arg(const py::handle& value, const std::string& what);
 
-
 // A Python value as JSON text (bool, int, float, str, os.PathLike, sequences, numpy
 // arrays and scalars, dicts); InputError naming `what` for a NaN or another type.
 std::string json_text(const py::handle& value, const std::string& what);

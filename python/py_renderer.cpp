@@ -56,7 +56,8 @@ RenderSetup setup_from_kwargs(const py::kwargs& kwargs, bool* want_stats, py::ob
     }
     if (value.is_none()) continue;  // the default
     if (key == "progress") {
-      if (!PyCallable_Check(value.ptr())) throw InputError("progress: must be callable (stage, done), got " + type_name(value));
+      if (!PyCallable_Check(value.ptr()))
+        throw InputError("progress: must be callable (stage, done), got " + type_name(value));
       *progress = py::reinterpret_borrow<py::object>(value);
       continue;
     }

@@ -3,7 +3,7 @@
 #   bash tools/setup.sh           building and rendering: compiler, CMake, GL run-times, the libraries
 #   bash tools/setup.sh --python  and the Python module: its headers, pybind11, numpy, pip, venv
 #   bash tools/setup.sh --test    and everything the tests and tools use: GoogleTest, pytest, Dask,
-#                                 clang-14 with libFuzzer and its sanitizers, POV-Ray, OpenImageIO's
+#                                 clang-14 with libFuzzer and its sanitizers, clang-format, POV-Ray, OpenImageIO's
 #                                 tools, the assimp test models, headless Chromium (the report's page),
 #                                 GNU time (a process's peak memory)
 # GL headers come from glad (generated at configure time); libEGL and libOSMesa are opened at
@@ -20,7 +20,7 @@ BASE=(
 PYTHON=(python3-dev pybind11-dev python3-numpy python3-pip python3-venv python3-setuptools python3-wheel)
 TEST=(
   libgtest-dev libgmock-dev python3-pytest python3-distributed openimageio-tools
-  clang-14 libclang-rt-14-dev libfuzzer-14-dev llvm-14 assimp-testmodels povray chromium time
+  clang-14 clang-format-14 libclang-rt-14-dev libfuzzer-14-dev llvm-14 assimp-testmodels povray chromium time
 )
 
 usage() { echo "usage: bash tools/setup.sh [--python | --test]" >&2; exit 2; }

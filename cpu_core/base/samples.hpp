@@ -37,8 +37,8 @@ inline int mask_count(CoverageMask m) { return __builtin_popcount(m); }
 //     difference, summed over the rungs, between a rung's coverage of a random straight edge
 //     and the 32 samples' coverage of it: the error against the reference where images differ.
 // tests/core/test_samples.cpp checks each property.
-constexpr int SAMPLE_LADDER[MASK_SAMPLES] = {17, 14, 2,  29, 8,  23, 27, 4,  24, 7, 1,  30, 18, 13, 11, 20,
-                                             0,  31, 16, 15, 9,  22, 25, 6,  10, 21, 26, 5,  3,  28, 19, 12};
+constexpr int SAMPLE_LADDER[MASK_SAMPLES] = {17, 14, 2,  29, 8, 23, 27, 4, 24, 7,  1,  30, 18, 13, 11, 20,
+                                             0,  31, 16, 15, 9, 22, 25, 6, 10, 21, 26, 5,  3,  28, 19, 12};
 // Whether S is a rung of the ladder.
 constexpr bool is_sample_rung(int s) { return s == 1 || s == 2 || s == 4 || s == 8 || s == 16 || s == 32; }
 

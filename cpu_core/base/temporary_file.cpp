@@ -88,8 +88,8 @@ pid_t temporary_writer(const std::string& name) {
 
 TemporaryFile::TemporaryFile(const std::string& final_path) : final_path_(final_path) {
   const std::filesystem::path p(final_path);
-  path_ = (p.parent_path() / ("." + p.stem().string() + ".tmp" + std::to_string(getpid()) + "-" + host_tag() +
-                              p.extension().string()))
+  path_ = (p.parent_path() /
+           ("." + p.stem().string() + ".tmp" + std::to_string(getpid()) + "-" + host_tag() + p.extension().string()))
               .string();
   slot_ = publish(path_);
 }

@@ -290,7 +290,9 @@ void render_row(const RayTracer& tracer, const CameraFrame& frame, int spp, int 
   glm::dvec3 colour[MASK_SAMPLES];
   for (int x = 0; x < frame.width; ++x) {
     if (only && !(*only)[static_cast<size_t>(y) * static_cast<size_t>(frame.width) + static_cast<size_t>(x)]) continue;
-    const auto sample = [&](double sx, double sy) { return tracer.trace(frame.eye, frame.direction(x + sx, y + sy), 0, counts); };
+    const auto sample = [&](double sx, double sy) {
+      return tracer.trace(frame.eye, frame.direction(x + sx, y + sy), 0, counts);
+    };
     glm::dvec3 sum(0.0);
     if (spp == 1) {
       sum = sample(0.5, 0.5);

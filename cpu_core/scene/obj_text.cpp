@@ -134,8 +134,9 @@ bool corner(const char*& p, const char* e, Part* part, std::string* why) {
       while (end < e && *end != '/' && !blank(*end) && *end != '\r') ++end;
       const char* name = which == FIELD_V ? "v" : which == FIELD_VT ? "vt" : "vn";
       *why = std::string("its ") + name + " index is " +
-             (end == start ? std::string("missing") : !digits ? "not a number: " + quote(std::string(start, end), 24)
-                                                                : std::string("0"));
+             (end == start ? std::string("missing")
+              : !digits    ? "not a number: " + quote(std::string(start, end), 24)
+                           : std::string("0"));
       return false;
     }
     while (p < e && *p != '/' && !blank(*p) && *p != '\r') ++p;  // the rest of the word

@@ -65,7 +65,8 @@ void check_radiance(const SceneData& scene, int max_depth, const std::string& wh
     }
   };
   consider("ambient", largest(scene.ambient));
-  for (size_t i = 0; i < scene.lights.size(); ++i) consider("lights[" + std::to_string(i) + "].color", largest(scene.lights[i].color));
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    consider("lights[" + std::to_string(i) + "].color", largest(scene.lights[i].color));
   for (uint32_t i = 0; i < scene.materials.size(); ++i) {
     consider("material \"" + scene.materials[i].name + "\" color", largest(scene.materials[i].color));
     const double t = texture_scale(scene, i);

@@ -66,7 +66,8 @@ uint64_t gltf_triangles(const Json& doc) {
     if (!index || !index->is_number_integer() || !accessors || !accessors->is_array()) return 0;
     const int64_t i = index->get<int64_t>();
     if (i < 0 || static_cast<size_t>(i) >= accessors->size()) return 0;
-    return static_cast<uint64_t>(std::max<int64_t>(integer_or(member((*accessors)[static_cast<size_t>(i)], "count"), 0), 0));
+    return static_cast<uint64_t>(
+        std::max<int64_t>(integer_or(member((*accessors)[static_cast<size_t>(i)], "count"), 0), 0));
   };
   const auto mesh_triangles = [&](int64_t m) -> uint64_t {
     if (!meshes || !meshes->is_array() || m < 0 || static_cast<size_t>(m) >= meshes->size()) return 0;
@@ -74,8 +75,10 @@ uint64_t gltf_triangles(const Json& doc) {
     uint64_t sum = 0;
     for (const Json& p : primitives && primitives->is_array() ? *primitives : Json::array()) {
       const int64_t mode = integer_or(member(p, "mode"), 4);
-      const uint64_t n = member(p, "indices") ? accessor_count(member(p, "indices"))
-                                               : accessor_count(member(member(p, "attributes") ? *member(p, "attributes") : p, "POSITION"));
+      const uint64_t n =
+          member(p, "indices")
+              ? accessor_count(member(p, "indices"))
+              : accessor_count(member(member(p, "attributes") ? *member(p, "attributes") : p, "POSITION"));
       sum += mode == 4 ? n / 3 : (mode == 5 || mode == 6) && n >= 2 ? n - 2 : 0;
     }
     return sum;
@@ -153,7 +156,8 @@ Counted count_object(const LoadState& st, const Json& object, size_t index) {
       c.obj_file = resolved;
     } else {
       try {
-        c.triangles = gltf_triangles(parse_document(gltf_json(resolved, st.limits.max_mesh_bytes), Source{resolved, "."}));
+        c.triangles =
+            gltf_triangles(parse_document(gltf_json(resolved, st.limits.max_mesh_bytes), Source{resolved, "."}));
       } catch (const InputError&) {
         c.triangles = 0;  // not JSON: the reader says so when the object loads
       }

@@ -318,8 +318,9 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
     scene.camera.fov_y_deg = c.fov_y_deg;
   }
   if (const Json* render = top.find("render")) {
-    scene.render = read_render(Fields(
-        src, *render, "render", {"method", "cube_resolution", "max_depth", "fresnel", "error_target", "target_db", "samples"}));
+    scene.render = read_render(
+        Fields(src, *render, "render",
+               {"method", "cube_resolution", "max_depth", "fresnel", "error_target", "target_db", "samples"}));
   }
   load_textures(st);
   check_radiance(scene, scene.render.max_depth, src.name + ": ");  // THE RADIANCE BOUND

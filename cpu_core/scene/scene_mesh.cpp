@@ -507,16 +507,16 @@ void add_obj_faces(LoadState& st, const std::string& path, const std::string& re
   std::vector<BadCorner> bad(runs.size());
   parallel_for(runs.size(), thread_count(st.limits.threads, runs.size()),
                [&](size_t r, int) { triangulate_run(obj, runs[r], materials, &m, &bad[r]); });
-  const BadCorner first = bad.empty() ? BadCorner{}
-                                      : *std::min_element(bad.begin(), bad.end(), [](const BadCorner& a, const BadCorner& b) {
-                                          return a.face < b.face;
-                                        });
+  const BadCorner first =
+      bad.empty() ? BadCorner{} : *std::min_element(bad.begin(), bad.end(), [](const BadCorner& a, const BadCorner& b) {
+        return a.face < b.face;
+      });
   if (first.face != UINT64_MAX) {
     const uint64_t line = obj_face_line(resolved, first.face);
     const char* name[3] = {"v", "vt", "vn"};
     const size_t lines[3] = {m.positions.size(), m.uvs.size(), m.normals.size()};
-    const std::string value = first.index == ObjCorner::OUT_OF_RANGE ? std::string("out of range")
-                                                                      : std::to_string(int64_t{first.index} + 1);
+    const std::string value =
+        first.index == ObjCorner::OUT_OF_RANGE ? std::string("out of range") : std::to_string(int64_t{first.index} + 1);
     fail(st.src, path,
          "mesh " + quote_path(resolved) + (line > 0 ? ": line " + std::to_string(line) : std::string()) +
              ": f: corner " + std::to_string(first.corner + 1) + ": " + name[first.field] + " index " + value +

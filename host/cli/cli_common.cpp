@@ -53,8 +53,8 @@ void RenderFlags::add_to(CLI::App* cmd) {
 }
 
 const std::vector<std::string>& scene_view_keys() {
-  static const std::vector<std::string> keys = {"width", "height", "size", "fov_y", "camera_position",
-                                                "look_at", "up", "set", "max_depth"};
+  static const std::vector<std::string> keys = {"width",   "height", "size", "fov_y",    "camera_position",
+                                                "look_at", "up",     "set",  "max_depth"};
   return keys;
 }
 

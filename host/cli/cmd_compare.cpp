@@ -56,9 +56,10 @@ struct CompareCommand {
     }
     // The verdict first, with the test that gave it: a bare comparison fails on one pixel
     // over 1/255, which a reader of its last line alone would take for "far apart".
-    std::printf("%s: %.4f%% of pixels differ by more than %.4g (--fail, displayed values), %.4g%% allowed "
-                "(--failpercent)\n",
-                pass ? "PASS" : "FAIL", 100.0 * failing, fail, fail_percent);
+    std::printf(
+        "%s: %.4f%% of pixels differ by more than %.4g (--fail, displayed values), %.4g%% allowed "
+        "(--failpercent)\n",
+        pass ? "PASS" : "FAIL", 100.0 * failing, fail, fail_percent);
     std::printf("RMSE        %.6g\n", e.rmse);
     if (std::isfinite(e.psnr)) {
       std::printf("PSNR        %.2f dB\n", e.psnr);
@@ -89,8 +90,7 @@ CommandRun add_compare_command(CLI::App& app) {
   cmd->add_option("--diff", c->diff_path,
                   "write a per-pixel error heat map here, its legend beneath (black 0 ... red 128/255)")
       ->type_name("PATH");
-  cmd->add_option("--fail", c->fail,
-                  "a pixel fails above this difference of displayed values (0 to 1; default: 1/255)")
+  cmd->add_option("--fail", c->fail, "a pixel fails above this difference of displayed values (0 to 1; default: 1/255)")
       ->type_name("NUMBER")
       ->check(CLI::Range(0.0, 1.0).description(""));
   cmd->add_option("--failpercent", c->fail_percent,

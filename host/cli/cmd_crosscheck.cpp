@@ -116,7 +116,8 @@ CommandRun add_crosscheck_command(CLI::App& app) {
       ->check(CLI::Range(1, 16384).description(""));
   cmd->add_option("--gl", c->gl, "GL path: auto | egl | egl-device | egl-surfaceless | osmesa (default: auto)")
       ->type_name("NAME");
-  cmd->add_option("--gl-device", c->device, "EGL device index (0 to 1024; default: ABCUBE_EGL_DEVICE, else the first GPU)")
+  cmd->add_option("--gl-device", c->device,
+                  "EGL device index (0 to 1024; default: ABCUBE_EGL_DEVICE, else the first GPU)")
       ->type_name("INT")
       ->check(CLI::Range(0, 1024).description(""));
   cmd->add_option("--threads", c->threads, "worker threads (threads, 0 to 4096; default: 0, every core)")

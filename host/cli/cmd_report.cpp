@@ -67,10 +67,10 @@ struct ReportCommand {
       }
       const nlohmann::json& db = x["error"]["psnr_db"];
       const nlohmann::json& rung = x["matched_rung"];
-      std::printf("  %-9s %s dB in %.0f ms; the tracer at %d samples a pixel is as close in %.0f ms (time ratio %.2f)\n",
-                  m.c_str(), db.is_number() ? std::to_string(db.get<double>()).c_str() : "inf",
-                  x["total_ms"].get<double>(), rung["samples"].get<int>(), rung["total_ms"].get<double>(),
-                  rung["time_ratio"].get<double>());
+      std::printf(
+          "  %-9s %s dB in %.0f ms; the tracer at %d samples a pixel is as close in %.0f ms (time ratio %.2f)\n",
+          m.c_str(), db.is_number() ? std::to_string(db.get<double>()).c_str() : "inf", x["total_ms"].get<double>(),
+          rung["samples"].get<int>(), rung["total_ms"].get<double>(), rung["time_ratio"].get<double>());
     }
     if (j["crosscheck"].contains("pass")) {
       std::printf("  crosscheck %s\n", j["crosscheck"]["pass"].get<bool>() ? "PASS" : "FAIL");

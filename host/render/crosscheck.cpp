@@ -342,10 +342,9 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   // below FEW_TEXELS the verdict says so, and what to do.
   constexpr size_t FEW_TEXELS = 10000;
   fail(r.distance_p99_rel > tol.distance_p99_rel,
-       r.both_covered < FEW_TEXELS
-           ? "distance p99 over few texels (" + std::to_string(r.both_covered) +
-                 " covered on both, its 1% at silhouettes): raise --cube-res"
-           : std::string("distance p99"));
+       r.both_covered < FEW_TEXELS ? "distance p99 over few texels (" + std::to_string(r.both_covered) +
+                                         " covered on both, its 1% at silhouettes): raise --cube-res"
+                                   : std::string("distance p99"));
   fail(r.both_covered > 0 && r.same_object < tol.same_object_min, "same object share");
   fail(mismatch > tol.coverage_mismatch_max, "coverage mismatch");
   fail(r.interior_rmse > tol.interior_rmse, "camera interior RMSE");

@@ -279,8 +279,8 @@ class Report {
           best = &rung;
       }
       const double ms = (*best)["total_ms"].get<double>();
-      x["matched_rung"] = {{"samples", (*best)["samples"]}, {"total_ms", ms},
-                           {"time_ratio", x["total_ms"].get<double>() / ms}};
+      x["matched_rung"] = {
+          {"samples", (*best)["samples"]}, {"total_ms", ms}, {"time_ratio", x["total_ms"].get<double>() / ms}};
     }
     struct Point {
       std::string name;

@@ -343,7 +343,8 @@ Image raytrace_for_target(MethodContext& mc) {
   json lines = json::array();
   for (int i = 0; i < LOWER_RUNGS; ++i) {
     const SampledError e = sampled_error(rungs[static_cast<size_t>(i)], exact, pixels);
-    lines.push_back({{"samples", 1 << i}, {"psnr_db", number_or_null(e.psnr)}, {"psnr_db_low", number_or_null(e.psnr_low)}});
+    lines.push_back(
+        {{"samples", 1 << i}, {"psnr_db", number_or_null(e.psnr)}, {"psnr_db_low", number_or_null(e.psnr_low)}});
     if (samples == MASK_SAMPLES && e.psnr_low >= target) {
       samples = 1 << i;
       chosen = &rungs[static_cast<size_t>(i)];
@@ -376,12 +377,15 @@ Image raytrace_for_target(MethodContext& mc) {
       {"target", target},
       {"samples", samples},
       {"reached", true},
-      {"why", samples == MASK_SAMPLES ? "no rung below 32 samples is predicted to reach the target: the reference's 32"
-                                      : "the smallest rung of the sample ladder whose predicted PSNR reaches the target"},
+      {"why", samples == MASK_SAMPLES
+                  ? "no rung below 32 samples is predicted to reach the target: the reference's 32"
+                  : "the smallest rung of the sample ladder whose predicted PSNR reaches the target"},
       {"predicted_psnr_db", number_or_null(chosen_error.psnr)},
       {"predicted_psnr_db_low", number_or_null(chosen_error.psnr_low)},
       {"sample",
-       {{"pixels", std::count(pixels.begin(), pixels.end(), uint8_t{1})}, {"block", block}, {"exact_trace_ms", pilot_ms}}},
+       {{"pixels", std::count(pixels.begin(), pixels.end(), uint8_t{1})},
+        {"block", block},
+        {"exact_trace_ms", pilot_ms}}},
       {"rungs", lines}};
   mc.stats["timings_ms"]["target_pilots"] = pilot_ms;
   return image;

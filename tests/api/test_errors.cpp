@@ -125,7 +125,8 @@ TEST(ErrorsApi, GpuTimeoutLeavesTheGlSceneWhole) {
 TEST(ErrorsApi, RadianceOverAFloatIsRefusedAndTheBoundRendersFinite) {
   const auto scene_with = [](const std::string& ambient) {
     return R"({"version": 1, "camera": {"position": [0, 1, 3], "look_at": [0, 0.5, 0], "width": 16, "height": 12},
-      "ambient": [)" + ambient + ", " + ambient + ", " + ambient + R"(],
+      "ambient": [)" +
+           ambient + ", " + ambient + ", " + ambient + R"(],
       "lights": [{"type": "point", "position": [1, 3, 2], "color": [1, 1, 1]}],
       "materials": {"both": {"color": [1, 1, 1], "reflect": 1, "transmit": 1, "ior": 1.5}, "white": {}},
       "objects": [{"type": "quad", "vertices": [[-3, 0, -3], [3, 0, -3], [3, 0, 3], [-3, 0, 3]], "material": "white"},
@@ -133,8 +134,9 @@ TEST(ErrorsApi, RadianceOverAFloatIsRefusedAndTheBoundRendersFinite) {
       "render": {"max_depth": 4}})";
   };
   const std::string message = input_error_of([&] { Scene::from_json(scene_with("3.4e38"), "over.json"); });
-  EXPECT_EQ(message.rfind("over.json: ambient: with this scene's lights, colours and max_depth 4, a pixel could reach ", 0),
-            0u)
+  EXPECT_EQ(
+      message.rfind("over.json: ambient: with this scene's lights, colours and max_depth 4, a pixel could reach ", 0),
+      0u)
       << message;
   EXPECT_NE(message.find("got 3.4e+38"), std::string::npos) << message;
   // At the bound: (ambient + 2 lights) (1 + 2 + 4 + 8 + 16) <= 1e37.

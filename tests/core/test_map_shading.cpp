@@ -226,7 +226,7 @@ TEST(MapShading, ContactShadowOfABoxOnAWideFloorIsExact) {
   const double margin = 0.02;
   const auto classify = [&](const glm::dvec3& p) {
     const double m = std::max(std::fabs(p.x), std::fabs(p.z));
-    if (p.z < 0.5 + margin) return -1;  // beside or behind the box: not judged
+    if (p.z < 0.5 + margin) return -1;                       // beside or behind the box: not judged
     if (std::fabs(m - 0.75) < margin || m > 3.0) return -1;  // at the ring's edge, or far (wide footprints)
     return m < 0.75 ? 1 : 2;
   };
@@ -237,7 +237,8 @@ TEST(MapShading, ContactShadowOfABoxOnAWideFloorIsExact) {
   const RayTracer rt(s);
   RaytraceOptions ro;
   ro.threads = 2;
-  for (const Case& c : {Case{"raytrace", render_raytrace(s, ro)}, Case{"abuffer", render_method(s, Method::abuffer).image}}) {
+  for (const Case& c :
+       {Case{"raytrace", render_raytrace(s, ro)}, Case{"abuffer", render_method(s, Method::abuffer).image}}) {
     int ring = 0, lit = 0, wrong = 0;
     for (int y = 0; y < c.image.height; ++y) {
       for (int x = 0; x < c.image.width; ++x) {

@@ -236,8 +236,9 @@ TEST(SceneLoadGltf, ImageBufferViewsLieInsideTheirBuffers) {
   EXPECT_EQ(error_for(R"({"buffer": 0, "byteOffset": 90, "byteLength": 4})", png),
             prefix + "bufferViews[3] (byteOffset 90 + byteLength 4) passes the end of buffers[0] (byteLength 92)");
   EXPECT_EQ(error_for(R"({"buffer": 0, "byteOffset": 18446744073709551615, "byteLength": 4})", png),
-            prefix + "bufferViews[3] (byteOffset 18446744073709551615 + byteLength 4) passes the end of buffers[0] "
-                     "(byteLength 92)");
+            prefix +
+                "bufferViews[3] (byteOffset 18446744073709551615 + byteLength 4) passes the end of buffers[0] "
+                "(byteLength 92)");
   EXPECT_EQ(error_for(R"({"buffer": 1, "byteLength": 4})", png),
             prefix + "bufferViews[3] names no buffer (the file has 1)");
   EXPECT_EQ(error_for(R"({"buffer": 0, "byteLength": 4})", R"({"bufferView": 7, "mimeType": "image/png"})"),

@@ -167,8 +167,7 @@ TEST(SceneLoadLimits, MeshOverTheCapsIsRefusedBeforeItIsParsed) {
     return input_error([&] { load_scene_text(mesh, "scene.json", dir.path().string(), limits); }, mesh);
   };
   const std::string counted = std::to_string(500 * 3 + 4 + 1);
-  EXPECT_NE(error().find(": line 1509: f: corner 3: v index 999999, but the file has 6 v lines"),
-            std::string::npos)
+  EXPECT_NE(error().find(": line 1509: f: corner 3: v index 999999, but the file has 6 v lines"), std::string::npos)
       << "with no cap, the check after parsing: " << error();
   limits.max_triangles = 1000;
   EXPECT_EQ(error(), "scene.json: objects[0].file: the scene would have " + counted +
