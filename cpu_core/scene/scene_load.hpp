@@ -28,10 +28,10 @@ struct LoadLimits {
   // "Limits"): a scene file (and an MTL file) is text of kilobytes, a mesh can be
   // gigabytes (a 1M-triangle OBJ is about 100 MB). A mesh file larger than the memory
   // available is refused too: its triangles take more room than its text.
-  // Threads the load may use, 0: every core (the result is the same for any number).
-  int threads = 0;
   uint64_t max_scene_bytes = MAX_SCENE_BYTES;
   uint64_t max_mesh_bytes = MAX_MESH_BYTES;
+  // Threads the load may use, 0: every core (the result is the same for any number).
+  int threads = 0;
   static constexpr uint64_t MAX_SCENE_BYTES = uint64_t{64} << 20;  // 64 MiB
   static constexpr uint64_t MAX_MESH_BYTES = uint64_t{8} << 30;    // 8 GiB
 };

@@ -95,7 +95,6 @@ struct MapShadingStats {
   void merge(const MapShadingStats& o);
 };
 
-// A point on a triangle: what the rules need to shade it.
 // Where a camera fragment is shaded (render_with_map): at up to four points of its
 // triangle's plane, the centroids of its covered samples in each 4x2 quarter of the 4x8
 // mask, weighted by their sample counts. One shading point per fragment would make an edge
@@ -111,9 +110,8 @@ constexpr double QUARTER_SPLIT_SRGB = 1.0 / 255.0;
 // whose colour differs from a 4-neighbour's by more than SPARSE_SPLIT_SRGB (sRGB-encoded, any
 // channel: an edge of a shadow, of a silhouette, of what a mirror or glass shows) are shaded
 // again, their fragments at the adaptive quarters. Elsewhere the pixel is smooth, and one
-// point stands for it as well as the quarters would. Measured at the N --target-db 40 takes
-// on the race's scenes, it renders within 0.05 dB of the quarters in about 0.7 of their
-// shading time (docs/performance.md). There is no SHADOW EDGES or SECONDARY EDGES pass.
+// point stands for it as well as the quarters would (docs/performance.md measures how
+// close). There is no SHADOW EDGES or SECONDARY EDGES pass.
 constexpr double SPARSE_SPLIT_SRGB = 16.0 / 255.0;
 //
 // SHADOW EDGES (shadow_edges.hpp). A shadow's edge through a fragment would still be
@@ -179,6 +177,7 @@ struct KnownBlockers {
   void clear() { triangle.clear(); }
 };
 
+// A point on a triangle: what the rules need to shade it.
 struct SurfacePoint {
   glm::dvec3 point{0.0};
   glm::dvec3 geometric_normal{0.0};  // unit, cross(b-a, c-a)

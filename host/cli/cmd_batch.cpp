@@ -140,13 +140,9 @@ struct BatchCommand {
     return abcube::read_jobs(in, jobs_path, shard_i, shard_n);
   }
 
-  int run() const {
-    const Clock::time_point start = Clock::now();
-    const auto [shard_i, shard_n] = parse_shard();
-    RenderSetup base = flags.setup();
-    if (job_timeout_s > 0) base.render.timeout_s = job_timeout_s;
-    const std::vector<Job> jobs = read_jobs(shard_i, shard_n);
-    for (const Job& job : jobs) {  // before anything renders, as a malformed line
+  // Every job's outputs and own options, before anything renders, as a malformed line is.
+  void check_jobs(const std::vector<Job>& jobs, const RenderSetup& base) const {
+    for (const Job& job : jobs) {
       for (const auto& [key, out] :
            {std::pair<const char*, const std::string*>{"out", &job.out}, {"stats", &job.stats}}) {
         try {
@@ -157,8 +153,12 @@ struct BatchCommand {
       }
       check_own_options(job, base, jobs_path);
     }
-    // What killed runs left (SIGKILL, a preempted machine): their temporaries, once their
-    // processes are gone. Every output lands whole, by rename, so what exists is complete.
+  }
+
+  // What killed runs left (SIGKILL, a preempted machine) in the jobs' output folders: their
+  // temporaries, once their processes are gone. Every output lands whole, by rename, so what
+  // exists is complete. Returns how many were removed.
+  static size_t clear_killed_runs(const std::vector<Job>& jobs) {
     size_t stale = 0;
     std::set<std::string> folders;
     for (const Job& job : jobs) {
@@ -167,6 +167,17 @@ struct BatchCommand {
           stale += remove_stale_temporaries(fs::path(*out).parent_path().string());
       }
     }
+    return stale;
+  }
+
+  int run() const {
+    const Clock::time_point start = Clock::now();
+    const auto [shard_i, shard_n] = parse_shard();
+    RenderSetup base = flags.setup();
+    if (job_timeout_s > 0) base.render.timeout_s = job_timeout_s;
+    const std::vector<Job> jobs = read_jobs(shard_i, shard_n);
+    check_jobs(jobs, base);
+    const size_t stale = clear_killed_runs(jobs);
     Renderer renderer(base.renderer);
     SceneShelf scenes(std::max<size_t>(scene_cache, 1), base.limits);
     const bool terminal = stderr_is_terminal();
@@ -225,8 +236,7 @@ struct BatchCommand {
         "batch %s shard %zu/%zu: %zu jobs, %zu rendered, %zu failed, %zu skipped; %zu scenes loaded; "
         "%.1f ms per render (median, with load and write), %.1f s in all%s\n",
         jobs_path.c_str(), shard_i, shard_n, jobs.size(), render_ms.size(), failed, skipped, scenes.loads(), median,
-        total_ms / 1000.0,
-        stale ? ("; " + std::to_string(stale) + " temporaries of killed runs removed").c_str() : "");
+        total_ms / 1000.0, stale ? ("; " + std::to_string(stale) + " temporaries of killed runs removed").c_str() : "");
     return failed ? 1 : 0;
   }
 };

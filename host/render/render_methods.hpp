@@ -45,7 +45,8 @@ struct MethodContext {
   Image* fallback;
 };
 
-// The Z-buffer raster on the GPU: camera view only, Phong, aliased.
+// The GPU's raster (GlScene): flat mirrors and hard shadows exact, curved mirrors and glass
+// from its cube texture; shadow maps and the environment only where the scene needs them.
 Image render_gpu(MethodContext& mc);
 // The cube-map methods (abuffer, zbuffer, envmap): the map is built only when something
 // needs it (a reflecting or refracting material, a shadow-casting light). `only`

@@ -119,8 +119,8 @@ std::string svg(const Plot& p) {
   const auto sx = [&](double v) { return L + (tx(v) - x0) / (x1 - x0) * (W - L - R); };
   const auto sy = [&](double v) { return H - B - (ty(v) - y0) / (y1 - y0) * (H - T - B); };
   std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\"" + (p.id.empty() ? "" : " id=\"" + escape(p.id) + "\"") +
-                  " width=\"" + fixed(W, 0) + "\" height=\"" + fixed(H, 0) +
-                  "\" viewBox=\"0 0 " + fixed(W, 0) + " " + fixed(H, 0) + "\" role=\"img\"><title>" + escape(p.title) +
+                  " width=\"" + fixed(W, 0) + "\" height=\"" + fixed(H, 0) + "\" viewBox=\"0 0 " + fixed(W, 0) + " " +
+                  fixed(H, 0) + "\" role=\"img\"><title>" + escape(p.title) +
                   "</title><rect width=\"100%\" height=\"100%\" fill=\"#fff\"/>";
   s += "<text x=\"" + fixed(W / 2, 0) + "\" y=\"18\" text-anchor=\"middle\" font-size=\"13\">" + escape(p.title) +
        "</text>";
@@ -152,9 +152,10 @@ std::string svg(const Plot& p) {
          "\" text-anchor=\"end\" font-size=\"11\" fill=\"#c33\">" + escape(p.curve_name) + "</text>";
     for (size_t i = 0; i < p.curve_labels.size() && i < p.curve.size(); ++i) {
       const auto& [x, y] = p.curve[i];
-      s += "<circle class=\"rung\" cx=\"" + fixed(sx(x), 1) + "\" cy=\"" + fixed(sy(y), 1) + "\" r=\"3\" fill=\"#c33\"/>";
-      s += "<text x=\"" + fixed(sx(x) + 5, 1) + "\" y=\"" + fixed(sy(y) + 12, 1) + "\" font-size=\"10\" fill=\"#c33\">" +
-           escape(p.curve_labels[i]) + "</text>";
+      s += "<circle class=\"rung\" cx=\"" + fixed(sx(x), 1) + "\" cy=\"" + fixed(sy(y), 1) +
+           "\" r=\"3\" fill=\"#c33\"/>";
+      s += "<text x=\"" + fixed(sx(x) + 5, 1) + "\" y=\"" + fixed(sy(y) + 12, 1) +
+           "\" font-size=\"10\" fill=\"#c33\">" + escape(p.curve_labels[i]) + "</text>";
     }
   }
   s += front_marks(p, sx, sy, [&](double x, double y) { return std::isfinite(tx(x)) && std::isfinite(ty(y)); });
@@ -460,24 +461,16 @@ void developers(std::string& h, const json& r) {
        "the thesis's bound, the crosscheck's figures</summary>";
   const json& points = r["sweep"]["points"];
   if (!points.empty()) {
-    Plot speed{"abuffer: error against time, one point a cube resolution N",
-               "time, ms",
-               "PSNR against raytrace, dB",
-               {},
-               {},
-               {},
-               "",
-               false,
-               false};
-    Plot bound{"abuffer: Error_Parallax of reflection rays against N",
-               "N (texels a face edge)",
-               "Error_Parallax",
-               {},
-               {},
-               {},
-               "the thesis's bound 1/(2 N^2)",
-               true,
-               true};
+    Plot speed;
+    speed.title = "abuffer: error against time, one point a cube resolution N";
+    speed.x_name = "time, ms";
+    speed.y_name = "PSNR against raytrace, dB";
+    Plot bound;
+    bound.title = "abuffer: Error_Parallax of reflection rays against N";
+    bound.x_name = "N (texels a face edge)";
+    bound.y_name = "Error_Parallax";
+    bound.curve_name = "the thesis's bound 1/(2 N^2)";
+    bound.log_y = bound.log_x = true;
     for (const json& p : points) {
       const json& db = p["error"]["psnr_db"];
       speed.points.push_back({p.value("total_ms", 0.0), db.is_number() ? db.get<double>() : 200.0});

@@ -57,24 +57,24 @@ struct CameraOverride {
 // The names the string options accept (the CLI's --help and the messages list them too).
 // Empty strings and negative numbers mean "the scene's own value".
 struct RenderOptions {
-  std::string method;                 // abuffer | zbuffer | envmap | raytrace | gpu | hybrid ("" = render.method)
-  int cube_resolution = 0;            // N texels per face edge (0 = render.cube_resolution, or error_target's)
-  int max_depth = -1;                 // bounces (< 0 = render.max_depth)
-  double error_target = -1;           // > 0: N from the Error_Parallax bound 1/(2 N^2) (< 0 = the scene's)
-  double target_db = -1;              // > 0: the PSNR to reach against the tracer: abuffer picks N, raytrace
-                                      // its samples (< 0 = the scene's)
-  int samples = 0;                    // raytrace: camera samples a pixel, 1, 2, 4, 8, 16 or 32 (0 = the scene's)
-  std::optional<bool> fresnel;        // Schlick weights for kr and kt (unset = the scene's)
-  int threads = 0;                    // 0 = the Renderer's (RendererOptions::threads)
-  bool reference = false;             // also trace the exact reference: error figures in the stats
-  std::string reference_image;        // the exact image rendered before (implies reference)
-  bool plan_everything = false;       // run the steps the plan would skip, to time them
-  std::string search = "crossing";    // crossing | thesis (map searches, thesis 7.4)
-  std::string refine = "mesh";        // mesh | plane (crossing refinement)
-  double theta_max_deg = 2.0;         // thesis mode's acceptance angle, degrees
-  std::string refraction = "search";  // search | thick_lens | thin_lens
-  std::string envmap_lookup = "R";    // R | bisector | position (envmap method)
-  std::string shading_points = "quarters";  // per camera fragment: quarters (adaptive, 2 to 4) | one
+  std::string method;                       // abuffer | zbuffer | envmap | raytrace | gpu | hybrid ("" = render.method)
+  int cube_resolution = 0;                  // N texels per face edge (0 = render.cube_resolution, or error_target's)
+  int max_depth = -1;                       // bounces (< 0 = render.max_depth)
+  double error_target = -1;                 // > 0: N from the Error_Parallax bound 1/(2 N^2) (< 0 = the scene's)
+  double target_db = -1;                    // > 0: the PSNR to reach against the tracer: abuffer picks N, raytrace
+                                            // its samples (< 0 = the scene's)
+  int samples = 0;                          // raytrace: camera samples a pixel, 1, 2, 4, 8, 16 or 32 (0 = the scene's)
+  std::optional<bool> fresnel;              // Schlick weights for kr and kt (unset = the scene's)
+  int threads = 0;                          // 0 = the Renderer's (RendererOptions::threads)
+  bool reference = false;                   // also trace the exact reference: error figures in the stats
+  std::string reference_image;              // the exact image rendered before (implies reference)
+  bool plan_everything = false;             // run the steps the plan would skip, to time them
+  std::string search = "crossing";          // crossing | thesis (map searches, thesis 7.4)
+  std::string refine = "mesh";              // mesh | plane (crossing refinement)
+  double theta_max_deg = 2.0;               // thesis mode's acceptance angle, degrees
+  std::string refraction = "search";        // search | thick_lens | thin_lens
+  std::string envmap_lookup = "R";          // R | bisector | position (envmap method)
+  std::string shading_points = "quarters";  // per camera fragment: quarters (adaptive, 2 to 4) | one | sparse
   std::string texture_lookups = "samples";  // a textured fragment's base colour: samples (averaged) | points
   std::string shadow_edges = "samples";     // a shadow edge inside a fragment: samples (each its own) | points
   std::string secondary_edges = "samples";  // reflections and refractions inside a fragment: samples | points

@@ -164,6 +164,33 @@ def test_product_source_holds_no_history():
     assert out.returncode == 1 and not out.stdout, out.stdout[:2000]
 
 
+# A measurement in a comment: a time (12 ms, 3.5 us), a decimal PSNR (43.91 dB), a bandwidth
+# (37 GB/s) or a speed-up (2.1x faster, 30% slower). Limits and derivations (64 MiB, 48 dB)
+# are invariants and stay.
+MEASUREMENT = re.compile(r"\b[0-9.]+ ?(ms|us|ns|µs)\b|\b[0-9]+\.[0-9]+ ?dB\b|\b[0-9.]+ ?[KMG]i?B/s\b"
+                         r"|\b[0-9.]+ ?(x|times|%) (faster|slower|the time)\b")
+
+
+def comment_of(path, line):
+    """The comment part of a source line ("" when none)."""
+    marker = "#" if path.suffix == ".py" else "//"
+    at = line.find(marker)
+    return line[at:] if at >= 0 else ""
+
+
+def test_product_comments_hold_no_measurements():
+    """Comments state invariants and reasons; measurements go to bench/results and
+    docs/performance.md, where they are dated by the run that made them."""
+    found = []
+    for path in product_sources():
+        for number, line in enumerate(path.read_text().splitlines(), 1):
+            if MEASUREMENT.search(comment_of(path, line)):
+                found.append(f"{path.relative_to(SRC)}:{number}: {line.strip()}")
+    assert not found, found
+    assert MEASUREMENT.search("// renders in 0.7 of the time: 43.91 dB, 12 ms")
+    assert not MEASUREMENT.search("// 64 MiB cap; 8-bit images one code apart are 48 dB")
+
+
 PRODUCT_DIRS = ("cpu_core", "host", "include", "python", "shaders")
 MAX_FILE_LINES = 600
 MAX_FUNCTION_LINES = 80
@@ -183,23 +210,41 @@ def test_product_files_are_short():
 
 
 def long_functions(lines, limit):
-    """(first line, length) of each function of a C++ file longer than `limit` lines. The
-    sources are formatted by .clang-format: outside a class, a function's signature starts at
-    column 0 and its body closes with a lone "}" at column 0, every line between indented."""
+    """(first line, length) of each function of a C++ file longer than `limit` lines, member
+    functions defined in a class included. The sources are formatted by .clang-format: a
+    function's signature starts at its scope's indent (column 0 outside a class, 2 inside one)
+    and its body closes with a lone "}" at that indent, every line between indented further.
+    A block inside a function closes the same way and is measured too: it is never longer than
+    the function that holds it."""
     out = []
     for end, line in enumerate(lines):
-        if line.rstrip() != "}":
+        m = re.fullmatch(r"( *)\}", line.rstrip())
+        if not m:
             continue
+        indent = m.group(1)
         start = end - 1
-        while start >= 0 and not (lines[start][:1].strip() and lines[start][:2] != "//" and lines[start][:1] != "#"):
+        while start >= 0 and not (lines[start].startswith(indent) and lines[start][len(indent):][:1] not in ("", " ", "#")
+                                  and not lines[start][len(indent):].startswith("//")):
             start -= 1
         if start >= 0 and end - start + 1 > limit:
             out.append((start + 1, end - start + 1))
     return out
 
 
+def test_long_functions_sees_members():
+    """The length rule's reader finds a long member function in a class, and a long function
+    outside one, and passes a short one."""
+    body = ["    x += 1;"] * 85
+    member = ["class A {", " public:", "  int f() const {"] + body + ["  }", "};"]
+    free = ["int g(int x,", "      int y) {"] + body + ["}"]
+    short = ["int h() {", "  return 1;", "}"]
+    assert long_functions(member, MAX_FUNCTION_LINES) == [(3, 87)]
+    assert long_functions(free, MAX_FUNCTION_LINES) == [(1, 88)]
+    assert long_functions(short, MAX_FUNCTION_LINES) == []
+
+
 def test_product_functions_are_short():
-    """No C++ function of the product outside a class runs past MAX_FUNCTION_LINES lines."""
+    """No C++ function of the product, member functions included, runs past MAX_FUNCTION_LINES lines."""
     long = []
     for path in product_sources():
         if path.suffix in (".cpp", ".hpp", ".h"):

@@ -107,12 +107,12 @@ def test_an_option_a_method_does_not_use_is_refused_through_every_door(option, t
     args = [BIN, "render", CORNELL, "-o", str(tmp_path / "x.png"), "--method", method, option["flag"]]
     r = subprocess.run(args + ([] if option["kind"] == "flag" else [text]), capture_output=True, text=True)
     assert r.returncode == 2 and f"{option['flag']}: {expected}" in r.stderr, r.stderr
-    # a batch job: rendered jobs fail one by one (exit 1), each named by its line
+    # a batch job: its own key is refused before anything renders (exit 2), named by its line
     jobs = tmp_path / "jobs.jsonl"
     jobs.write_text(json.dumps({"scene": CORNELL, "out": str(tmp_path / "y.png"), "method": method,
                                 option["key"]: good}) + "\n")
     r = subprocess.run([BIN, "batch", str(jobs)], capture_output=True, text=True)
-    assert r.returncode == 1 and f'jobs.jsonl:1: "{option["key"]}": {expected}' in r.stderr, r.stderr
+    assert r.returncode == 2 and f'jobs.jsonl:1: "{option["key"]}": {expected}' in r.stderr, r.stderr
     # Python
     with pytest.raises(abcube.SceneError, match=f"{option['key']}: {expected}"):
         abcube.Renderer(gl="none").render(abcube.load_scene(CORNELL), method=method, **{option["key"]: good})
