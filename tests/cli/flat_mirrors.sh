@@ -3,7 +3,8 @@
 # a mirror whose plane holds the camera, a floor mirror showing a hidden quad, mirror boxes,
 # grazing water, a light on a mirror), one scene of each template for a fixed seed and for
 # one seed new each run (printed): against the exact tracer it must reach 35 dB and come
-# within 1 dB of abuffer or better; hybrid must be no less accurate than abuffer. Rendered
+# within 1 dB of abuffer or better; hybrid must be no less accurate than abuffer but for
+# shadow-edge samples the GPU decides in float (lib/shadow_flips.py). Rendered
 # small (128 x 96, abuffer at N = 128) in one batch per method. Then hybrid against abuffer
 # on the repository's scenes, where it sends to the CPU the pixels the GPU approximates. Usage (ctest runs it so): bash flat_mirrors.sh /path/to/abcube /path/to/repo
 # ABCUBE_FLAT_SEED=S repeats a run's new seed.
@@ -18,14 +19,16 @@ echo "seeds: 1 and $SEED (ABCUBE_FLAT_SEED=$SEED repeats this run)"
 require_gl
 for seed in 1 "$SEED"; do generate flat_mirror_scenes "$seed" 5 "$WORK/scenes"; done
 # batch_all DIR PREFIX METHOD...: every scene of DIR rendered by each method in one batch,
-# into $WORK/PREFIX$method/.
+# into $WORK/PREFIX$method/; raytrace writes the shadowed AOV beside its image.
 batch_all() {
   local dir=$1 prefix=$2 method scene
   shift 2
   for method in "$@"; do
     : > "$WORK/$prefix$method.jsonl"
     for scene in "$dir"/*.json; do
-      echo "{\"scene\": \"$scene\", \"out\": \"$prefix$method/$(basename "$scene" .json).exr\", \"method\": \"$method\"}" \
+      aovs=""
+      [ "$method" = raytrace ] && aovs=', "aovs": ["shadowed"]'
+      echo "{\"scene\": \"$scene\", \"out\": \"$prefix$method/$(basename "$scene" .json).exr\", \"method\": \"$method\"$aovs}" \
         >> "$WORK/$prefix$method.jsonl"
     done
     "$ABCUBE" batch "$WORK/$prefix$method.jsonl" > /dev/null 2> "$WORK/$prefix$method.err"
@@ -44,20 +47,27 @@ at_least() {
      BEGIN { exit !(x != "" && y != "" && cap(x) >= cap(y) - slack) }'
 }
 # hybrid_no_worse NAME REFERENCE ABUFFER HYBRID: hybrid's PSNR against the reference is at
-# least abuffer's less 0.1 dB, both capped at 75 dB (RMSE 1.8e-4). The cap: hybrid's GPU
-# passes shade once a pixel and surface (--gpu-shading pixels), whose error inside a pixel
-# is about 80 dB on plane_through_camera_5_2 at 128x96, where abuffer searching a mirror's
-# samples one by one reaches 86 (at 64x48: hybrid 77.3, abuffer 76.5, and hybrid with
-# --gpu-shading samples 137.0). The 0.1 dB: where abuffer
-# searches a shadow's edge from every sample, in double, a sample on the edge can flip in
-# the GPU's float (camera_inside_16334_3: 3 pixels a sample off, 56.19 against 56.21 dB); a
-# lost shadow, as in the tiles below, costs tens of dB.
+# least abuffer's, both capped at 75 dB (RMSE 1.8e-4). The cap: hybrid's GPU passes shade once
+# a pixel and surface (--gpu-shading pixels), whose error inside a pixel is about 80 dB on
+# plane_through_camera_5_2 at 128x96, where abuffer searching a mirror's samples one by one
+# reaches 86 (at 64x48: hybrid 77.3, abuffer 76.5, and hybrid with --gpu-shading samples
+# 137.0). Below abuffer, every pixel of the excess must be a shadow-edge sample the GPU
+# decided in float (lib/shadow_flips.py, from REFERENCE's shadowed AOV beside it): a volume's
+# side meeting the surface within float rounding of a sample (camera_inside_16334_3: 3
+# pixels a sample off, 56.19 against 56.21 dB; coplanar_21883_1: 7 pixels along a grazing
+# shadow edge, 70.14 against 76.29). A lost shadow, as in the tiles below, is neither.
 hybrid_no_worse() {
   local ab hy
   ab=$(psnr "$3" "$2")
   hy=$(psnr "$4" "$2")
   echo "$1: hybrid $hy dB, abuffer $ab dB"
-  check "$1: hybrid no less accurate than abuffer ($hy against $ab)" at_least "$(cap75 "$hy")" "$(cap75 "$ab")" 0.1
+  if at_least "$(cap75 "$hy")" "$(cap75 "$ab")"; then
+    check "$1: hybrid no less accurate than abuffer ($hy against $ab)" true
+  else
+    check "$1: hybrid below abuffer ($hy against $ab) only by shadow-edge flips" \
+      env PYTHONPATH="$(dirname "$ABCUBE")/python" /usr/bin/python3 "$(dirname "$0")/lib/shadow_flips.py" "$2" "$3" "$4" \
+      "${2%.exr}.shadowed.exr"
+  fi
 }
 cap75() { awk -v v="$1" 'BEGIN { print (v == "inf" || v + 0 > 75) ? 75 : v }'; }
 for scene in "$WORK"/scenes/*.json; do
@@ -108,7 +118,10 @@ done
 for scene in "$WORK/tiles/light_on_mirror_3_4.json" "$WORK"/tiles/light_on_open_mirror_*.json; do
   stem=$(basename "$scene" .json)
   for method in raytrace abuffer hybrid; do
-    "$ABCUBE" render "$scene" -o "$WORK/tiles_${stem}_$method.exr" --method $method 2> "$WORK/err"
+    aovs=""
+    [ $method = raytrace ] && aovs="--aovs shadowed"
+    # shellcheck disable=SC2086
+    "$ABCUBE" render "$scene" -o "$WORK/tiles_${stem}_$method.exr" --method $method $aovs 2> "$WORK/err"
     status=$?
     check "$stem (640x480): $method renders ($(head -c 200 "$WORK/err"))" [ $status -eq 0 ]
   done
@@ -118,10 +131,10 @@ done
 # The repository's scenes (glass, a curved mirror, coverage transparency: pixels for the CPU).
 for name in cornell default hidden_point shadows textured; do
   for method in raytrace abuffer hybrid; do
-    size="--cube-res 128"
-    [ $method = raytrace ] && size=""
+    extra="--cube-res 128"
+    [ $method = raytrace ] && extra="--aovs shadowed"
     # shellcheck disable=SC2086
-    "$ABCUBE" render "$REPO/scenes/$name.json" -o "$WORK/repo_${name}_$method.exr" --method $method $size 2> "$WORK/err"
+    "$ABCUBE" render "$REPO/scenes/$name.json" -o "$WORK/repo_${name}_$method.exr" --method $method $extra 2> "$WORK/err"
     status=$?
     check "$name: $method renders ($(head -c 200 "$WORK/err"))" [ $status -eq 0 ]
   done

@@ -156,6 +156,22 @@ def test_example_runs(doc, line, language, code, tmp_path):
             assert image.mean() > 0.01, f"{path.name} from {doc.relative_to(SRC)}:{line} is black ({image.mean():.4f})"
 
 
+def test_performance_page_holds_current_figures():
+    """docs/performance.md gives today's figures and how to measure them again: under 400 lines,
+    no commit hashes (git keeps the history), and bench/results holds no file named after a
+    commit."""
+    def is_hash(word):  # 7 to 40 hex digits, a letter and a digit among them
+        return bool(re.fullmatch(r"[0-9a-f]{7,40}", word) and re.search(r"[a-f]", word) and re.search(r"[0-9]", word))
+
+    page = (SRC / "docs" / "performance.md").read_text()
+    assert len(page.splitlines()) < 400, len(page.splitlines())
+    found = [w for w in re.findall(r"\w+", page) if is_hash(w)]
+    assert not found, found
+    named = [p.name for p in (SRC / "bench" / "results").iterdir() if any(map(is_hash, re.split(r"[_.-]", p.name)))]
+    assert not named, named
+    assert is_hash("5f1206c") and not any(map(is_hash, ["seed9000", "1280x720", "deadbeef"]))
+
+
 def test_product_source_holds_no_history():
     """Comments state invariants and reasons: dates and issue numbers go to commit messages
     and CHANGELOG.md, figures to bench/results and docs/performance.md."""
