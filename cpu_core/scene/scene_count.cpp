@@ -47,6 +47,10 @@ std::string gltf_json(const std::string& resolved, uint64_t max_bytes) {
     if (in.gcount() < 20) return "";
     uint32_t length = 0;
     std::copy(header + 12, header + 16, reinterpret_cast<char*>(&length));
+    // The chunk's length is the file's word: nothing is allocated beyond what the file holds.
+    std::error_code ec;
+    const uint64_t size = std::filesystem::file_size(resolved, ec);
+    if (ec || length > size - 20) return "";
     std::string json(length, '\0');
     in.read(json.data(), length);
     return static_cast<uint32_t>(in.gcount()) == length ? json : "";

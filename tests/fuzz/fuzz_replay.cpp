@@ -3,19 +3,40 @@
 // (sorted), and prints how many ran. The ctest tests fuzz.replay.* run it on the seeds
 // and on every input that once crashed (tests/fuzz/regressions/), so that a fixed crash
 // stays fixed. A failed check aborts (fuzz_checks.hpp); no input at all is an error too.
+// Like libFuzzer, which reports any one allocation over 2 GiB, the replay runs in an
+// address space of REPLAY_ADDRESS_SPACE, so that an input that once made a loader allocate
+// what its header claims fails here too (std::bad_alloc is not an InputError). Not under a
+// sanitizer, whose shadow memory needs the address space.
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sys/resource.h>
 #include <string>
 #include <vector>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define ABCUBE_REPLAY_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define ABCUBE_REPLAY_SANITIZED 1
+#endif
+#endif
+
+namespace {
+constexpr rlim_t REPLAY_ADDRESS_SPACE = rlim_t{3} << 30;
+}
+
 int main(int argc, char** argv) {
   namespace fs = std::filesystem;
+#ifndef ABCUBE_REPLAY_SANITIZED
+  const rlimit cap{REPLAY_ADDRESS_SPACE, REPLAY_ADDRESS_SPACE};
+  if (setrlimit(RLIMIT_AS, &cap) != 0) std::perror("fuzz_replay: setrlimit");
+#endif
   std::vector<fs::path> files;
   for (int i = 1; i < argc; ++i) {
     const fs::path p(argv[i]);
