@@ -12,17 +12,17 @@ uniform vec2 u_grid;       // the target's size in samples
 uniform dvec3 u_center;    // the view's eye (scene.vert)
 uniform bool u_uvs;        // the scene has texture coordinates (Uvs bound)
 uniform bool u_portals;    // the scene has planar reflectors (Portals bound)
-layout(rgba32f, binding = 0) uniform image2D u_target;
+layout(rgba32f, binding = TARGET_IMAGE) uniform image2D u_target;
 uniform bool u_pixels;  // the camera's own view: uniform pixels go to the two images below
-layout(rgba32f, binding = 1) uniform writeonly image2D u_pixel_color;
-layout(rgba32f, binding = 2) uniform writeonly image2D u_pixel_weight;
+layout(rgba32f, binding = PIXEL_COLOR_IMAGE) uniform writeonly image2D u_pixel_color;
+layout(rgba32f, binding = PIXEL_WEIGHT_IMAGE) uniform writeonly image2D u_pixel_weight;
 // The scene's arrays (gl_scene_buffers.cpp): positions and normals as the soup holds them, 3 floats
 // a vertex; each triangle's material.
-layout(std430, binding = 3) readonly buffer Positions { float positions[]; };
-layout(std430, binding = 4) readonly buffer Uvs { vec2 uvs[]; };
-layout(std430, binding = 5) readonly buffer Portals { uint portals[]; };  // per vertex (0: none)
-layout(std430, binding = 6) readonly buffer Normals { float normals[]; };
-layout(std430, binding = 7) readonly buffer TriangleMaterials { uint material_ids[]; };
+layout(std430, binding = POSITIONS_BINDING) readonly buffer Positions { float positions[]; };
+layout(std430, binding = UVS_BINDING) readonly buffer Uvs { vec2 uvs[]; };
+layout(std430, binding = PORTALS_BINDING) readonly buffer Portals { uint portals[]; };  // per vertex (0: none)
+layout(std430, binding = NORMALS_BINDING) readonly buffer Normals { float normals[]; };
+layout(std430, binding = TRIANGLE_MATERIALS_BINDING) readonly buffer TriangleMaterials { uint material_ids[]; };
 
 vec3 normal_of(uint v) { return vec3(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]); }
 
@@ -63,8 +63,7 @@ bool curved(uint t) {
 uint portal_of(uint t) { return u_portals ? portals[3u * t] : 0u; }
 
 ivec2 base;
-ivec2 sample_at(int k) { return base + ivec2(k & 7, k >> 3); }
-const int MASK_LAST_COLUMN = 7, MASK_LAST_ROW = 3;  // sample_at(31) - base
+ivec2 sample_at(int k) { return base + ivec2(k % MASK_COLUMNS, k / MASK_COLUMNS); }
 
 // A triangle's corners relative to the eye (read once a group: storage reads are dear on
 // llvmpipe), and its plane: its normal n (not unit) and dot(n, r0).
@@ -107,6 +106,10 @@ bool foreshortened(Corners c, ivec2 lo, ivec2 hi) {
 }
 
 // The same over the bounding rectangle of the samples `members`.
+// (A mask's byte is a row of 8 columns.)
+#if MASK_COLUMNS != 8 || MASK_ROWS != 4
+#error "group_foreshortened reads a mask as 4 bytes, one a row"
+#endif
 bool group_foreshortened(Corners c, uint members) {
   uint columns = (members | members >> 8 | members >> 16 | members >> 24) & 0xffu;
   uint rows = uint((members & 0xffu) != 0u) | uint((members & 0xff00u) != 0u) << 1 |
@@ -176,14 +179,14 @@ void shade(uvec2 key, uint members, bool pixel, Corners c) {
 }
 
 void main() {
-  base = ivec2(gl_FragCoord.xy) * ivec2(8, 4);
+  base = ivec2(gl_FragCoord.xy) * ivec2(MASK_COLUMNS, MASK_ROWS);
   // The common case first: one key over the whole pixel.
   uvec2 first = texelFetch(u_keys, base, 0).xy;
   uint same = 1u;
-  for (int k = 1; k < 32; ++k) same &= uint(texelFetch(u_keys, sample_at(k), 0).xy == first);
+  for (int k = 1; k < MASK_SAMPLES; ++k) same &= uint(texelFetch(u_keys, sample_at(k), 0).xy == first);
   if (same != 0u && first.x != 0u) {
     Corners c = corners_of(first.x - 1u);
-    if (!foreshortened(c, ivec2(0), ivec2(MASK_LAST_COLUMN, MASK_LAST_ROW))) {
+    if (!foreshortened(c, ivec2(0), ivec2(MASK_COLUMNS - 1, MASK_ROWS - 1))) {
       shade(first, 0xffffffffu, u_pixels, c);
       return;
     }
@@ -191,7 +194,7 @@ void main() {
   if (u_pixels) imageStore(u_pixel_weight, ivec2(gl_FragCoord.xy), vec4(-1.0));
   // Else group by group: the first sample left names the next group.
   uint left = 0u;
-  for (int k = 0; k < 32; ++k) left |= uint(texelFetch(u_keys, sample_at(k), 0).x != 0u) << uint(k);
+  for (int k = 0; k < MASK_SAMPLES; ++k) left |= uint(texelFetch(u_keys, sample_at(k), 0).x != 0u) << uint(k);
   while (left != 0u) {
     uvec2 key = texelFetch(u_keys, sample_at(findLSB(left)), 0).xy;
     uint members = 0u;

@@ -12,7 +12,7 @@
 // counted (weight 1). The hybrid method has the CPU redo every pixel with a sample above 0.
 uniform bool u_bounces_left;        // this view's level is below max_depth: kr and kt terms count
 uniform bool u_shadows_approximate; // shadows from maps here (no volume for a light), or lights past the volumes
-layout(std430, binding = 2) readonly buffer Recursed { uint recursed[]; };  // per reflector + 1
+layout(std430, binding = RECURSED_BINDING) readonly buffer Recursed { uint recursed[]; };  // per reflector + 1
 
 // Whether a planar mirror's virtual view was drawn behind it (portal: its reflector + 1).
 bool drawn_behind(uint portal) { return portal != 0u && recursed[portal] != 0u; }

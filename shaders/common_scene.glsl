@@ -10,8 +10,8 @@ struct LightGpu {
   vec4 color;     // rgb intensity; w = the shadow-volume count of its opaque blockers, -1 = none
   vec4 volumes;   // x = the count of its translucent blockers, -1 = none (gl_shadow_volumes.cpp)
 };
-layout(std430, binding = 0) readonly buffer Materials { MaterialGpu materials[]; };
-layout(std430, binding = 1) readonly buffer Lights { LightGpu lights[]; };
+layout(std430, binding = MATERIALS_BINDING) readonly buffer Materials { MaterialGpu materials[]; };
+layout(std430, binding = LIGHTS_BINDING) readonly buffer Lights { LightGpu lights[]; };
 uniform int u_light_count;
 uniform vec3 u_ambient;
 
@@ -30,7 +30,6 @@ uniform float u_shadow_texel;        // 2/N: a texel's width at unit distance, f
 uniform float u_shadow_bias_texels;  // the bias, in texels of the shadow map
 // The translucent casters, peeled front to back: layer k of light i holds the k-th nearest
 // translucent crossing (distance, triangle, material; +inf distance: none).
-const int MAX_SHADOW_PEELS = 8;      // gl_passes.hpp MAX_SHADOW_PEELS
 uniform int u_shadow_peels;          // layers built (0: no translucent caster)
 uniform samplerCubeArray u_shadow_peel_maps[MAX_SHADOW_PEELS];
 
@@ -44,7 +43,6 @@ uniform samplerCube u_environment_map;
 // transmission.w = array + MAX_TEXTURE_ARRAYS * layer. Each array is sampled in its own
 // branch with the derivatives taken outside it (uniform control flow), so the index need
 // not be uniform.
-const int MAX_TEXTURE_ARRAYS = 4;  // gl_passes.hpp MAX_TEXTURE_ARRAYS
 uniform sampler2DArray u_textures[MAX_TEXTURE_ARRAYS];
 // True: level 0 only (zero derivatives), the CPU's point sample (abcube crosscheck).
 uniform bool u_texture_level0;

@@ -13,26 +13,26 @@ uniform sampler2D u_pixel_color, u_pixel_weight;  // per pixel of the target, ma
 layout(location = 0) out vec4 o_pixel;
 
 void main() {
-  ivec2 base = u_margin + ivec2(gl_FragCoord.xy) * ivec2(8, 4);
+  ivec2 base = u_margin + ivec2(gl_FragCoord.xy) * ivec2(MASK_COLUMNS, MASK_ROWS);
   vec4 weight = vec4(-1.0), color = vec4(0.0);
   if (u_pixels) {
-    weight = texelFetch(u_pixel_weight, base / ivec2(8, 4), 0);
-    color = texelFetch(u_pixel_color, base / ivec2(8, 4), 0);
+    weight = texelFetch(u_pixel_weight, base / ivec2(MASK_COLUMNS, MASK_ROWS), 0);
+    color = texelFetch(u_pixel_color, base / ivec2(MASK_COLUMNS, MASK_ROWS), 0);
     if (weight == vec4(0.0)) {  // shaded whole, nothing behind: no sample to read
-      o_pixel = vec4(color.rgb, color.a != 0.0 ? 32.0 : 0.0);
+      o_pixel = vec4(color.rgb, color.a != 0.0 ? float(MASK_SAMPLES) : 0.0);
       return;
     }
   }
   vec3 sum = vec3(0.0);
   float approximate = 0.0;
-  for (int row = 0; row < 4; ++row) {
-    for (int col = 0; col < 8; ++col) {
+  for (int row = 0; row < MASK_ROWS; ++row) {
+    for (int col = 0; col < MASK_COLUMNS; ++col) {
       vec4 s = texelFetch(u_samples, base + ivec2(col, row), 0);
       sum += s.rgb;
       approximate += s.a != 0.0 ? 1.0 : 0.0;
     }
   }
-  o_pixel = vec4(sum / 32.0, approximate);
+  o_pixel = vec4(sum / float(MASK_SAMPLES), approximate);
   if (weight.a < 0.0) return;  // per sample (or no per-pixel shading)
-  o_pixel = vec4(color.rgb + weight.rgb * o_pixel.rgb, color.a != 0.0 ? 32.0 : weight.a != 0.0 ? approximate : 0.0);
+  o_pixel = vec4(color.rgb + weight.rgb * o_pixel.rgb, color.a != 0.0 ? float(MASK_SAMPLES) : weight.a != 0.0 ? approximate : 0.0);
 }

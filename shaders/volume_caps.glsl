@@ -3,10 +3,10 @@
 // is its surface's triangle, the same vertices in the same order through the same transform
 // (the same depth at every sample), and reads each triangle's code here: 0 none (the
 // triangle casts nothing in this volume), 1 a cap as wound, 2 a cap oriented against its
-// winding. Four codes a word, byte k of word i for triangle 4 i + k. Binding 6:
-// gl_passes_internal.hpp VOLUME_CAPS_BINDING.
+// winding. Four codes a word, byte k of word i for triangle 4 i + k. Its binding:
+// glsl_shared.hpp VOLUME_CAPS_BINDING.
 #define VOLUME_CAPS 1
-layout(std430, binding = 6) readonly buffer VolumeCaps { uint volume_caps[]; };
+layout(std430, binding = VOLUME_CAPS_BINDING) readonly buffer VolumeCaps { uint volume_caps[]; };
 uniform bool u_caps;  // drawing the near caps (the faces at infinity come clipped, with their own flags)
 
 uint volume_cap_code(int vertex) {

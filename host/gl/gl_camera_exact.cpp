@@ -170,7 +170,7 @@ Image GlExactCamera::render(const Camera& camera) {
   glBlendFunc(GL_ONE, GL_ZERO);
   glLogicOp(GL_COPY);
   glStencilFunc(GL_ALWAYS, 0, 0xff);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, RECURSED_BINDING, 0);
   stats_.pixels_exact = static_cast<uint64_t>(std::count(pixels_.begin(), pixels_.end(), 1));
   check_gl("exact camera pass");
   return out;
@@ -375,7 +375,7 @@ void GlExactCamera::shade_view(const glm::mat4& clip, const MirrorView& view, co
   glBindBuffer(GL_SHADER_STORAGE_BUFFER, recursed_);
   glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(recursed.size() * sizeof(uint32_t)), recursed.data(),
                GL_STREAM_DRAW);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, recursed_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, RECURSED_BINDING, recursed_);
   shading.set(*exact_program_);
   glActiveTexture(GL_TEXTURE0 + VOLUME_COUNT_UNIT);
   glBindTexture(GL_TEXTURE_2D_ARRAY, shading.volumes ? parts_.volumes.counts() : 0);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "gl/gl_program.hpp"
+#include "gl/glsl_shared.hpp"
 #include "io/image.hpp"
 #include "gpu_geometry/planar_reflectors.hpp"
 #include "scene/scene_data.hpp"
@@ -31,9 +32,6 @@ struct GpuTimings {
 
 // Shadow bias of the GPU cube shadow maps, in texels (common_shading.glsl).
 constexpr double SHADOW_BIAS_TEXELS = 1.5;
-// Translucent shadow casters peeled per light, at most (shadow_caster.frag; the GLSL
-// constant of the same name). Crossings beyond the last layer let the light through.
-constexpr int MAX_SHADOW_PEELS = 8;
 // Layers of the camera view peeled when a material has coverage transparency (opacity
 // < 1), at most; behind the last, the background shows through what is left.
 constexpr int MAX_CAMERA_LAYERS = 16;
@@ -45,9 +43,9 @@ enum class CameraSamples { pixel_centre, mask_4x8 };
 
 // Base-colour textures on the GPU: the scene's images (scene/texture.hpp, linear RGB) are
 // uploaded once per GlScene as RGB32F 2D arrays with GL's mipmaps, one array per distinct
-// image size, at most this many sizes (common_scene.glsl; more is a RuntimeFailure naming
-// the limit). The uvs go in a vertex buffer of their own, made only when the scene has them.
-constexpr int MAX_TEXTURE_ARRAYS = 4;
+// image size, at most MAX_TEXTURE_ARRAYS sizes (glsl_shared.hpp; more is a RuntimeFailure
+// naming the limit). The uvs go in a vertex buffer of their
+// own, made only when the scene has them.
 
 // What the camera pass renders exactly where the GPU can (gl_camera_exact.cpp;
 // docs/design/gl-camera-exact.md): planar mirrors by virtual objects and the stencil test

@@ -1,6 +1,6 @@
-// Internal to the GL passes (host/gl/gl_*.cpp): texture units and storage bindings, the pass
-// state, the stencil test, the camera's sample tiles, the framebuffers the passes render
-// into, and the view a draw is made through.
+// Internal to the GL passes (host/gl/gl_*.cpp): texture units, the pass state, the stencil
+// test, the camera's sample tiles, the framebuffers the passes render into, and the view a
+// draw is made through. What the shaders share with them: glsl_shared.hpp.
 #pragma once
 #include <glad/gl.h>
 
@@ -35,22 +35,7 @@ static_assert(TEXTURE_UNIT + MAX_TEXTURE_ARRAYS <= 16, "texture units");
 // The shadow volumes' counts in the camera pass: unit 16 (llvmpipe and NVIDIA offer 32; the
 // exact pass checks GL_MAX_TEXTURE_IMAGE_UNITS).
 constexpr GLenum VOLUME_COUNT_UNIT = 16;
-// Storage buffer bindings: 0 materials, 1 lights (common_scene.glsl), 2 the recursed
-// reflectors (camera_surface.glsl), 3-7 the positions, uvs, portals, normals and each
-// triangle's material (camera_groups.frag); 6 also a shadow volume's caps' codes, read by
-// the volume program's vertex stage (volume_caps.glsl; the exact pass checks
-// GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS), bound before each draw that reads it; 8 and 9 each
-// triangle's object and material for scene.vert (triangle_ids.glsl), where the GL offers 10
-// bindings and 3 blocks to a vertex stage (GL 4.5's minimums are 8 and 0; llvmpipe and
-// NVIDIA offer more).
-constexpr GLuint POSITIONS_BINDING = 3;
-constexpr GLuint UVS_BINDING = 4;
-constexpr GLuint PORTALS_BINDING = 5;
-constexpr GLuint NORMALS_BINDING = 6;
-constexpr GLuint TRIANGLE_MATERIALS_BINDING = 7;
-constexpr GLuint VOLUME_CAPS_BINDING = 6;
-constexpr GLuint OBJECT_IDS_BINDING = 8;
-constexpr GLuint MATERIAL_IDS_BINDING = 9;
+// Storage buffer bindings and image units: glsl_shared.hpp.
 
 // The state every pass relies on: infinite reversed-Z (cube_map.hpp: depth in [0, 1], 1 at
 // the near plane, GL_GREATER), no culling (the map holds every surface), no blending.

@@ -3,14 +3,33 @@
 #include <sstream>
 
 #include "base/error.hpp"
+#include "gl/glsl_shared.hpp"
 #include "gl/shader_sources.hpp"
 
 namespace abcube {
 
+// One #define a constant, named as in C++ (the macro keeps the name and the value one text).
+#define ABCUBE_GLSL_CONSTANT(name) "#define " #name " " + std::to_string(name) + "\n"
+
+std::string glsl_prelude() {
+  return std::string("// ---- glsl_shared.hpp\n") + ABCUBE_GLSL_CONSTANT(MAX_SHADOW_PEELS) +
+         ABCUBE_GLSL_CONSTANT(MAX_TEXTURE_ARRAYS) + ABCUBE_GLSL_CONSTANT(MATERIALS_BINDING) +
+         ABCUBE_GLSL_CONSTANT(LIGHTS_BINDING) + ABCUBE_GLSL_CONSTANT(RECURSED_BINDING) +
+         ABCUBE_GLSL_CONSTANT(POSITIONS_BINDING) + ABCUBE_GLSL_CONSTANT(UVS_BINDING) +
+         ABCUBE_GLSL_CONSTANT(PORTALS_BINDING) + ABCUBE_GLSL_CONSTANT(NORMALS_BINDING) +
+         ABCUBE_GLSL_CONSTANT(TRIANGLE_MATERIALS_BINDING) + ABCUBE_GLSL_CONSTANT(VOLUME_CAPS_BINDING) +
+         ABCUBE_GLSL_CONSTANT(OBJECT_IDS_BINDING) + ABCUBE_GLSL_CONSTANT(MATERIAL_IDS_BINDING) +
+         ABCUBE_GLSL_CONSTANT(TARGET_IMAGE) + ABCUBE_GLSL_CONSTANT(PIXEL_COLOR_IMAGE) +
+         ABCUBE_GLSL_CONSTANT(PIXEL_WEIGHT_IMAGE) + ABCUBE_GLSL_CONSTANT(MASK_COLUMNS) +
+         ABCUBE_GLSL_CONSTANT(MASK_ROWS) + ABCUBE_GLSL_CONSTANT(MASK_SAMPLES);
+}
+
+#undef ABCUBE_GLSL_CONSTANT
+
 namespace {
 
 std::string assemble(const std::vector<const char*>& files) {
-  std::string src = "#version 450 core\n";
+  std::string src = "#version 450 core\n" + glsl_prelude();
   for (const char* f : files) {
     const char* text = embedded_shader(f);
     if (text == nullptr) throw RuntimeFailure(std::string("shader not embedded in this build: ") + f);

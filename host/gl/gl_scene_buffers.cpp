@@ -289,8 +289,8 @@ void GlSceneBuffers::set_view(const GlProgram& program, const glm::mat4& clip, c
   glUniform1f(program.uniform("u_tie_step"), ties ? float(gl_tie_step(scene_.objects.size())) : 0.f);
   glUniform3f(program.uniform("u_ambient"), float(scene_.ambient.r), float(scene_.ambient.g), float(scene_.ambient.b));
   glUniform1i(program.uniform("u_light_count"), static_cast<GLint>(scene_.lights.size()));
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, materials_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, lights_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MATERIALS_BINDING, materials_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, LIGHTS_BINDING, lights_);
 }
 
 void GlSceneBuffers::draw_scene(const GlProgram& program, const glm::mat4& clip, const MirrorView& view,

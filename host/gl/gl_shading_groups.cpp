@@ -153,9 +153,9 @@ void GlShadingGroups::shade(GlTarget& t, const glm::mat4& clip, const MirrorView
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, NORMALS_BINDING, buffers_.normals());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, TRIANGLE_MATERIALS_BINDING, buffers_.material_ids());
   glUniform1i(p.uniform("u_pixels"), view.level == 0);
-  glBindImageTexture(0, t.color0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-  glBindImageTexture(1, v.pixel_color, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(2, v.pixel_weight, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(TARGET_IMAGE, t.color0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  glBindImageTexture(PIXEL_COLOR_IMAGE, v.pixel_color, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(PIXEL_WEIGHT_IMAGE, v.pixel_weight, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, v.ids);
   buffers_.bind_vertex_array();
@@ -163,7 +163,8 @@ void GlShadingGroups::shade(GlTarget& t, const glm::mat4& clip, const MirrorView
   glBindTexture(GL_TEXTURE_2D, 0);
   // Its image stores seen by what follows: blending, the parent view's passes, the resolve.
   glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-  for (GLuint unit = 0; unit < 3; ++unit) glBindImageTexture(unit, 0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  for (GLuint unit : {TARGET_IMAGE, PIXEL_COLOR_IMAGE, PIXEL_WEIGHT_IMAGE})
+    glBindImageTexture(unit, 0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glViewport(0, 0, t.width, t.height);
   glEnable(GL_DEPTH_TEST);
   glEnable(GL_STENCIL_TEST);

@@ -267,3 +267,17 @@ def test_product_functions_are_short():
             long += [f"{path.relative_to(SRC)}:{first}: {n} lines"
                      for first, n in long_functions(path.read_text().splitlines(), MAX_FUNCTION_LINES)]
     assert not long, long
+
+
+def test_shaders_take_shared_constants_from_the_prelude():
+    """Every constant of host/gl/glsl_shared.hpp reaches the shaders' prelude (gl_program.cpp),
+    and no shader states a binding number or defines one of those names itself: C++ and
+    GLSL cannot drift apart."""
+    header = (SRC / "host/gl/glsl_shared.hpp").read_text()
+    names = re.findall(r"^constexpr \w+ (\w+) =", header, re.M) + ["MASK_COLUMNS", "MASK_ROWS", "MASK_SAMPLES"]
+    prelude = set(re.findall(r"ABCUBE_GLSL_CONSTANT\(([A-Z_]+)\)", (SRC / "host/gl/gl_program.cpp").read_text()))
+    assert len(names) > 10 and set(names) == prelude, set(names) ^ prelude
+    own = re.compile(r"binding\s*=\s*\d|^\s*(const\s+\w+|#define)\s+(" + "|".join(names) + r")\b", re.M)
+    stated = [f"{p.name}: {m.group(0).strip()}" for p in sorted((SRC / "shaders").iterdir())
+              for m in own.finditer(p.read_text())]
+    assert not stated, stated

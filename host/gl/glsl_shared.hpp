@@ -1,0 +1,50 @@
+// The constants the C++ side of the GL passes and their shaders share: storage-buffer and
+// image bindings, the array bounds, the 4x8 sample grid. Defined here once; every shader
+// is compiled with glsl_prelude() after its #version line, which #defines each of them by
+// the same name with the value given here, so that no shader states a binding or a bound of
+// its own (tests/docs/test_docs.py test_shaders_take_shared_constants_from_the_prelude).
+#pragma once
+#include <string>
+
+#include "base/samples.hpp"
+
+namespace abcube {
+
+// Translucent shadow casters peeled per light, at most (shadow_caster.frag, common_scene.glsl).
+// Crossings beyond the last layer let the light through.
+constexpr int MAX_SHADOW_PEELS = 8;
+// Base-colour texture arrays, one per distinct image size, at most (common_scene.glsl; more
+// is a RuntimeFailure naming the limit).
+constexpr int MAX_TEXTURE_ARRAYS = 4;
+
+// Storage buffer bindings: the materials and lights (common_scene.glsl); the recursed
+// reflectors (camera_surface.glsl); the positions, uvs, portals, normals and each
+// triangle's material (camera_groups.frag); a shadow volume's caps' codes, read by the
+// volume program's vertex stage (volume_caps.glsl; the exact pass checks
+// GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS), bound before each draw that reads it, so that it
+// may share the normals' binding, which that program does not read; each triangle's object
+// and material for scene.vert (triangle_ids.glsl), where the GL offers 10 bindings and 3
+// blocks to a vertex stage (GL 4.5's minimums are 8 and 0; llvmpipe and NVIDIA offer more).
+constexpr unsigned MATERIALS_BINDING = 0;
+constexpr unsigned LIGHTS_BINDING = 1;
+constexpr unsigned RECURSED_BINDING = 2;
+constexpr unsigned POSITIONS_BINDING = 3;
+constexpr unsigned UVS_BINDING = 4;
+constexpr unsigned PORTALS_BINDING = 5;
+constexpr unsigned NORMALS_BINDING = 6;
+constexpr unsigned TRIANGLE_MATERIALS_BINDING = 7;
+constexpr unsigned VOLUME_CAPS_BINDING = 6;
+constexpr unsigned OBJECT_IDS_BINDING = 8;
+constexpr unsigned MATERIAL_IDS_BINDING = 9;
+
+// Image units of the per-group colour pass (camera_groups.frag): the sample grid it blends
+// into, and the camera's per-pixel colour and weight.
+constexpr unsigned TARGET_IMAGE = 0;
+constexpr unsigned PIXEL_COLOR_IMAGE = 1;
+constexpr unsigned PIXEL_WEIGHT_IMAGE = 2;
+
+// The #define lines of every constant above and of the sample grid (base/samples.hpp:
+// MASK_COLUMNS, MASK_ROWS, MASK_SAMPLES), one a line.
+std::string glsl_prelude();
+
+}  // namespace abcube
