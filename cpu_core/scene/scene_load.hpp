@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include <abcube/scene.hpp>
+#include <abcube/scene_limits.hpp>
 
 #include "scene/scene_data.hpp"
 
@@ -36,7 +36,7 @@ struct LoadLimits {
   static constexpr uint64_t MAX_MESH_BYTES = uint64_t{8} << 30;    // 8 GiB
 };
 
-// SceneOverride and SceneOverrides: <abcube/scene.hpp>.
+// SceneOverride and SceneOverrides: <abcube/scene_limits.hpp>.
 
 // Parses, validates, tessellates and transforms. Throws InputError with one line that
 // names the place: "FILE:LINE:COL: ..." for JSON syntax, "FILE: objects[3].radius: ..."

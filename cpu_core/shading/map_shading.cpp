@@ -76,10 +76,6 @@ SurfacePoint surface_point(const SceneData& scene, uint32_t triangle, const glm:
   return sp;
 }
 
-const char* shading_points_name(const MapShadingOptions& o) {
-  return !o.one_point ? "quarters" : (o.quarters_at_edges ? "sparse" : "one");
-}
-
 MapShader::MapShader(const SceneData& scene, const CubeABuffer& cube, const MapShadingOptions& options,
                      const RayTracer* reference, const SceneCache* cache)
     : scene_(scene), cube_(cube), options_(options), reference_(reference) {

@@ -24,6 +24,7 @@
 #include "reference/raytrace.hpp"
 #include "search/search.hpp"
 #include "material/shading.hpp"
+#include "shading/shading_plan.hpp"
 
 namespace abcube {
 
@@ -33,10 +34,6 @@ class SceneCache;
 enum class EnvmapLookup { reflected, bisector, position };  // R, [[R + [[W]]]], [[W]]
 const char* envmap_lookup_name(EnvmapLookup l);
 bool parse_envmap_lookup(const std::string& s, EnvmapLookup* out);  // "R" | "bisector" | "position"
-
-struct MapShadingOptions;
-// --shading-points of a plan as it shades: "quarters", "sparse" or "one".
-const char* shading_points_name(const MapShadingOptions& o);
 
 struct MapShadingOptions {
   Method method = Method::abuffer;  // abuffer, zbuffer or envmap
@@ -50,23 +47,13 @@ struct MapShadingOptions {
   // The resolve of intersecting fragments (resolve.hpp): exact priority masks, or the
   // thesis' Vis_front estimate (--resolve thesis).
   bool exact_priority = true;
-  // Shading points per camera fragment: the adaptive quarters (below), or one, at the
-  // centroid of its covered samples (--shading-points one: about half the shading of a
-  // covered pixel; an edge of a shadow or a reflection inside the pixel is then all or
-  // nothing).
-  bool one_point = false;
-  // With one_point, --shading-points sparse (SPARSE, below): the pixels whose colour
-  // differs from a neighbour's are shaded again at their quarters.
-  bool quarters_at_edges = false;
-  // SHADOW EDGES (below): where a camera fragment's shading points disagree about a light,
-  // each covered sample gets its own shadow answer. Off: the points' answers stand.
-  bool shadow_edges = true;
-  // A textured fragment's base colour averaged over the covered samples each shading point
-  // stands for (render_with_map), else looked up at the point.
-  bool texture_samples = true;
-  // SECONDARY EDGES (below): a mirror or glass fragment whose shading points disagree is
-  // shaded at each covered sample. Off: the points' colours stand.
-  bool secondary_edges = true;
+  // Shading points per camera fragment, and the edges refined at the samples
+  // (shading_plan.hpp; SPARSE, SHADOW EDGES and SECONDARY EDGES below). One point, at the
+  // centroid of its covered samples, takes about half the shading of a covered pixel; an
+  // edge of a shadow or a reflection inside the pixel is then all or nothing. A textured
+  // fragment's base colour is averaged over the covered samples each shading point stands
+  // for (render_with_map), or looked up at the point.
+  ShadingPlan plan;
 };
 
 // Ray-level error against the exact tracer (thesis ch. 9), for the reflection rays of
@@ -232,11 +219,11 @@ class MapShader {
   bool refines_on_mesh() const { return options_.search.refine == SearchRefine::mesh; }
   bool exact_priority() const { return options_.exact_priority; }
   const MapShadingOptions& options() const { return options_; }
-  bool one_point() const { return options_.one_point; }
-  bool quarters_at_edges() const { return options_.quarters_at_edges; }
-  bool shadow_edges() const { return options_.shadow_edges; }
-  bool texture_samples() const { return options_.texture_samples; }
-  bool secondary_edges() const { return options_.secondary_edges; }
+  bool one_point() const { return options_.plan.one_point(); }
+  bool quarters_at_edges() const { return options_.plan.sparse(); }
+  bool shadow_edges() const { return options_.plan.shadow_edges(); }
+  bool texture_samples() const { return options_.plan.texture_samples(); }
+  bool secondary_edges() const { return options_.plan.secondary_edges(); }
 
  private:
   // A crossing set (media.hpp): the surface point shaded, the furthest crossing, the interface.

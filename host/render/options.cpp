@@ -293,14 +293,14 @@ void add_map_methods(Table& t) {
   add(t, {"shadow_edges", "--shadow-edges", OptionKind::choice, OptionScope::job, {"samples", "points"}, 0, 0,
        d.shadow_edges, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
        "a shadow's edge inside a camera fragment: samples (searched again from each covered sample where the "
-       "shading points disagree) | points (the shading points' answers)",
+       "shading points disagree; with the quarters) | points (the shading points' answers)",
        {}},
       [](RenderSetup& s, const json& v) { s.render.shadow_edges = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.shadow_edges, d.shadow_edges); });
   add(t, {"secondary_edges", "--secondary-edges", OptionKind::choice, OptionScope::job, {"samples", "points"}, 0, 0,
        d.secondary_edges, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
        "what a mirror or glass fragment shows: samples (shaded again at each covered sample where its shading "
-       "points disagree) | points (the shading points' answers)",
+       "points disagree; with the quarters or sparse) | points (the shading points' answers)",
        {}},
       [](RenderSetup& s, const json& v) { s.render.secondary_edges = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.secondary_edges, d.secondary_edges); });

@@ -293,27 +293,6 @@ Image render_reference(MethodContext& mc, const char* key) {
   return image;
 }
 
-MapShadingOptions map_shading_options(const MethodContext& mc) {
-  MapShadingOptions options = mc.request.map;
-  // hybrid: abuffer's searches
-  options.method = mc.scene.render.method == Method::hybrid ? Method::abuffer : mc.scene.render.method;
-  options.walk_all_shadows = mc.request.plan_everything;
-  return options;
-}
-
-CubeMap build_cube_map(const MethodContext& mc, int n, const ABufferOptions& options, const RayTracer* reference,
-                       const MapShadingOptions& shading) {
-  CubeMap m;
-  m.n = n;
-  Clock::time_point t0 = Clock::now();
-  m.cube = std::make_unique<CubeABuffer>(build_cube_abuffer(mc.scene, mc.scene.camera.position, n, options, &m.stats));
-  m.build_ms = ms_since(t0);
-  t0 = Clock::now();
-  m.shader = std::make_unique<MapShader>(mc.scene, *m.cube, shading, reference, &mc.cache);
-  m.setup_ms = ms_since(t0);
-  return m;
-}
-
 Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   const SceneData& scene = mc.scene;
   const RenderRequest& r = mc.request;
@@ -330,7 +309,8 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
                             {"why", "no cube map: nothing reflects, refracts or casts a shadow, so N is not used"}};
     }
     pass_progress(mc, "shading", 0.0);
-    Image image = render_abuffer_local(scene, r.abuffer, &stats, r.map.exact_priority, r.map.texture_samples, only);
+    Image image =
+        render_abuffer_local(scene, r.abuffer, &stats, r.map.exact_priority, r.map.plan.texture_samples(), only);
     pass_progress(mc, "shading", 1.0);
     return image;
   }

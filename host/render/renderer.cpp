@@ -127,11 +127,7 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   r.map.refraction = parse_checked(o.refraction, parse_refraction_mode);
   r.map.lookup = parse_checked(o.envmap_lookup, parse_envmap_lookup);
   r.map.exact_priority = o.resolve == "exact";
-  r.map.one_point = o.shading_points == "one" || o.shading_points == "sparse";
-  r.map.quarters_at_edges = o.shading_points == "sparse";
-  r.map.shadow_edges = o.shadow_edges == "samples";
-  r.map.texture_samples = o.texture_lookups == "samples";
-  r.map.secondary_edges = o.secondary_edges == "samples";
+  r.map.plan = ShadingPlan::from_names(o.shading_points, o.shadow_edges, o.secondary_edges, o.texture_lookups);
   r.map.search.side_structure = o.side_structure;
   r.gpu.planar_mirrors = o.gpu_mirrors == "stencil";
   r.gpu.shadow_volumes = o.gpu_shadows == "volumes";
@@ -180,12 +176,9 @@ json request_stats(const SceneData& view, const RenderRequest& request) {
                              {"refraction", refraction_mode_name(request.map.refraction)},
                              {"envmap_lookup", envmap_lookup_name(request.map.lookup)},
                              {"resolve", request.map.exact_priority ? "exact" : "thesis"},
-                             {"shading_points", shading_points_name(request.map)},
-                             {"shadow_edges", request.map.shadow_edges ? "samples" : "points"},
-                             {"texture_lookups", request.map.texture_samples ? "samples" : "points"},
-                             {"secondary_edges", request.map.secondary_edges ? "samples" : "points"},
                              {"side_structure", request.map.search.side_structure},
                              {"fresnel", view.render.fresnel}};
+  for (const auto& [key, value] : request.map.plan.settings()) stats["method_options"][key] = value;
   return stats;
 }
 

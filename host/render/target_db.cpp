@@ -122,6 +122,15 @@ struct Pilot {
 
 // A pilot: the sampled pixels rendered by `shader`, their error against the tracer's, and a
 // line of the stats' "pilots" (its time counted from `t0`, its cube map's build included).
+// A stats line with the shading plan's choices. The target never changes the texture
+// lookups; method_options has them.
+json with_plan(json line, const ShadingPlan& plan) {
+  for (const auto& [key, value] : plan.settings()) {
+    if (std::string(key) != "texture_lookups") line[key] = value;
+  }
+  return line;
+}
+
 Pilot run_pilot(MethodContext& mc, const ABuffer& camera, const MapShader& shader, const PilotSample& sample, int n,
                 Clock::time_point t0, json* pilots) {
   MapShadingStats ms;
@@ -134,50 +143,12 @@ Pilot run_pilot(MethodContext& mc, const ABuffer& camera, const MapShader& shade
     p.fragments += static_cast<double>(k->fragments);
     p.mesh_triangles += static_cast<double>(k->mesh_triangles);
   }
-  pilots->push_back({{"cube_resolution", n},
-                     {"shading_points", shading_points_name(shader.options())},
-                     {"shadow_edges", shader.shadow_edges() ? "samples" : "points"},
-                     {"secondary_edges", shader.secondary_edges() ? "samples" : "points"},
-                     {"psnr_db", number_or_null(e.psnr)},
-                     {"psnr_db_low", number_or_null(e.psnr_low)},
-                     {"model_shading_ms", p.shading_ns() * 1e-6},
-                     {"ms", ms_since(t0)}});
+  pilots->push_back(with_plan({{"cube_resolution", n}}, shader.options().plan));
+  pilots->back().update({{"psnr_db", number_or_null(e.psnr)},
+                         {"psnr_db_low", number_or_null(e.psnr_low)},
+                         {"model_shading_ms", p.shading_ns() * 1e-6},
+                         {"ms", ms_since(t0)}});
   return p;
-}
-
-// The shading plans cheaper than `chosen` (quarters), cheapest first: one shading point per
-// fragment (about half the shading of a covered pixel, and no edges refined at the samples);
-// one point with the quarters where neighbouring pixels differ (SPARSE, map_shading.hpp:
-// the quarters' error where their gain is at edges, for little more than one point's cost);
-// the quarters with neither SHADOW EDGES nor SECONDARY EDGES; then without SECONDARY EDGES
-// alone (map_shading.hpp: each costs where its edges are). Below sparse, only one point.
-std::vector<MapShadingOptions> cheaper_plans(const MapShadingOptions& chosen) {
-  std::vector<MapShadingOptions> plans;
-  if (chosen.one_point && !chosen.quarters_at_edges) return plans;
-  MapShadingOptions one = chosen;
-  one.one_point = true;
-  one.quarters_at_edges = false;
-  plans.push_back(one);
-  if (chosen.one_point) return plans;
-  MapShadingOptions sparse = one;
-  sparse.quarters_at_edges = true;
-  plans.push_back(sparse);
-  if (chosen.shadow_edges && chosen.secondary_edges) {
-    MapShadingOptions neither = chosen;
-    neither.shadow_edges = neither.secondary_edges = false;
-    plans.push_back(neither);
-  }
-  if (chosen.secondary_edges) {
-    MapShadingOptions no_secondary = chosen;
-    no_secondary.secondary_edges = false;
-    plans.push_back(no_secondary);
-  }
-  return plans;
-}
-
-bool same_plan(const MapShadingOptions& a, const MapShadingOptions& b) {
-  return a.one_point == b.one_point && a.quarters_at_edges == b.quarters_at_edges && a.shadow_edges == b.shadow_edges &&
-         a.secondary_edges == b.secondary_edges;
 }
 
 // The pilots' state: the sample, every pilot's stats line, and the best map found so far
@@ -295,27 +266,19 @@ struct Pilots {
 // The choice into the render's stats: its size, method_options and target_db.
 void write_stats(const Pilots& p, json* out) {
   json& stats = *out;
-  const MapShadingOptions& chosen = p.best_plan;
+  const ShadingPlan& chosen = p.best_plan.plan;
   stats["size"]["cube_resolution"] = p.best.n;
-  const char* shadow_edges = chosen.shadow_edges && !chosen.one_point ? "samples" : "points";
-  const char* secondary_edges = chosen.secondary_edges && !chosen.one_point ? "samples" : "points";
-  stats["method_options"]["shading_points"] = shading_points_name(chosen);
-  stats["method_options"]["shadow_edges"] = shadow_edges;
-  stats["method_options"]["secondary_edges"] = secondary_edges;
-  stats["target_db"] = {
-      {"target", p.target},
-      {"cube_resolution", p.best.n},
-      {"shading_points", shading_points_name(chosen)},
-      {"shadow_edges", shadow_edges},
-      {"secondary_edges", secondary_edges},
-      {"scene_cube_resolution", p.mc.scene.render.cube_resolution},
-      {"reached", p.reached},
-      {"why", p.why},
-      {"predicted_psnr_db", number_or_null(p.best_pilot.error.psnr)},
-      {"predicted_psnr_db_low", number_or_null(p.best_pilot.error.psnr_low)},
-      {"sample",
-       {{"pixels", p.best_pilot.error.pixels}, {"block", p.sample.block}, {"exact_trace_ms", p.sample.trace_ms}}},
-      {"pilots", p.lines}};
+  for (const auto& [key, value] : chosen.settings()) stats["method_options"][key] = value;
+  stats["target_db"] = with_plan({{"target", p.target}, {"cube_resolution", p.best.n}}, chosen);
+  stats["target_db"].update(
+      {{"scene_cube_resolution", p.mc.scene.render.cube_resolution},
+       {"reached", p.reached},
+       {"why", p.why},
+       {"predicted_psnr_db", number_or_null(p.best_pilot.error.psnr)},
+       {"predicted_psnr_db_low", number_or_null(p.best_pilot.error.psnr_low)},
+       {"sample",
+        {{"pixels", p.best_pilot.error.pixels}, {"block", p.sample.block}, {"exact_trace_ms", p.sample.trace_ms}}},
+       {"pilots", p.lines}});
 }
 
 }  // namespace
@@ -400,28 +363,31 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
   // short is it climbed again with the plan asked for, whose edges refined at the samples
   // lift the error's floor.
   const MapShadingOptions asked = map_shading_options(mc);
-  MapShadingOptions plain = asked;
-  plain.shadow_edges = plain.secondary_edges = false;
+  const auto options_with = [&asked](const ShadingPlan& plan) {
+    MapShadingOptions o = asked;
+    o.plan = plan;
+    return o;
+  };
+  const ShadingPlan plain = asked.plan.without_edges();
   // Before them, the cheapest plan at the ladder's first N: one shading point a fragment
   // reaches most targets on open scenes, and its pilot costs a fraction of the quarters'.
-  MapShadingOptions one = plain;
-  one.one_point = true;
+  const ShadingPlan one = plain.with_points(ShadingPoints::one);
   const int first_n = target_ladder(mc.scene.render.cube_resolution).front();
-  const bool one_first = !plain.one_point;
-  if (one_first && p.pilot(first_n, one).error.psnr_low >= p.target) {
+  const bool one_first = plain != one;
+  if (one_first && p.pilot(first_n, options_with(one)).error.psnr_low >= p.target) {
     p.reached = true;
     p.why = "one shading point a fragment reaches the target at the ladder's smallest N";
   }
-  if (!p.reached) p.climb(plain);
-  if (!p.reached && !same_plan(plain, asked)) p.climb(asked);
+  if (!p.reached) p.climb(options_with(plain));
+  if (!p.reached && plain != asked.plan) p.climb(asked);
   if (p.reached) {
     // The plain plan was piloted at this N on its climb, or stopped short below it; one
     // point, at the first N.
     std::vector<MapShadingOptions> plans;
-    for (const MapShadingOptions& plan : cheaper_plans(p.best_plan)) {
-      if (same_plan(plan, plain) && !same_plan(p.best_plan, plain)) continue;
-      if (one_first && same_plan(plan, one) && p.best.n == first_n) continue;
-      plans.push_back(plan);
+    for (const ShadingPlan& plan : p.best_plan.plan.cheaper()) {
+      if (plan == plain && p.best_plan.plan != plain) continue;
+      if (one_first && plan == one && p.best.n == first_n) continue;
+      plans.push_back(options_with(plan));
     }
     p.cheapen(plans);
     // Then the cost: a plan cheaper than the one kept fell short at this N, and is not

@@ -21,7 +21,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "render/render_methods.hpp"
+#include "render/method_context.hpp"
 
 namespace abcube {
 

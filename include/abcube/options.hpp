@@ -15,8 +15,8 @@
 #include <vector>
 
 #include <abcube/error.hpp>
-#include <abcube/renderer.hpp>
-#include <abcube/scene.hpp>
+#include <abcube/render_options.hpp>
+#include <abcube/scene_limits.hpp>
 
 namespace abcube {
 

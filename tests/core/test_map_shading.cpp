@@ -108,15 +108,13 @@ TEST(MapShading, SparseShadesTheQuartersOnlyWhereNeighboursDiffer) {
   const auto render = [&](bool one, bool sparse, MapShadingStats* stats) {
     MapShadingOptions o;
     o.search.known_blockers = false;
-    o.one_point = one;
-    o.quarters_at_edges = sparse;
-    o.shadow_edges = o.secondary_edges = false;
+    o.plan = ShadingPlan(one ? (sparse ? ShadingPoints::sparse : ShadingPoints::one) : ShadingPoints::quarters, false,
+                         false);
     return maps.render(o, 2, stats);
   };
   MapShadingStats one_stats, sparse_stats, quarters_stats;
   const Image one = render(true, false, &one_stats), sparse = render(true, true, &sparse_stats),
               quarters = render(false, false, &quarters_stats);
-  EXPECT_EQ(shading_points_name(MapShadingOptions{}), std::string("quarters"));
   const size_t pixels = static_cast<size_t>(s.camera.width) * static_cast<size_t>(s.camera.height);
   size_t as_one = 0, as_quarters = 0;
   for (size_t p = 0; p < pixels; ++p) {
