@@ -6,7 +6,8 @@ rule no test pins.
     /usr/bin/python3 tools/mutate.py [--build DIR] [--only NAME,...] [--out FILE.md] [--list]
 
 Each change replaces one exact text, found exactly once in its file (else the check stops:
-the list is stale). The file is restored after each change, and on any exit. The build
+the list is stale). The file is restored after each change, and on any exit but SIGKILL
+(a run then refuses to start until the file is git's again). The build
 folder (default build-mutate, configured on first use) is the project's, built with the
 change; the tests run by label, fastest first (core, api, gl, hard, cli), and stop at the
 first failure: a change is KILLED by that test. About 3 to 10 minutes a change on 2 cores,
@@ -18,6 +19,7 @@ apart, and the check reports them as "equivalent" when they survive, "killed" ot
 import argparse
 import os
 import re
+import signal
 import subprocess
 import sys
 import time
@@ -119,6 +121,15 @@ def main():
     ap.add_argument("--list", action="store_true")
     a = ap.parse_args()
     chosen = [m for m in MUTATIONS if not a.only or m[0] in a.only.split(",")]
+    # A run killed mid-change (SIGKILL, a power cut) leaves its change in the file: refuse to
+    # start on a file that differs from git's, so that no later run measures a mutated tree.
+    changed = run(["git", "diff", "--name-only", "--", *sorted({m[1] for m in chosen})]).stdout.split()
+    if changed:
+        sys.exit(f"mutate: {', '.join(changed)} differ from git (a change of a killed run?): "
+                 "git checkout -- FILE, then run again")
+    # SIGTERM and SIGHUP end the run through the `finally` below, which restores the file.
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, lambda number, frame: sys.exit(f"mutate: stopped by signal {number}"))
     for name, path, old, new, _, _ in chosen:  # the list must match the sources
         text = (ROOT / path).read_text()
         if text.count(old) != 1:
