@@ -281,3 +281,38 @@ def test_shaders_take_shared_constants_from_the_prelude():
     stated = [f"{p.name}: {m.group(0).strip()}" for p in sorted((SRC / "shaders").iterdir())
               for m in own.finditer(p.read_text())]
     assert not stated, stated
+
+
+# A design page explains what its header cannot (reasons, examples, measurements) and links
+# to it for the rest: a run of this many words copied from a source comment is a paragraph
+# kept in two places, which drift apart.
+MAX_SHARED_WORDS = 20
+
+
+def comment_words(path):
+    words = []
+    for line in path.read_text().splitlines():
+        s = line.strip()
+        if s.startswith("//"):
+            words += s[2:].replace("`", "").split()
+    return words
+
+
+def test_design_pages_link_their_sources_not_copy_them():
+    from difflib import SequenceMatcher
+    by_name = {}
+    for p in tracked_files():
+        if p.suffix in (".hpp", ".cpp", ".frag", ".vert", ".glsl"):
+            by_name.setdefault(p.name, []).append(p)
+    copied = []
+    for page in sorted((SRC / "docs/design").glob("*.md")):
+        text = page.read_text()
+        named = set(re.findall(r"`(?:[\w]+/)*([\w]+\.(?:hpp|cpp|frag|vert|glsl))`", text))
+        named |= {Path(link).name for link in re.findall(r"\]\(((?:\.\./)+[\w/]+\.(?:hpp|cpp|frag|vert|glsl))\)", text)}
+        body = re.sub(r"[`*|]", "", text).split()
+        for source in sorted(p for name in named for p in by_name.get(name, [])):
+            match = SequenceMatcher(None, comment_words(source), body, autojunk=False)
+            longest = max((b.size for b in match.get_matching_blocks()), default=0)
+            if longest >= MAX_SHARED_WORDS:
+                copied.append(f"{page.name} <- {source.relative_to(SRC)}: {longest} words")
+    assert not copied, copied
