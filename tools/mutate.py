@@ -82,8 +82,20 @@ MUTATIONS = [
 LABELS = ["core", "api", "gl", "hard", "cli"]
 
 
-def run(cmd, **kw):
-    return subprocess.run(cmd, cwd=ROOT, text=True, capture_output=True, **kw)
+def run(cmd):
+    """The command's result. It runs in a process group of its own, which is killed whole if
+    this script is stopped meanwhile: a ninja left running under a stopped cmake could
+    compile a mutated file after the file was restored, and leave that object looking newer
+    than its source."""
+    proc = subprocess.Popen(cmd, cwd=ROOT, text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            start_new_session=True)
+    try:
+        out, err = proc.communicate()
+    except BaseException:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+        raise
+    return subprocess.CompletedProcess(cmd, proc.returncode, out, err)
 
 
 def configure(build):

@@ -87,14 +87,15 @@ class MapRender {
         only_(only),
         pixels_(static_cast<size_t>(camera.width()) * static_cast<size_t>(camera.height())) {
     if (fallback_) pixel_searches_.assign(pixels_, {0, 0});
-    edges_ = shader.shadow_edges() && !shader.one_point() &&
+    // The plan holds shadow edges only with the quarters (shading_plan.hpp).
+    edges_ = shader.shadow_edges() &&
              std::any_of(scene.lights.begin(), scene.lights.end(), [](const PointLight& l) { return l.cast_shadows; });
     if (edges_) {
       seen_.lit.assign(pixels_, 0);
       seen_.dark.assign(pixels_, 0);
       seen_.sides.assign(pixels_, 0);
     }
-    sparse_ = shader.one_point() && shader.quarters_at_edges();
+    sparse_ = shader.quarters_at_edges();  // one point first, then the quarters where neighbours differ
     trails_on_ = shader.secondary_edges() && !shader.one_point() && scene.render.max_depth > 0 &&
                  std::any_of(scene.materials.begin(), scene.materials.end(),
                              [](const Material& m) { return m.reflect > 0.0 || m.transmit > 0.0; });

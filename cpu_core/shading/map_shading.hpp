@@ -98,7 +98,8 @@ constexpr double QUARTER_SPLIT_SRGB = 1.0 / 255.0;
 // channel: an edge of a shadow, of a silhouette, of what a mirror or glass shows) are shaded
 // again, their fragments at the adaptive quarters. Elsewhere the pixel is smooth, and one
 // point stands for it as well as the quarters would (docs/performance.md measures how
-// close). There is no SHADOW EDGES or SECONDARY EDGES pass.
+// close). There is no SHADOW EDGES or SECONDARY EDGES pass; inside the pixels shaded again,
+// SECONDARY EDGES refine mirror and glass fragments as with the quarters (shading_plan.hpp).
 constexpr double SPARSE_SPLIT_SRGB = 16.0 / 255.0;
 //
 // SHADOW EDGES (shadow_edges.hpp). A shadow's edge through a fragment would still be

@@ -41,12 +41,6 @@ constexpr int MAX_CAMERA_LAYERS = 16;
 // its masks.
 enum class CameraSamples { pixel_centre, mask_4x8 };
 
-// Base-colour textures on the GPU: the scene's images (scene/texture.hpp, linear RGB) are
-// uploaded once per GlScene as RGB32F 2D arrays with GL's mipmaps, one array per distinct
-// image size, at most MAX_TEXTURE_ARRAYS sizes (glsl_shared.hpp; more is a RuntimeFailure
-// naming the limit). The uvs go in a vertex buffer of their
-// own, made only when the scene has them.
-
 // What the camera pass renders exactly where the GPU can (gl_camera_exact.cpp;
 // docs/design/gl-camera-exact.md): planar mirrors by virtual objects and the stencil test
 // (course notes 4.1.2; Kilgard 1999), recursively to max_depth; hard shadows of opaque

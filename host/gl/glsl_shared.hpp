@@ -10,11 +10,13 @@
 
 namespace abcube {
 
-// Translucent shadow casters peeled per light, at most (shadow_caster.frag, common_scene.glsl).
-// Crossings beyond the last layer let the light through.
+// Translucent shadow casters peeled per light, at most (gl_shadow_maps.cpp; common_scene.glsl
+// samples them). Crossings beyond the last layer let the light through.
 constexpr int MAX_SHADOW_PEELS = 8;
-// Base-colour texture arrays, one per distinct image size, at most (common_scene.glsl; more
-// is a RuntimeFailure naming the limit).
+// Base-colour textures on the GPU: the scene's images (scene/texture.hpp, linear RGB) are
+// uploaded once per GlScene as RGB32F 2D arrays with GL's mipmaps, one array per distinct
+// image size, at most this many (common_scene.glsl; more is a RuntimeFailure naming the
+// limit). The uvs go in a vertex buffer of their own, made only when the scene has them.
 constexpr int MAX_TEXTURE_ARRAYS = 4;
 
 // Storage buffer bindings: the materials and lights (common_scene.glsl); the recursed

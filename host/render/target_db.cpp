@@ -120,8 +120,6 @@ struct Pilot {
   }
 };
 
-// A pilot: the sampled pixels rendered by `shader`, their error against the tracer's, and a
-// line of the stats' "pilots" (its time counted from `t0`, its cube map's build included).
 // A stats line with the shading plan's choices. The target never changes the texture
 // lookups; method_options has them.
 json with_plan(json line, const ShadingPlan& plan) {
@@ -131,6 +129,8 @@ json with_plan(json line, const ShadingPlan& plan) {
   return line;
 }
 
+// A pilot: the sampled pixels rendered by `shader`, their error against the tracer's, and a
+// line of the stats' "pilots" (its time counted from `t0`, its cube map's build included).
 Pilot run_pilot(MethodContext& mc, const ABuffer& camera, const MapShader& shader, const PilotSample& sample, int n,
                 Clock::time_point t0, json* pilots) {
   MapShadingStats ms;
@@ -373,7 +373,7 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
   // reaches most targets on open scenes, and its pilot costs a fraction of the quarters'.
   const ShadingPlan one = plain.with_points(ShadingPoints::one);
   const int first_n = target_ladder(mc.scene.render.cube_resolution).front();
-  const bool one_first = plain != one;
+  const bool one_first = !plain.one_point();  // asked for one or sparse: no pilot before it
   if (one_first && p.pilot(first_n, options_with(one)).error.psnr_low >= p.target) {
     p.reached = true;
     p.why = "one shading point a fragment reaches the target at the ladder's smallest N";

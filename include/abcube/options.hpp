@@ -3,6 +3,9 @@
 // methods that use each are all read from it, so that every door takes the same options
 // with the same checks and the same messages.
 //
+//   #include <abcube/options.hpp>
+//   #include <abcube/renderer.hpp>  // Scene, Renderer, refuse_unused_options
+//
 //   abcube::RenderSetup setup;
 //   abcube::set_render_option(setup, "cube_res", "256");            // JSON text
 //   abcube::set_render_option_text(setup, "--camera-position", "0,1,2");  // as typed

@@ -3,9 +3,11 @@
 // (sorted), and prints how many ran. The ctest tests fuzz.replay.* run it on the seeds
 // and on every input that once crashed (tests/fuzz/regressions/), so that a fixed crash
 // stays fixed. A failed check aborts (fuzz_checks.hpp); no input at all is an error too.
-// Like libFuzzer, which reports any one allocation over 2 GiB, the replay runs in an
-// address space of REPLAY_ADDRESS_SPACE, so that an input that once made a loader allocate
-// what its header claims fails here too (std::bad_alloc is not an InputError). Not under a
+// Like libFuzzer, which reports any one allocation over 2 GiB, the replay runs in a bounded
+// address space, so that an input that once made a loader allocate what its header claims
+// fails here too (std::bad_alloc is not an InputError): REPLAY_ADDRESS_SPACE, and per core
+// REPLAY_SPACE_PER_CORE for what each of the load's threads reserves (its stack, a malloc
+// arena), so that a machine with many cores does not fail for its cores. Not under a
 // sanitizer, whose shadow memory needs the address space.
 #include <algorithm>
 #include <cstdint>
@@ -15,6 +17,7 @@
 #include <iterator>
 #include <sys/resource.h>
 #include <string>
+#include <thread>
 #include <vector>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
@@ -29,12 +32,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
 namespace {
 constexpr rlim_t REPLAY_ADDRESS_SPACE = rlim_t{3} << 30;
-}
+constexpr rlim_t REPLAY_SPACE_PER_CORE = rlim_t{256} << 20;
+}  // namespace
 
 int main(int argc, char** argv) {
   namespace fs = std::filesystem;
 #ifndef ABCUBE_REPLAY_SANITIZED
-  const rlimit cap{REPLAY_ADDRESS_SPACE, REPLAY_ADDRESS_SPACE};
+  const rlim_t space = REPLAY_ADDRESS_SPACE + REPLAY_SPACE_PER_CORE * std::max(1u, std::thread::hardware_concurrency());
+  const rlimit cap{space, space};
   if (setrlimit(RLIMIT_AS, &cap) != 0) std::perror("fuzz_replay: setrlimit");
 #endif
   std::vector<fs::path> files;
