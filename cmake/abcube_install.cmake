@@ -3,13 +3,15 @@
 #   P/include/abcube/*.hpp                the public API
 #   P/lib/libabcube.a                     abcube::abcube, with the static libraries it links
 #   P/lib/libabcube_core.a, libabcube_options.a, libabcube_glad.a
+#   P/lib/libabcube_report.a              abcube::report, the comparison report (<abcube/report.hpp>)
 #   P/lib/cmake/abcube/abcubeConfig.cmake (+ version file and exported targets)
-# so that another project does find_package(abcube REQUIRED) and links abcube::abcube.
+# so that another project does find_package(abcube REQUIRED) and links abcube::abcube (and
+# abcube::report for the report).
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
 set(ABCUBE_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/abcube)
-install(TARGETS abcube_library abcube_options abcube_core abcube_glad EXPORT abcubeTargets
+install(TARGETS abcube_library abcube_report abcube_options abcube_core abcube_glad EXPORT abcubeTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/abcube DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
   FILES_MATCHING PATTERN "*.hpp")

@@ -269,9 +269,11 @@ const std::string& render_doc() {
       if (s.scope != OptionScope::job) continue;
       std::string line = "  " + s.key + ": " + s.help;
       if (!s.choices.empty()) line += " (" + join(s.choices, " | ") + ")";
+      if (s.kind == OptionKind::method) line += " (" + join(method_names(), " | ") + ")";
       if (!s.unit.empty()) line += "; " + s.unit;
       line += "; default: " + s.default_text;
-      if (!s.methods.empty()) line += "; methods: " + join(s.methods, ", ");
+      const std::vector<std::string> readers = methods_reading(s.key);
+      if (!readers.empty()) line += "; methods: " + join(readers, ", ");
       d += line + "\n";
     }
     return d + RENDER_DOC_TAIL;
@@ -322,8 +324,8 @@ py::dict report(const py::handle& scene_object, const py::handle& dir, const py:
 
 // The option table as Python data: a list of dicts, one an option.
 py::list option_table() {
-  static const char* const KINDS[] = {"choice", "integer", "number", "flag",   "path",
-                                      "text",   "vec3",    "names",  "setting"};
+  static const char* const KINDS[] = {"choice", "integer", "number", "flag",    "path",
+                                      "text",   "vec3",    "names",  "setting", "choice"};
   static const char* const SCOPES[] = {"job", "process", "scene"};
   py::list out;
   for (const OptionSpec& s : render_option_table()) {
@@ -332,11 +334,11 @@ py::list option_table() {
     d["flag"] = s.flag;
     d["kind"] = KINDS[static_cast<int>(s.kind)];
     d["scope"] = SCOPES[static_cast<int>(s.scope)];
-    d["choices"] = s.choices;
+    d["choices"] = s.kind == OptionKind::method ? method_names() : s.choices;  // a method: the registered ones
     if (s.kind == OptionKind::integer || s.kind == OptionKind::number) d["range"] = py::make_tuple(s.min, s.max);
     d["default"] = s.default_text;
     d["unit"] = s.unit;
-    d["methods"] = s.methods;
+    d["methods"] = methods_reading(s.key);
     d["help"] = s.help;
     d["aliases"] = s.aliases;
     out.append(d);

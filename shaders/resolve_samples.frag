@@ -7,7 +7,7 @@
 // -1 was shaded whole: C = color + weight * mean, and its samples are approximate where
 // its colour is, or where what they show behind it is (weight.a 1).
 uniform sampler2D u_samples;
-uniform ivec2 u_margin;  // the tile's margin (gl_passes_internal.hpp SampleTiles), not kept
+uniform ivec2 u_margin;  // the tile's margin (gl_targets.hpp SampleTiles), not kept
 uniform bool u_pixels;
 uniform sampler2D u_pixel_color, u_pixel_weight;  // per pixel of the target, margins included
 layout(location = 0) out vec4 o_pixel;

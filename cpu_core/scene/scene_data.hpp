@@ -14,13 +14,6 @@ namespace abcube {
 
 class TextureSet;  // scene/texture.hpp
 
-enum class Method { abuffer, zbuffer, envmap, raytrace, gpu, hybrid };
-const char* method_name(Method m);
-// Parses a method name; returns false for an unknown one.
-bool parse_method(const std::string& s, Method* out);
-// Every method's name, in the enum's order: the one list that messages and help print.
-const std::vector<std::string>& method_names();
-
 struct Camera {
   glm::dvec3 position{0, 1, -4};
   glm::dvec3 look_at{0, 0.5, 0};
@@ -104,7 +97,9 @@ struct EmbeddedImage {
 };
 
 struct RenderSettings {
-  Method method = Method::abuffer;
+  // A render method's name. The core knows none: the host's registry of methods holds them,
+  // and the loader checks the name against LoadLimits::methods.
+  std::string method = "abuffer";
   int cube_resolution = 512;
   int max_depth = 4;
   bool fresnel = false;     // Schlick weights for kr/kt (shading.hpp secondary_weights); off = thesis

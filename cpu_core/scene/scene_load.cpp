@@ -320,7 +320,8 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
   if (const Json* render = top.find("render")) {
     scene.render = read_render(
         Fields(src, *render, "render",
-               {"method", "cube_resolution", "max_depth", "fresnel", "error_target", "target_db", "samples"}));
+               {"method", "cube_resolution", "max_depth", "fresnel", "error_target", "target_db", "samples"}),
+        st.limits.methods);
   }
   load_textures(st);
   check_radiance(scene, scene.render.max_depth, src.name + ": ");  // THE RADIANCE BOUND

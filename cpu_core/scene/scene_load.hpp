@@ -32,6 +32,8 @@ struct LoadLimits {
   uint64_t max_mesh_bytes = MAX_MESH_BYTES;
   // Threads the load may use, 0: every core (the result is the same for any number).
   int threads = 0;
+  // The names render.method may take: the host's registered methods. Empty: any name.
+  std::vector<std::string> methods;
   static constexpr uint64_t MAX_SCENE_BYTES = uint64_t{64} << 20;  // 64 MiB
   static constexpr uint64_t MAX_MESH_BYTES = uint64_t{8} << 30;    // 8 GiB
 };
@@ -66,11 +68,12 @@ uint64_t memory_budget_bytes(uint64_t max_memory_bytes);
 std::string budget_words(uint64_t budget_bytes, bool capped);
 
 // Bytes a render of this scene needs at its camera size and cube resolution (images and
-// their per-pixel indices, cube faces, triangles, the gpu method's GL copies and shadow
-// maps) beside its A-buffers' fragments, which are counted when they are built (the
-// A-buffer gets what is left of the budget). Throws InputError naming the sizes when it
-// exceeds `budget_bytes`; `capped` says whether that is --max-memory.
-uint64_t estimate_render_bytes(const SceneData& scene);
-void check_render_size(const SceneData& scene, uint64_t budget_bytes, bool capped);
+// their per-pixel indices, cube faces, triangles and, for a method that draws with GL
+// (`gl`), the GL copies, shadow volumes and shadow maps) beside its A-buffers' fragments,
+// which are counted when they are built (the A-buffer gets what is left of the budget).
+// check_render_size throws InputError naming the sizes when it exceeds `budget_bytes`;
+// `capped` says whether that is --max-memory.
+uint64_t estimate_render_bytes(const SceneData& scene, bool gl);
+void check_render_size(const SceneData& scene, bool gl, uint64_t budget_bytes, bool capped);
 
 }  // namespace abcube

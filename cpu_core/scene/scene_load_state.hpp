@@ -51,7 +51,8 @@ CameraSection read_camera(const Fields& f);
 PointLight read_light(const Fields& f);
 // Phong material with the format's defaults (docs/scene-format.md "materials").
 Material read_material(const Fields& f, const std::string& name);
-RenderSettings read_render(const Fields& f);
+// `methods`: the names render.method may take (empty: any name but "").
+RenderSettings read_render(const Fields& f, const std::vector<std::string>& methods);
 Transform read_transform(const Fields& f);
 
 // ---- The objects ----

@@ -90,12 +90,15 @@ Material read_material(const Fields& f, const std::string& name) {
   return m;
 }
 
-RenderSettings read_render(const Fields& f) {
+RenderSettings read_render(const Fields& f, const std::vector<std::string>& methods) {
   RenderSettings r;
   if (const Json* v = f.find("method")) {
-    const std::string name = read_string(f.src(), *v, f.at("method"));
-    if (!parse_method(name, &r.method)) {
-      fail(f.src(), f.at("method"), "must be one of " + join(method_names(), ", ") + ", got " + describe(*v));
+    r.method = read_string(f.src(), *v, f.at("method"));
+    const bool known = methods.empty() ? !r.method.empty() : std::count(methods.begin(), methods.end(), r.method) > 0;
+    if (!known) {
+      fail(f.src(), f.at("method"),
+           (methods.empty() ? std::string("must be a method's name") : "must be one of " + join(methods, ", ")) +
+               ", got " + describe(*v));
     }
   }
   r.cube_resolution = f.integer("cube_resolution", r.cube_resolution, 1, MAX_CUBE_RESOLUTION);

@@ -46,10 +46,9 @@ std::string budget_words(uint64_t budget_bytes, bool capped) {
                 : "above the " + std::to_string(budget_bytes / MIB) + " MiB of memory available";
 }
 
-uint64_t estimate_render_bytes(const SceneData& scene) {
+uint64_t estimate_render_bytes(const SceneData& scene, bool gpu) {
   const uint64_t pixels = static_cast<uint64_t>(scene.camera.width) * static_cast<uint64_t>(scene.camera.height);
   const uint64_t n = static_cast<uint64_t>(scene.render.cube_resolution);
-  const bool gpu = scene.render.method == Method::gpu || scene.render.method == Method::hybrid;
   uint64_t shadow_lights = 0;
   for (const PointLight& l : scene.lights) shadow_lights += l.cast_shadows ? 1 : 0;
   const uint64_t volume_lights = std::min(shadow_lights, uint64_t{MAX_VOLUME_LIGHTS});
@@ -63,8 +62,8 @@ uint64_t estimate_render_bytes(const SceneData& scene) {
          (gpu ? shadow_lights * n * n * GL_SHADOW_TEXEL_BYTES + pairing : 0);
 }
 
-void check_render_size(const SceneData& scene, uint64_t budget_bytes, bool capped) {
-  const uint64_t need = estimate_render_bytes(scene);
+void check_render_size(const SceneData& scene, bool gl, uint64_t budget_bytes, bool capped) {
+  const uint64_t need = estimate_render_bytes(scene, gl);
   if (need <= budget_bytes) return;
   throw InputError(one_line(scene.file + ": render: estimated " + mib(need) + " MiB for " +
                             std::to_string(scene.camera.width) + "x" + std::to_string(scene.camera.height) + ", cube " +

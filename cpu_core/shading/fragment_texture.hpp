@@ -9,8 +9,10 @@
 
 #include <glm/glm.hpp>
 
+#include "raster/abuffer.hpp"
 #include "raster/raster.hpp"
 #include "scene/scene_data.hpp"
+#include "shading/resolve.hpp"
 
 namespace abcube {
 
@@ -19,5 +21,11 @@ namespace abcube {
 // texture or `mask` is empty.
 bool mean_diffuse_color(const SceneData& scene, const RasterView& view, uint32_t triangle, int x, int y,
                         CoverageMask mask, glm::dvec3* od);
+
+// Local Phong of a camera A-buffer fragment at the point it stands for (shading.hpp), no
+// search: a textured one's base colour looked up there, or averaged over its covered
+// samples (`texture_samples`, as above). The map methods' shader where nothing is searched,
+// and the CPU side of the GPU cross-check.
+PixelShader local_phong_shader(const SceneData& scene, const ABuffer& buffer, bool texture_samples);
 
 }  // namespace abcube

@@ -100,14 +100,14 @@ MapShader::MapShader(const MapShader& base, const MapShadingOptions& options, co
       ctx_(base.ctx_),
       lenses_(base.lenses_),
       lens_of_object_(base.lens_of_object_) {
-  ABCUBE_CHECK(options.method == base.options_.method && options.refraction == base.options_.refraction,
-               "a shader over another's map keeps its method and refraction");
+  ABCUBE_CHECK(options.variant == base.options_.variant && options.refraction == base.options_.refraction,
+               "a shader over another's map keeps its variant and refraction");
   set_method_state();
 }
 
 void MapShader::set_method_state() {
-  options_.search.layers = options_.method == Method::zbuffer ? SearchLayers::nearest : SearchLayers::all;
-  if (options_.method == Method::envmap) {
+  options_.search.layers = options_.variant == MapVariant::zbuffer ? SearchLayers::nearest : SearchLayers::all;
+  if (options_.variant == MapVariant::envmap) {
     env_colour_ = CubeImage(cube_.n, 3);
     texel_state_ =
         std::make_unique<std::atomic<uint8_t>[]>(6 * static_cast<size_t>(cube_.n) * static_cast<size_t>(cube_.n));
@@ -271,7 +271,7 @@ glm::dvec3 MapShader::reflected(const SurfacePoint& sp, const glm::dvec3& dir, i
                                 const MediumStack& stack, MapShadingStats* stats, KnownBlockers* known,
                                 uint64_t* trail) const {
   const glm::dvec3 r = glm::normalize(reflect_dir(dir, sp.shading_normal));
-  if (options_.method == Method::envmap) {
+  if (options_.variant == MapVariant::envmap) {
     if (stats) ++stats->envmap_lookups;
     const glm::dvec3 lookup = envmap_direction(sp.point, r);
     if (primary && reference_ && stats) measure(sp, r, nullptr, &lookup, stats);
@@ -294,7 +294,7 @@ glm::dvec3 MapShader::transmitted(const Crossed& c, const glm::dvec3& dir, int d
                                   KnownBlockers* known, uint64_t* trail) const {
   const SurfacePoint& sp = c.sp;
   const Transmission tr = transmission_between(dir, sp.geometric_normal, sp.shading_normal, c.itf.n_from, c.itf.n_to);
-  if (options_.method == Method::envmap) {
+  if (options_.variant == MapVariant::envmap) {
     if (stats) ++stats->envmap_lookups;
     return envmap_at(envmap_direction(sp.point, glm::normalize(tr.dir)));
   }

@@ -35,9 +35,14 @@ enum class EnvmapLookup { reflected, bisector, position };  // R, [[R + [[W]]]],
 const char* envmap_lookup_name(EnvmapLookup l);
 bool parse_envmap_lookup(const std::string& s, EnvmapLookup* out);  // "R" | "bisector" | "position"
 
+// What a map search returns (thesis 7.2, 7.3, 5.6): the abuffer method's searches through
+// every layer of the lists, the zbuffer method's through the nearest layer only, or the
+// envmap method's lookups in the map's colours with no search.
+enum class MapVariant { abuffer, zbuffer, envmap };
+
 struct MapShadingOptions {
-  Method method = Method::abuffer;  // abuffer, zbuffer or envmap
-  SearchOptions search;             // layers are set from the method
+  MapVariant variant = MapVariant::abuffer;
+  SearchOptions search;  // layers are set from the variant
   RefractionMode refraction = RefractionMode::search;
   EnvmapLookup lookup = EnvmapLookup::reflected;
   int threads = 0;

@@ -19,10 +19,12 @@ namespace {
 std::string help_line(const OptionSpec& s) {
   std::string h = s.help;
   if (s.kind == OptionKind::choice || s.kind == OptionKind::names) h += ": " + join(s.choices, " | ");
+  if (s.kind == OptionKind::method) h += ": " + join(method_names(), " | ");
   std::string notes;
   if (!s.unit.empty()) notes += s.unit;
   if (!s.default_text.empty()) notes += std::string(notes.empty() ? "" : "; ") + "default: " + s.default_text;
-  if (!s.methods.empty()) notes += std::string(notes.empty() ? "" : "; ") + "methods: " + join(s.methods, ", ");
+  const std::vector<std::string> readers = methods_reading(s.key);
+  if (!readers.empty()) notes += std::string(notes.empty() ? "" : "; ") + "methods: " + join(readers, ", ");
   return notes.empty() ? h : h + " (" + notes + ")";
 }
 

@@ -40,7 +40,7 @@ struct CrosscheckCommand {
     const Scene loaded = Scene::load(scene_path, setup.limits, setup.set);
     SceneData scene = scene_view(loaded.data(), setup.render);  // shares the triangles
     if (cube_res > 0) scene.render.cube_resolution = cube_res;
-    check_render_size(scene, memory_budget_bytes(0), false);
+    check_render_size(scene, true, memory_budget_bytes(0), false);
 
     std::string log;
     auto ctx = open_gl_context(choice, device, &log);

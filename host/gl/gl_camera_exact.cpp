@@ -11,7 +11,7 @@
 #include "base/parallel.hpp"
 #include "base/samples.hpp"
 #include "base/timer.hpp"
-#include "gl/gl_passes_internal.hpp"
+#include "gl/gl_targets.hpp"
 #include "gl/gl_scene_parts.hpp"
 #include "gl/gl_shading_groups.hpp"
 

@@ -15,7 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "gl/gl_passes.hpp"
+#include "gl/gl_types.hpp"
+#include "io/image.hpp"
 #include "gl/gl_planar_mirrors.hpp"
 #include "gl/gl_program.hpp"
 

@@ -4,7 +4,7 @@
 
 #include "base/error.hpp"
 #include "base/parallel.hpp"
-#include "gl/gl_passes_internal.hpp"
+#include "gl/gl_targets.hpp"
 #include "raster/cube_map.hpp"
 
 namespace abcube {

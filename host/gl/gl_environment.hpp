@@ -6,7 +6,8 @@
 
 #include <functional>
 
-#include "gl/gl_passes.hpp"
+#include "gl/gl_types.hpp"
+#include "shading/map_shading.hpp"
 #include "gl/gl_program.hpp"
 
 namespace abcube {

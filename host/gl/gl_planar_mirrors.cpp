@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "gl/gl_passes_internal.hpp"
+#include "gl/gl_targets.hpp"
 #include "gl/gl_scene_buffers.hpp"
 
 namespace abcube {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "base/error.hpp"
-#include "gl/gl_passes_internal.hpp"
+#include "gl/gl_targets.hpp"
 #include "scene/texture.hpp"
 #include "scene/tie_rule.hpp"
 

@@ -8,7 +8,7 @@
 
 #include <glm/glm.hpp>
 
-#include "gl/gl_passes.hpp"
+#include "gl/gl_types.hpp"
 #include "gl/gl_program.hpp"
 #include "scene/scene_data.hpp"
 
@@ -44,7 +44,7 @@ class GlSceneBuffers {
   // none).
   void upload_lights(const glm::dvec3& center, const std::vector<int>& shadow_layer, const std::vector<int>& volume_bit,
                      const std::vector<int>& translucent_bit) const;
-  // The base-colour texture arrays on their units (gl_passes_internal.hpp TEXTURE_UNIT), and
+  // The base-colour texture arrays on their units (gl_targets.hpp TEXTURE_UNIT), and
   // whether they are sampled at level 0 alone.
   void bind_textures(const GlProgram& program, bool level0) const;
 

@@ -6,8 +6,7 @@
 #include <memory>
 
 #include "gl/gl_environment.hpp"
-#include "gl/gl_passes.hpp"
-#include "gl/gl_passes_internal.hpp"
+#include "gl/gl_targets.hpp"
 #include "gl/gl_program.hpp"
 #include "gl/gl_scene_buffers.hpp"
 #include "gl/gl_shadow_maps.hpp"

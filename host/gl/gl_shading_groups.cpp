@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "base/samples.hpp"
-#include "gl/gl_passes_internal.hpp"
+#include "gl/gl_targets.hpp"
 #include "gl/gl_scene_buffers.hpp"
 
 namespace abcube {

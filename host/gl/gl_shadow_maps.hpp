@@ -8,7 +8,7 @@
 #include <memory>
 #include <vector>
 
-#include "gl/gl_passes.hpp"
+#include "gl/gl_types.hpp"
 #include "gl/gl_program.hpp"
 
 namespace abcube {
@@ -26,7 +26,7 @@ class GlShadowMaps {
   // One map per light with cast_shadows, n x n a face, rendered through `lookup`. Returns
   // how many lights. Maps of the same size built before are kept (the lights do not change).
   int build(int n, LookupTarget& lookup, GpuTimings& timings);
-  // The maps and their peels on their units (gl_passes_internal.hpp), and their uniforms on
+  // The maps and their peels on their units (gl_targets.hpp), and their uniforms on
   // `program`, made current; without maps, u_shadows false.
   void bind(const GlProgram& program) const;
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "base/timer.hpp"
-#include "gl/gl_passes_internal.hpp"
+#include "gl/gl_targets.hpp"
 #include "gl/gl_scene_buffers.hpp"
 #include "material/shading.hpp"
 #include "scene/gpu_limits.hpp"

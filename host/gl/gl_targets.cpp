@@ -1,8 +1,8 @@
 // The framebuffers the GL passes render into: the camera and cube-face target, and the
-// lookup target of the cube textures (gl_passes_internal.hpp).
+// lookup target of the cube textures (gl_targets.hpp).
 #include <string>
 
-#include "gl/gl_passes_internal.hpp"
+#include "gl/gl_targets.hpp"
 
 namespace abcube {
 

@@ -24,22 +24,6 @@ namespace abcube {
 
 namespace {
 
-// Local Phong of a camera A-buffer fragment at the point it stands for (shading.hpp); a
-// textured one's base colour looked up there, or averaged over its covered samples
-// (`texture_samples`: fragment_texture.hpp).
-PixelShader local_phong_shader(const SceneData& scene, const ABuffer& buffer, bool texture_samples) {
-  return [&scene, &buffer, texture_samples](const Fragment& f, int x, int y) {
-    const Material& m = scene.materials[scene.triangles->material_id[f.triangle()]];
-    const glm::dvec3 p = fragment_point(buffer, *scene.triangles, f, x, y);
-    glm::dvec3 od;
-    if (!texture_samples || !mean_diffuse_color(scene, buffer.view, f.triangle(), x, y, f.mask, &od)) {
-      od = diffuse_color_at(scene, f.triangle(), p);
-    }
-    return ShadedFragment{phong_local(m, p, f.shading_normal(), scene.camera.position, scene.ambient, scene.lights, od),
-                          m.opacity};
-  };
-}
-
 // A pixel whose colour is one triangle's alone: its front fragment covers all 32 samples,
 // is opaque, no fragment behind it reaches into its depth range, and its triangle alone
 // covers them all. The last rule leaves out the fragments the A-buffer merged (thesis
@@ -411,33 +395,6 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
                 {"volumes_agreement_min", tol.volumes_agreement_min}}},
               {"pass", r.pass},
               {"failures", r.failures}};
-}
-
-Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options, nlohmann::json* stats,
-                           bool exact_priority, bool texture_samples, const std::vector<uint8_t>* only) {
-  ABufferStats s;
-  Clock::time_point t0 = Clock::now();
-  const ABuffer camera = build_camera_abuffer(scene, options, &s);
-  const double build_ms = ms_since(t0);
-  ResolveOptions ro;
-  ro.threads = options.threads;
-  ro.exact_priority = exact_priority;
-  ro.only = only;
-  t0 = Clock::now();
-  Image image =
-      resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera, texture_samples), scene.background, ro);
-  (*stats)["timings_ms"]["camera_abuffer"] = build_ms;
-  (*stats)["timings_ms"]["resolve"] = ms_since(t0);
-  (*stats)["abuffer"] = {{"fragments", s.fragments},
-                         {"raw_fragments", s.raw_fragments},
-                         {"max_list_length", s.max_list_length},
-                         {"bytes_per_fragment", s.bytes_per_fragment},
-                         {"bytes_total", s.bytes_total},
-                         {"dropped_by_cap", s.dropped_by_cap},
-                         {"triangles_degenerate", s.triangles_degenerate},
-                         {"triangles_clipped", s.triangles_clipped},
-                         {"triangles_culled", s.triangles_culled}};
-  return image;
 }
 
 Image disagreement_overlay(const Image& share, const Image& base) {

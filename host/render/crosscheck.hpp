@@ -102,14 +102,4 @@ Image disagreement_overlay(const Image& share, const Image& base);
 
 nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolerances& tol);
 
-// The camera view through the CPU A-buffer with local Phong (no searches yet).
-// Options: threads, layer cap, memory budget (abuffer.hpp).
-// `exact_priority`: the resolve's rule for intersecting fragments (resolve.hpp).
-// `texture_samples`: a textured fragment's base colour averaged over its covered samples
-// (shading/fragment_texture.hpp), else looked up at its point.
-// `only` (optional): the pixels to render (ResolveOptions::only).
-Image render_abuffer_local(const SceneData& scene, const ABufferOptions& options, nlohmann::json* stats,
-                           bool exact_priority = true, bool texture_samples = true,
-                           const std::vector<uint8_t>* only = nullptr);
-
 }  // namespace abcube

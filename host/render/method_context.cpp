@@ -6,8 +6,6 @@ namespace abcube {
 
 MapShadingOptions map_shading_options(const MethodContext& mc) {
   MapShadingOptions options = mc.request.map;
-  // hybrid: abuffer's searches
-  options.method = mc.scene.render.method == Method::hybrid ? Method::abuffer : mc.scene.render.method;
   options.walk_all_shadows = mc.request.plan_everything;
   return options;
 }

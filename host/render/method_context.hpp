@@ -4,19 +4,22 @@
 // neither calls back into the other.
 #pragma once
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "gl/gl_passes.hpp"
+#include "gl/gl_types.hpp"
 #include "raster/abuffer.hpp"
 #include "scene/scene_data.hpp"
 #include "shading/map_shading.hpp"
 #include "shading/scene_cache.hpp"
 
 namespace abcube {
+
+class GlScene;  // gl/gl_passes.hpp: the GL methods' units include it
 
 // One render's settings after validation (RenderOptions resolved against the scene).
 struct RenderRequest {
@@ -25,9 +28,22 @@ struct RenderRequest {
   std::string reference_image;  // the exact image, rendered before
   bool plan_everything = false;
   ABufferOptions abuffer;  // threads, layer cap, memory budget
-  MapShadingOptions map;   // search mode, refinement, theta_max, refraction, envmap lookup
+  // What the method read of its own options (RenderMethod::read_options):
+  MapShadingOptions map;       // the map searches: variant, mode, refinement, refraction, lookup, plan
+  ExactCameraOptions gpu;      // the GPU's exact camera pass (gl_passes.hpp)
+  bool target_pilots = false;  // --target-db picks the cube map's N and shading by pilots
   std::vector<std::string> aovs;
-  ExactCameraOptions gpu;  // the gpu method's exact camera pass (gl_passes.hpp)
+};
+
+// What a render measured that RenderStats carries, typed. The passes write it; after them
+// the Renderer writes it into the stats JSON, once ("timings_ms", each tracer's
+// "timings_ms", the "gl" object's path and renderer), and fills RenderStats from it.
+struct RenderRecord {
+  std::map<std::string, double> timings_ms;  // per pass
+  // The exact tracer's passes (bvh_build, trace) by its stats key: "raytrace", "reference".
+  std::map<std::string, std::map<std::string, double>> tracer_timings_ms;
+  std::string gl_path = "none";  // the GL path the render drew with, or "none"
+  std::string gl_renderer = "none (CPU)";
 };
 
 // What every method's passes read and write.
@@ -35,7 +51,8 @@ struct MethodContext {
   const SceneData& scene;  // with this render's camera and settings
   const SceneCache& cache;
   const RenderRequest& request;
-  nlohmann::json& stats;
+  nlohmann::json& stats;  // the figures of the passes, beside the record's
+  RenderRecord& record;
   const std::function<void(const std::string&, double)>& progress;
   GlScene* gl_scene;     // the scene on the GPU (gpu method only)
   GpuTimings gl_before;  // its timings before this render (zero when it uploaded now)
@@ -52,7 +69,7 @@ struct CubeMap {
   double build_ms = 0, setup_ms = 0;
   std::unique_ptr<MapShader> shader;
 };
-// The map methods' shading options for this render.
+// The map searches' options for this render (request.map, and --plan everything's walks).
 MapShadingOptions map_shading_options(const MethodContext& mc);
 // The cube A-buffer around the camera at `n`, within `options`' memory budget, and its
 // shader with `shading`. `reference` (optional): the tracer the searches' ray errors are

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
-#include <map>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -25,10 +24,13 @@ using nlohmann::json;
 
 // One option: what users read (spec), how a checked value is stored (apply) and read back
 // (read: null while the option keeps its default, so that "given" is read == null).
+// A per-method option also says how it goes back to its default (reset), for a render by
+// a method that does not read it.
 struct Entry {
   OptionSpec spec;
   std::function<void(RenderSetup&, const json&)> apply;
   std::function<json(const RenderSetup&)> read;
+  std::function<void(RenderOptions&)> reset;
 };
 
 std::string format_limit(double x) {
@@ -81,6 +83,14 @@ void check_value(const OptionSpec& s, const json& v) {
     case OptionKind::text:
       if (!v.is_string()) bad(s, "a string", v);
       return;
+    case OptionKind::method: {
+      // Which names exist is the registry's to say (the library checks it before a render).
+      const bool name =
+          v.is_string() && !v.get<std::string>().empty() &&
+          v.get<std::string>().find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") == std::string::npos;
+      if (!name) bad(s, "a method's name", v);
+      return;
+    }
     case OptionKind::vec3: {
       bool ok = v.is_array() && v.size() == 3;
       for (size_t i = 0; ok && i < 3; ++i) ok = v[i].is_number() && std::isfinite(v[i].get<double>());
@@ -109,17 +119,6 @@ void check_value(const OptionSpec& s, const json& v) {
   }
 }
 
-const std::vector<std::string> MAP_METHODS = {"abuffer", "zbuffer", "envmap", "hybrid"};
-const std::vector<std::string> GPU_METHODS = {"gpu", "hybrid"};
-
-std::vector<std::string> all_but_raytrace() {
-  std::vector<std::string> m;
-  for (const std::string& name : method_names()) {
-    if (name != "raytrace") m.push_back(name);
-  }
-  return m;
-}
-
 // Helpers that make the common entries.
 template <class T>
 json unless(const T& value, const T& fallback) {
@@ -130,10 +129,17 @@ json unless(const T& value, const T& fallback) {
 // group of options in the order --help lists them.
 using Apply = std::function<void(RenderSetup&, const json&)>;
 using Read = std::function<json(const RenderSetup&)>;
+using Reset = std::function<void(RenderOptions&)>;
 using Table = std::vector<Entry>;
 
-void add(Table& t, OptionSpec spec, Apply apply, Read read) {
-  t.push_back({std::move(spec), std::move(apply), std::move(read)});
+void add(Table& t, OptionSpec spec, Apply apply, Read read, Reset reset = nullptr) {
+  ABCUBE_CHECK(spec.per_method == static_cast<bool>(reset), "option " + spec.key + ": a per-method option has a reset");
+  t.push_back({std::move(spec), std::move(apply), std::move(read), std::move(reset)});
+}
+// The field `member` back to RenderOptions' default.
+template <class T>
+Reset reset(T RenderOptions::*member) {
+  return [member](RenderOptions& o) { o.*member = RenderOptions{}.*member; };
 }
 std::array<double, 3> vec3_of(const json& v) {
   return std::array<double, 3>{v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
@@ -143,37 +149,41 @@ json opt_vec3(const std::optional<std::array<double, 3>>& v) { return v ? json(*
 // clang-format off
 // What to render.
 void add_what_to_render(Table& t) {
-  add(t, {"method", "--method", OptionKind::choice, OptionScope::job, method_names(), 0, 0, "the scene's render.method", "",
-       {}, "", "the rendering method", {}},
+  add(t, {"method", "--method", OptionKind::method, OptionScope::job, {}, 0, 0, "the scene's render.method", "",
+       false, "the rendering method", {}},
       [](RenderSetup& s, const json& v) { s.render.method = v.get<std::string>(); },
       [](const RenderSetup& s) { return unless(s.render.method, std::string()); });
-  add(t, {"cube_res", "--cube-res", OptionKind::integer, OptionScope::job, {}, 1, 16384, "the scene's render.cube_resolution",
-       "texels", all_but_raytrace(), "the exact tracer builds no cube map", "cube map face edge N", {}},
+  add(t, {"cube_res", "--cube-res", OptionKind::integer, OptionScope::job, {}, 1, 16384,
+       "the scene's render.cube_resolution",
+       "texels", true, "cube map face edge N", {}},
       [](RenderSetup& s, const json& v) { s.render.cube_resolution = v.get<int>(); },
-      [](const RenderSetup& s) { return unless(s.render.cube_resolution, 0); });
+      [](const RenderSetup& s) { return unless(s.render.cube_resolution, 0); },
+      reset(&RenderOptions::cube_resolution));
   add(t, {"max_depth", "--max-depth", OptionKind::integer, OptionScope::job, {}, 0, 64, "the scene's render.max_depth",
-       "bounces", {}, "", "bounces of reflection and refraction", {}},
+       "bounces", false, "bounces of reflection and refraction", {}},
       [](RenderSetup& s, const json& v) { s.render.max_depth = v.get<int>(); },
       [](const RenderSetup& s) { return unless(s.render.max_depth, -1); });
   add(t, {"error_target", "--error-target", OptionKind::number, OptionScope::job, {}, 1e-12, 0.5,
-       "the scene's render.error_target", "", all_but_raytrace(), "it picks the cube map's N; the exact tracer has no map",
+       "the scene's render.error_target", "", true,
        "Error_Parallax target: the cube map's N from the bound 1/(2 N^2) of the thesis's error analysis", {}},
       [](RenderSetup& s, const json& v) { s.render.error_target = v.get<double>(); },
-      [](const RenderSetup& s) { return s.render.error_target < 0 ? json() : json(s.render.error_target); });
+      [](const RenderSetup& s) { return s.render.error_target < 0 ? json() : json(s.render.error_target); },
+      reset(&RenderOptions::error_target));
   add(t, {"target_db", "--target-db", OptionKind::number, OptionScope::job, {}, MIN_TARGET_DB, MAX_TARGET_DB,
-       "the scene's render.target_db", "dB", {"abuffer", "raytrace"},
-       "only abuffer and raytrace choose their cost from pilot renders",
+       "the scene's render.target_db", "dB", true,
        "PSNR to reach against the exact tracer, from pilot renders checked against exact pixels: abuffer picks the "
        "cube map's N and shading (overrides cube_resolution), raytrace its samples a pixel (overrides samples)", {}},
       [](RenderSetup& s, const json& v) { s.render.target_db = v.get<double>(); },
-      [](const RenderSetup& s) { return s.render.target_db < 0 ? json() : json(s.render.target_db); });
+      [](const RenderSetup& s) { return s.render.target_db < 0 ? json() : json(s.render.target_db); },
+      reset(&RenderOptions::target_db));
   add(t, {"samples", "--samples", OptionKind::integer, OptionScope::job, {}, 1, 32, "the scene's render.samples",
-       "samples a pixel", {"raytrace"}, "the other methods shade the 32 samples of the A-buffer's masks",
+       "samples a pixel", true,
        "the exact tracer's camera samples a pixel: 1 (the centre), 2, 4, 8, 16 (the first of the 32, evenly "
        "spread) or 32 (the reference)", {}},
       [](RenderSetup& s, const json& v) { s.render.samples = v.get<int>(); },
-      [](const RenderSetup& s) { return unless(s.render.samples, 0); });
-  add(t, {"fresnel", "--fresnel", OptionKind::flag, OptionScope::job, {}, 0, 0, "the scene's render.fresnel", "", {}, "",
+      [](const RenderSetup& s) { return unless(s.render.samples, 0); },
+      reset(&RenderOptions::samples));
+  add(t, {"fresnel", "--fresnel", OptionKind::flag, OptionScope::job, {}, 0, 0, "the scene's render.fresnel", "", false,
        "Schlick weights for reflect and transmit", {}},
       [](RenderSetup& s, const json& v) { s.render.fresnel = v.get<bool>(); },
       [](const RenderSetup& s) { return s.render.fresnel ? json(*s.render.fresnel) : json(); });
@@ -181,16 +191,16 @@ void add_what_to_render(Table& t) {
 
 // The camera: only the values given change; the rest come from the scene.
 void add_camera(Table& t) {
-  add(t, {"width", "--width", OptionKind::integer, OptionScope::job, {}, 1, 32768, "the scene's camera.width", "pixels", {},
-       "", "image width", {}},
+  add(t, {"width", "--width", OptionKind::integer, OptionScope::job, {}, 1, 32768, "the scene's camera.width",
+       "pixels", false, "image width", {}},
       [](RenderSetup& s, const json& v) { s.render.camera.width = v.get<int>(); },
       [](const RenderSetup& s) { return s.render.camera.width ? json(*s.render.camera.width) : json(); });
-  add(t, {"height", "--height", OptionKind::integer, OptionScope::job, {}, 1, 32768, "the scene's camera.height", "pixels",
-       {}, "", "image height", {}},
+  add(t, {"height", "--height", OptionKind::integer, OptionScope::job, {}, 1, 32768, "the scene's camera.height",
+       "pixels", false, "image height", {}},
       [](RenderSetup& s, const json& v) { s.render.camera.height = v.get<int>(); },
       [](const RenderSetup& s) { return s.render.camera.height ? json(*s.render.camera.height) : json(); });
   add(t, {"size", "--size", OptionKind::text, OptionScope::job, {}, 0, 0, "the scene's camera.width x camera.height",
-       "pixels", {}, "", "image size WxH, e.g. 320x240 (width and height at once)", {}},
+       "pixels", false, "image size WxH, e.g. 320x240 (width and height at once)", {}},
       [](RenderSetup& s, const json& v) {
         const std::string text = v.get<std::string>();
         int w = 0, h = 0;
@@ -204,22 +214,23 @@ void add_camera(Table& t) {
       },
       [](const RenderSetup&) { return json(); });  // read as width and height
   add(t, {"fov_y", "--fov", OptionKind::number, OptionScope::job, {}, 1e-6, 179.999999, "the scene's camera.fov_y",
-       "degrees", {}, "", "vertical field of view", {}},
+       "degrees", false, "vertical field of view", {}},
       [](RenderSetup& s, const json& v) { s.render.camera.fov_y = v.get<double>(); },
       [](const RenderSetup& s) { return s.render.camera.fov_y ? json(*s.render.camera.fov_y) : json(); });
-  add(t, {"camera_position", "--camera-position", OptionKind::vec3, OptionScope::job, {}, 0, 0, "the scene's camera.position",
-       "world units", {}, "", "where the camera is, X,Y,Z", {}},
+  add(t, {"camera_position", "--camera-position", OptionKind::vec3, OptionScope::job, {}, 0, 0,
+       "the scene's camera.position",
+       "world units", false, "where the camera is, X,Y,Z", {}},
       [](RenderSetup& s, const json& v) { s.render.camera.position = vec3_of(v); },
       [](const RenderSetup& s) { return opt_vec3(s.render.camera.position); });
-  add(t, {"look_at", "--look-at", OptionKind::vec3, OptionScope::job, {}, 0, 0, "the scene's camera.look_at", "world units",
-       {}, "", "the point the camera looks at, X,Y,Z", {}},
+  add(t, {"look_at", "--look-at", OptionKind::vec3, OptionScope::job, {}, 0, 0, "the scene's camera.look_at",
+       "world units", false, "the point the camera looks at, X,Y,Z", {}},
       [](RenderSetup& s, const json& v) { s.render.camera.look_at = vec3_of(v); },
       [](const RenderSetup& s) { return opt_vec3(s.render.camera.look_at); });
-  add(t, {"up", "--up", OptionKind::vec3, OptionScope::job, {}, 0, 0, "the scene's camera.up", "", {}, "",
+  add(t, {"up", "--up", OptionKind::vec3, OptionScope::job, {}, 0, 0, "the scene's camera.up", "", false,
        "the camera's up direction, X,Y,Z", {}},
       [](RenderSetup& s, const json& v) { s.render.camera.up = vec3_of(v); },
       [](const RenderSetup& s) { return opt_vec3(s.render.camera.up); });
-  add(t, {"set", "--set", OptionKind::setting, OptionScope::job, {}, 0, 0, "none", "", {}, "",
+  add(t, {"set", "--set", OptionKind::setting, OptionScope::job, {}, 0, 0, "none", "", false,
        "replace a value of the scene file, KEY=VALUE (VALUE as JSON, else a string): camera.fov_y=30, "
        "render.max_depth=2, lights[0].position=[1,4,2]; repeatable", {}},
       [](RenderSetup& s, const json& v) {
@@ -235,120 +246,140 @@ void add_camera(Table& t) {
 
 // Outputs and the reference.
 void add_outputs(Table& t) {
-  add(t, {"aovs", "--aovs", OptionKind::names, OptionScope::job, {"distance", "normal", "object_id", "shadowed", "fallback"}, 0, 0,
-       "none", "", {}, "", "extra outputs beside the image, comma-separated (OUT_STEM.NAME.exr)", {}},
+  add(t, {"aovs", "--aovs", OptionKind::names, OptionScope::job, {"distance", "normal", "object_id", "shadowed",
+       "fallback"}, 0, 0,
+       "none", "", false, "extra outputs beside the image, comma-separated (OUT_STEM.NAME.exr)", {}},
       [](RenderSetup& s, const json& v) { s.render.aovs = v.get<std::vector<std::string>>(); },
       [](const RenderSetup& s) { return s.render.aovs.empty() ? json() : json(s.render.aovs); });
-  add(t, {"reference", "--reference", OptionKind::flag, OptionScope::job, {}, 0, 0, "false", "", {}, "",
+  add(t, {"reference", "--reference", OptionKind::flag, OptionScope::job, {}, 0, 0, "false", "", false,
        "also trace the exact reference; error figures in the stats", {}},
       [](RenderSetup& s, const json& v) { s.render.reference = v.get<bool>(); },
       [](const RenderSetup& s) { return unless(s.render.reference, false); });
-  add(t, {"reference_image", "--reference-image", OptionKind::path, OptionScope::job, {}, 0, 0, "none", "", {}, "",
+  add(t, {"reference_image", "--reference-image", OptionKind::path, OptionScope::job, {}, 0, 0, "none", "", false,
        "the exact image rendered before (implies reference)", {}},
       [](RenderSetup& s, const json& v) { s.render.reference_image = v.get<std::string>(); },
       [](const RenderSetup& s) { return unless(s.render.reference_image, std::string()); });
-  add(t, {"plan", "--plan", OptionKind::choice, OptionScope::job, {"needed", "everything"}, 0, 0, "needed", "",
-       all_but_raytrace(), "the exact tracer skips no pass", "everything: run and time the passes the plan skips", {}},
+  add(t, {"plan", "--plan", OptionKind::choice, OptionScope::job, {"needed", "everything"}, 0, 0, "needed", "", true,
+       "everything: run and time the passes the plan skips", {}},
       [](RenderSetup& s, const json& v) { s.render.plan_everything = v.get<std::string>() == "everything"; },
-      [](const RenderSetup& s) { return s.render.plan_everything ? json("everything") : json(); });
+      [](const RenderSetup& s) { return s.render.plan_everything ? json("everything") : json(); },
+      reset(&RenderOptions::plan_everything));
 }
 
 // The map methods.
 void add_map_methods(Table& t) {
   const RenderOptions d;  // the defaults
-  const char* searches = "map searches: abuffer, zbuffer, envmap, hybrid";
-  add(t, {"search", "--search", OptionKind::choice, OptionScope::job, {"crossing", "thesis"}, 0, 0, d.search, "", MAP_METHODS,
-       searches, "map search mode", {}},
+  add(t, {"search", "--search", OptionKind::choice, OptionScope::job, {"crossing", "thesis"}, 0, 0, d.search, "",
+       true, "map search mode", {}},
       [](RenderSetup& s, const json& v) { s.render.search = v.get<std::string>(); },
-      [d](const RenderSetup& s) { return unless(s.render.search, d.search); });
-  add(t, {"refine", "--refine", OptionKind::choice, OptionScope::job, {"mesh", "plane"}, 0, 0, d.refine, "", MAP_METHODS,
-       searches, "how a crossing is refined", {}},
+      [d](const RenderSetup& s) { return unless(s.render.search, d.search); },
+      reset(&RenderOptions::search));
+  add(t, {"refine", "--refine", OptionKind::choice, OptionScope::job, {"mesh", "plane"}, 0, 0, d.refine, "", true,
+       "how a crossing is refined", {}},
       [](RenderSetup& s, const json& v) { s.render.refine = v.get<std::string>(); },
-      [d](const RenderSetup& s) { return unless(s.render.refine, d.refine); });
-  add(t, {"theta_max_deg", "--theta-max", OptionKind::number, OptionScope::job, {}, 1e-6, 90, format_limit(d.theta_max_deg),
-       "degrees", MAP_METHODS, searches, "the thesis search mode's acceptance angle", {}},
+      [d](const RenderSetup& s) { return unless(s.render.refine, d.refine); },
+      reset(&RenderOptions::refine));
+  add(t, {"theta_max_deg", "--theta-max", OptionKind::number, OptionScope::job, {}, 1e-6, 90,
+       format_limit(d.theta_max_deg),
+       "degrees", true, "the thesis search mode's acceptance angle", {}},
       [](RenderSetup& s, const json& v) { s.render.theta_max_deg = v.get<double>(); },
-      [d](const RenderSetup& s) { return unless(s.render.theta_max_deg, d.theta_max_deg); });
-  add(t, {"map_only", "--map-only", OptionKind::flag, OptionScope::job, {}, 0, 0, "false", "", MAP_METHODS, searches,
+      [d](const RenderSetup& s) { return unless(s.render.theta_max_deg, d.theta_max_deg); },
+      reset(&RenderOptions::theta_max_deg));
+  add(t, {"map_only", "--map-only", OptionKind::flag, OptionScope::job, {}, 0, 0, "false", "", true,
        "searches see only the map: no side structure for the triangles it cannot hold", {}},
       [](RenderSetup& s, const json& v) { s.render.side_structure = !v.get<bool>(); },
-      [](const RenderSetup& s) { return s.render.side_structure ? json() : json(true); });
-  add(t, {"refraction", "--refraction", OptionKind::choice, OptionScope::job, {"search", "thick_lens", "thin_lens"}, 0, 0,
-       d.refraction, "", {"abuffer", "zbuffer", "hybrid"}, "the lens replaces an exit search: abuffer, zbuffer, hybrid",
+      [](const RenderSetup& s) { return s.render.side_structure ? json() : json(true); },
+      reset(&RenderOptions::side_structure));
+  add(t, {"refraction", "--refraction", OptionKind::choice, OptionScope::job, {"search", "thick_lens", "thin_lens"},
+       0, 0,
+       d.refraction, "", true,
        "how a ray leaves a refracting object", {}},
       [](RenderSetup& s, const json& v) { s.render.refraction = v.get<std::string>(); },
-      [d](const RenderSetup& s) { return unless(s.render.refraction, d.refraction); });
+      [d](const RenderSetup& s) { return unless(s.render.refraction, d.refraction); },
+      reset(&RenderOptions::refraction));
   add(t, {"envmap_lookup", "--envmap-lookup", OptionKind::choice, OptionScope::job, {"R", "bisector", "position"}, 0, 0,
-       d.envmap_lookup, "", {"envmap", "gpu"}, "environment map lookups: envmap, gpu",
+       d.envmap_lookup, "", true,
        "the environment map's lookup direction", {}},
       [](RenderSetup& s, const json& v) { s.render.envmap_lookup = v.get<std::string>(); },
-      [d](const RenderSetup& s) { return unless(s.render.envmap_lookup, d.envmap_lookup); });
+      [d](const RenderSetup& s) { return unless(s.render.envmap_lookup, d.envmap_lookup); },
+      reset(&RenderOptions::envmap_lookup));
   add(t, {"shading_points", "--shading-points", OptionKind::choice, OptionScope::job, {"quarters", "sparse", "one"},
-       0, 0, d.shading_points, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
+       0, 0, d.shading_points, "", true,
        "shading points per camera fragment: quarters (2 to 4, more where they differ) | sparse (one, the quarters "
        "in the pixels whose colour differs from a neighbour's) | one (its centroid)",
        {}},
       [](RenderSetup& s, const json& v) { s.render.shading_points = v.get<std::string>(); },
-      [d](const RenderSetup& s) { return unless(s.render.shading_points, d.shading_points); });
+      [d](const RenderSetup& s) { return unless(s.render.shading_points, d.shading_points); },
+      reset(&RenderOptions::shading_points));
   add(t, {"shadow_edges", "--shadow-edges", OptionKind::choice, OptionScope::job, {"samples", "points"}, 0, 0,
-       d.shadow_edges, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
+       d.shadow_edges, "", true,
        "a shadow's edge inside a camera fragment: samples (searched again from each covered sample where the "
        "shading points disagree; with the quarters) | points (the shading points' answers)",
        {}},
       [](RenderSetup& s, const json& v) { s.render.shadow_edges = v.get<std::string>(); },
-      [d](const RenderSetup& s) { return unless(s.render.shadow_edges, d.shadow_edges); });
+      [d](const RenderSetup& s) { return unless(s.render.shadow_edges, d.shadow_edges); },
+      reset(&RenderOptions::shadow_edges));
   add(t, {"secondary_edges", "--secondary-edges", OptionKind::choice, OptionScope::job, {"samples", "points"}, 0, 0,
-       d.secondary_edges, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
+       d.secondary_edges, "", true,
        "what a mirror or glass fragment shows: samples (shaded again at each covered sample where its shading "
        "points disagree; with the quarters or sparse) | points (the shading points' answers)",
        {}},
       [](RenderSetup& s, const json& v) { s.render.secondary_edges = v.get<std::string>(); },
-      [d](const RenderSetup& s) { return unless(s.render.secondary_edges, d.secondary_edges); });
+      [d](const RenderSetup& s) { return unless(s.render.secondary_edges, d.secondary_edges); },
+      reset(&RenderOptions::secondary_edges));
   add(t, {"texture_lookups", "--texture-lookups", OptionKind::choice, OptionScope::job, {"samples", "points"}, 0, 0,
-       d.texture_lookups, "", MAP_METHODS, "the CPU A-buffer's shading: abuffer, zbuffer, envmap, hybrid",
+       d.texture_lookups, "", true,
        "a textured fragment's base colour: samples (averaged over the covered samples each shading point stands "
        "for) | points (looked up at the shading points)",
        {}},
       [](RenderSetup& s, const json& v) { s.render.texture_lookups = v.get<std::string>(); },
-      [d](const RenderSetup& s) { return unless(s.render.texture_lookups, d.texture_lookups); });
-  add(t, {"resolve", "--resolve", OptionKind::choice, OptionScope::job, {"exact", "thesis"}, 0, 0, d.resolve, "", MAP_METHODS,
-       "the CPU A-buffer's resolve: abuffer, zbuffer, envmap, hybrid",
+      [d](const RenderSetup& s) { return unless(s.render.texture_lookups, d.texture_lookups); },
+      reset(&RenderOptions::texture_lookups));
+  add(t, {"resolve", "--resolve", OptionKind::choice, OptionScope::job, {"exact", "thesis"}, 0, 0, d.resolve, "", true,
        "intersecting fragments: exact (per-sample priority masks) | thesis (the Vis_front estimate)", {}},
       [](RenderSetup& s, const json& v) { s.render.resolve = v.get<std::string>(); },
-      [d](const RenderSetup& s) { return unless(s.render.resolve, d.resolve); });
-  add(t, {"max_layers", "--max-layers", OptionKind::integer, OptionScope::job, {}, 0, 4294967295.0, "0 (all)", "layers",
-       MAP_METHODS, "the CPU A-buffer's lists: abuffer, zbuffer, envmap, hybrid", "A-buffer layers kept per list, 0 = all", {}},
+      [d](const RenderSetup& s) { return unless(s.render.resolve, d.resolve); },
+      reset(&RenderOptions::resolve));
+  add(t, {"max_layers", "--max-layers", OptionKind::integer, OptionScope::job, {}, 0, 4294967295.0, "0 (all)",
+       "layers", true, "A-buffer layers kept per list, 0 = all", {}},
       [](RenderSetup& s, const json& v) { s.render.max_layers = v.get<uint32_t>(); },
-      [](const RenderSetup& s) { return unless(s.render.max_layers, uint32_t{0}); });
+      [](const RenderSetup& s) { return unless(s.render.max_layers, uint32_t{0}); },
+      reset(&RenderOptions::max_layers));
 }
 
 // The camera pass of the gpu and hybrid methods.
 void add_gpu_camera(Table& t) {
   const RenderOptions d;  // the defaults
-  const char* gpu = "the GPU's camera pass: gpu, hybrid";
-  add(t, {"gpu_mirrors", "--gpu-mirrors", OptionKind::choice, OptionScope::job, {"stencil", "envmap"}, 0, 0, d.gpu_mirrors,
-       "", GPU_METHODS, gpu, "planar mirrors by the stencil test (exact) | from the cube texture", {}},
+  add(t, {"gpu_mirrors", "--gpu-mirrors", OptionKind::choice, OptionScope::job, {"stencil", "envmap"}, 0, 0,
+       d.gpu_mirrors,
+       "", true, "planar mirrors by the stencil test (exact) | from the cube texture", {}},
       [](RenderSetup& s, const json& v) { s.render.gpu_mirrors = v.get<std::string>(); },
-      [d](const RenderSetup& s) { return unless(s.render.gpu_mirrors, d.gpu_mirrors); });
-  add(t, {"gpu_shadows", "--gpu-shadows", OptionKind::choice, OptionScope::job, {"volumes", "maps"}, 0, 0, d.gpu_shadows, "",
-       GPU_METHODS, gpu, "shadow volumes (exact) | cube shadow maps", {}},
+      [d](const RenderSetup& s) { return unless(s.render.gpu_mirrors, d.gpu_mirrors); },
+      reset(&RenderOptions::gpu_mirrors));
+  add(t, {"gpu_shadows", "--gpu-shadows", OptionKind::choice, OptionScope::job, {"volumes", "maps"}, 0, 0,
+       d.gpu_shadows, "", true, "shadow volumes (exact) | cube shadow maps", {}},
       [](RenderSetup& s, const json& v) { s.render.gpu_shadows = v.get<std::string>(); },
-      [d](const RenderSetup& s) { return unless(s.render.gpu_shadows, d.gpu_shadows); });
+      [d](const RenderSetup& s) { return unless(s.render.gpu_shadows, d.gpu_shadows); },
+      reset(&RenderOptions::gpu_shadows));
   add(t, {"gpu_max_views", "--gpu-max-views", OptionKind::integer, OptionScope::job, {}, 0, 1 << 20,
-       std::to_string(d.gpu_max_views), "views", GPU_METHODS, gpu,
+       std::to_string(d.gpu_max_views), "views", true,
        "mirror views drawn per camera tile, at most (a mirror past it shows the cube texture)", {}},
       [](RenderSetup& s, const json& v) { s.render.gpu_max_views = v.get<int>(); },
-      [d](const RenderSetup& s) { return unless(s.render.gpu_max_views, d.gpu_max_views); });
-  add(t, {"gpu_shading", "--gpu-shading", OptionKind::choice, OptionScope::job, {"pixels", "samples"}, 0, 0, d.gpu_shading,
-       "", GPU_METHODS, gpu, "shade once a pixel and surface (samples grouped) | once a sample", {}},
+      [d](const RenderSetup& s) { return unless(s.render.gpu_max_views, d.gpu_max_views); },
+      reset(&RenderOptions::gpu_max_views));
+  add(t, {"gpu_shading", "--gpu-shading", OptionKind::choice, OptionScope::job, {"pixels", "samples"}, 0, 0,
+       d.gpu_shading,
+       "", true, "shade once a pixel and surface (samples grouped) | once a sample", {}},
       [](RenderSetup& s, const json& v) { s.render.gpu_shading = v.get<std::string>(); },
-      [d](const RenderSetup& s) { return unless(s.render.gpu_shading, d.gpu_shading); });
+      [d](const RenderSetup& s) { return unless(s.render.gpu_shading, d.gpu_shading); },
+      reset(&RenderOptions::gpu_shading));
 }
 
 // Resources and limits.
 void add_resources(Table& t) {
   const RendererOptions rd;
-  add(t, {"threads", "--threads", OptionKind::integer, OptionScope::job, {}, 0, 4096, "0 (every core)", "threads", {}, "",
+  add(t, {"threads", "--threads", OptionKind::integer, OptionScope::job, {}, 0, 4096, "0 (every core)", "threads",
+       false,
        "worker threads, for the render and for loading the scene, 0 = every core", {}},
       [](RenderSetup& s, const json& v) {
         s.render.threads = v.get<int>();
@@ -356,36 +387,38 @@ void add_resources(Table& t) {
         s.limits.threads = v.get<int>();
       },
       [](const RenderSetup& s) { return unless(s.render.threads, 0); });
-  add(t, {"timeout", "--timeout", OptionKind::number, OptionScope::job, {}, 0, 1e9, "0 (no limit)", "seconds", {}, "",
+  add(t, {"timeout", "--timeout", OptionKind::number, OptionScope::job, {}, 0, 1e9, "0 (no limit)", "seconds", false,
        "stop the render past this many seconds (exit 1), 0 = no limit", {}},
       [](RenderSetup& s, const json& v) { s.render.timeout_s = v.get<double>(); },
       [](const RenderSetup& s) { return unless(s.render.timeout_s, 0.0); });
-  add(t, {"max_memory", "--max-memory", OptionKind::integer, OptionScope::job, {}, 0, 1073741824.0, "0 (the memory available)",
-       "MiB", {}, "", "the whole render's memory budget (scene, A-buffers, maps, images)", {"max_memory_mib"}},
+  add(t, {"max_memory", "--max-memory", OptionKind::integer, OptionScope::job, {}, 0, 1073741824.0,
+       "0 (the memory available)",
+       "MiB", false, "the whole render's memory budget (scene, A-buffers, maps, images)", {"max_memory_mib"}},
       [](RenderSetup& s, const json& v) {
         s.render.max_memory_mib = v.get<uint64_t>();
         s.limits.max_memory_mib = v.get<uint64_t>();  // the scene's triangles are checked as they load
       },
       [](const RenderSetup& s) { return unless(s.render.max_memory_mib, uint64_t{0}); });
-  add(t, {"max_pixels", "--max-pixels", OptionKind::integer, OptionScope::job, {}, 0, 9.0e15, "0 (no cap)", "pixels", {}, "",
+  add(t, {"max_pixels", "--max-pixels", OptionKind::integer, OptionScope::job, {}, 0, 9.0e15, "0 (no cap)", "pixels",
+       false,
        "refuse a larger camera image", {}},
       [](RenderSetup& s, const json& v) { s.render.max_pixels = v.get<uint64_t>(); },
       [](const RenderSetup& s) { return unless(s.render.max_pixels, uint64_t{0}); });
   add(t, {"max_triangles", "--max-triangles", OptionKind::integer, OptionScope::scene, {}, 0, 9.0e15, "0 (no cap)",
-       "triangles", {}, "", "refuse a scene with more triangles", {}},
+       "triangles", false, "refuse a scene with more triangles", {}},
       [](RenderSetup& s, const json& v) { s.limits.max_triangles = v.get<uint64_t>(); },
       [](const RenderSetup& s) { return unless(s.limits.max_triangles, uint64_t{0}); });
-  add(t, {"root", "--root", OptionKind::path, OptionScope::scene, {}, 0, 0, "anywhere", "", {}, "",
+  add(t, {"root", "--root", OptionKind::path, OptionScope::scene, {}, 0, 0, "anywhere", "", false,
        "untrusted scenes: every file they reference must resolve inside this folder", {}},
       [](RenderSetup& s, const json& v) { s.limits.root = v.get<std::string>(); },
       [](const RenderSetup& s) { return unless(s.limits.root, std::string()); });
   add(t, {"gl", "--gl", OptionKind::choice, OptionScope::process,
-       {"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"}, 0, 0, rd.gl, "", {}, "",
+       {"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"}, 0, 0, rd.gl, "", false,
        "GL path (auto: EGL device, EGL surfaceless, OSMesa, then none)", {}},
       [](RenderSetup& s, const json& v) { s.renderer.gl = v.get<std::string>(); },
       [rd](const RenderSetup& s) { return unless(s.renderer.gl, rd.gl); });
   add(t, {"gl_device", "--gl-device", OptionKind::integer, OptionScope::process, {}, 0, 1024,
-       "ABCUBE_EGL_DEVICE, else the first GPU", "", {}, "", "EGL device index", {}},
+       "ABCUBE_EGL_DEVICE, else the first GPU", "", false, "EGL device index", {}},
       [](RenderSetup& s, const json& v) { s.renderer.gl_device = v.get<int>(); },
       [rd](const RenderSetup& s) { return unless(s.renderer.gl_device, rd.gl_device); });
 }
@@ -466,6 +499,7 @@ json value_from_text(const OptionSpec& s, const std::string& text) {
       return json{{text.substr(0, eq), parsed.is_discarded() ? json(value) : parsed}};
     }
     case OptionKind::choice:
+    case OptionKind::method:
     case OptionKind::path:
     case OptionKind::text: return text;
   }
@@ -536,57 +570,20 @@ void check_render_options(const RenderOptions& options) {
   }
 }
 
-void refuse_options_unused_by(const std::string& scene_method, const RenderOptions& options) {
-  check_render_options(options);
-  const std::string method = options.method.empty() ? scene_method : options.method;
+std::vector<std::string> given_render_options(const RenderOptions& options) {
   RenderSetup setup;
   setup.render = options;
+  std::vector<std::string> keys;
   for (const Entry& e : entries()) {
-    const std::vector<std::string>& m = e.spec.methods;
-    if (m.empty() || std::find(m.begin(), m.end(), method) != m.end()) continue;
-    if (!e.read(setup).is_null())
-      throw OptionError(e.spec.key, "not used by method " + method + " (" + e.spec.why + ")");
+    if (e.spec.scope == OptionScope::job && !e.read(setup).is_null()) keys.push_back(e.spec.key);
   }
+  return keys;
 }
 
-// clang-format off
-RenderOptions without_unused_options(const RenderOptions& options, const std::string& method) {
-  const RenderOptions d;
-  // Each option some methods do not use, set back to its default (the table's "methods").
-  static const std::map<std::string, std::function<void(RenderOptions&, const RenderOptions&)>> RESET = {
-      {"cube_res", [](RenderOptions& o, const RenderOptions& x) { o.cube_resolution = x.cube_resolution; }},
-      {"error_target", [](RenderOptions& o, const RenderOptions& x) { o.error_target = x.error_target; }},
-      {"target_db", [](RenderOptions& o, const RenderOptions& x) { o.target_db = x.target_db; }},
-      {"samples", [](RenderOptions& o, const RenderOptions& x) { o.samples = x.samples; }},
-      {"plan", [](RenderOptions& o, const RenderOptions& x) { o.plan_everything = x.plan_everything; }},
-      {"search", [](RenderOptions& o, const RenderOptions& x) { o.search = x.search; }},
-      {"refine", [](RenderOptions& o, const RenderOptions& x) { o.refine = x.refine; }},
-      {"theta_max_deg", [](RenderOptions& o, const RenderOptions& x) { o.theta_max_deg = x.theta_max_deg; }},
-      {"map_only", [](RenderOptions& o, const RenderOptions& x) { o.side_structure = x.side_structure; }},
-      {"refraction", [](RenderOptions& o, const RenderOptions& x) { o.refraction = x.refraction; }},
-      {"envmap_lookup", [](RenderOptions& o, const RenderOptions& x) { o.envmap_lookup = x.envmap_lookup; }},
-      {"resolve", [](RenderOptions& o, const RenderOptions& x) { o.resolve = x.resolve; }},
-      {"shading_points", [](RenderOptions& o, const RenderOptions& x) { o.shading_points = x.shading_points; }},
-      {"shadow_edges", [](RenderOptions& o, const RenderOptions& x) { o.shadow_edges = x.shadow_edges; }},
-      {"secondary_edges", [](RenderOptions& o, const RenderOptions& x) { o.secondary_edges = x.secondary_edges; }},
-      {"texture_lookups", [](RenderOptions& o, const RenderOptions& x) { o.texture_lookups = x.texture_lookups; }},
-      {"max_layers", [](RenderOptions& o, const RenderOptions& x) { o.max_layers = x.max_layers; }},
-      {"gpu_mirrors", [](RenderOptions& o, const RenderOptions& x) { o.gpu_mirrors = x.gpu_mirrors; }},
-      {"gpu_shadows", [](RenderOptions& o, const RenderOptions& x) { o.gpu_shadows = x.gpu_shadows; }},
-      {"gpu_max_views", [](RenderOptions& o, const RenderOptions& x) { o.gpu_max_views = x.gpu_max_views; }},
-      {"gpu_shading", [](RenderOptions& o, const RenderOptions& x) { o.gpu_shading = x.gpu_shading; }},
-  };
-  // clang-format on
-  RenderOptions out = options;
-  out.method = method;
-  for (const Entry& e : entries()) {
-    const std::vector<std::string>& m = e.spec.methods;
-    if (m.empty() || std::find(m.begin(), m.end(), method) != m.end()) continue;
-    const auto reset = RESET.find(e.spec.key);
-    ABCUBE_CHECK(reset != RESET.end(), "option " + e.spec.key + " has methods but no reset");
-    reset->second(out, d);
-  }
-  return out;
+void reset_render_option(RenderOptions& options, const std::string& key) {
+  const Entry& e = need_entry(key);
+  ABCUBE_CHECK(e.reset != nullptr, "option " + key + " is read by every method: it has no reset");
+  e.reset(options);
 }
 
 }  // namespace abcube

@@ -17,7 +17,9 @@
 #include "base/parallel.hpp"
 #include "base/timer.hpp"
 #include "gl/gl_context.hpp"
+#include "gl/gl_passes.hpp"
 #include "render/aovs.hpp"
+#include "render/method.hpp"
 #include "render/render_methods.hpp"
 #include "render/stats_json.hpp"
 #include "scene/framing.hpp"
@@ -66,24 +68,16 @@ Camera override_camera(Camera c, const CameraOverride& o) {
   return c;
 }
 
-// A name the option table has checked (check_render_options) parsed into its enum.
-template <class Enum>
-Enum parse_checked(const std::string& value, bool (*parse)(const std::string&, Enum*)) {
-  Enum e{};
-  const bool known = parse(value, &e);
-  ABCUBE_CHECK(known, "a checked option's value " + quote(value) + " has no enum value");
-  return e;
-}
-
-// The render request: the scene's settings with the options' overrides, validated.
-RenderRequest make_request(const SceneData& base, const RenderOptions& o, int renderer_threads, SceneData* view) {
+// The render request: the scene's settings with the options' overrides, validated, and
+// what the method reads of its own options.
+RenderRequest make_request(const SceneData& base, const RenderOptions& o, int renderer_threads, SceneData* view,
+                           const RenderMethod** method) {
   check_render_options(o);  // every value in range, with the option table's messages
   RenderRequest r;
   *view = base;  // shares the triangles (SharedTriangles)
   RenderSettings& rs = view->render;
-  if (!o.method.empty()) {
-    rs.method = parse_checked(o.method, parse_method);
-  }
+  if (!o.method.empty()) rs.method = o.method;
+  *method = &method_named(rs.method);
   if (o.target_db > 0) rs.target_db = o.target_db;
   // An N or samples the render asks for, or a bound that gives an N, wins over the scene's
   // target; the scene's target wins over its own samples (as over its own N).
@@ -120,45 +114,37 @@ RenderRequest make_request(const SceneData& base, const RenderOptions& o, int re
   r.reference = o.reference || !o.reference_image.empty();
   r.plan_everything = o.plan_everything;
   r.abuffer.threads = r.threads;
-  r.map.threads = r.threads;
-  r.map.search.mode = parse_checked(o.search, parse_search_mode);
-  r.map.search.refine = parse_checked(o.refine, parse_search_refine);
-  r.map.search.theta_max = glm::radians(o.theta_max_deg);
-  r.map.refraction = parse_checked(o.refraction, parse_refraction_mode);
-  r.map.lookup = parse_checked(o.envmap_lookup, parse_envmap_lookup);
-  r.map.exact_priority = o.resolve == "exact";
-  r.map.plan = ShadingPlan::from_names(o.shading_points, o.shadow_edges, o.secondary_edges, o.texture_lookups);
-  r.map.search.side_structure = o.side_structure;
-  r.gpu.planar_mirrors = o.gpu_mirrors == "stencil";
-  r.gpu.shadow_volumes = o.gpu_shadows == "volumes";
-  r.gpu.max_views = o.gpu_max_views;
-  r.gpu.shading =
-      o.gpu_shading == "pixels" ? ExactCameraOptions::Shading::pixels : ExactCameraOptions::Shading::samples;
-  r.gpu.max_depth = view->render.max_depth;
   r.abuffer.max_layers = o.max_layers;
   r.abuffer.max_memory_bytes = o.max_memory_mib << 20;  // the whole render's budget
   r.aovs = o.aovs;
+  (*method)->read_options(o, *view, &r);
   // Everything but the A-buffers' fragments, from the declared sizes, before any pass; the
   // A-buffers get what is left when they have counted their fragments.
-  check_render_size(*view, memory_budget_bytes(r.abuffer.max_memory_bytes), o.max_memory_mib > 0);
-  r.abuffer.reserved_bytes = estimate_render_bytes(*view);
+  const uint64_t budget = memory_budget_bytes(r.abuffer.max_memory_bytes);
+  r.abuffer.reserved_bytes = (*method)->render_bytes(*view);
+  if (r.abuffer.reserved_bytes > budget) {
+    check_render_size(*view, (*method)->needs_gl(), budget, o.max_memory_mib > 0);  // names the sizes
+    throw InputError(view->file + ": render: method " + view->render.method + " estimates " +
+                     std::to_string(r.abuffer.reserved_bytes >> 20) + " MiB before its A-buffers, " +
+                     budget_words(budget, o.max_memory_mib > 0));
+  }
   return r;
 }
 
 // What a render's stats say before any pass: the scene, sizes, method and its options.
-json request_stats(const SceneData& view, const RenderRequest& request) {
+json request_stats(const SceneData& view, const RenderRequest& request, const RenderOptions& o) {
   json stats;
   stats["scene"] = view.file;
-  stats["method"] = method_name(view.render.method);
+  stats["method"] = view.render.method;
   stats["counts"] = {{"triangles", view.triangles->triangle_count()},
                      {"dropped_triangles", view.dropped_triangles},
                      {"objects", view.objects.size()},
                      {"lights", view.lights.size()}};
-  if (view.render.target_db > 0 && view.render.method != Method::abuffer && view.render.method != Method::raytrace) {
+  const std::vector<std::string> targeted = methods_reading("target_db");
+  if (view.render.target_db > 0 && std::find(targeted.begin(), targeted.end(), view.render.method) == targeted.end()) {
     stats["target_db"] = {{"target", view.render.target_db},
-                          {"why", std::string("not used: only abuffer and raytrace choose their cost from a target, "
-                                              "the method is ") +
-                                      method_name(view.render.method)}};
+                          {"why", "not used: only " + join(targeted, " and ") +
+                                      " choose their cost from a target, the method is " + view.render.method}};
   }
   if (view.render.error_target > 0) {
     stats["error_target"] = {{"target", view.render.error_target},
@@ -170,31 +156,40 @@ json request_stats(const SceneData& view, const RenderRequest& request) {
                    {"cube_resolution", view.render.cube_resolution},
                    {"max_depth", view.render.max_depth}};
   stats["threads"] = thread_count(request.threads, SIZE_MAX);
-  stats["method_options"] = {{"search", search_mode_name(request.map.search.mode)},
-                             {"refine", search_refine_name(request.map.search.refine)},
-                             {"theta_max_deg", glm::degrees(request.map.search.theta_max)},
-                             {"refraction", refraction_mode_name(request.map.refraction)},
-                             {"envmap_lookup", envmap_lookup_name(request.map.lookup)},
-                             {"resolve", request.map.exact_priority ? "exact" : "thesis"},
-                             {"side_structure", request.map.search.side_structure},
+  // The options as given, whichever the method reads (the same keys for every method).
+  stats["method_options"] = {{"search", o.search},
+                             {"refine", o.refine},
+                             {"theta_max_deg", glm::degrees(glm::radians(o.theta_max_deg))},
+                             {"refraction", o.refraction},
+                             {"envmap_lookup", o.envmap_lookup},
+                             {"resolve", o.resolve},
+                             {"side_structure", o.side_structure},
                              {"fresnel", view.render.fresnel}};
-  for (const auto& [key, value] : request.map.plan.settings()) stats["method_options"][key] = value;
+  const ShadingPlan plan =
+      ShadingPlan::from_names(o.shading_points, o.shadow_edges, o.secondary_edges, o.texture_lookups);
+  for (const auto& [key, value] : plan.settings()) stats["method_options"][key] = value;
   return stats;
 }
 
-// The structure beside the JSON (renderer.hpp RenderStats).
-RenderStats render_stats(const json& stats, int built, std::optional<double> psnr, bool with_json) {
+// The record into the stats JSON, once: the passes' timings, the tracers' and the GL's path.
+void write_record(const RenderRecord& record, json* stats) {
+  (*stats)["timings_ms"] = record.timings_ms;
+  for (const auto& [tracer, timings] : record.tracer_timings_ms) (*stats)[tracer]["timings_ms"] = timings;
+  (*stats)["gl"]["path"] = record.gl_path;
+  (*stats)["gl"]["renderer"] = record.gl_renderer;
+}
+
+// RenderStats (renderer.hpp) from the record, beside the JSON.
+RenderStats render_stats(const RenderRecord& record, const json& stats, int built, std::optional<double> psnr,
+                         bool with_json) {
   RenderStats rs;
-  rs.total_ms = stats["timings_ms"]["total"].get<double>();
-  for (const auto& [k, v] : stats["timings_ms"].items()) rs.timings_ms[k] = v.get<double>();
-  for (const char* tracer : {"raytrace", "reference"}) {  // the exact tracer's passes, by name
-    if (stats.contains(tracer) && stats[tracer].contains("timings_ms")) {
-      for (const auto& [k, v] : stats[tracer]["timings_ms"].items())
-        rs.timings_ms[std::string(tracer) + "." + k] = v.get<double>();
-    }
+  rs.total_ms = record.timings_ms.at("total");
+  rs.timings_ms = record.timings_ms;
+  for (const auto& [tracer, timings] : record.tracer_timings_ms) {  // "raytrace.trace", "reference.bvh_build"
+    for (const auto& [pass, ms] : timings) rs.timings_ms[tracer + "." + pass] = ms;
   }
-  rs.gl_path = stats["gl"]["path"].get<std::string>();
-  rs.gl_renderer = stats["gl"]["renderer"].get<std::string>();
+  rs.gl_path = record.gl_path;
+  rs.gl_renderer = record.gl_renderer;
   rs.scene_data_built = built;
   rs.psnr_db = psnr;
   if (with_json) rs.json = stats.dump(2);
@@ -263,23 +258,25 @@ struct Renderer::Impl {
     return *gl_scene;
   }
 
-  // The gpu and hybrid methods: GL opened (a clear error where no path works), the scene
+  // A method that draws with GL: GL opened (a clear error where no path works), the scene
   // uploaded unless it is the last one's, then the method.
-  Image render_on_gl(const Scene& scene, MethodContext& mc) {
+  Image render_on_gl(const Scene& scene, const RenderMethod& method, MethodContext& mc) {
     const SceneData& view = mc.scene;
     json& stats = mc.stats;
     const Clock::time_point t0 = Clock::now();
     const bool first_open = !gl_tried;
     GlContext* ctx = open_gl();
-    const std::string which = std::string("--method ") + method_name(view.render.method);
+    const std::string which = "--method " + method.name();
     if (!ctx) {
       if (gl_choice == GlChoice::none) throw InputError(which + " needs OpenGL, but --gl none was given");
       std::string log = gl_log;
       for (char& c : log) c = c == '\n' ? ';' : c;
       throw RuntimeFailure(which + " needs OpenGL and no GL path works here: " + log);
     }
-    stats["gl"] = gl_json(ctx);
-    stats["timings_ms"]["gl_init"] = first_open ? ms_since(t0) : 0.0;
+    stats["gl"] = gl_json(*ctx);
+    mc.record.gl_path = ctx->info().api;
+    mc.record.gl_renderer = ctx->info().gl_renderer;
+    mc.record.timings_ms["gl_init"] = first_open ? ms_since(t0) : 0.0;
     check_gl_limits(view);  // before the upload
     bool uploaded = false;
     mc.gl_scene = &gl_scene_for(scene, &uploaded);
@@ -288,7 +285,7 @@ struct Renderer::Impl {
     // Each triangle's ids: read by the vertex stage from the soup's arrays, or carried by every vertex.
     stats["gl"]["scene_ids"] = mc.gl_scene->triangle_ids() ? "per triangle" : "per vertex";
     if (!uploaded) mc.gl_before = mc.gl_scene->timings();  // else its upload is this render's
-    return view.render.method == Method::gpu ? render_gpu(mc) : render_hybrid(mc);
+    return method.render(mc);
   }
 };
 
@@ -330,37 +327,23 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   const ScopedDeadline scope(options.timeout_s > 0 ? &deadline : nullptr);
 
   SceneData view;
-  const RenderRequest request = make_request(scene.data(), options, impl_->options.threads, &view);
+  const RenderMethod* method = nullptr;
+  const RenderRequest request = make_request(scene.data(), options, impl_->options.threads, &view, &method);
   const SceneCache::Builds before = scene.cache().builds();
-  json stats = request_stats(view, request);
+  json stats = request_stats(view, request, options);
   Image fallback;  // the map methods' "fallback" AOV, when asked
   const bool wants_fallback = std::find(request.aovs.begin(), request.aovs.end(), "fallback") != request.aovs.end();
+  RenderRecord record;
   MethodContext mc{
-      view, scene.cache(), request, stats, options.progress, nullptr, {}, wants_fallback ? &fallback : nullptr};
-  Image image;
-  switch (view.render.method) {
-    case Method::gpu:
-    case Method::hybrid: image = impl_->render_on_gl(scene, mc); break;
-    case Method::abuffer:
-    case Method::zbuffer:
-    case Method::envmap:
-      image = render_map_method(mc);
-      stats["gl"] = {{"path", "none"}, {"renderer", "none (CPU A-buffer)"}};
-      break;
-    case Method::raytrace:
-      image = render_reference(mc, "raytrace");
-      stats["plan"]["passes"] = {"raytrace"};
-      stats["plan"]["skipped"] = {{{"pass", "gl"}, {"why", "the exact tracer needs no GL"}}};
-      stats["gl"] = {{"path", "none"}, {"renderer", "none (the tracer is CPU only)"}};
-      break;
-  }
+      view, scene.cache(), request, stats, record, options.progress, nullptr, {}, wants_fallback ? &fallback : nullptr};
+  Image image = method->needs_gl() ? impl_->render_on_gl(scene, *method, mc) : method->render(mc);
   std::optional<double> psnr;
   if (request.reference) psnr = add_reference_error(mc, image);
   RenderResult result;
   if (!request.aovs.empty()) {
     const Clock::time_point t0 = Clock::now();
     result.aovs = render_aovs(mc, request.aovs);
-    stats["timings_ms"]["aovs"] = ms_since(t0);
+    record.timings_ms["aovs"] = ms_since(t0);
   }
 
   // What this render built of the per-scene data (0 when an earlier render did).
@@ -369,18 +352,20 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   stats["scene_data"] = scene_data_stats(before, after, built, scene.load_ms());
   ++impl_->renders;
   stats["renderer"] = {{"renders", impl_->renders}};
-  stats["timings_ms"]["total"] = ms_since(start);
+  record.timings_ms["total"] = ms_since(start);
   stats["memory"] = {{"peak_rss_bytes", peak_rss_bytes()}};
+  write_record(record, &stats);
 
   result.image = std::move(image);
-  result.stats = render_stats(stats, built, psnr, options.stats);
+  result.stats = render_stats(record, stats, built, psnr, options.stats);
   return result;
 }
 
 // What each method honours (docs/methods.md; renderer.hpp).
 SceneData scene_view(const SceneData& base, const RenderOptions& options) {
   SceneData view;
-  make_request(base, options, 0, &view);
+  const RenderMethod* method = nullptr;
+  make_request(base, options, 0, &view, &method);
   return view;
 }
 

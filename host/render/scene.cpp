@@ -3,10 +3,32 @@
 
 #include "base/error.hpp"
 #include "base/timer.hpp"
-#include "render/scene_state.hpp"
+#include "render/method.hpp"
 #include "scene/scene_load.hpp"
+#include "shading/scene_cache.hpp"
 
 namespace abcube {
+
+// Where a scene came from, so that it can be loaded again with values replaced
+// (Scene::with_overrides): a file, or JSON text with its name and folder.
+struct SceneSource {
+  std::string path;  // the file; empty for text
+  std::string text, name, base_dir;
+  SceneLimits limits;
+  SceneOverrides set;  // the overrides it was loaded with
+};
+
+// What an abcube::Scene shares between its copies: the loaded scene and its cache.
+struct Scene::State {
+  State(SceneData d, double ms, SceneSource s) : data(std::move(d)), cache(data), load_ms(ms), source(std::move(s)) {}
+  State(const State&) = delete;
+  State& operator=(const State&) = delete;
+
+  const SceneData data;
+  const SceneCache cache;  // refers to `data`: State never moves (held by shared_ptr)
+  const double load_ms;    // parsing, validating and tessellating the file
+  const SceneSource source;
+};
 
 namespace {
 
@@ -18,6 +40,7 @@ LoadLimits load_limits(const SceneLimits& limits) {
   l.max_memory_bytes = limits.max_memory_mib << 20;
   if (limits.threads < 0) throw InputError("threads: must be >= 0, got " + std::to_string(limits.threads));
   l.threads = limits.threads;
+  for (const RenderMethod* m : registered_methods()) l.methods.push_back(m->name());  // render.method
   return l;
 }
 
@@ -61,7 +84,7 @@ int Scene::width() const { return state_->data.camera.width; }
 int Scene::height() const { return state_->data.camera.height; }
 size_t Scene::triangle_count() const { return state_->data.triangles->triangle_count(); }
 size_t Scene::object_count() const { return state_->data.objects.size(); }
-std::string Scene::method() const { return method_name(state_->data.render.method); }
+std::string Scene::method() const { return state_->data.render.method; }
 int Scene::cube_resolution() const { return state_->data.render.cube_resolution; }
 int Scene::max_depth() const { return state_->data.render.max_depth; }
 double Scene::load_ms() const { return state_->load_ms; }

@@ -98,9 +98,12 @@ json cube_abuffer_json(const ABufferStats& s) {
           {"dropped_by_cap", s.dropped_by_cap}};
 }
 
+std::map<std::string, double> tracer_timings(const RaytraceStats& rs) {
+  return {{"bvh_build", rs.build_ms}, {"trace", rs.trace_ms}};
+}
+
 json raytrace_json(const RaytraceStats& rs) {
-  return {{"timings_ms", {{"bvh_build", rs.build_ms}, {"trace", rs.trace_ms}}},
-          {"counts",
+  return {{"counts",
            {{"primary_rays", rs.primary_rays}, {"secondary_rays", rs.secondary_rays}, {"shadow_rays", rs.shadow_rays}}},
           {"threads", rs.threads}};
 }

@@ -334,6 +334,7 @@ Image raytrace_for_target(MethodContext& mc) {
   rs.secondary_rays += pilot_stats.secondary_rays;
   rs.shadow_rays += pilot_stats.shadow_rays;
   mc.stats["raytrace"].update(raytrace_json(rs));
+  mc.record.tracer_timings_ms["raytrace"] = tracer_timings(rs);
   mc.stats["counts"]["camera_samples_per_pixel"] = samples;
   mc.stats["method_options"]["samples"] = samples;
   mc.stats["target_db"] = {
@@ -350,7 +351,7 @@ Image raytrace_for_target(MethodContext& mc) {
         {"block", block},
         {"exact_trace_ms", pilot_ms}}},
       {"rungs", lines}};
-  mc.stats["timings_ms"]["target_pilots"] = pilot_ms;
+  mc.record.timings_ms["target_pilots"] = pilot_ms;
   return image;
 }
 
@@ -400,7 +401,7 @@ CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABuf
     p.best.setup_ms = ms_since(t0);
   }
   write_stats(p, &mc.stats);
-  mc.stats["timings_ms"]["target_pilots"] = ms_since(start);
+  mc.record.timings_ms["target_pilots"] = ms_since(start);
   return std::move(p.best);
 }
 

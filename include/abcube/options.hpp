@@ -1,7 +1,8 @@
 // The render options, in one table. The command line's flags (`abcube render`, `abcube
-// batch`), the batch jobs' keys, the Python keywords, their validation, their help and the
-// methods that use each are all read from it, so that every door takes the same options
-// with the same checks and the same messages.
+// batch`), the batch jobs' keys, the Python keywords, their validation and their help are
+// all read from it, so that every door takes the same options with the same checks and the
+// same messages. Which method reads a per-method option is the method's to say: its unit
+// lists the keys it reads (<abcube/renderer.hpp> methods_reading).
 //
 //   #include <abcube/options.hpp>
 //   #include <abcube/renderer.hpp>  // Scene, Renderer, refuse_unused_options
@@ -41,6 +42,7 @@ enum class OptionKind {
   vec3,     // 3 finite numbers ("X,Y,Z" on the command line)
   names,    // a list of `choices` ("a,b" on the command line)
   setting,  // a scene value replaced: KEY=VALUE (batch and Python: an object {KEY: VALUE})
+  method,   // a render method's name (<abcube/renderer.hpp> method_names: the registered ones)
 };
 
 // Where an option can be given. Every option is a command-line flag of `abcube render`.
@@ -59,10 +61,9 @@ struct OptionSpec {
   double min = 0, max = 0;           // integer and number: the range, both ends in
   std::string default_text;          // what an option not given means
   std::string unit;                  // "texels", "degrees", "MiB", ... or ""
-  // The methods that use it (empty: every method); given with another method, the render
-  // is refused (refuse_unused_options) and `why` says what uses it instead.
-  std::vector<std::string> methods;
-  std::string why;
+  // Read only by the methods that list it (RenderMethod::reads); given with another
+  // method, the render is refused (refuse_unused_options). False: every method reads it.
+  bool per_method = false;
   std::string help;
   std::vector<std::string> aliases;  // other keys taken for it (older Python keywords)
 };
@@ -103,13 +104,11 @@ void set_render_option_text(RenderSetup& setup, const std::string& name, const s
 // guard for options set in C++): OptionError for the first bad one. Renderer::render calls it.
 void check_render_options(const RenderOptions& options);
 
-// refuse_unused_options (<abcube/renderer.hpp>) for a scene whose render.method is
-// `scene_method`: OptionError "KEY: not used by method M (what uses it)".
-void refuse_options_unused_by(const std::string& scene_method, const RenderOptions& options);
+// The keys of the job options `options` gives: those whose value is not the default.
+std::vector<std::string> given_render_options(const RenderOptions& options);
 
-// `options` for a render by `method`: the method set, and every option that method does
-// not use back at its default (one set of options for renders of several methods, as
-// `abcube report` makes them).
-RenderOptions without_unused_options(const RenderOptions& options, const std::string& method);
+// A per-method option set back to its default in `options` (InternalError for an option
+// every method reads). <abcube/renderer.hpp> without_unused_options does it for a method.
+void reset_render_option(RenderOptions& options, const std::string& key);
 
 }  // namespace abcube

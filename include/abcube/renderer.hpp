@@ -67,15 +67,29 @@ struct RenderResult {
   RenderStats stats;
 };
 
+// The registered render methods' names, built-ins first: the values of --method,
+// render.method and method=.
+std::vector<std::string> method_names();
+
+// The methods that read the option `key` (the table's key): for a per-method option those
+// whose unit lists it; empty for an option every method reads.
+std::vector<std::string> methods_reading(const std::string& key);
+
 // What each method honours (docs/methods.md): throws OptionError (an InputError) with one
 // line when `options` gives a setting that the render's method (options.method, or the
-// scene's) has no use for, e.g. refraction "thick_lens" with raytrace; the methods each
-// option serves are in the option table (<abcube/options.hpp>). `abcube render`, `abcube
-// batch` and the Python module call it before rendering; Renderer::render itself leaves
-// such settings unused, so that one RenderOptions can serve renders of several methods.
-// The scene file's own settings (render.cube_resolution, ...) are every method's defaults
-// and never refused.
+// scene's) does not read, e.g. refraction "thick_lens" with raytrace, naming the methods
+// that read it; and for a method name no method has. `abcube render`, `abcube batch` and the
+// Python module call it before rendering; Renderer::render itself leaves such settings
+// unused, so that one RenderOptions can serve renders of several methods. The scene file's
+// own settings (render.cube_resolution, ...) are every method's defaults and never refused.
 void refuse_unused_options(const Scene& scene, const RenderOptions& options);
+// The same for a scene whose render.method is `scene_method`.
+void refuse_options_unused_by(const std::string& scene_method, const RenderOptions& options);
+
+// `options` for a render by `method`: the method set, and every option that method does
+// not read back at its default (one set of options for renders of several methods, as
+// `abcube report` makes them).
+RenderOptions without_unused_options(const RenderOptions& options, const std::string& method);
 
 class Renderer {
  public:

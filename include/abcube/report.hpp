@@ -9,6 +9,8 @@
 //   DIR/images/*.png    each method's image, its heat map against the reference (with its
 //                       legend), the reference, the crosscheck's disagreement overlay
 //   DIR/stats/*.json    each render's stats (as `abcube render --stats` writes them)
+//
+// A tool over the library, in a library of its own: link abcube::report (find_package(abcube)).
 #pragma once
 #include <functional>
 #include <string>
@@ -26,7 +28,7 @@ struct ReportOptions {
   // time (empty: no sweep).
   std::vector<int> sweep;
   // Options of every render (size, camera, depth, threads, ...); each method's render takes
-  // those it uses (without_unused_options, <abcube/options.hpp>).
+  // those it uses (without_unused_options, <abcube/renderer.hpp>).
   RenderOptions render;
   RendererOptions renderer;
   // The GPU against the CPU (`abcube crosscheck`), where a GL path works.

@@ -41,11 +41,11 @@ struct Rendered {
   MapShadingStats stats;
 };
 
-Rendered render_method(const SceneData& s, Method method, const RayTracer* reference = nullptr,
+Rendered render_method(const SceneData& s, MapVariant variant, const RayTracer* reference = nullptr,
                        SearchMode mode = SearchMode::crossing, SearchRefine refine = SearchRefine::mesh) {
   const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, s.render.cube_resolution);
   MapShadingOptions o;
-  o.method = method;
+  o.variant = variant;
   o.search.mode = mode;
   o.search.refine = refine;
   const MapShader shader(s, cube, o, reference);
@@ -172,8 +172,8 @@ TEST(MapShading, HiddenPointIsFoundOnlyWithAllLayers) {
       hidden[static_cast<size_t>(y * w + x)] = seen.object_id != green;
     }
   }
-  const Image ab = render_method(s, Method::abuffer).image;
-  const Image zb = render_method(s, Method::zbuffer).image;
+  const Image ab = render_method(s, MapVariant::abuffer).image;
+  const Image zb = render_method(s, MapVariant::zbuffer).image;
   int judged = 0, ab_green = 0, zb_green = 0;
   for (int y = 1; y + 1 < h; ++y) {
     for (int x = 1; x + 1 < w; ++x) {
@@ -236,7 +236,7 @@ TEST(MapShading, ContactShadowOfABoxOnAWideFloorIsExact) {
   RaytraceOptions ro;
   ro.threads = 2;
   for (const Case& c :
-       {Case{"raytrace", render_raytrace(s, ro)}, Case{"abuffer", render_method(s, Method::abuffer).image}}) {
+       {Case{"raytrace", render_raytrace(s, ro)}, Case{"abuffer", render_method(s, MapVariant::abuffer).image}}) {
     int ring = 0, lit = 0, wrong = 0;
     for (int y = 0; y < c.image.height; ++y) {
       for (int x = 0; x < c.image.width; ++x) {
@@ -288,11 +288,11 @@ TEST_P(MethodsAgainstReference, AbufferIsClosestToTheExactImage) {
   const SceneData s = small_scene(c.scene, c.width, 256);
   const RayTracer rt(s);
   const Image ref = render_raytrace(s);
-  const Rendered ab = render_method(s, Method::abuffer, &rt);
-  const Rendered th = render_method(s, Method::abuffer, &rt, SearchMode::thesis);
-  const Rendered zb = render_method(s, Method::zbuffer, &rt);
-  const Rendered em = render_method(s, Method::envmap, &rt);
-  const Rendered pl = render_method(s, Method::abuffer, nullptr, SearchMode::crossing, SearchRefine::plane);
+  const Rendered ab = render_method(s, MapVariant::abuffer, &rt);
+  const Rendered th = render_method(s, MapVariant::abuffer, &rt, SearchMode::thesis);
+  const Rendered zb = render_method(s, MapVariant::zbuffer, &rt);
+  const Rendered em = render_method(s, MapVariant::envmap, &rt);
+  const Rendered pl = render_method(s, MapVariant::abuffer, nullptr, SearchMode::crossing, SearchRefine::plane);
   const double p_pl = image_error(pl.image, ref).psnr;
   const double p_ab = image_error(ab.image, ref).psnr, p_th = image_error(th.image, ref).psnr;
   const double p_zb = image_error(zb.image, ref).psnr, p_em = image_error(em.image, ref).psnr;

@@ -38,7 +38,7 @@ SceneData empty_scene(const dvec3& eye, const dvec3& look_at, double fov_y_deg, 
   s.camera.height = height;
   s.background = dvec3(0.0);
   s.ambient = dvec3(0.0);
-  s.render.method = Method::raytrace;
+  s.render.method = "raytrace";
   s.render.max_depth = 4;
   return s;
 }

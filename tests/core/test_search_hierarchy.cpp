@@ -369,10 +369,10 @@ TEST(SearchHierarchy, SearchesGiveThePlainWalksAnswers) {
 
 // ---- Whole renders ----------------------------------------------------------------------
 
-Image render(const SceneData& s, const CubeABuffer& cube, const ABuffer& camera, bool hierarchy, Method method,
+Image render(const SceneData& s, const CubeABuffer& cube, const ABuffer& camera, bool hierarchy, MapVariant variant,
              MapShadingStats* stats, int threads = 2) {
   MapShadingOptions o;
-  o.method = method;
+  o.variant = variant;
   o.search.hierarchy = hierarchy;
   const MapShader shader(s, cube, o, nullptr);
   return render_with_map(s, camera, shader, threads, stats);
@@ -392,10 +392,10 @@ TEST(SearchMemo, AnswersDoNotDependOnWhatTheThreadSearchedBefore) {
   const CubeABuffer there = build_cube_abuffer(s, s.camera.position + glm::dvec3(0.5, -0.3, 0.2), 96);
   MapShadingStats stats;
   Image fresh;
-  std::thread([&] { fresh = render(s, here, camera, true, Method::abuffer, &stats, 1); }).join();
+  std::thread([&] { fresh = render(s, here, camera, true, MapVariant::abuffer, &stats, 1); }).join();
   EXPECT_GT(stats.searches.shadow.candidates, 0u);
-  const Image elsewhere = render(s, there, camera, true, Method::abuffer, nullptr, 1);
-  const Image after = render(s, here, camera, true, Method::abuffer, nullptr, 1);
+  const Image elsewhere = render(s, there, camera, true, MapVariant::abuffer, nullptr, 1);
+  const Image after = render(s, here, camera, true, MapVariant::abuffer, nullptr, 1);
   ASSERT_EQ(fresh.data.size(), after.data.size());
   EXPECT_NE(std::memcmp(fresh.data.data(), elsewhere.data.data(), fresh.data.size() * sizeof(float)), 0);
   EXPECT_EQ(std::memcmp(fresh.data.data(), after.data.data(), fresh.data.size() * sizeof(float)), 0);
@@ -427,14 +427,14 @@ TEST_P(SearchHierarchyRenders, AreIdentical) {
     for (const int n : {96, 200}) {
       const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, n);
       const ABuffer camera = build_camera_abuffer(s);
-      for (const Method method : {Method::abuffer, Method::zbuffer}) {
-        if (method == Method::zbuffer && n != 96) continue;
+      for (const MapVariant variant : {MapVariant::abuffer, MapVariant::zbuffer}) {
+        if (variant == MapVariant::zbuffer && n != 96) continue;
         MapShadingStats plain_stats, hier_stats;
-        const Image plain = render(s, cube, camera, false, method, &plain_stats);
-        const Image hier = render(s, cube, camera, true, method, &hier_stats);
+        const Image plain = render(s, cube, camera, false, variant, &plain_stats);
+        const Image hier = render(s, cube, camera, true, variant, &hier_stats);
         ASSERT_EQ(plain.data.size(), hier.data.size());
         EXPECT_EQ(std::memcmp(plain.data.data(), hier.data.data(), plain.data.size() * sizeof(float)), 0)
-            << file << " N=" << n << " method " << static_cast<int>(method) << ": the images differ";
+            << file << " N=" << n << " variant " << static_cast<int>(variant) << ": the images differ";
         const SearchKindStats* a[] = {&plain_stats.searches.reflection, &plain_stats.searches.refraction_exit,
                                       &plain_stats.searches.shadow};
         const SearchKindStats* b[] = {&hier_stats.searches.reflection, &hier_stats.searches.refraction_exit,

@@ -1,6 +1,7 @@
-// Internal to the GL passes (host/gl/gl_*.cpp): texture units, the pass state, the stencil
-// test, the camera's sample tiles, the framebuffers the passes render into, and the view a
-// draw is made through. What the shaders share with them: glsl_shared.hpp.
+// What the GL techniques share beneath their front (host/gl/gl_*.cpp): texture units, the
+// pass state, the stencil test, the camera's sample tiles, the framebuffers the passes render
+// into (gl_targets.cpp), and the view a draw is made through. What the shaders share with
+// them: glsl_shared.hpp.
 #pragma once
 #include <glad/gl.h>
 
@@ -11,7 +12,7 @@
 #include <glm/glm.hpp>
 
 #include "base/error.hpp"
-#include "gl/gl_passes.hpp"
+#include "gl/gl_types.hpp"
 #include "raster/cube_map.hpp"
 #include "base/samples.hpp"
 

@@ -1,0 +1,184 @@
+// The map methods (thesis ch. 7): abuffer, zbuffer and envmap. One pipeline, three
+// variants of the search (MapVariant): the camera's A-buffer, the cube map around the
+// camera only when a material reflects or refracts or a light casts shadows, each camera
+// fragment shaded by searches in that map, and the resolve of the masks.
+#include <memory>
+
+#include <glm/glm.hpp>
+
+#include "base/parallel.hpp"
+#include "base/timer.hpp"
+#include "io/metrics.hpp"
+#include "reference/raytrace.hpp"
+#include "render/method.hpp"
+#include "render/render_methods.hpp"
+#include "render/stats_json.hpp"
+#include "render/target_db.hpp"
+#include "scene/plan.hpp"
+#include "shading/fragment_texture.hpp"
+#include "shading/resolve.hpp"
+
+namespace abcube {
+
+using nlohmann::json;
+
+namespace {
+
+// The camera view through the CPU A-buffer with local Phong, for a scene with nothing to
+// search: the resolve's rule for intersecting fragments and the texture lookups as the
+// request's map options say. `only` (optional): the pixels to render (ResolveOptions::only).
+Image render_abuffer_local(MethodContext& mc, const std::vector<uint8_t>* only) {
+  const SceneData& scene = mc.scene;
+  const RenderRequest& r = mc.request;
+  ABufferStats s;
+  Clock::time_point t0 = Clock::now();
+  const ABuffer camera = build_camera_abuffer(scene, r.abuffer, &s);
+  const double build_ms = ms_since(t0);
+  ResolveOptions ro;
+  ro.threads = r.abuffer.threads;
+  ro.exact_priority = r.map.exact_priority;
+  ro.only = only;
+  t0 = Clock::now();
+  const PixelShader shade = local_phong_shader(scene, camera, r.map.plan.texture_samples());
+  Image image = resolve_image(camera, *scene.triangles, shade, scene.background, ro);
+  mc.record.timings_ms["camera_abuffer"] = build_ms;
+  mc.record.timings_ms["resolve"] = ms_since(t0);
+  mc.stats["abuffer"] = abuffer_json(s, true);
+  return image;
+}
+
+}  // namespace
+
+void read_map_options(const RenderOptions& o, MapVariant variant, RenderRequest* r) {
+  r->map.variant = variant;
+  r->map.threads = r->threads;
+  r->map.search.mode = parse_checked(o.search, parse_search_mode);
+  r->map.search.refine = parse_checked(o.refine, parse_search_refine);
+  r->map.search.theta_max = glm::radians(o.theta_max_deg);
+  r->map.search.side_structure = o.side_structure;
+  r->map.refraction = parse_checked(o.refraction, parse_refraction_mode);
+  r->map.lookup = parse_checked(o.envmap_lookup, parse_envmap_lookup);
+  r->map.exact_priority = o.resolve == "exact";
+  r->map.plan = ShadingPlan::from_names(o.shading_points, o.shadow_edges, o.secondary_edges, o.texture_lookups);
+}
+
+Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
+  const SceneData& scene = mc.scene;
+  const RenderRequest& r = mc.request;
+  json& stats = mc.stats;
+  const RenderPlan plan = make_plan(scene, r.plan_everything);
+  json passes = json::array(), skipped = json::array();
+  for (const PlanStep& s : plan.steps) (s.run ? passes : skipped).push_back({{"pass", s.pass}, {"why", s.why}});
+  stats["plan"]["passes"] = passes;
+  stats["plan"]["skipped"] = skipped;
+  stats["plan"]["mode"] = r.plan_everything ? "everything" : "needed";
+  if (!plan.cube_map) {
+    if (scene.render.target_db > 0) {
+      stats["target_db"] = {{"target", scene.render.target_db},
+                            {"why", "no cube map: nothing reflects, refracts or casts a shadow, so N is not used"}};
+    }
+    pass_progress(mc, "shading", 0.0);
+    Image image = render_abuffer_local(mc, only);
+    pass_progress(mc, "shading", 1.0);
+    return image;
+  }
+  std::unique_ptr<RayTracer> reference;
+  if (r.reference) reference = std::make_unique<RayTracer>(scene, mc.cache.bvh());
+  // The camera's A-buffer first, then the cube's, budgeted with the camera's held: the
+  // camera build's per-triangle bins are gone before the cube's A-buffer, its mesh
+  // neighbours and its side structure are made (peak memory), and every pilot of
+  // --target-db shades the same camera fragments.
+  ABufferStats as;
+  const Clock::time_point camera_start = Clock::now();
+  pass_progress(mc, "camera A-buffer", 0.0);
+  const ABuffer camera = build_camera_abuffer(scene, r.abuffer, &as);
+  pass_progress(mc, "camera A-buffer", 1.0);
+  const double camera_ms = ms_since(camera_start);
+  ABufferOptions cube_options = r.abuffer;
+  cube_options.reserved_bytes += as.bytes_total;
+  const bool target = r.map.variant == MapVariant::abuffer && r.target_pilots && scene.render.target_db > 0;
+  const char* cube_pass = target ? "choosing N and the shading (pilots)" : "cube A-buffer";
+  pass_progress(mc, cube_pass, 0.0);
+  const CubeMap map =
+      target ? cube_map_for_target(mc, camera, cube_options, reference.get())
+             : build_cube_map(mc, scene.render.cube_resolution, cube_options, reference.get(), map_shading_options(mc));
+  pass_progress(mc, cube_pass, 1.0);
+  mc.record.timings_ms["cube_abuffer"] = map.build_ms;
+  stats["cube_abuffer"] = cube_abuffer_json(map.stats);
+  mc.record.timings_ms["map_setup"] = map.setup_ms;
+  mc.record.timings_ms["camera_abuffer"] = camera_ms;
+  const Clock::time_point t0 = Clock::now();
+  MapShadingStats ms;
+  std::function<void(double)> shading;
+  if (mc.progress) shading = [&mc](double done) { mc.progress("shading", done); };
+  Image image = render_with_map(scene, camera, *map.shader, r.threads, &ms, mc.fallback, only, true, &shading);
+  mc.record.timings_ms["shade_and_resolve"] = ms_since(t0);
+  stats["abuffer"] = abuffer_json(as, false);
+  stats["searches"] = map_shading_json(ms);
+  if (reference) {
+    const double bound = parallax_bound(map.n);
+    stats["reference"]["ray_error"] = {{"rays", "reflection rays of camera-visible surfaces"},
+                                       {"error_cp", error_stats_json(ms.errors.error_cp)},
+                                       {"error_parallax", error_stats_json(ms.errors.error_parallax)},
+                                       {"false_hits", ms.errors.false_hits},
+                                       {"wrong_object", ms.errors.wrong_object},
+                                       {"bound_1_over_2n2", bound},
+                                       {"error_parallax_within_bound", ms.errors.error_parallax.share_within(bound)}};
+  }
+  return image;
+}
+
+namespace {
+
+// The three variants differ in what a search returns and so in the options they read: the
+// lens transfer replaces an exit search (not envmap's lookups), the lookup direction is
+// envmap's, and only abuffer chooses its N and shading from --target-db.
+class MapMethod : public RenderMethod {
+ public:
+  MapMethod(MapVariant variant, std::string name, std::string summary)
+      : variant_(variant), name_(std::move(name)), summary_(std::move(summary)) {}
+  std::string name() const override { return name_; }
+  std::string summary() const override { return summary_; }
+  std::vector<std::string> reads() const override {
+    std::vector<std::string> keys = {
+        "cube_res",        "error_target", "plan",           "search",       "refine",
+        "theta_max_deg",   "map_only",     "shading_points", "shadow_edges", "secondary_edges",
+        "texture_lookups", "resolve",      "max_layers"};
+    if (variant_ != MapVariant::envmap) keys.push_back("refraction");
+    if (variant_ == MapVariant::envmap) keys.push_back("envmap_lookup");
+    if (variant_ == MapVariant::abuffer) keys.push_back("target_db");
+    return keys;
+  }
+  void read_options(const RenderOptions& options, const SceneData& view, RenderRequest* request) const override {
+    (void)view;
+    read_map_options(options, variant_, request);
+    request->target_pilots = variant_ == MapVariant::abuffer;
+  }
+  Image render(MethodContext& mc) const override {
+    Image image = render_map_method(mc);
+    mc.record.gl_renderer = "none (CPU A-buffer)";
+    return image;
+  }
+
+ private:
+  MapVariant variant_;
+  std::string name_, summary_;
+};
+
+}  // namespace
+
+std::unique_ptr<RenderMethod> make_map_method(MapVariant variant) {
+  switch (variant) {
+    case MapVariant::zbuffer:
+      return std::make_unique<MapMethod>(variant, "zbuffer",
+                                         "the cube map's nearest layer only: the Z-buffer searches (thesis 7.3)");
+    case MapVariant::envmap:
+      return std::make_unique<MapMethod>(variant, "envmap",
+                                         "environment-map lookups in the cube map's colours, no search (thesis 5.6)");
+    case MapVariant::abuffer: break;
+  }
+  return std::make_unique<MapMethod>(
+      variant, "abuffer", "the A-buffered cube map's linear searches (thesis 7.2): the method of this renderer");
+}
+
+}  // namespace abcube
