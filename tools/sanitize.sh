@@ -92,7 +92,9 @@ case $kind in
     # cli.crosscheck_cli through OSMesa alone (ABCUBE_CROSSCHECK_GL): the egl.* tests check
     # the EGL context's code.
     export ABCUBE_CROSSCHECK_GL=osmesa
-    repeats='RendererApi\.HundredEglRenderersInARow|ResourcesApi\.ThreeHundredRendersHoldNoMore|hard\.generated|cli\.flat_mirrors|cli\.gpu_shading|cli\.determinism'
+    # Left out as well: install.consumer, which checks the installed package's layout by
+    # building examples/two_views against it (its calls are the api tests').
+    repeats='RendererApi\.HundredEglRenderersInARow|ResourcesApi\.ThreeHundredRendersHoldNoMore|hard\.generated|cli\.flat_mirrors|cli\.gpu_shading|cli\.determinism|install\.consumer'
     # The tests that decode broken images run apart, with whole stacks for LeakSanitizer
     # (fast_unwind_on_malloc=0, slower): OpenImageIO's PNG reader leaks a string when libpng
     # longjmps out of a corrupt image, and libstdc++'s missing frame pointers cut the stack
