@@ -53,7 +53,7 @@ void check_triangle_cap(const LoadState& st, const std::string& path, uint64_t a
     fail(st.src, path,
          "the scene would have " + std::to_string(total) + " triangles, an estimated " + std::to_string(mib) +
              " MiB at " + std::to_string(SCENE_TRIANGLE_BYTES) + " bytes each, " +
-             budget_words(st.memory_budget, st.limits.max_memory_bytes > 0));
+             budget_words(st.memory_budget, st.limits.max_memory_mib > 0));
   }
 }
 
@@ -297,7 +297,7 @@ SceneData read_scene(const Json& doc, const Source& src, const LoadLimits& limit
           read_light(Fields(src, list[i], index_path("lights", i), {"type", "position", "color", "cast_shadows"})));
     }
   }
-  LoadState st{src, scene, limits, root, {}, {}, -1, {}, {}, memory_budget_bytes(limits.max_memory_bytes)};
+  LoadState st{src, scene, limits, root, {}, {}, -1, {}, {}, memory_budget_bytes(limits.max_memory_bytes())};
   if (const Json* materials = top.find("materials")) read_materials(st, *materials);
   const Json& objects = read_array(src, top.need("objects"), "objects");
   check_scene_triangles(st, objects);

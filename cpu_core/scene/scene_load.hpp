@@ -12,30 +12,22 @@ namespace abcube {
 
 // What a scene may ask of the machine that loads it (a server loading scenes it did not
 // write): where its files may be, and how many triangles it may hold.
-struct LoadLimits {
-  // Empty: any file. Otherwise every file the scene reads (the scene itself, OBJ meshes,
-  // the MTL files they name) must resolve, symbolic links and ".." included, inside this
-  // folder; one that does not is an InputError naming the field.
-  std::string root;
-  // 0: no cap (beyond the loader's own). Otherwise a scene with more triangles is refused
-  // with an InputError naming the count and the cap, before its triangles are made.
-  uint64_t max_triangles = 0;
-  // The whole render's memory budget (--max-memory), 0: the memory available
-  // (available_memory_bytes). A scene whose triangles alone would exceed it, at
-  // SCENE_TRIANGLE_BYTES each, is refused as max_triangles is, before they are made.
-  uint64_t max_memory_bytes = 0;
+// The public limits (SceneLimits: the root folder, the triangle cap, the memory budget in
+// MiB, the threads; each refused with an InputError naming the field or the count before
+// anything is made for it) and what only the loader's callers set.
+struct LoadLimits : SceneLimits {
   // Input files larger than these are refused before they are read (docs/scene-format.md
   // "Limits"): a scene file (and an MTL file) is text of kilobytes, a mesh can be
   // gigabytes (a 1M-triangle OBJ is about 100 MB). A mesh file larger than the memory
   // available is refused too: its triangles take more room than its text.
   uint64_t max_scene_bytes = MAX_SCENE_BYTES;
   uint64_t max_mesh_bytes = MAX_MESH_BYTES;
-  // Threads the load may use, 0: every core (the result is the same for any number).
-  int threads = 0;
   // The names render.method may take: the host's registered methods. Empty: any name.
   std::vector<std::string> methods;
   static constexpr uint64_t MAX_SCENE_BYTES = uint64_t{64} << 20;  // 64 MiB
   static constexpr uint64_t MAX_MESH_BYTES = uint64_t{8} << 30;    // 8 GiB
+
+  uint64_t max_memory_bytes() const { return max_memory_mib << 20; }
 };
 
 // SceneOverride and SceneOverrides: <abcube/scene_limits.hpp>.

@@ -34,7 +34,7 @@ struct LoadState {
   std::map<std::string, std::pair<std::string, std::string>> texture_place;
   // The first perspective camera of a gltf object with "use_camera" (world space).
   std::optional<Camera> file_camera;
-  // memory_budget_bytes(limits.max_memory_bytes), read once when loading starts.
+  // memory_budget_bytes(limits.max_memory_bytes()), read once when loading starts.
   uint64_t memory_budget = 0;
 };
 

@@ -372,7 +372,7 @@ void check_obj_file(LoadState& st, const std::string& path, const std::string& r
   const uint64_t size = problem.empty() ? std::filesystem::file_size(resolved, ec) : 0;
   if (problem.empty() && st.memory_budget > 0 && size > st.memory_budget) {
     problem = "is " + format_bytes(size) + ", more than the " + format_bytes(st.memory_budget) +
-              (st.limits.max_memory_bytes > 0 ? " of --max-memory" : " of memory available");
+              (st.limits.max_memory_mib > 0 ? " of --max-memory" : " of memory available");
   }
   if (!problem.empty()) fail(st.src, path, "cannot read mesh " + quote_path(resolved) + ": " + problem);
   // A face line of n corners takes at least 2n + 2 bytes ("f 1 2 3\n") for its n - 2

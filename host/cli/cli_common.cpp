@@ -10,6 +10,7 @@
 
 #include "base/error.hpp"
 #include "io/image_io.hpp"
+#include "render/method.hpp"
 
 namespace abcube {
 
@@ -87,6 +88,7 @@ RenderSetup RenderFlags::setup() const {
       if (given == texts_.end()) continue;  // not a flag of this command
       for (const std::string& t : given->second) set_render_option_text(setup, s.key, t);
     }
+    if (!setup.render.method.empty()) method_named(setup.render.method);  // a registered method
   } catch (const OptionError& e) {
     throw_as_flag(e);
   }

@@ -1,4 +1,4 @@
-// The camera pass of the gpu method where the GPU is exact (GlExactCamera; gl_passes.hpp
+// The camera pass of the gpu method where the GPU is exact (GlExactCamera; gl_types.hpp
 // ExactCameraOptions; docs/design/gl-camera-exact.md). The stencil holds the mirror level of
 // the view a sample shows: each visible planar mirror marks its samples, clears them, and
 // draws the scene reflected about its plane there (gl_planar_mirrors.hpp), recursively to

@@ -39,14 +39,16 @@ class RenderMethod {
   // Bytes the render needs besides its A-buffers' fragments (which are counted as they are
   // built), checked against the budget before any pass.
   virtual uint64_t render_bytes(const SceneData& scene) const;
-  // The image. Its passes write their figures into mc.stats: "plan", "timings_ms", "gl" and
-  // the method's own sections.
+  // The image. Its passes write their figures into mc.stats ("plan" and the method's own
+  // sections), and their timings and the GL path they drew with into mc.record.
   virtual Image render(MethodContext& mc) const = 0;
 };
 
-// Adds `method` to the registry; InputError when its name is taken or malformed. The
-// registry is process-wide; register before the first render (at start or in a static
-// initializer). Returns true, so that a unit can register itself with
+// Adds `method` to the registry; InputError when its name is taken or malformed, or when it
+// reads an option the table does not mark per-method (thrown from a static initializer, that
+// ends the program before main). The registry is process-wide; register before the first
+// render (at start or in a static initializer). Returns true, so that a unit can register
+// itself with
 //   const bool registered = abcube::register_method(std::make_unique<MyMethod>());
 bool register_method(std::unique_ptr<RenderMethod> method);
 

@@ -30,7 +30,7 @@ struct RenderRequest {
   ABufferOptions abuffer;  // threads, layer cap, memory budget
   // What the method read of its own options (RenderMethod::read_options):
   MapShadingOptions map;       // the map searches: variant, mode, refinement, refraction, lookup, plan
-  ExactCameraOptions gpu;      // the GPU's exact camera pass (gl_passes.hpp)
+  ExactCameraOptions gpu;      // the GPU's exact camera pass (gl_types.hpp)
   bool target_pilots = false;  // --target-db picks the cube map's N and shading by pilots
   std::vector<std::string> aovs;
 };
@@ -54,7 +54,7 @@ struct MethodContext {
   nlohmann::json& stats;  // the figures of the passes, beside the record's
   RenderRecord& record;
   const std::function<void(const std::string&, double)>& progress;
-  GlScene* gl_scene;     // the scene on the GPU (gpu method only)
+  GlScene* gl_scene;     // the scene on the GPU (a method that needs_gl)
   GpuTimings gl_before;  // its timings before this render (zero when it uploaded now)
   // Filled by the map methods for the "fallback" AOV: per pixel, the share of secondary
   // searches that found nothing.

@@ -83,14 +83,11 @@ void check_value(const OptionSpec& s, const json& v) {
     case OptionKind::text:
       if (!v.is_string()) bad(s, "a string", v);
       return;
-    case OptionKind::method: {
-      // Which names exist is the registry's to say (the library checks it before a render).
-      const bool name =
-          v.is_string() && !v.get<std::string>().empty() &&
-          v.get<std::string>().find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") == std::string::npos;
-      if (!name) bad(s, "a method's name", v);
+    case OptionKind::method:
+      // Which names exist is the registry's to say: the doors check the name against it
+      // (method_named) with the list of names and the nearest one.
+      if (!v.is_string() || v.get<std::string>().empty()) bad(s, "a method's name", v);
       return;
-    }
     case OptionKind::vec3: {
       bool ok = v.is_array() && v.size() == 3;
       for (size_t i = 0; ok && i < 3; ++i) ok = v[i].is_number() && std::isfinite(v[i].get<double>());

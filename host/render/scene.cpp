@@ -33,13 +33,10 @@ struct Scene::State {
 namespace {
 
 LoadLimits load_limits(const SceneLimits& limits) {
-  LoadLimits l;
-  l.root = limits.root;
-  l.max_triangles = limits.max_triangles;
   if (limits.max_memory_mib > (uint64_t{1} << 30)) throw InputError("max-memory: must be at most 2^30 MiB");
-  l.max_memory_bytes = limits.max_memory_mib << 20;
   if (limits.threads < 0) throw InputError("threads: must be >= 0, got " + std::to_string(limits.threads));
-  l.threads = limits.threads;
+  LoadLimits l;
+  static_cast<SceneLimits&>(l) = limits;
   for (const RenderMethod* m : registered_methods()) l.methods.push_back(m->name());  // render.method
   return l;
 }

@@ -30,7 +30,7 @@ namespace abcube {
 // (pilot_pixels) at the 32 samples and the pixel's centre: every lower rung is a prefix of
 // them, so one pilot judges them all. The image is then traced at that rung, the pilot's
 // pixels taken from the pilot (the same bits). Writes stats["target_db"] and
-// timings_ms["target_pilots"]; the stats' raytrace entry is the whole image's.
+// record.timings_ms["target_pilots"]; the stats' raytrace entry is the whole image's.
 Image raytrace_for_target(MethodContext& mc);
 
 // The ladder of N the pilots climb, up to max(1024, the scene's own N).
@@ -41,7 +41,7 @@ std::vector<uint8_t> pilot_pixels(int width, int height, int* block);
 
 // The cube map at the chosen N, its shader measuring ray errors against `reference` when
 // given. `camera` is the camera's A-buffer the pilots shade; `cube_options` budget the
-// cube with it held. Writes stats["target_db"] and timings_ms["target_pilots"].
+// cube with it held. Writes stats["target_db"] and record.timings_ms["target_pilots"].
 CubeMap cube_map_for_target(MethodContext& mc, const ABuffer& camera, const ABufferOptions& cube_options,
                             const RayTracer* reference);
 

@@ -23,7 +23,7 @@ struct CameraOverride {
 // The names the string options accept (the CLI's --help and the messages list them too).
 // Empty strings and negative numbers mean "the scene's own value".
 struct RenderOptions {
-  std::string method;                       // abuffer | zbuffer | envmap | raytrace | gpu | hybrid ("" = render.method)
+  std::string method;                       // a registered method (method_names(): abuffer, ...) ("" = render.method)
   int cube_resolution = 0;                  // N texels per face edge (0 = render.cube_resolution, or error_target's)
   int max_depth = -1;                       // bounces (< 0 = render.max_depth)
   double error_target = -1;                 // > 0: N from the Error_Parallax bound 1/(2 N^2) (< 0 = the scene's)

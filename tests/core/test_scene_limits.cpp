@@ -158,7 +158,7 @@ TEST(SceneLoadLimits, TriangleCapNamesTheCountAndTheCap) {
 TEST(SceneLoadLimits, MeshOverTheCapsIsRefusedBeforeItIsParsed) {
   TempDir dir;
   std::string obj = "# a fan of quads and one hexagon\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 2 0\nv 1 2 0\n";
-  for (int k = 0; k < 500; ++k) obj += "f 1 2 3 4\n  f\t1 2  3\r\nfo 1 2 3\n";
+  for (int k = 0; k < 2500; ++k) obj += "f 1 2 3 4\n  f\t1 2  3\r\nfo 1 2 3\n";
   obj += "f 1 2 3 4 5 6\nf 1 2 999999";  // the last face's index is out of range, no newline
   dir.write("fan.obj", obj);
   const std::string mesh = with_objects(R"([{"type": "mesh", "file": "fan.obj"}])").str();
@@ -166,14 +166,14 @@ TEST(SceneLoadLimits, MeshOverTheCapsIsRefusedBeforeItIsParsed) {
   const auto error = [&] {
     return input_error([&] { load_scene_text(mesh, "scene.json", dir.path().string(), limits); }, mesh);
   };
-  const std::string counted = std::to_string(500 * 3 + 4 + 1);
-  EXPECT_NE(error().find(": line 1509: f: corner 3: v index 999999, but the file has 6 v lines"), std::string::npos)
+  const std::string counted = std::to_string(2500 * 3 + 4 + 1);
+  EXPECT_NE(error().find(": line 7509: f: corner 3: v index 999999, but the file has 6 v lines"), std::string::npos)
       << "with no cap, the check after parsing: " << error();
   limits.max_triangles = 1000;
   EXPECT_EQ(error(), "scene.json: objects[0].file: the scene would have " + counted +
                          " triangles, over the cap of 1000 (max_triangles)");
   limits.max_triangles = 0;
-  limits.max_memory_bytes = 64 * 1024;  // 385 triangles at SCENE_TRIANGLE_BYTES
+  limits.max_memory_mib = 1;  // 6168 triangles at SCENE_TRIANGLE_BYTES
   EXPECT_NE(error().find("the scene would have " + counted + " triangles, an estimated"), std::string::npos) << error();
 }
 

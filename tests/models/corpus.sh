@@ -20,7 +20,7 @@
 # Usage (ctest runs it so): bash corpus.sh /path/to/abcube /path/to/repo [CORPUS_DIR]
 # ABCUBE_CORPUS_ARGS, when set, is added to every render's arguments: the ASan stage of
 # tools/sanitize.sh renders at --size 96x72, since what it checks is the loading of each
-# file, not the tracer's millions of rays.
+# file, not the tracer's millions of rays; and ABCUBE_CORPUS_EVERY (below).
 set -u
 
 if [ $# -lt 2 ]; then
@@ -100,8 +100,10 @@ check_one() {
 export -f check_one
 export ABCUBE CORPUS WORK
 
-# Two renders at a time, one thread each.
+# Two renders at a time, one thread each. ABCUBE_CORPUS_EVERY=N (the ASan stage) renders the
+# first file of each kind (OBJ, glTF, GLB) and every Nth after it.
 grep -v '^#' "$TABLE" | sed '/^$/d' |
+  awk -F'\t' -v every="${ABCUBE_CORPUS_EVERY:-1}" '{ kind = tolower($1); sub(/.*\./, "", kind); if (n[kind]++ % every == 0) print }' |
   while IFS=$'\t' read -r path want view fragment; do printf '%s\0%s\0%s\0%s\0' "$path" "$want" "$view" "$fragment"; done |
   xargs -0 -n 4 -P 2 bash -c 'check_one "$@"' _ > "$WORK/results"
 sort "$WORK/results"
