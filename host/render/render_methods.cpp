@@ -37,6 +37,10 @@ void read_gpu_options(const RenderOptions& o, int max_depth, RenderRequest* r) {
   r->gpu.max_depth = max_depth;
 }
 
+std::vector<std::string> gpu_camera_option_keys() {
+  return {"gpu_mirrors", "gpu_shadows", "gpu_max_views", "gpu_shading"};
+}
+
 json gl_json(const GlContext& ctx) {
   const GlInfo& i = ctx.info();
   json j = {{"gl_version", i.gl_version}, {"gl_vendor", i.gl_vendor}};

@@ -33,6 +33,11 @@ void pass_progress(const MethodContext& mc, const char* pass, double done);
 void read_map_options(const RenderOptions& options, MapVariant variant, RenderRequest* request);
 // The GPU camera pass's options (--gpu-*) into request->gpu.
 void read_gpu_options(const RenderOptions& options, int max_depth, RenderRequest* request);
+// The table's keys of what read_map_options reads for every variant (the cube map's N and
+// plan, the searches, the shading plan, the resolve, the layer cap; refraction and the
+// lookup are the variants' own), and of what read_gpu_options reads: the units' reads().
+std::vector<std::string> map_option_keys();
+std::vector<std::string> gpu_camera_option_keys();
 
 // The map methods' passes: the camera's A-buffer, and the cube map only when something
 // needs it (a reflecting or refracting material, a shadow-casting light), searched by the

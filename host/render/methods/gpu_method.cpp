@@ -87,8 +87,9 @@ class GpuMethod : public RenderMethod {
     return "the GPU's raster: planar mirrors and shadows exact, curved mirrors and glass from a cube texture";
   }
   std::vector<std::string> reads() const override {
-    return {"cube_res",    "error_target", "plan",          "envmap_lookup",
-            "gpu_mirrors", "gpu_shadows",  "gpu_max_views", "gpu_shading"};
+    std::vector<std::string> keys = {"cube_res", "error_target", "plan", "envmap_lookup"};
+    for (const std::string& k : gpu_camera_option_keys()) keys.push_back(k);
+    return keys;
   }
   void read_options(const RenderOptions& options, const SceneData& view, RenderRequest* request) const override {
     request->map.lookup = parse_checked(options.envmap_lookup, parse_envmap_lookup);

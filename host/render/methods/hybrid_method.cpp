@@ -149,9 +149,10 @@ class HybridMethod : public RenderMethod {
     return "the GPU's exact camera pass, and abuffer on the CPU for the pixels the GPU only approximates";
   }
   std::vector<std::string> reads() const override {
-    return {"cube_res", "error_target", "plan",           "search",       "refine",          "theta_max_deg",
-            "map_only", "refraction",   "shading_points", "shadow_edges", "secondary_edges", "texture_lookups",
-            "resolve",  "max_layers",   "gpu_mirrors",    "gpu_shadows",  "gpu_max_views",   "gpu_shading"};
+    std::vector<std::string> keys = map_option_keys();  // abuffer's, with the lens transfer
+    keys.push_back("refraction");
+    for (const std::string& k : gpu_camera_option_keys()) keys.push_back(k);
+    return keys;
   }
   void read_options(const RenderOptions& options, const SceneData& view, RenderRequest* request) const override {
     read_map_options(options, MapVariant::abuffer, request);  // abuffer's searches

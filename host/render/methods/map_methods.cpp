@@ -49,6 +49,12 @@ Image render_abuffer_local(MethodContext& mc, const std::vector<uint8_t>* only) 
 
 }  // namespace
 
+std::vector<std::string> map_option_keys() {
+  return {"cube_res",        "error_target", "plan",           "search",       "refine",
+          "theta_max_deg",   "map_only",     "shading_points", "shadow_edges", "secondary_edges",
+          "texture_lookups", "resolve",      "max_layers"};
+}
+
 void read_map_options(const RenderOptions& o, MapVariant variant, RenderRequest* r) {
   r->map.variant = variant;
   r->map.threads = r->threads;
@@ -140,10 +146,7 @@ class MapMethod : public RenderMethod {
   std::string name() const override { return name_; }
   std::string summary() const override { return summary_; }
   std::vector<std::string> reads() const override {
-    std::vector<std::string> keys = {
-        "cube_res",        "error_target", "plan",           "search",       "refine",
-        "theta_max_deg",   "map_only",     "shading_points", "shadow_edges", "secondary_edges",
-        "texture_lookups", "resolve",      "max_layers"};
+    std::vector<std::string> keys = map_option_keys();
     if (variant_ != MapVariant::envmap) keys.push_back("refraction");
     if (variant_ == MapVariant::envmap) keys.push_back("envmap_lookup");
     if (variant_ == MapVariant::abuffer) keys.push_back("target_db");
