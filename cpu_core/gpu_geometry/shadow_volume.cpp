@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "base/constants.hpp"
 #include "material/shading.hpp"
 
 namespace abcube {
@@ -77,7 +78,7 @@ std::vector<uint8_t> lights_outside_closed(const SceneData& scene, const glm::dv
     solid_angle[object] += 2.0 * std::atan2(num, den);
   }
   std::vector<uint8_t> outside(scene.objects.size(), 0);
-  constexpr double FOUR_PI = 4.0 * 3.14159265358979323846;
+  constexpr double FOUR_PI = 4.0 * PI;
   for (size_t o = 0; o < outside.size(); ++o) {
     // Off the surface the winding number is an integer up to rounding: below 1/2 is 0.
     outside[o] = scene.objects[o].closed && !on_plane[o] && std::fabs(solid_angle[o] / FOUR_PI) < 0.5;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "base/constants.hpp"
+
 namespace abcube {
 
 namespace {
@@ -19,7 +21,6 @@ Sphere bounding_sphere(const Bounds& b) {
   return s;
 }
 
-constexpr double PI = 3.14159265358979323846;
 constexpr double MARGIN = 1.05;
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "base/constants.hpp"
 #include "base/error.hpp"
 #include "base/input_file.hpp"
 #include "scene/scene_gltf_reader.hpp"
@@ -170,7 +171,7 @@ void GltfReader::add_camera(int index, const std::string& at, const glm::dmat4& 
     return;
   }
   if (extras_->has_camera) return;  // the first one found
-  const double yfov_deg = c.perspective.yfov * 180.0 / 3.14159265358979323846;
+  const double yfov_deg = c.perspective.yfov * 180.0 / PI;
   if (!(yfov_deg > 0 && yfov_deg < 180)) {
     bad(index_path("cameras", static_cast<size_t>(index)) + ".perspective.yfov",
         "must be in (0, pi), got " + format_number(c.perspective.yfov));

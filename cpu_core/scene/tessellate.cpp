@@ -5,14 +5,13 @@
 #include <cstring>
 #include <utility>
 
+#include "base/constants.hpp"
 #include "base/error.hpp"
 #include "base/parallel.hpp"
 
 namespace abcube {
 
 namespace {
-
-constexpr double PI = 3.14159265358979323846;
 
 // A triangle is zero-area when twice its area is below this share of its squared
 // longest edge (a relative test, so it does not depend on the scene's units).

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <vector>
 
+#include "base/constants.hpp"
 #include "raster/cube_map.hpp"
 #include "search/cube_walk.hpp"
 
@@ -16,7 +17,6 @@ namespace abcube {
 namespace {
 
 constexpr double INF = std::numeric_limits<double>::infinity();
-constexpr double PI = 3.14159265358979323846;
 
 struct Ray {
   glm::dvec3 w, d;

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/constants.hpp"
 #include "search/lens.hpp"
 #include "reference/raytrace.hpp"
 
@@ -30,8 +31,6 @@ namespace {
 using glm::dvec2;
 using glm::dvec3;
 using namespace testkit;
-
-constexpr double PI = 3.14159265358979323846;
 
 // A lens of revolution with a knife edge: two spherical caps (or a cap and a disc) meeting
 // on the rim circle of radius `aperture`. c1, c2 >= 0 are the curvatures of the faces on the

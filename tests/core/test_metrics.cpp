@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "base/constants.hpp"
 #include "base/error.hpp"
 #include "io/image_io.hpp"
 #include "io/metrics.hpp"
@@ -13,8 +14,6 @@ namespace abcube {
 namespace {
 
 using glm::dvec3;
-
-constexpr double PI = 3.14159265358979323846;
 
 // An image whose displayed (sRGB-encoded) value is `shown` everywhere.
 Image displayed_flat(int w, int h, float shown) { return Image(w, h, 3, srgb_decode(shown)); }

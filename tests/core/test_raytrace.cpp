@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "scene/camera.hpp"
+#include "base/constants.hpp"
 #include "base/error.hpp"
 #include "io/image_io.hpp"
 #include "io/metrics.hpp"
@@ -159,8 +160,6 @@ namespace {
 
 using glm::dvec3;
 using namespace testkit;
-
-constexpr double PI = 3.14159265358979323846;
 
 // The image point (pixel units) where world point p projects (inverse of CameraFrame::direction).
 glm::dvec2 project(const CameraFrame& f, const dvec3& p) {

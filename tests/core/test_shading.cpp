@@ -3,12 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include "base/constants.hpp"
 #include "material/shading.hpp"
 
 namespace abcube {
 namespace {
-
-constexpr double PI = 3.14159265358979323846;
 
 // Unit direction at angle theta from -z towards +x (incident on the plane z = 0 from above
 // when the normal is +z).
