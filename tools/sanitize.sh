@@ -4,6 +4,8 @@
 #                            target but the benchmarks and the Python module, the ctest suite
 #                            but the tests that repeat covered paths over many scenes (below)
 #   tools/sanitize.sh tsan   ThreadSanitizer (build-tsan): test_core, its multi-threaded tests
+#                            but the hierarchy's sweep over generated scenes
+#   tools/sanitize.sh asan-all, tsan-all   the same builds, every test (CI runs asan and tsan)
 # Any report fails the run (exit 1): undefined behaviour stops the program, and the
 # suppressions in tools/sanitizers/ each say why they are there.
 # Extra arguments go to ctest (e.g. -R fuzz). ABCUBE_SANITIZE_BUILD_ONLY=1 builds only.
@@ -70,7 +72,7 @@ asan_ctest() {
 }
 
 case $kind in
-  asan)
+  asan | asan-all)
     configure build-asan address,undefined
     cmake --build build-asan
     [[ ${ABCUBE_SANITIZE_BUILD_ONLY:-0} == 1 ]] && exit 0
@@ -78,31 +80,48 @@ case $kind in
     export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1:new_delete_type_mismatch=0
     export LSAN_OPTIONS=suppressions=$supp/lsan.supp:print_suppressions=0
     export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:suppressions=$supp/ubsan.supp
-    # The sanitizers check code, not scenes: left out are the tests that run paths other
-    # tests already run, over many scenes or many times (the ordinary build runs them all):
-    # 100 EGL Renderers opened and closed (every GL test opens one), the 22 generated hard
-    # scenes, and the accuracy sweeps over generated scenes, cli.flat_mirrors (gpu and
-    # hybrid against the tracer), cli.gpu_shading (two gpu shadings) and cli.determinism
-    # (every method at three thread counts): their passes are those of cli.golden_cli, the
-    # osmesa.* GL tests and the core tests. Left out too: ResourcesApi's 300 renders through
-    # one Renderer, the other api tests' renders again, whose measure (resident memory from
-    # render 50 to 300) ASan's quarantine and shadow memory blur. The third-party corpus
-    # renders small (ABCUBE_CORPUS_ARGS): each file is still loaded whole.
+    # The sanitizers check code, not scenes or accuracy: left out are the tests that run paths
+    # other tests already run, over many scenes or many times (the ordinary build runs them
+    # all; `tools/sanitize.sh asan-all` runs every one):
+    # - 100 EGL Renderers opened and closed (every GL test opens one);
+    # - ResourcesApi's 300 renders through one Renderer, whose measure (resident memory from
+    #   render 50 to 300) ASan's quarantine and shadow memory blur;
+    # - the 22 generated hard scenes, and the accuracy sweeps: cli.flat_mirrors (gpu and hybrid
+    #   against the tracer), cli.gpu_shading (two gpu shadings), cli.determinism (every method
+    #   at two thread counts), cli.golden_cli (every golden image), the hierarchy against the
+    #   plain walks over generated scenes (SearchHierarchyRenders; SearchHierarchy's own tests
+    #   stay), TargetDb's sweep of mesh sizes, the methods against the tracer on cornell (the
+    #   same test on hidden_point stays), the Embree tracer and POV-Ray on every repository
+    #   scene (one scene each stays): their passes are those of the osmesa.* GL tests, the
+    #   core and api tests and the command-line tests that stay;
+    # - install.consumer, which checks the installed package's layout by building
+    #   examples/two_views against it (its calls are the api tests').
+    # The third-party corpus renders small (ABCUBE_CORPUS_ARGS): each file is still loaded whole.
     export ABCUBE_CORPUS_ARGS="--size 96x72"
-    # and one file in three of each kind (ABCUBE_CORPUS_EVERY): each loader on real files.
-    export ABCUBE_CORPUS_EVERY=3
+    # and one file in six of each kind (ABCUBE_CORPUS_EVERY): each loader on real files.
+    export ABCUBE_CORPUS_EVERY=6
     # cli.crosscheck_cli through OSMesa alone (ABCUBE_CROSSCHECK_GL): the egl.* tests check
-    # the EGL context's code.
+    # the EGL context's code. It checks two repository scenes and three generated ones, small
+    # (ABCUBE_CHECKED_BUILD), not every one.
     export ABCUBE_CROSSCHECK_GL=osmesa
-    # Left out as well: install.consumer, which checks the installed package's layout by
-    # building examples/two_views against it (its calls are the api tests'); and the second
-    # half of SearchHierarchyRenders, the same comparison as the first on other scenes.
-    repeats='RendererApi\.HundredEglRenderersInARow|ResourcesApi\.ThreeHundredRendersHoldNoMore|hard\.generated|cli\.flat_mirrors|cli\.gpu_shading|cli\.determinism|install\.consumer|SearchHierarchyHalves/SearchHierarchyRenders\.AreIdentical/1'
+    [[ $kind == asan-all ]] && unset ABCUBE_CORPUS_EVERY
+    # The GoogleTest executables run as shards (tests/CMakeLists.txt, abcube_gtests): their
+    # tests are chosen by GTEST_FILTER patterns, the others by ctest's regular expressions.
+    gtest_repeats='RendererApi.HundredEglRenderersInARow:ResourcesApi.ThreeHundredRendersHoldNoMore'
+    gtest_repeats+=':SearchHierarchyHalves/*:TargetDb.FinerMeshesThanTheTexelsMoveNUpWhereItShadesForLess'
+    gtest_repeats+=':Scenes/MethodsAgainstReference.*/cornell.json:Raytrace.EmbreeTracerMatchesThePreEmbreeImagesOnEveryRepositoryScene'
+    gtest_repeats+=':Pov.RepositoryScenesMatchOnTheSharedModel'
+    repeats='hard\.generated|cli\.flat_mirrors|cli\.gpu_shading|cli\.determinism|cli\.golden_cli|install\.consumer'
+    if [[ $kind == asan-all ]]; then  # every test but the package's layout
+      gtest_repeats=''
+      repeats='install\.consumer'
+    fi
     # The tests that decode broken images run apart, with whole stacks for LeakSanitizer
     # (fast_unwind_on_malloc=0, slower): OpenImageIO's PNG reader leaks a string when libpng
     # longjmps out of a corrupt image, and libstdc++'s missing frame pointers cut the stack
     # at two frames, too few for its entry in lsan.supp to match.
-    decodes='^(Textures\.|TexturesApi\.|SceneLoadGltf\.|fuzz\.replay\.gltf$)'
+    gtest_decodes='Textures.*:TexturesApi.*:SceneLoadGltf.*'
+    decodes='^fuzz\.replay\.gltf$'
     # The egl.* GL tests (test_gl on an EGL context) run apart without LeakSanitizer (ASan and
     # UBSan still on): on EGL, LeakSanitizer's tracer crashes at exit, on a dynamic-TLS record
     # of the main thread it cannot read ("DTLS 41 at 0x0000000035e1-0x0018000046e3" with
@@ -124,21 +143,27 @@ case $kind in
     # render through EGL, 3 times of 3 in a fresh clone's CI. The CPU methods' command-line
     # runs keep leak checking in cli.render_cli, cli.batch_cli and methods.registry.
     no_leaks='^(egl\.|cli\.crosscheck_cli$|cli\.golden_cli$|cli\.method_options$)'
-    asan_ctest -E "^($repeats|bundle\.clean)$|$decodes|$no_leaks" "$@" || exit 1
-    ASAN_OPTIONS=$ASAN_OPTIONS:detect_leaks=0 asan_ctest -R "$no_leaks" "$@" || exit 1
-    ASAN_OPTIONS=$ASAN_OPTIONS:fast_unwind_on_malloc=0 asan_ctest -R "$decodes" "$@"
+    GTEST_FILTER="-$gtest_repeats:$gtest_decodes" asan_ctest -E "^($repeats|bundle\.clean)$|$decodes|$no_leaks" "$@" || exit 1
+    ASAN_OPTIONS=$ASAN_OPTIONS:detect_leaks=0 GTEST_FILTER="-$gtest_repeats" asan_ctest -R "$no_leaks" -E "^($repeats)$" "$@" ||
+      exit 1
+    ASAN_OPTIONS=$ASAN_OPTIONS:fast_unwind_on_malloc=0 GTEST_FILTER="$gtest_decodes" \
+      asan_ctest -R "^(core|api)\.shard|$decodes" "$@"
     ;;
-  tsan)
+  tsan | tsan-all)
     configure build-tsan thread
     cmake --build build-tsan --target test_core
     [[ ${ABCUBE_SANITIZE_BUILD_ONLY:-0} == 1 ]] && exit 0
     export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1:suppressions=$supp/tsan.supp
     # The tests that run more than one thread (the parallel loop of cpu_core/base/parallel.hpp):
     # the A-buffer build and resolve, the searches, the tracer, the thread-count determinism tests.
-    ctest --test-dir build-tsan --output-on-failure -j2 -L core -R "$(cat "$supp/tsan_tests.txt" | grep -v '^#' | paste -sd'|')" "$@"
+    # Left out but by tsan-all: SearchHierarchyRenders, the hierarchy against the plain walks
+    # over generated scenes, whose threaded passes SearchHierarchy's own tests run.
+    filter=$(grep -v '^#' "$supp/tsan_tests.txt" | paste -sd:)
+    [[ $kind == tsan-all ]] || filter+='-SearchHierarchyHalves/*'
+    GTEST_FILTER=$filter ctest --test-dir build-tsan --output-on-failure -j2 -R '^core\.shard' "$@"
     ;;
   *)
-    echo "usage: tools/sanitize.sh asan|tsan [ctest arguments]" >&2
+    echo "usage: tools/sanitize.sh asan|tsan|asan-all|tsan-all [ctest arguments]" >&2
     exit 2
     ;;
 esac
