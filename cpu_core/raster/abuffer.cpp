@@ -209,16 +209,6 @@ void compact(ViewBuild* vb) {
 
 std::string mib(uint64_t bytes) { return std::to_string((bytes + MIB - 1) / MIB); }
 
-// The A-buffer's estimate `need` with the rest of the render's, against the budget.
-void check_budget(const char* what, uint64_t need, const std::string& detail, const ABufferOptions& o,
-                  uint64_t budget) {
-  if (need <= budget && o.reserved_bytes <= budget - need) return;
-  const std::string beside =
-      o.reserved_bytes > 0 ? " beside " + mib(o.reserved_bytes) + " MiB for the rest of the render" : "";
-  throw InputError(std::string(what) + " needs " + mib(need) + " MiB (" + detail + ")" + beside + ", " +
-                   budget_words(budget, o.max_memory_bytes > 0));
-}
-
 void check_options(const ABufferOptions& o) {
   if (o.threads < 0) throw InputError("A-buffer: threads must be >= 0, got " + std::to_string(o.threads));
   if (!(o.near_distance >= 0.0) || !std::isfinite(o.near_distance)) {
@@ -294,7 +284,7 @@ std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView>
       bands.push_back({v, y, std::min(y + BAND_ROWS, rasters[v].height)});
   }
   const uint64_t budget = memory_budget_bytes(options.max_memory_bytes);
-  check_budget(what, index_bytes, "its per-pixel index alone", options, budget);
+  check_abuffer_budget(what, index_bytes, "its per-pixel index alone", options, budget);
   const int threads = thread_count(options.threads, bands.size());
 
   const uint8_t* masks = views_of_triangle ? views_of_triangle->data() : nullptr;
@@ -306,8 +296,9 @@ std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView>
   uint64_t bin_bytes = 0;
   for (const ViewBuild& vb : views) bin_bytes += vb.bins.size() * sizeof(BinEntry);
   const uint64_t estimate = raw * sizeof(Fragment) + index_bytes + bin_bytes;
-  check_budget(what, estimate, std::to_string(raw) + " fragments at " + std::to_string(sizeof(Fragment)) + " bytes",
-               options, budget);
+  check_abuffer_budget(what, estimate,
+                       std::to_string(raw) + " fragments at " + std::to_string(sizeof(Fragment)) + " bytes", options,
+                       budget);
   for (ViewBuild& vb : views) {
     vb.cursor.assign(vb.view.pixel_count(), 0);
     vb.fragments.resize(vb.offsets.back());
@@ -338,12 +329,31 @@ std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView>
   return out;
 }
 
-double near_for(const SceneData& scene, const glm::dvec3& centre, const ABufferOptions& options) {
+}  // namespace
+
+void check_abuffer_budget(const char* what, uint64_t need, const std::string& detail, const ABufferOptions& o,
+                          uint64_t budget) {
+  if (need <= budget && o.reserved_bytes <= budget - need) return;
+  const std::string beside =
+      o.reserved_bytes > 0 ? " beside " + mib(o.reserved_bytes) + " MiB for the rest of the render" : "";
+  throw InputError(std::string(what) + " needs " + mib(need) + " MiB (" + detail + ")" + beside + ", " +
+                   budget_words(budget, o.max_memory_bytes > 0));
+}
+
+std::vector<uint8_t> triangle_cube_faces(const TriangleSoup& soup, const glm::dvec3& centre, int threads) {
+  std::vector<uint8_t> faces_of(soup.triangle_count());
+  parallel_for_runs(faces_of.size(), size_t{1} << 14, threads, [&](size_t t) {
+    const uint32_t k = static_cast<uint32_t>(t);
+    faces_of[t] = triangle_shape(centre, soup, k) == SetupResult::visible ? cube_faces_of(centre, soup, k)
+                                                                          : uint8_t{(1u << CUBE_FACES) - 1};
+  });
+  return faces_of;
+}
+
+double abuffer_near_distance(const SceneData& scene, const glm::dvec3& centre, const ABufferOptions& options) {
   check_options(options);
   return options.near_distance > 0.0 ? options.near_distance : default_near_distance(max_distance_from(scene, centre));
 }
-
-}  // namespace
 
 CubeABuffer build_cube_abuffer(const SceneData& scene, const glm::dvec3& centre, int n, const ABufferOptions& options,
                                ABufferStats* stats) {
@@ -351,18 +361,12 @@ CubeABuffer build_cube_abuffer(const SceneData& scene, const glm::dvec3& centre,
   if (!std::isfinite(centre.x) || !std::isfinite(centre.y) || !std::isfinite(centre.z)) {
     throw InputError("cube A-buffer: the centre must be finite");
   }
-  const double near = near_for(scene, centre, options);
+  const double near = abuffer_near_distance(scene, centre, options);
   std::vector<RasterView> rasters;
   for (int f = 0; f < CUBE_FACES; ++f) rasters.push_back(cube_face_view(f, centre, n, near));
   // Each triangle's faces first (one byte a triangle, for the build): most triangles lie in
   // one face's pyramid, and the five other faces then skip them unset up.
-  const TriangleSoup& soup = *scene.triangles;
-  std::vector<uint8_t> faces_of(soup.triangle_count());
-  parallel_for_runs(faces_of.size(), size_t{1} << 14, options.threads, [&](size_t t) {
-    const uint32_t k = static_cast<uint32_t>(t);
-    faces_of[t] = triangle_shape(centre, soup, k) == SetupResult::visible ? cube_faces_of(centre, soup, k)
-                                                                          : uint8_t{(1u << CUBE_FACES) - 1};
-  });
+  std::vector<uint8_t> faces_of = triangle_cube_faces(*scene.triangles, centre, options.threads);
   std::vector<ABuffer> faces = build_views(scene, std::move(rasters), "cube A-buffer", options, stats, &faces_of);
   faces_of = std::vector<uint8_t>();
   // The build's bins and its workers' small blocks, freed in their threads' heaps: handed
@@ -379,7 +383,7 @@ CubeABuffer build_cube_abuffer(const SceneData& scene, const glm::dvec3& centre,
 
 ABuffer build_camera_abuffer(const SceneData& scene, const ABufferOptions& options, ABufferStats* stats) {
   const CameraFrame frame = make_camera_frame(scene.camera);
-  const double near = near_for(scene, frame.eye, options);
+  const double near = abuffer_near_distance(scene, frame.eye, options);
   std::vector<ABuffer> one = build_views(scene, {camera_view(frame, near)}, "camera A-buffer", options, stats);
   return std::move(one.front());
 }

@@ -106,6 +106,19 @@ struct ABufferStats {
   int threads = 0;
 };
 
+// What a cube build does before it rasterises, shared with the GPU build (host/gl/gl_abuffer.hpp):
+// per triangle, the faces that may hold its samples (cube_faces_of; all six for a degenerate
+// or edge-on triangle, so that every face counts it), one byte a triangle.
+std::vector<uint8_t> triangle_cube_faces(const TriangleSoup& soup, const glm::dvec3& centre, int threads);
+// The A-buffer's estimate `need` with the rest of the render's (options.reserved_bytes)
+// against `budget`; throws InputError "WHAT needs N MiB (DETAIL) beside R MiB for the rest of
+// the render, above ..." when over it.
+void check_abuffer_budget(const char* what, uint64_t need, const std::string& detail, const ABufferOptions& options,
+                          uint64_t budget);
+// The near distance a build around `centre` uses: options.near_distance, or when 0 the
+// default for the farthest vertex. Throws InputError for a bad option.
+double abuffer_near_distance(const SceneData& scene, const glm::dvec3& centre, const ABufferOptions& options);
+
 // The cube A-buffer of `scene` around `centre` (the environment map), n x n
 // per face. Throws InputError for n < 1, a bad option, or when the estimate exceeds the
 // budget: "cube A-buffer needs N MiB (F fragments at 20 bytes) beside R MiB for the rest of

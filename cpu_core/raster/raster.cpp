@@ -11,9 +11,6 @@ namespace {
 
 // Edge-on threshold: the plane passes within this share of the farthest vertex's distance.
 constexpr double EDGE_ON_REL = 1e-9;
-// Margin for the trivial accept/reject of a pixel, relative to the terms of the edge
-// function: far above the rounding of a x + b y + c (a few 1e-16), far below any real gap.
-constexpr double TRIVIAL_REL = 1e-12;
 
 RasterView make_view(const glm::dvec3& centre, const glm::dvec3& row_x, const glm::dvec3& row_y,
                      const glm::dvec3& row_w, const glm::dmat3& to_direction, int width, int height,
@@ -229,7 +226,8 @@ CoverageMask pixel_mask(const TriangleSetup& s, int x, int y) {
   bool all_inside = true;
   for (int k = 0; k < s.edge_count; ++k) {
     const glm::dvec3& e = s.edge[static_cast<size_t>(k)];
-    const double tol = TRIVIAL_REL * (std::fabs(e.x) * (x_hi + 1.0) + std::fabs(e.y) * (y_hi + 1.0) + std::fabs(e.z));
+    const double tol =
+        RASTER_TRIVIAL_REL * (std::fabs(e.x) * (x_hi + 1.0) + std::fabs(e.y) * (y_hi + 1.0) + std::fabs(e.z));
     const double e_max = e.x * (e.x > 0 ? x_hi : x_lo) + e.y * (e.y > 0 ? y_hi : y_lo) + e.z;
     if (e_max < -tol) return 0;
     const double e_min = e.x * (e.x > 0 ? x_lo : x_hi) + e.y * (e.y > 0 ? y_lo : y_hi) + e.z;
@@ -294,7 +292,7 @@ double segment_distance2(const glm::dvec3& a, const glm::dvec3& b) {
 bool pixel_inside(const TriangleSetup& s, int x, int y) {
   for (int k = 0; k < s.edge_count; ++k) {
     const glm::dvec3& e = s.edge[static_cast<size_t>(k)];
-    const double tol = TRIVIAL_REL * (std::fabs(e.x) * (x + 2.0) + std::fabs(e.y) * (y + 2.0) + std::fabs(e.z));
+    const double tol = RASTER_TRIVIAL_REL * (std::fabs(e.x) * (x + 2.0) + std::fabs(e.y) * (y + 2.0) + std::fabs(e.z));
     if (!(e.x * (e.x > 0 ? x : x + 1.0) + e.y * (e.y > 0 ? y : y + 1.0) + e.z > tol)) return false;
   }
   return true;

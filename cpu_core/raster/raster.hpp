@@ -18,6 +18,11 @@
 
 namespace abcube {
 
+// Margin for the trivial accept/reject of a pixel, relative to the terms of the edge
+// function: far above the rounding of a x + b y + c (a few 1e-16), far below any real gap.
+// Public because the GPU A-buffer (shaders/abuffer_common.glsl) takes it as a uniform.
+constexpr double RASTER_TRIVIAL_REL = 1e-12;
+
 struct RasterView {
   glm::dvec3 centre{0.0};
   glm::dvec3 row_x{1, 0, 0}, row_y{0, 1, 0}, row_w{0, 0, 1};  // row_w unit

@@ -1,5 +1,6 @@
 #include "gl/gl_program.hpp"
 
+#include <initializer_list>
 #include <sstream>
 
 #include "base/error.hpp"
@@ -20,7 +21,12 @@ std::string glsl_prelude() {
          ABCUBE_GLSL_CONSTANT(TRIANGLE_MATERIALS_BINDING) + ABCUBE_GLSL_CONSTANT(VOLUME_CAPS_BINDING) +
          ABCUBE_GLSL_CONSTANT(OBJECT_IDS_BINDING) + ABCUBE_GLSL_CONSTANT(MATERIAL_IDS_BINDING) +
          ABCUBE_GLSL_CONSTANT(TARGET_IMAGE) + ABCUBE_GLSL_CONSTANT(PIXEL_COLOR_IMAGE) +
-         ABCUBE_GLSL_CONSTANT(PIXEL_WEIGHT_IMAGE) + ABCUBE_GLSL_CONSTANT(MASK_COLUMNS) +
+         ABCUBE_GLSL_CONSTANT(PIXEL_WEIGHT_IMAGE) + ABCUBE_GLSL_CONSTANT(ABUFFER_SETUPS_BINDING) +
+         ABCUBE_GLSL_CONSTANT(ABUFFER_VIEWS_BINDING) + ABCUBE_GLSL_CONSTANT(ABUFFER_OFFSETS_BINDING) +
+         ABCUBE_GLSL_CONSTANT(ABUFFER_CURSORS_BINDING) + ABCUBE_GLSL_CONSTANT(ABUFFER_FRAGMENTS_BINDING) +
+         ABCUBE_GLSL_CONSTANT(ABUFFER_TRIANGLES_BINDING) + ABCUBE_GLSL_CONSTANT(ABUFFER_STATS_BINDING) +
+         ABCUBE_GLSL_CONSTANT(ABUFFER_SCAN_VALUES_BINDING) + ABCUBE_GLSL_CONSTANT(ABUFFER_SCAN_SUMS_BINDING) +
+         ABCUBE_GLSL_CONSTANT(ABUFFER_SCAN_BLOCK) + ABCUBE_GLSL_CONSTANT(MASK_COLUMNS) +
          ABCUBE_GLSL_CONSTANT(MASK_ROWS) + ABCUBE_GLSL_CONSTANT(MASK_SAMPLES);
 }
 
@@ -38,6 +44,15 @@ std::string assemble(const std::vector<const char*>& files) {
   return src;
 }
 
+// A shader's or a program's info log (`get` is glGetShaderInfoLog or glGetProgramInfoLog).
+std::string info_log(GLuint id, void (*get)(GLuint, GLsizei, GLsizei*, GLchar*)) {
+  std::string log(4096, '\0');
+  GLsizei len = 0;
+  get(id, static_cast<GLsizei>(log.size()), &len, log.data());
+  log.resize(static_cast<size_t>(len));
+  return log;
+}
+
 GLuint compile(GLenum stage, const std::vector<const char*>& files) {
   const std::string src = assemble(files);
   const GLuint s = glCreateShader(stage);
@@ -47,14 +62,27 @@ GLuint compile(GLenum stage, const std::vector<const char*>& files) {
   GLint ok = 0;
   glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
   if (!ok) {
-    std::string log(4096, '\0');
-    GLsizei len = 0;
-    glGetShaderInfoLog(s, static_cast<GLsizei>(log.size()), &len, log.data());
-    log.resize(static_cast<size_t>(len));
+    const std::string log = info_log(s, glGetShaderInfoLog);
     glDeleteShader(s);
     throw RuntimeFailure(std::string("GLSL compile failed (") + files.back() + "): " + log);
   }
   return s;
+}
+
+// A program of the compiled `stages`, which it deletes, linked or not.
+GLuint link(std::initializer_list<GLuint> stages) {
+  const GLuint id = glCreateProgram();
+  for (GLuint s : stages) glAttachShader(id, s);
+  glLinkProgram(id);
+  for (GLuint s : stages) glDeleteShader(s);
+  GLint ok = 0;
+  glGetProgramiv(id, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    const std::string log = info_log(id, glGetProgramInfoLog);
+    glDeleteProgram(id);
+    throw RuntimeFailure("GLSL link failed: " + log);
+  }
+  return id;
 }
 
 }  // namespace
@@ -68,23 +96,11 @@ GlProgram::GlProgram(const std::vector<const char*>& vertex_files, const std::ve
     glDeleteShader(vs);
     throw;
   }
-  id_ = glCreateProgram();
-  glAttachShader(id_, vs);
-  glAttachShader(id_, fs);
-  glLinkProgram(id_);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(id_, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    std::string log(4096, '\0');
-    GLsizei len = 0;
-    glGetProgramInfoLog(id_, static_cast<GLsizei>(log.size()), &len, log.data());
-    log.resize(static_cast<size_t>(len));
-    glDeleteProgram(id_);
-    throw RuntimeFailure("GLSL link failed: " + log);
-  }
+  id_ = link({vs, fs});
 }
+
+GlProgram::GlProgram(const std::vector<const char*>& compute_files)
+    : id_(link({compile(GL_COMPUTE_SHADER, compute_files)})) {}
 
 GlProgram::~GlProgram() { glDeleteProgram(id_); }
 

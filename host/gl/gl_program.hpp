@@ -12,6 +12,8 @@ namespace abcube {
 class GlProgram {
  public:
   GlProgram(const std::vector<const char*>& vertex_files, const std::vector<const char*>& fragment_files);
+  // A compute program of one stage.
+  explicit GlProgram(const std::vector<const char*>& compute_files);
   ~GlProgram();
   GlProgram(const GlProgram&) = delete;
   GlProgram& operator=(const GlProgram&) = delete;

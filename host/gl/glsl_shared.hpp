@@ -39,6 +39,20 @@ constexpr unsigned VOLUME_CAPS_BINDING = 6;
 constexpr unsigned OBJECT_IDS_BINDING = 8;
 constexpr unsigned MATERIAL_IDS_BINDING = 9;
 
+// Storage buffer bindings of the GPU cube A-buffer's compute passes (gl_abuffer.cpp,
+// abuffer_*.comp): after the scene's, so that a build leaves the scene's bindings alone. The
+// scan (abuffer_scan.comp) runs on blocks of ABUFFER_SCAN_BLOCK values, one workgroup each.
+constexpr unsigned ABUFFER_SETUPS_BINDING = 10;
+constexpr unsigned ABUFFER_VIEWS_BINDING = 11;
+constexpr unsigned ABUFFER_OFFSETS_BINDING = 12;
+constexpr unsigned ABUFFER_CURSORS_BINDING = 13;
+constexpr unsigned ABUFFER_FRAGMENTS_BINDING = 14;
+constexpr unsigned ABUFFER_TRIANGLES_BINDING = 15;
+constexpr unsigned ABUFFER_STATS_BINDING = 16;
+constexpr unsigned ABUFFER_SCAN_VALUES_BINDING = 17;
+constexpr unsigned ABUFFER_SCAN_SUMS_BINDING = 18;
+constexpr unsigned ABUFFER_SCAN_BLOCK = 512;
+
 // Image units of the per-group colour pass (camera_groups.frag): the sample grid it blends
 // into, and the camera's per-pixel colour and weight.
 constexpr unsigned TARGET_IMAGE = 0;

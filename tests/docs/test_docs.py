@@ -215,7 +215,7 @@ MAX_FUNCTION_LINES = 80
 def product_sources():
     out = subprocess.run(["git", "-C", str(SRC), "ls-files", "--", *PRODUCT_DIRS], capture_output=True, text=True,
                          check=True).stdout.split()
-    return [SRC / p for p in out if Path(p).suffix in (".cpp", ".hpp", ".h", ".glsl", ".vert", ".frag", ".py")]
+    return [SRC / p for p in out if Path(p).suffix in (".cpp", ".hpp", ".h", ".glsl", ".vert", ".frag", ".comp", ".py")]
 
 
 def test_product_files_are_short():
@@ -302,12 +302,12 @@ def test_design_pages_link_their_sources_not_copy_them():
     from difflib import SequenceMatcher
     by_name = {}
     for p in tracked_files():
-        if p.suffix in (".hpp", ".cpp", ".frag", ".vert", ".glsl"):
+        if p.suffix in (".hpp", ".cpp", ".frag", ".vert", ".glsl", ".comp"):
             by_name.setdefault(p.name, []).append(p)
     copied = []
     for page in sorted((SRC / "docs/design").glob("*.md")):
         text = page.read_text()
-        named = set(re.findall(r"`(?:[\w]+/)*([\w]+\.(?:hpp|cpp|frag|vert|glsl))`", text))
+        named = set(re.findall(r"`(?:[\w]+/)*([\w]+\.(?:hpp|cpp|frag|vert|glsl|comp))`", text))
         named |= {Path(link).name for link in re.findall(r"\]\(((?:\.\./)+[\w/]+\.(?:hpp|cpp|frag|vert|glsl))\)", text)}
         body = re.sub(r"[`*|]", "", text).split()
         for source in sorted(p for name in named for p in by_name.get(name, [])):

@@ -1,0 +1,130 @@
+// The cube A-buffer built by GL compute shaders (host/gl/gl_abuffer.hpp) against the CPU
+// core's (raster/abuffer.hpp): the same lists, fragment for fragment and bit for bit (masks,
+// triangles and facing, depths rounded outward, encoded normals), on the repository's scenes
+// and the hard cases kept as regressions, and the same cap, merge switch and budget refusal.
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "base/error.hpp"
+#include "gl/gl_abuffer.hpp"
+#include "gl_test_support.hpp"
+#include "raster/abuffer.hpp"
+#include "raster/abuffer_compare.hpp"
+#include "scene/scene_load.hpp"
+
+namespace abcube {
+namespace {
+
+// Every list and fragment identical (compare_lists), else each class of difference with its
+// count and first example.
+void expect_same_lists(const CubeABuffer& cpu, const CubeABuffer& gpu, const std::string& what) {
+  const ListComparison c = compare_lists(cpu, gpu);
+  for (int k = 0; k < LIST_DIFFERENCE_CLASSES; ++k) {
+    EXPECT_EQ(c.count[static_cast<size_t>(k)], 0u)
+        << what << ": " << list_difference_name(static_cast<ListDifference>(k)) << ", first at "
+        << c.example[static_cast<size_t>(k)];
+  }
+  EXPECT_EQ(c.lists_identical, c.lists) << what;
+  EXPECT_EQ(c.fragments_identical, c.fragments) << what;
+  EXPECT_GT(c.fragments, 0u) << what;
+}
+
+// In the checked builds (ABCUBE_CHECKED_BUILD, tools/sanitize.sh) the same code runs on the
+// repository's scenes alone, from their cameras: the sanitizers check code, not scenes.
+bool checked_build() {
+  const char* v = std::getenv("ABCUBE_CHECKED_BUILD");
+  return v != nullptr && std::string(v) == "1";
+}
+
+std::vector<std::string> scene_files() {
+  std::vector<std::string> files;
+  std::vector<const char*> dirs{"/scenes"};
+  if (!checked_build()) dirs.insert(dirs.end(), {"/tests/hard/regressions", "/tests/cli/crosscheck_regressions"});
+  for (const char* dir : dirs) {
+    for (const auto& e : std::filesystem::directory_iterator(std::string(ABCUBE_SOURCE_DIR) + dir)) {
+      if (e.path().extension() == ".json") files.push_back(e.path().string());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// Every repository scene and kept hard case, from its camera and from a point off it, at two
+// resolutions: near-clipped triangles (camera_inside, a light on a surface), coplanar ties,
+// nested glass, thin features, kilometre scales.
+TEST(AbufferGl, ListsAreTheCpuCoresOnEveryKeptScene) {
+  test::test_context();
+  const std::vector<std::string> files = scene_files();
+  ASSERT_GE(files.size(), checked_build() ? 5u : 15u);
+  for (const std::string& file : files) {
+    const SceneData scene = load_scene(file);
+    const glm::dvec3 eye = scene.camera.position;
+    const glm::dvec3 off = eye + 0.37 * (scene.camera.look_at - eye) + glm::dvec3(0.01, -0.02, 0.03);
+    std::vector<std::pair<glm::dvec3, int>> views{{eye, 24}, {off, 41}};
+    if (checked_build()) views.pop_back();
+    for (const auto& [centre, n] : views) {
+      ABufferStats cs, gs;
+      const CubeABuffer cpu = build_cube_abuffer(scene, centre, n, {}, &cs);
+      const CubeABuffer gpu = build_cube_abuffer_gl(scene, centre, n, {}, &gs);
+      const std::string what = std::filesystem::path(file).filename().string() + " at N = " + std::to_string(n);
+      expect_same_lists(cpu, gpu, what);
+      EXPECT_EQ(cs.raw_fragments, gs.raw_fragments) << what;
+      EXPECT_EQ(cs.fragments, gs.fragments) << what;
+      EXPECT_EQ(cs.max_list_length, gs.max_list_length) << what;
+      EXPECT_EQ(cs.triangle_views, gs.triangle_views) << what;
+      EXPECT_EQ(cs.triangles_clipped, gs.triangles_clipped) << what;
+      EXPECT_EQ(cs.triangles_culled, gs.triangles_culled) << what;
+      EXPECT_EQ(cs.triangles_degenerate, gs.triangles_degenerate) << what;
+      EXPECT_EQ(cs.triangles_edge_on, gs.triangles_edge_on) << what;
+    }
+  }
+}
+
+// The options that change the lists: no merging, and a cap on the layers (the dropped
+// fragments counted alike).
+TEST(AbufferGl, CapAndMergeSwitchAsTheCpuCore) {
+  test::test_context();
+  const SceneData scene = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/cornell.json");
+  ABufferOptions unmerged;
+  unmerged.merge = false;
+  ABufferOptions capped;
+  capped.max_layers = 2;
+  for (const ABufferOptions& o : {unmerged, capped}) {
+    ABufferStats cs, gs;
+    const CubeABuffer cpu = build_cube_abuffer(scene, scene.camera.position, 32, o, &cs);
+    const CubeABuffer gpu = build_cube_abuffer_gl(scene, scene.camera.position, 32, o, &gs);
+    expect_same_lists(cpu, gpu, o.merge ? "capped" : "unmerged");
+    EXPECT_EQ(cs.dropped_by_cap, gs.dropped_by_cap);
+    EXPECT_EQ(cs.fragments, gs.fragments);
+  }
+  EXPECT_GT(build_cube_abuffer_gl(scene, scene.camera.position, 32, unmerged).faces[0].fragments.size(),
+            build_cube_abuffer_gl(scene, scene.camera.position, 32).faces[0].fragments.size());
+}
+
+// Above --max-memory the build is refused before the fragments are allocated, naming its
+// need; bad arguments are refused as the CPU core refuses them.
+TEST(AbufferGl, RefusesAboveTheBudgetAndBadArguments) {
+  test::test_context();
+  const SceneData scene = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/cornell.json");
+  ABufferOptions small;
+  small.max_memory_bytes = 1 << 20;
+  try {
+    build_cube_abuffer_gl(scene, scene.camera.position, 256, small);
+    FAIL() << "a 256 cube under 1 MiB was built";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cube A-buffer (GPU) needs"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--max-memory 1 MiB"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(build_cube_abuffer_gl(scene, scene.camera.position, 0), InputError);
+  EXPECT_THROW(build_cube_abuffer_gl(scene, glm::dvec3(NAN, 0, 0), 8), InputError);
+}
+
+}  // namespace
+}  // namespace abcube
