@@ -2,7 +2,8 @@
 // cube resolutions, median of R runs, with the renderer string, and the prepass's error
 // against the exact tracer (relative distance at texel centres), so no speed is quoted
 // without its error. Beside it, the CPU cube A-buffer build of the same faces (every
-// fragment of every surface) and its ratio to the GPU prepass.
+// fragment of every surface) and its ratio to the GPU prepass, and the same A-buffer built by
+// GL compute shaders (gl_abuffer.hpp) with the share of its lists identical to the CPU's.
 //
 //   bench_gl_passes SCENE.json [--sizes 256,512,1024] [--runs 5] [--gl auto|egl|osmesa]
 //                   [--error-samples 20000]
@@ -16,8 +17,10 @@
 #include "base/statistics.hpp"
 #include "base/timer.hpp"
 #include "raster/abuffer.hpp"
+#include "raster/abuffer_compare.hpp"
 #include "raster/cube_map.hpp"
 #include "base/error.hpp"
+#include "gl/gl_abuffer.hpp"
 #include "gl/gl_context.hpp"
 #include "gl/gl_passes.hpp"
 #include "reference/raytrace.hpp"
@@ -105,7 +108,8 @@ int run(const Options& o) {
   std::printf(
       "| N | prepass 6 faces ms | readback ms | camera %dx%d raster ms | prepass rel. distance error "
       "vs exact: median / p99 / max | same object | texels checked | CPU cube A-buffer ms | fragments | "
-      "CPU/GPU |\n|---|---|---|---|---|---|---|---|---|---|\n",
+      "CPU/GPU | GPU cube A-buffer ms | its lists identical to the CPU's |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|\n",
       scene.camera.width, scene.camera.height);
   for (int n : o.sizes) {
     std::vector<double> prepass, readback, camera;
@@ -124,19 +128,30 @@ int run(const Options& o) {
     ABufferStats as;
     ABufferOptions options;
     options.near_distance = gl.near_distance();
+    CubeABuffer cube;
     for (int r = 0; r < o.runs; ++r) {
       const Clock::time_point t0 = Clock::now();
-      const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, n, options, &as);
+      cube = build_cube_abuffer(scene, scene.camera.position, n, options, &as);
       cpu.push_back(ms_since(t0));
     }
-    const Spread p = spread(prepass), rb = spread(readback), c = spread(camera), a = spread(cpu);
+    std::vector<double> gpu_abuffer;
+    ListComparison lists;
+    for (int r = 0; r < o.runs; ++r) {
+      const Clock::time_point t0 = Clock::now();
+      const CubeABuffer on_gpu = build_cube_abuffer_gl(scene, scene.camera.position, n, options);
+      gpu_abuffer.push_back(ms_since(t0));
+      if (r == 0) lists = compare_lists(cube, on_gpu);
+    }
+    const Spread p = spread(prepass), rb = spread(readback), c = spread(camera), a = spread(cpu),
+                 g = spread(gpu_abuffer);
     const PrepassError e = prepass_error(scene, rt, dist, ids, o.error_samples);
     std::printf(
         "| %d | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1e / %.1e / %.1e | %.4f | %zu "
-        "| %.1f [%.1f, %.1f] | %llu | %.1f |\n",
+        "| %.1f [%.1f, %.1f] | %llu | %.1f | %.1f [%.1f, %.1f] | %llu of %llu |\n",
         n, p.median, p.lo, p.hi, rb.median, rb.lo, rb.hi, c.median, c.lo, c.hi, e.median_rel, e.p99_rel, e.max_rel,
         e.same_object, e.texels, a.median, a.lo, a.hi, static_cast<unsigned long long>(as.fragments),
-        a.median / p.median);
+        a.median / p.median, g.median, g.lo, g.hi, static_cast<unsigned long long>(lists.lists_identical),
+        static_cast<unsigned long long>(lists.lists));
     std::fflush(stdout);
   }
   return 0;

@@ -21,7 +21,9 @@ namespace abcube {
 namespace {
 
 constexpr const char* CROSSCHECK_COVERS =
-    "covers: visibility (cube texels, camera samples), direct shading of interior pixels, hard shadows; not "
+    "covers: visibility (cube texels, camera samples), the cube A-buffer's lists, direct shading of interior pixels, "
+    "hard "
+    "shadows; not "
     "covered: reflections, refractions, antialiased edges (abcube report compares whole images with the exact tracer)";
 
 struct CrosscheckCommand {
@@ -60,6 +62,17 @@ struct CrosscheckCommand {
     std::printf("same object id: %.5f (>= %.3f)\n", r.same_object, tol.same_object_min);
     std::printf("exact ties (two objects at the same distance, tie_rule.hpp): %zu texels, resolved alike %zu\n", r.tied,
                 r.tied_agree);
+    std::printf("GPU cube A-buffer lists: %llu of %llu identical, fragments %llu of %llu (%.1f ms)\n",
+                static_cast<unsigned long long>(r.lists.lists_identical),
+                static_cast<unsigned long long>(r.lists.lists),
+                static_cast<unsigned long long>(r.lists.fragments_identical),
+                static_cast<unsigned long long>(r.lists.fragments), r.gpu_abuffer_ms);
+    for (int k = 0; k < LIST_DIFFERENCE_CLASSES; ++k) {
+      const size_t i = static_cast<size_t>(k);
+      if (r.lists.count[i] == 0) continue;
+      std::printf("  %s: %llu, first at %s\n", list_difference_name(static_cast<ListDifference>(k)),
+                  static_cast<unsigned long long>(r.lists.count[i]), r.lists.example[i].c_str());
+    }
     std::printf("camera interior pixels: %zu of %zu, RMSE %.2e (<= %.0e), max abs %.2e (<= %.2e)\n", r.interior_pixels,
                 r.pixels, r.interior_rmse, tol.interior_rmse, r.interior_max_abs, tol.interior_max_abs);
     std::printf(

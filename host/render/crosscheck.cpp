@@ -16,6 +16,7 @@
 #include "io/image_io.hpp"
 #include "shading/fragment_texture.hpp"
 #include "shading/resolve.hpp"
+#include "gl/gl_abuffer.hpp"
 #include "gl/gl_shadow_probe.hpp"
 #include "material/shading.hpp"
 #include "base/timer.hpp"
@@ -65,6 +66,9 @@ void compare_cube(const SceneData& scene, int n, int threads, GlScene& gl, Cross
   const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, n, options, &stats);
   r->cpu_ms = ms_since(t0);
   r->fragments = stats.fragments;
+  const Clock::time_point t1 = Clock::now();
+  r->lists = compare_lists(cube, build_cube_abuffer_gl(scene, scene.camera.position, n, options));
+  r->gpu_abuffer_ms = ms_since(t1);
   const NearestLayer cpu = nearest_layer(cube, *scene.triangles);
 
   std::vector<double> rel;
@@ -335,6 +339,7 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   fail(r.interior_max_abs > tol.interior_max_abs, "camera interior max abs");
   fail(r.sample_agreement < tol.sample_agreement_min, "camera sample agreement");
   fail(r.volumes.interior_share() < tol.volumes_agreement_min, "shadow volumes against the tracer");
+  fail(!r.lists.within_bounds(), "GPU A-buffer lists");
   r.pass = r.failures.empty();
   return r;
 }
@@ -348,9 +353,26 @@ nlohmann::json shadow_json(const ShadowAgreement& a) {
           {"interior_agreement", a.interior_share()}};
 }
 
+nlohmann::json lists_json(const ListComparison& c) {
+  nlohmann::json classes = nlohmann::json::object();
+  for (int k = 0; k < LIST_DIFFERENCE_CLASSES; ++k) {
+    const size_t i = static_cast<size_t>(k);
+    classes[list_difference_name(static_cast<ListDifference>(k))] = {{"count", c.count[i]}, {"first", c.example[i]}};
+  }
+  return {{"lists", c.lists},
+          {"lists_identical", c.lists_identical},
+          {"fragments", c.fragments},
+          {"fragments_identical", c.fragments_identical},
+          {"depth_rel_max", c.depth_max_rel},
+          {"differences", classes},
+          {"within_bounds", c.within_bounds()}};
+}
+
 nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolerances& tol) {
   using nlohmann::json;
-  return json{{"cube",
+  return json{{"abuffer_lists", lists_json(r.lists)},
+              {"gpu_abuffer_ms", r.gpu_abuffer_ms},
+              {"cube",
                {{"texels", r.texels},
                 {"both_covered", r.both_covered},
                 {"gpu_only", r.gpu_only},

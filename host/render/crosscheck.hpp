@@ -1,12 +1,14 @@
 // GPU against CPU, texel by texel and pixel by pixel (`abcube crosscheck`):
-// the GL distance prepass against the CPU A-buffer's nearest layer, and the GL Z-buffer
-// camera image against the CPU A-buffer's resolved image away from silhouettes.
+// the GL distance prepass against the CPU A-buffer's nearest layer, the GPU's cube A-buffer
+// (gl_abuffer.hpp) against the CPU's list by list, and the GL Z-buffer camera image against
+// the CPU A-buffer's resolved image away from silhouettes.
 #pragma once
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "raster/abuffer.hpp"
+#include "raster/abuffer_compare.hpp"
 #include "gl/gl_passes.hpp"
 #include "scene/scene_data.hpp"
 
@@ -86,6 +88,10 @@ struct CrosscheckResult {
   int shadow_width = 0, shadow_height = 0, shadow_lights = 0;
   ShadowAgreement volumes, maps, search;
   Image shadow_disagreement;
+  // The GPU's cube A-buffer against the CPU's, fragment by fragment (compare_lists): it
+  // fails beyond LIST_DEPTH_REL and LIST_NORMAL_STEPS, or on any other difference.
+  ListComparison lists;
+  double gpu_abuffer_ms = 0;
   double gpu_ms = 0, cpu_ms = 0;  // prepass vs cube A-buffer build
   uint64_t fragments = 0;
   bool pass = false;
