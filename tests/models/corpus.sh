@@ -15,12 +15,13 @@
 # adds or drops fails the test, so none is skipped silently.
 #
 # Each file renders by the exact tracer at 4 samples a pixel, a rung of its ladder, at an
-# eighth of the rays of all 32: what is checked is the file's loading and framing.
+# eighth of the rays of all 32, and at 320 x 240: what is checked is the file's loading and
+# framing, which a smaller image frames alike (the view is fitted to the model's bounds).
 #
 # Usage (ctest runs it so): bash corpus.sh /path/to/abcube /path/to/repo [CORPUS_DIR]
-# ABCUBE_CORPUS_ARGS, when set, is added to every render's arguments: the ASan stage of
-# tools/sanitize.sh renders at --size 96x72, since what it checks is the loading of each
-# file, not the tracer's millions of rays; and ABCUBE_CORPUS_EVERY (below).
+# ABCUBE_CORPUS_ARGS, when set, replaces --size 320x240 in every render's arguments: the
+# ASan stage of tools/sanitize.sh renders at --size 96x72, since what it checks is the
+# loading of each file, not the tracer's millions of rays; and ABCUBE_CORPUS_EVERY (below).
 set -u
 
 if [ $# -lt 2 ]; then
@@ -57,7 +58,7 @@ check_one() {
   out="$WORK/$name.exr"
   # shellcheck disable=SC2086 # ABCUBE_CORPUS_ARGS is a list of words
   timeout 300 "$ABCUBE" render "$CORPUS/$path" -o "$out" --method raytrace --samples 4 --gl none --threads 1 \
-    ${ABCUBE_CORPUS_ARGS:-} \
+    ${ABCUBE_CORPUS_ARGS:---size 320x240} \
     > "$WORK/$name.stdout" 2> "$WORK/$name.stderr"
   status=$?
   [ "$status" -eq 124 ] && problems+=("still running after 300 s")
