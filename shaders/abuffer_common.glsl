@@ -1,10 +1,10 @@
-// The cube A-buffer on the GPU (host/gl/gl_abuffer.hpp): the CPU raster's rules
+// The A-buffers on the GPU (host/gl/gl_abuffer.hpp): the CPU raster's rules
 // (cpu_core/raster/raster.cpp) in double precision, operation for operation, so that every
 // coverage mask equals the CPU's bit for bit. `precise` keeps the compiler from fusing a
 // multiply and an add (the CPU build rounds each); every dot product and matrix product is
 // written out in the CPU's order (glm's), not left to the built-ins.
 
-// One visible (triangle, face) pair, set up on the CPU (setup_triangle): GpuSetup in
+// One visible (triangle, view) pair, set up on the CPU (setup_triangle): GpuSetup in
 // gl_abuffer.cpp is the same layout.
 struct Setup {
   dvec4 edge[4];     // (a, b, c, -): edge functions in pixel coordinates, then the near line
@@ -19,12 +19,12 @@ struct Setup {
   uint id;  // triangle | back-face bit
 };
 
-// A face of the cube (RasterView): pixel (x, y) looks along to_dir * (x, y, 1).
+// A view (RasterView: a cube face, or the camera): pixel (x, y) looks along to_dir * (x, y, 1).
 struct View {
   dvec4 to_dir[3];  // the columns of to_direction
   dvec4 row_x, row_y, row_w;
   double near_distance;
-  int size, first_pixel;  // n, and the face's first pixel in the cube's pixel order
+  int width, first_pixel;  // pixels a row, and the view's first pixel in the build's pixel order
 };
 
 // A fragment as the CPU stores it (raster/abuffer.hpp Fragment, 20 bytes).
@@ -34,6 +34,8 @@ struct Fragment {
 };
 
 layout(std430, binding = ABUFFER_SETUPS_BINDING) readonly buffer Setups { Setup setups[]; };
+// The count and fill passes' work items: (setup, tile of its pixel bounds), an invocation each.
+layout(std430, binding = ABUFFER_ITEMS_BINDING) readonly buffer Items { uvec2 items[]; };
 layout(std430, binding = ABUFFER_VIEWS_BINDING) readonly buffer Views { View views[]; };
 
 // The relative margin of the trivial accept and reject (raster.cpp TRIVIAL_REL).
@@ -45,6 +47,14 @@ const uint BACK_FACE_BIT = 0x80000000u;
 const uint FULL_MASK = 0xffffffffu;
 
 uint flat_group() { return gl_WorkGroupID.y * groups_per_row + gl_WorkGroupID.x; }
+
+// Tile `tile` of setup s's pixel bounds (row by row, ABUFFER_TILE pixels square, the last
+// ones cut): its first pixel and its size.
+ivec4 setup_tile(Setup s, uint tile) {
+  int across = (s.x1 - s.x0 + ABUFFER_TILE - 1) / ABUFFER_TILE;
+  int x = s.x0 + int(tile) % across * ABUFFER_TILE, y = s.y0 + int(tile) / across * ABUFFER_TILE;
+  return ivec4(x, y, min(ABUFFER_TILE, s.x1 - x), min(ABUFFER_TILE, s.y1 - y));
+}
 
 double sample_dx(int k) { return (double(k % MASK_COLUMNS) + 0.5lf) / double(MASK_COLUMNS); }
 double sample_dy(int k) { return (double(k / MASK_COLUMNS) + 0.5lf) / double(MASK_ROWS); }

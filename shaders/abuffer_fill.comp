@@ -1,4 +1,5 @@
-// Fill pass of the GPU cube A-buffer (host/gl/gl_abuffer.cpp): the count pass's walk again,
+// Fill pass of the GPU A-buffer (host/gl/gl_abuffer.cpp): the count pass's walk again (an
+// invocation a tile),
 // each covered pixel's fragment written at its list's next slot with its geometry
 // (fragment_geometry, raster.cpp): zmin and zmax over the triangle's part in the pixel,
 // rounded outward to float, and the interpolated normal at the covered samples' centroid.
@@ -7,7 +8,7 @@ layout(local_size_x = 64) in;
 layout(std430, binding = ABUFFER_OFFSETS_BINDING) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = ABUFFER_CURSORS_BINDING) buffer Cursors { uint cursors[]; };
 layout(std430, binding = ABUFFER_FRAGMENTS_BINDING) writeonly buffer Fragments { Fragment fragments[]; };
-uniform uint setup_count;
+uniform uint item_count;
 
 // Whether the whole pixel square is inside every edge function, with the trivial margin.
 bool pixel_inside(Setup s, int x, int y) {
@@ -112,16 +113,17 @@ Fragment make_fragment(View v, Setup s, int x, int y, uint mask) {
 }
 
 void main() {
-  uint index = flat_group();
-  if (index >= setup_count) return;
-  Setup s = setups[index];
+  uint index = flat_group() * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+  if (index >= item_count) return;
+  uvec2 item = items[index];
+  Setup s = setups[item.x];
   View v = views[s.view];
-  int w = s.x1 - s.x0, h = s.y1 - s.y0;
-  for (int i = int(gl_LocalInvocationID.x); i < w * h; i += int(gl_WorkGroupSize.x)) {
-    int x = s.x0 + i % w, y = s.y0 + i / w;
+  ivec4 tile = setup_tile(s, item.y);
+  for (int i = 0; i < tile.z * tile.w; ++i) {
+    int x = tile.x + i % tile.z, y = tile.y + i / tile.z;
     uint mask = pixel_mask(s, x, y);
     if (mask == 0u) continue;
-    uint p = uint(v.first_pixel) + uint(y) * uint(v.size) + uint(x);
+    uint p = uint(v.first_pixel) + uint(y) * uint(v.width) + uint(x);
     fragments[offsets[p] + atomicAdd(cursors[p], 1u)] = make_fragment(v, s, x, y, mask);
   }
 }

@@ -1,7 +1,9 @@
-// Finish pass of the GPU cube A-buffer (host/gl/gl_abuffer.cpp), one invocation a pixel:
+// Finish pass of the GPU A-buffer (host/gl/gl_abuffer.cpp), one invocation a pixel:
 // its list sorted front to back (zmin, then triangle and facing: a total order, so the fill's
-// order does not matter), merged and capped as finish_list does (raster/abuffer.cpp, MERGE);
-// the kept count goes back into the pixel's cursor.
+// order does not matter), merged and capped as finish_fragment_list does (raster/abuffer.hpp,
+// MERGE); the kept count goes back into the pixel's cursor. A list longer than
+// ABUFFER_GPU_LIST_MAX is left as filled, for the CPU's finish: its sort and merge would take
+// more loop iterations than llvmpipe runs in one invocation (glsl_shared.hpp).
 layout(local_size_x = 64) in;
 layout(std430, binding = ABUFFER_OFFSETS_BINDING) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = ABUFFER_CURSORS_BINDING) buffer Cursors { uint cursors[]; };
@@ -50,6 +52,7 @@ void main() {
   uint p = flat_group() * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
   if (p >= pixel_count) return;
   uint first = offsets[p], count = cursors[p];
+  if (count > ABUFFER_GPU_LIST_MAX) return;
   sort_list(first, count);
   uint kept = 0u;
   bool merged_any = false;

@@ -1,4 +1,4 @@
-// Exclusive prefix sum of the GPU cube A-buffer's per-pixel counts (host/gl/gl_abuffer.cpp),
+// Exclusive prefix sum of the GPU A-buffer's per-pixel counts (host/gl/gl_abuffer.cpp),
 // one level: each workgroup scans ABUFFER_SCAN_BLOCK values in place and writes their sum
 // to `sums`; the host scans the sums the same way, a level up, and add_block_sums adds each
 // block's offset back.

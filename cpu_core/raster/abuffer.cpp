@@ -137,30 +137,10 @@ void merge_into(Fragment* into, const Fragment& f) {
   into->zmax = std::max(into->zmax, f.zmax);
 }
 
-// Sorts one pixel's raw list, merges it, applies the cap; returns the kept count.
+// finish_fragment_list, with the band's figures.
 uint32_t finish_list(const TriangleSoup& soup, const ABufferOptions& options, Fragment* list, uint32_t count,
                      BandResult* r) {
-  std::sort(list, list + count, before);
-  uint32_t kept = 0;
-  bool merged_any = false;
-  float reach = -1.0f;  // the largest zmax kept so far: no overlap in z beyond it
-  for (uint32_t i = 0; i < count; ++i) {
-    bool merged = false;
-    const bool may_merge = options.merge && list[i].zmin <= reach;
-    for (uint32_t j = 0; may_merge && j < kept && !merged; ++j) {
-      if (mergeable(soup, list[j], list[i])) {
-        merge_into(&list[j], list[i]);
-        merged = merged_any = true;
-      }
-    }
-    reach = std::max(reach, list[i].zmax);
-    if (!merged) list[kept++] = list[i];
-  }
-  if (merged_any) std::sort(list, list + kept, before);  // a merge may change the tie key
-  if (options.max_layers > 0 && kept > options.max_layers) {
-    r->dropped += kept - options.max_layers;
-    kept = options.max_layers;
-  }
+  const uint32_t kept = finish_fragment_list(soup, options, list, count, &r->dropped);
   r->max_list = std::max<uint64_t>(r->max_list, kept);
   return kept;
 }
@@ -331,6 +311,32 @@ std::vector<ABuffer> build_views(const SceneData& scene, std::vector<RasterView>
 
 }  // namespace
 
+uint32_t finish_fragment_list(const TriangleSoup& soup, const ABufferOptions& options, Fragment* list, uint32_t count,
+                              uint64_t* dropped) {
+  std::sort(list, list + count, before);
+  uint32_t kept = 0;
+  bool merged_any = false;
+  float reach = -1.0f;  // the largest zmax kept so far: no overlap in z beyond it
+  for (uint32_t i = 0; i < count; ++i) {
+    bool merged = false;
+    const bool may_merge = options.merge && list[i].zmin <= reach;
+    for (uint32_t j = 0; may_merge && j < kept && !merged; ++j) {
+      if (mergeable(soup, list[j], list[i])) {
+        merge_into(&list[j], list[i]);
+        merged = merged_any = true;
+      }
+    }
+    reach = std::max(reach, list[i].zmax);
+    if (!merged) list[kept++] = list[i];
+  }
+  if (merged_any) std::sort(list, list + kept, before);  // a merge may change the tie key
+  if (options.max_layers > 0 && kept > options.max_layers) {
+    *dropped += kept - options.max_layers;
+    kept = options.max_layers;
+  }
+  return kept;
+}
+
 void check_abuffer_budget(const char* what, uint64_t need, const std::string& detail, const ABufferOptions& o,
                           uint64_t budget) {
   if (need <= budget && o.reserved_bytes <= budget - need) return;
@@ -355,15 +361,22 @@ double abuffer_near_distance(const SceneData& scene, const glm::dvec3& centre, c
   return options.near_distance > 0.0 ? options.near_distance : default_near_distance(max_distance_from(scene, centre));
 }
 
-CubeABuffer build_cube_abuffer(const SceneData& scene, const glm::dvec3& centre, int n, const ABufferOptions& options,
-                               ABufferStats* stats) {
-  if (n < 1) throw InputError("cube A-buffer: resolution must be >= 1, got " + std::to_string(n));
+std::vector<RasterView> cube_build_views(const char* what, const SceneData& scene, const glm::dvec3& centre, int n,
+                                         const ABufferOptions& options) {
+  if (n < 1) throw InputError(std::string(what) + ": resolution must be >= 1, got " + std::to_string(n));
   if (!std::isfinite(centre.x) || !std::isfinite(centre.y) || !std::isfinite(centre.z)) {
-    throw InputError("cube A-buffer: the centre must be finite");
+    throw InputError(std::string(what) + ": the centre must be finite");
   }
   const double near = abuffer_near_distance(scene, centre, options);
   std::vector<RasterView> rasters;
   for (int f = 0; f < CUBE_FACES; ++f) rasters.push_back(cube_face_view(f, centre, n, near));
+  return rasters;
+}
+
+CubeABuffer build_cube_abuffer(const SceneData& scene, const glm::dvec3& centre, int n, const ABufferOptions& options,
+                               ABufferStats* stats) {
+  std::vector<RasterView> rasters = cube_build_views("cube A-buffer", scene, centre, n, options);
+  const double near = rasters.front().near_distance;
   // Each triangle's faces first (one byte a triangle, for the build): most triangles lie in
   // one face's pyramid, and the five other faces then skip them unset up.
   std::vector<uint8_t> faces_of = triangle_cube_faces(*scene.triangles, centre, options.threads);

@@ -115,6 +115,17 @@ std::vector<uint8_t> triangle_cube_faces(const TriangleSoup& soup, const glm::dv
 // the render, above ..." when over it.
 void check_abuffer_budget(const char* what, uint64_t need, const std::string& detail, const ABufferOptions& options,
                           uint64_t budget);
+// A pixel's raw list (`count` fragments from `list`, in any order) finished as every build
+// finishes it: sorted front to back, merged (options.merge: MERGE) and cut to
+// options.max_layers. Returns the kept count (the kept fragments first in `list`), and adds
+// to *dropped the fragments the cap left out.
+uint32_t finish_fragment_list(const TriangleSoup& soup, const ABufferOptions& options, Fragment* list, uint32_t count,
+                              uint64_t* dropped);
+// A cube build's six face views around `centre` at `n` (cube_map.hpp's order), after its
+// arguments are checked (InputError naming `what`: n < 1, a centre not finite) and its near
+// distance chosen (abuffer_near_distance).
+std::vector<RasterView> cube_build_views(const char* what, const SceneData& scene, const glm::dvec3& centre, int n,
+                                         const ABufferOptions& options);
 // The near distance a build around `centre` uses: options.near_distance, or when 0 the
 // default for the farthest vertex. Throws InputError for a bad option.
 double abuffer_near_distance(const SceneData& scene, const glm::dvec3& centre, const ABufferOptions& options);

@@ -71,46 +71,64 @@ bool ListComparison::within_bounds() const {
   return true;
 }
 
+namespace {
+
+// One view's lists into `r`; `where` names a pixel of it ("face 2 texel", "pixel").
+void compare_view(const ABuffer& a, const ABuffer& b, const std::string& where, const char* a_name, const char* b_name,
+                  ListComparison* r) {
+  ABCUBE_CHECK(a.view.width == b.view.width && a.view.height == b.view.height,
+               "compare_lists: A-buffers of different sizes");
+  // The first of each class: where (pixel, fragment index or -1) and what.
+  const auto note = [&](ListDifference d, int x, int y, int i, const auto& what) {
+    const size_t k = static_cast<size_t>(d);
+    if (r->count[k]++ > 0) return;
+    r->example[k] = where + " (" + std::to_string(x) + ", " + std::to_string(y) + ")" +
+                    (i >= 0 ? " fragment " + std::to_string(i) : std::string()) + ": " + what();
+  };
+  for (int y = 0; y < a.view.height; ++y) {
+    for (int x = 0; x < a.view.width; ++x) {
+      const FragmentList la = a.list(x, y), lb = b.list(x, y);
+      ++r->lists;
+      if (la.size() != lb.size()) {
+        note(ListDifference::length, x, y, -1, [&] {
+          return std::string(a_name) + " " + std::to_string(la.size()) + " fragments, " + b_name + " " +
+                 std::to_string(lb.size());
+        });
+        continue;
+      }
+      bool identical = true;
+      for (size_t i = 0; i < la.size(); ++i) {
+        ++r->fragments;
+        ListDifference d;
+        if (!classify(la[i], lb[i], r, &d)) {
+          ++r->fragments_identical;
+          continue;
+        }
+        identical = false;
+        note(d, x, y, static_cast<int>(i), [&] {
+          return std::string(a_name) + " {" + describe(la[i]) + "}, " + b_name + " {" + describe(lb[i]) + "}";
+        });
+      }
+      r->lists_identical += identical;
+    }
+  }
+}
+
+}  // namespace
+
 ListComparison compare_lists(const CubeABuffer& a, const CubeABuffer& b, const char* a_name, const char* b_name) {
   ABCUBE_CHECK(a.n == b.n, "compare_lists: cube A-buffers of different resolutions");
   ListComparison r;
-  // The first of each class: where (face, texel, fragment index or -1) and what.
-  const auto note = [&](ListDifference d, int f, int x, int y, int i, const auto& what) {
-    const size_t k = static_cast<size_t>(d);
-    if (r.count[k]++ > 0) return;
-    r.example[k] = "face " + std::to_string(f) + " texel (" + std::to_string(x) + ", " + std::to_string(y) + ")" +
-                   (i >= 0 ? " fragment " + std::to_string(i) : std::string()) + ": " + what();
-  };
   for (int f = 0; f < CUBE_FACES; ++f) {
-    const ABuffer &fa = a.faces[static_cast<size_t>(f)], &fb = b.faces[static_cast<size_t>(f)];
-    for (int y = 0; y < a.n; ++y) {
-      for (int x = 0; x < a.n; ++x) {
-        const FragmentList la = fa.list(x, y), lb = fb.list(x, y);
-        ++r.lists;
-        if (la.size() != lb.size()) {
-          note(ListDifference::length, f, x, y, -1, [&] {
-            return std::string(a_name) + " " + std::to_string(la.size()) + " fragments, " + b_name + " " +
-                   std::to_string(lb.size());
-          });
-          continue;
-        }
-        bool identical = true;
-        for (size_t i = 0; i < la.size(); ++i) {
-          ++r.fragments;
-          ListDifference d;
-          if (!classify(la[i], lb[i], &r, &d)) {
-            ++r.fragments_identical;
-            continue;
-          }
-          identical = false;
-          note(d, f, x, y, static_cast<int>(i), [&] {
-            return std::string(a_name) + " {" + describe(la[i]) + "}, " + b_name + " {" + describe(lb[i]) + "}";
-          });
-        }
-        r.lists_identical += identical;
-      }
-    }
+    compare_view(a.faces[static_cast<size_t>(f)], b.faces[static_cast<size_t>(f)],
+                 "face " + std::to_string(f) + " texel", a_name, b_name, &r);
   }
+  return r;
+}
+
+ListComparison compare_lists(const ABuffer& a, const ABuffer& b, const char* a_name, const char* b_name) {
+  ListComparison r;
+  compare_view(a, b, "pixel", a_name, b_name, &r);
   return r;
 }
 

@@ -1,4 +1,4 @@
-// Two builds of one cube A-buffer compared list by list and fragment by fragment (the CPU
+// Two builds of one A-buffer (a cube's or the camera's) compared list by list and fragment by fragment (the CPU
 // core's against the GPU's, host/gl/gl_abuffer.hpp; `abcube crosscheck`): each difference
 // put in one class, the first of its class kept as an example.
 #pragma once
@@ -42,6 +42,9 @@ struct ListComparison {
 // `a` and `b` must have the same n; a fragment is put in the first class it shows, in the
 // order of ListDifference.
 ListComparison compare_lists(const CubeABuffer& a, const CubeABuffer& b, const char* a_name = "CPU",
+                             const char* b_name = "GPU");
+// The camera's A-buffers (`a` and `b` of the same size): the examples name a pixel.
+ListComparison compare_lists(const ABuffer& a, const ABuffer& b, const char* a_name = "CPU",
                              const char* b_name = "GPU");
 
 }  // namespace abcube

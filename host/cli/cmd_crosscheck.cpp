@@ -21,10 +21,22 @@ namespace abcube {
 namespace {
 
 constexpr const char* CROSSCHECK_COVERS =
-    "covers: visibility (cube texels, camera samples), the cube A-buffer's lists, direct shading of interior pixels, "
-    "hard "
-    "shadows; not "
-    "covered: reflections, refractions, antialiased edges (abcube report compares whole images with the exact tracer)";
+    "covers: visibility (cube texels, camera samples), the cube's and the camera's A-buffer lists, direct shading of "
+    "interior pixels, hard shadows; not covered: reflections, refractions, antialiased edges (abcube report compares "
+    "whole images with the exact tracer)";
+
+// A GPU build's lists against the CPU's: the counts, then each class of difference found.
+void print_lists(const char* what, const ListComparison& c, double ms) {
+  std::printf("%s: %llu of %llu identical, fragments %llu of %llu (%.1f ms)\n", what,
+              static_cast<unsigned long long>(c.lists_identical), static_cast<unsigned long long>(c.lists),
+              static_cast<unsigned long long>(c.fragments_identical), static_cast<unsigned long long>(c.fragments), ms);
+  for (int k = 0; k < LIST_DIFFERENCE_CLASSES; ++k) {
+    const size_t i = static_cast<size_t>(k);
+    if (c.count[i] == 0) continue;
+    std::printf("  %s: %llu, first at %s\n", list_difference_name(static_cast<ListDifference>(k)),
+                static_cast<unsigned long long>(c.count[i]), c.example[i].c_str());
+  }
+}
 
 struct CrosscheckCommand {
   std::string scene_path, stats_path, samples_image, shadow_image, gl = "auto";
@@ -62,17 +74,8 @@ struct CrosscheckCommand {
     std::printf("same object id: %.5f (>= %.3f)\n", r.same_object, tol.same_object_min);
     std::printf("exact ties (two objects at the same distance, tie_rule.hpp): %zu texels, resolved alike %zu\n", r.tied,
                 r.tied_agree);
-    std::printf("GPU cube A-buffer lists: %llu of %llu identical, fragments %llu of %llu (%.1f ms)\n",
-                static_cast<unsigned long long>(r.lists.lists_identical),
-                static_cast<unsigned long long>(r.lists.lists),
-                static_cast<unsigned long long>(r.lists.fragments_identical),
-                static_cast<unsigned long long>(r.lists.fragments), r.gpu_abuffer_ms);
-    for (int k = 0; k < LIST_DIFFERENCE_CLASSES; ++k) {
-      const size_t i = static_cast<size_t>(k);
-      if (r.lists.count[i] == 0) continue;
-      std::printf("  %s: %llu, first at %s\n", list_difference_name(static_cast<ListDifference>(k)),
-                  static_cast<unsigned long long>(r.lists.count[i]), r.lists.example[i].c_str());
-    }
+    print_lists("GPU cube A-buffer lists", r.lists, r.gpu_abuffer_ms);
+    print_lists("GPU camera A-buffer lists", r.camera_lists, r.gpu_camera_abuffer_ms);
     std::printf("camera interior pixels: %zu of %zu, RMSE %.2e (<= %.0e), max abs %.2e (<= %.2e)\n", r.interior_pixels,
                 r.pixels, r.interior_rmse, tol.interior_rmse, r.interior_max_abs, tol.interior_max_abs);
     std::printf(

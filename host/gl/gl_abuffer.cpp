@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "base/error.hpp"
@@ -16,6 +17,7 @@
 #include "gl/glsl_shared.hpp"
 #include "raster/cube_map.hpp"
 #include "raster/raster.hpp"
+#include "scene/camera.hpp"
 #include "scene/scene_load.hpp"
 
 namespace abcube {
@@ -45,10 +47,10 @@ struct GpuView {
   double to_dir[3][4];
   double row_x[4], row_y[4], row_w[4];
   double near_distance;
-  int32_t size, first_pixel;
+  int32_t width, first_pixel;
   uint32_t pad[4];
 };
-static_assert(sizeof(GpuView) == 224 && offsetof(GpuView, size) == 200, "GpuView must match View");
+static_assert(sizeof(GpuView) == 224 && offsetof(GpuView, width) == 200, "GpuView must match View");
 
 void put(double* out, const glm::dvec3& v, double w = 0.0) {
   out[0] = v.x;
@@ -88,26 +90,27 @@ GpuView pack(const RasterView& v, int first_pixel) {
   put(g.row_y, v.row_y);
   put(g.row_w, v.row_w);
   g.near_distance = v.near_distance;
-  g.size = v.width;
+  g.width = v.width;
   g.first_pixel = first_pixel;
   return g;
 }
 
-// One face's visible (triangle, face) pairs, set up, and its counts for the stats.
-struct FaceSetups {
+// One view's visible (triangle, view) pairs, set up, and its counts for the stats.
+struct ViewSetups {
   std::vector<GpuSetup> setups;
   uint64_t clipped = 0, degenerate = 0, edge_on = 0;
 };
 
-FaceSetups set_up_face(const TriangleSoup& soup, const std::vector<uint8_t>& faces_of, const RasterView& view,
-                       int face) {
-  FaceSetups out;
+// `views_of` (optional, one byte a triangle, as the CPU build's): bit `v` clear where view `v`
+// is known to cover none of the triangle's samples, which is then culled unset up.
+ViewSetups set_up_view(const TriangleSoup& soup, const uint8_t* views_of, const RasterView& view, int v) {
+  ViewSetups out;
   TriangleSetup s;
   for (uint32_t t = 0; t < static_cast<uint32_t>(soup.triangle_count()); ++t) {
-    if (!((faces_of[t] >> face) & 1u)) continue;
+    if (views_of && !((views_of[t] >> v) & 1u)) continue;
     switch (setup_triangle(view, soup, t, &s)) {
       case SetupResult::visible:
-        out.setups.push_back(pack(s, face));
+        out.setups.push_back(pack(s, v));
         out.clipped += s.near_clipped() ? 1 : 0;
         break;
       case SetupResult::degenerate: ++out.degenerate; break;
@@ -185,57 +188,115 @@ uint64_t scan(const GlProgram& p, const GlBuffer& values, uint64_t count, bool t
 
 std::string mib(uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20); }
 
-// The kept lists (kept[p] fragments from offsets[p] of `raw`) as one ABuffer per face.
-void compact_faces(const std::vector<RasterView>& rasters, const std::vector<uint32_t>& offsets,
-                   const std::vector<uint32_t>& kept, const std::vector<Fragment>& raw, CubeABuffer* cube) {
-  const size_t face_pixels = static_cast<size_t>(cube->n) * static_cast<size_t>(cube->n);
-  for (size_t f = 0; f < CUBE_FACES; ++f) {
-    ABuffer& b = cube->faces[f];
-    b.view = rasters[f];
-    b.offsets.assign(face_pixels + 1, 0);
+// The count and fill passes' work items: (setup, tile) for every ABUFFER_TILE-square tile
+// of each setup's pixel bounds, so that no invocation walks more than a tile.
+std::vector<uint32_t> work_items(const std::vector<GpuSetup>& setups) {
+  std::vector<uint32_t> items;
+  for (uint32_t i = 0; i < static_cast<uint32_t>(setups.size()); ++i) {
+    const GpuSetup& s = setups[i];
+    const uint32_t across = static_cast<uint32_t>((s.x1 - s.x0 + ABUFFER_TILE - 1) / ABUFFER_TILE);
+    const uint32_t down = static_cast<uint32_t>((s.y1 - s.y0 + ABUFFER_TILE - 1) / ABUFFER_TILE);
+    for (uint32_t t = 0; t < across * down; ++t) items.insert(items.end(), {i, t});
+  }
+  return items;
+}
+
+// What one build is: its views in the build's pixel order (view v from first_pixel[v]), the
+// views each triangle may cover (optional), and the words of its errors.
+struct ViewSet {
+  std::vector<RasterView> rasters;
+  std::vector<uint64_t> first_pixel;
+  uint64_t pixels = 0;
+  const std::vector<uint8_t>* views_of = nullptr;
+  const char* what;   // "cube A-buffer (GPU)"
+  const char* lower;  // the option that lowers its size
+};
+
+ViewSet view_set(std::vector<RasterView> rasters, const char* what, const char* lower) {
+  ViewSet set{std::move(rasters), {}, 0, nullptr, what, lower};
+  for (const RasterView& r : set.rasters) {
+    set.first_pixel.push_back(set.pixels);
+    set.pixels += r.pixel_count();
+  }
+  return set;
+}
+
+// The lists longer than ABUFFER_GPU_LIST_MAX, which the finish pass left as filled,
+// finished by the CPU's rule in `raw`: their kept counts into `kept`, the cap's drops into
+// *dropped, the longest into *max_list.
+void finish_long_lists(const TriangleSoup& soup, const ABufferOptions& options, const std::vector<uint32_t>& offsets,
+                       std::vector<uint32_t>* kept, std::vector<Fragment>* raw, uint64_t* dropped, uint32_t* max_list) {
+  for (size_t p = 0; p < offsets.size(); ++p) {
+    const uint32_t count = (*kept)[p];
+    if (count <= ABUFFER_GPU_LIST_MAX) continue;
+    (*kept)[p] = finish_fragment_list(soup, options, raw->data() + offsets[p], count, dropped);
+    *max_list = std::max(*max_list, (*kept)[p]);
+  }
+}
+
+// The kept lists (kept[p] fragments from offsets[p] of `raw`) as one ABuffer per view.
+std::vector<ABuffer> compact_views(const ViewSet& set, const std::vector<uint32_t>& offsets,
+                                   const std::vector<uint32_t>& kept, const std::vector<Fragment>& raw) {
+  std::vector<ABuffer> out(set.rasters.size());
+  for (size_t v = 0; v < out.size(); ++v) {
+    ABuffer& b = out[v];
+    b.view = set.rasters[v];
+    const size_t first = set.first_pixel[v], pixels = b.view.pixel_count();
+    b.offsets.assign(pixels + 1, 0);
     size_t total = 0;
-    for (size_t p = 0; p < face_pixels; ++p) total += kept[f * face_pixels + p];
+    for (size_t p = 0; p < pixels; ++p) total += kept[first + p];
     b.fragments.resize(total);
     uint32_t write = 0;
-    for (size_t p = 0; p < face_pixels; ++p) {
-      const size_t g = f * face_pixels + p;
+    for (size_t p = 0; p < pixels; ++p) {
+      const size_t g = first + p;
       b.offsets[p] = write;
       std::copy_n(raw.begin() + offsets[g], kept[g], b.fragments.begin() + write);
       write += kept[g];
     }
-    b.offsets[face_pixels] = write;
+    b.offsets[pixels] = write;
   }
+  return out;
 }
 
 // The GL passes' run, from the uploaded setups to the read-back lists.
 struct GpuRun {
-  uint64_t raw = 0;
-  uint32_t max_list = 0, dropped = 0;
+  std::vector<ABuffer> views;
+  uint64_t raw = 0, dropped = 0;
+  uint32_t max_list = 0;
   double count_ms = 0;
 };
 
-GpuRun run_passes(const SceneData& scene, const std::vector<GpuSetup>& setups, const std::vector<GpuView>& views,
-                  const std::vector<RasterView>& rasters, const ABufferOptions& options, uint64_t index_bytes,
-                  uint64_t budget, CubeABuffer* cube, Clock::time_point start) {
+}  // namespace
+
+struct GlABufferBuilder::Programs {
+  GlProgram count{std::vector<const char*>{"abuffer_common.glsl", "abuffer_count.comp"}};
+  GlProgram scan{std::vector<const char*>{"abuffer_scan.comp"}};
+  GlProgram fill{std::vector<const char*>{"abuffer_common.glsl", "abuffer_fill.comp"}};
+  GlProgram finish{std::vector<const char*>{"abuffer_common.glsl", "abuffer_finish.comp"}};
+};
+
+namespace {
+
+GpuRun run_passes(const GlABufferBuilder::Programs& programs, const SceneData& scene,
+                  const std::vector<GpuSetup>& setups, const std::vector<uint32_t>& items, const ViewSet& set,
+                  const ABufferOptions& options, uint64_t index_bytes, uint64_t budget, Clock::time_point start) {
   const TriangleSoup& soup = *scene.triangles;
-  const uint64_t pixels = CUBE_FACES * static_cast<uint64_t>(cube->n) * static_cast<uint64_t>(cube->n);
+  const uint64_t pixels = set.pixels;
+  std::vector<GpuView> views;
+  for (size_t v = 0; v < set.rasters.size(); ++v)
+    views.push_back(pack(set.rasters[v], static_cast<int>(set.first_pixel[v])));
   std::vector<uint32_t> object_material(2 * soup.triangle_count());
   for (size_t t = 0; t < soup.triangle_count(); ++t) {
     object_material[2 * t] = soup.object_id[t];
     object_material[2 * t + 1] = soup.material_id[t];
   }
-  const GlProgram count({"abuffer_common.glsl", "abuffer_count.comp"});
-  const GlProgram scan_program({"abuffer_scan.comp"});
-  const GlProgram fill({"abuffer_common.glsl", "abuffer_fill.comp"});
-  const GlProgram finish({"abuffer_common.glsl", "abuffer_finish.comp"});
   const GlBuffer setup_buffer(setups.size() * sizeof(GpuSetup), setups.data());
+  const GlBuffer item_buffer(items.size() * sizeof(uint32_t), items.data());
   const GlBuffer view_buffer(views.size() * sizeof(GpuView), views.data());
   const GlBuffer triangles(object_material.size() * sizeof(uint32_t), object_material.data());
   const GlBuffer offsets(pixels * sizeof(uint32_t), nullptr), cursors(pixels * sizeof(uint32_t), nullptr);
   const uint32_t stats_init[2] = {0, 0};
   const GlBuffer stats(sizeof stats_init, stats_init);
-  setup_buffer.bind(ABUFFER_SETUPS_BINDING);
-  view_buffer.bind(ABUFFER_VIEWS_BINDING);
   offsets.zero();
   cursors.zero();
 
@@ -243,22 +304,23 @@ GpuRun run_passes(const SceneData& scene, const std::vector<GpuSetup>& setups, c
   const auto setup_pass = [&](const GlProgram& p) {
     p.use();
     setup_buffer.bind(ABUFFER_SETUPS_BINDING);
+    item_buffer.bind(ABUFFER_ITEMS_BINDING);
     view_buffer.bind(ABUFFER_VIEWS_BINDING);
     glUniform1d(p.uniform("trivial_rel"), RASTER_TRIVIAL_REL);
-    glUniform1ui(p.uniform("setup_count"), static_cast<GLuint>(setups.size()));
-    dispatch(p, setups.size());
+    glUniform1ui(p.uniform("item_count"), static_cast<GLuint>(items.size() / 2));
+    dispatch(p, (items.size() / 2 + 63) / 64);
   };
   offsets.bind(ABUFFER_OFFSETS_BINDING);
-  setup_pass(count);
-  run.raw = scan(scan_program, offsets, pixels, true);
+  setup_pass(programs.count);
+  run.raw = scan(programs.scan, offsets, pixels, true);
   run.count_ms = ms_since(start);
-  if (run.raw > std::numeric_limits<uint32_t>::max()) {
-    throw InputError("cube A-buffer (GPU): more than 2^32 fragments (" + std::to_string(run.raw) +
-                     "); lower --cube-res");
+  if (run.raw > std::numeric_limits<uint32_t>::max()) {  // the offsets are 32 bits
+    throw InputError(std::string(set.what) + ": more than 2^32 fragments (" + std::to_string(run.raw) + "); lower " +
+                     set.lower);
   }
   // The fragments twice (the GPU's array and its copy read back) and the per-pixel index.
   const uint64_t estimate = index_bytes + 2 * run.raw * sizeof(Fragment);
-  check_abuffer_budget("cube A-buffer (GPU)", estimate,
+  check_abuffer_budget(set.what, estimate,
                        std::to_string(run.raw) + " fragments at " + std::to_string(sizeof(Fragment)) +
                            " bytes, on the GPU and read back, and " + mib(index_bytes) + " MiB of set-up and index",
                        options, budget);
@@ -266,8 +328,9 @@ GpuRun run_passes(const SceneData& scene, const std::vector<GpuSetup>& setups, c
   offsets.bind(ABUFFER_OFFSETS_BINDING);
   cursors.bind(ABUFFER_CURSORS_BINDING);
   fragments.bind(ABUFFER_FRAGMENTS_BINDING);
-  setup_pass(fill);
+  setup_pass(programs.fill);
 
+  const GlProgram& finish = programs.finish;
   finish.use();
   triangles.bind(ABUFFER_TRIANGLES_BINDING);
   stats.bind(ABUFFER_STATS_BINDING);
@@ -282,55 +345,43 @@ GpuRun run_passes(const SceneData& scene, const std::vector<GpuSetup>& setups, c
   const std::vector<uint32_t> stat_values = stats.read<uint32_t>(2);
   run.max_list = stat_values[0];
   run.dropped = stat_values[1];
-  compact_faces(rasters, offsets.read<uint32_t>(pixels), cursors.read<uint32_t>(pixels),
-                fragments.read<Fragment>(run.raw), cube);
+  const std::vector<uint32_t> starts = offsets.read<uint32_t>(pixels);
+  std::vector<uint32_t> kept = cursors.read<uint32_t>(pixels);
+  std::vector<Fragment> raw = fragments.read<Fragment>(run.raw);
+  finish_long_lists(soup, options, starts, &kept, &raw, &run.dropped, &run.max_list);
+  run.views = compact_views(set, starts, kept, raw);
   return run;
 }
 
-}  // namespace
-
-CubeABuffer build_cube_abuffer_gl(const SceneData& scene, const glm::dvec3& centre, int n,
-                                  const ABufferOptions& options, ABufferStats* stats) {
-  if (n < 1) throw InputError("cube A-buffer (GPU): resolution must be >= 1, got " + std::to_string(n));
-  if (!std::isfinite(centre.x) || !std::isfinite(centre.y) || !std::isfinite(centre.z)) {
-    throw InputError("cube A-buffer (GPU): the centre must be finite");
-  }
+// The lists of every view of `set` (build_views of raster/abuffer.cpp, on the GPU).
+std::vector<ABuffer> build_views_gl(const GlABufferBuilder::Programs& programs, const SceneData& scene,
+                                    const ViewSet& set, const ABufferOptions& options, ABufferStats* stats) {
   const Clock::time_point start = Clock::now();
-  const double near = abuffer_near_distance(scene, centre, options);
   const TriangleSoup& soup = *scene.triangles;
-  CubeABuffer cube;
-  cube.n = n;
-  cube.centre = centre;
-  cube.near_distance = near;
-  const uint64_t face_pixels = static_cast<uint64_t>(n) * static_cast<uint64_t>(n);
   const uint64_t budget = memory_budget_bytes(options.max_memory_bytes);
   // The per-pixel offsets and cursors on the GPU and read back: the index alone first.
-  uint64_t index_bytes = 4 * CUBE_FACES * face_pixels * sizeof(uint32_t);
-  check_abuffer_budget("cube A-buffer (GPU)", index_bytes, "its per-pixel index alone", options, budget);
+  uint64_t index_bytes = 4 * set.pixels * sizeof(uint32_t);
+  check_abuffer_budget(set.what, index_bytes, "its per-pixel index alone", options, budget);
 
-  std::vector<RasterView> rasters;
-  std::vector<GpuView> views;
-  for (int f = 0; f < CUBE_FACES; ++f) {
-    rasters.push_back(cube_face_view(f, centre, n, near));
-    views.push_back(pack(rasters.back(), static_cast<int>(f * face_pixels)));
-  }
-  const std::vector<uint8_t> faces_of = triangle_cube_faces(soup, centre, options.threads);
-  std::vector<FaceSetups> faces(CUBE_FACES);
-  const int threads = thread_count(options.threads, CUBE_FACES);
-  parallel_for(CUBE_FACES, threads,
-               [&](size_t f, int) { faces[f] = set_up_face(soup, faces_of, rasters[f], static_cast<int>(f)); });
+  std::vector<ViewSetups> per_view(set.rasters.size());
+  const int threads = thread_count(options.threads, per_view.size());
+  const uint8_t* views_of = set.views_of ? set.views_of->data() : nullptr;
+  parallel_for(per_view.size(), threads,
+               [&](size_t v, int) { per_view[v] = set_up_view(soup, views_of, set.rasters[v], static_cast<int>(v)); });
   std::vector<GpuSetup> setups;
   ABufferStats st;
-  for (const FaceSetups& f : faces) {
-    setups.insert(setups.end(), f.setups.begin(), f.setups.end());
-    st.triangles_clipped += f.clipped;
+  for (const ViewSetups& v : per_view) {
+    setups.insert(setups.end(), v.setups.begin(), v.setups.end());
+    st.triangles_clipped += v.clipped;
   }
-  st.triangles_degenerate = faces.front().degenerate;  // every face counts them (triangle_cube_faces)
-  st.triangles_edge_on = faces.front().edge_on;
-  faces = std::vector<FaceSetups>();
-  index_bytes += setups.size() * sizeof(GpuSetup) + soup.triangle_count() * 2 * sizeof(uint32_t);
+  st.triangles_degenerate = per_view.front().degenerate;  // every view counts them (as the CPU's bins)
+  st.triangles_edge_on = per_view.front().edge_on;
+  per_view = std::vector<ViewSetups>();
+  const std::vector<uint32_t> items = work_items(setups);
+  index_bytes +=
+      setups.size() * sizeof(GpuSetup) + items.size() * sizeof(uint32_t) + soup.triangle_count() * 2 * sizeof(uint32_t);
 
-  const GpuRun run = run_passes(scene, setups, views, rasters, options, index_bytes, budget, &cube, start);
+  GpuRun run = run_passes(programs, scene, setups, items, set, options, index_bytes, budget, start);
   if (stats) {
     std::vector<unsigned char> seen(soup.triangle_count(), 0);
     for (const GpuSetup& s : setups) seen[s.id & ~Fragment::BACK_FACE_BIT] = 1;
@@ -340,21 +391,63 @@ CubeABuffer build_cube_abuffer_gl(const SceneData& scene, const glm::dvec3& cent
     st.raw_fragments = run.raw;
     st.max_list_length = run.max_list;
     st.dropped_by_cap = run.dropped;
-    for (const ABuffer& b : cube.faces) {
+    for (const ABuffer& b : run.views) {
       st.fragments_per_view.push_back(b.fragments.size());
       st.fragments += b.fragments.size();
       st.bytes_total += b.fragments.size() * sizeof(Fragment) + b.offsets.size() * sizeof(uint32_t);
     }
     st.estimated_bytes = index_bytes + 2 * run.raw * sizeof(Fragment);
     st.budget_bytes = budget;
-    st.near_distance = near;
+    st.near_distance = set.rasters.front().near_distance;
     st.count_ms = run.count_ms;
     st.total_ms = ms_since(start);
     st.fill_ms = st.total_ms - run.count_ms;
     st.threads = threads;
     *stats = std::move(st);
   }
+  return std::move(run.views);
+}
+
+}  // namespace
+
+GlABufferBuilder::GlABufferBuilder() {
+  GLint bindings = 0;
+  glGetIntegerv(GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS, &bindings);
+  if (bindings <= static_cast<GLint>(ABUFFER_ITEMS_BINDING)) {
+    throw RuntimeFailure("GPU A-buffer: the GL offers " + std::to_string(bindings) + " storage buffer bindings, " +
+                         std::to_string(ABUFFER_ITEMS_BINDING + 1) + " needed");
+  }
+  programs_ = std::make_unique<Programs>();
+}
+GlABufferBuilder::~GlABufferBuilder() = default;
+
+CubeABuffer GlABufferBuilder::cube(const SceneData& scene, const glm::dvec3& centre, int n,
+                                   const ABufferOptions& options, ABufferStats* stats) const {
+  const char* what = "cube A-buffer (GPU)";
+  ViewSet set = view_set(cube_build_views(what, scene, centre, n, options), what, "--cube-res");
+  const double near = set.rasters.front().near_distance;
+  const std::vector<uint8_t> faces_of = triangle_cube_faces(*scene.triangles, centre, options.threads);
+  set.views_of = &faces_of;
+  std::vector<ABuffer> faces = build_views_gl(*programs_, scene, set, options, stats);
+  CubeABuffer cube;
+  cube.n = n;
+  cube.centre = centre;
+  cube.near_distance = near;
+  for (size_t f = 0; f < faces.size(); ++f) cube.faces[f] = std::move(faces[f]);
   return cube;
+}
+
+ABuffer GlABufferBuilder::camera(const SceneData& scene, const ABufferOptions& options, ABufferStats* stats) const {
+  const CameraFrame frame = make_camera_frame(scene.camera);
+  const double near = abuffer_near_distance(scene, frame.eye, options);
+  const ViewSet set = view_set({camera_view(frame, near)}, "camera A-buffer (GPU)", "the image size");
+  std::vector<ABuffer> one = build_views_gl(*programs_, scene, set, options, stats);
+  return std::move(one.front());
+}
+
+CubeABuffer build_cube_abuffer_gl(const SceneData& scene, const glm::dvec3& centre, int n,
+                                  const ABufferOptions& options, ABufferStats* stats) {
+  return GlABufferBuilder().cube(scene, centre, n, options, stats);
 }
 
 }  // namespace abcube

@@ -49,6 +49,10 @@ std::unique_ptr<GlContext> create_osmesa_context(std::string* why);
 // Fills gl_version, gl_renderer and gl_vendor from the current context ("" if GL has none).
 void read_gl_strings(GlInfo* info);
 
+// Whether a GL_RENDERER string names one of Mesa's software rasterizers (llvmpipe, softpipe,
+// swrast): Mesa may serve a DRM device in software too (kms_swrast), so the renderer decides.
+bool software_renderer(const std::string& renderer);
+
 // EGL devices visible here (empty with *why set if enumeration is unavailable).
 std::vector<EglDeviceInfo> list_egl_devices(std::string* why);
 

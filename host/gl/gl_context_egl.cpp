@@ -175,15 +175,14 @@ std::unique_ptr<EglContext> start_device(EGLDeviceEXT device, int index, std::st
   return ctx;
 }
 
-// Mesa may serve a DRM device in software too (kms_swrast): judge by the renderer.
+}  // namespace
+
 bool software_renderer(const std::string& renderer) {
   for (const char* name : {"llvmpipe", "softpipe", "swrast", "Software Rasterizer"}) {
     if (renderer.find(name) != std::string::npos) return true;
   }
   return false;
 }
-
-}  // namespace
 
 std::unique_ptr<GlContext> create_egl_device_context(int device_index, std::string* why) {
   const std::vector<EGLDeviceEXT> devices = query_devices(why);

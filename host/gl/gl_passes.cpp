@@ -7,6 +7,7 @@
 
 #include "base/error.hpp"
 #include "base/timer.hpp"
+#include "gl/gl_abuffer.hpp"
 #include "gl/gl_camera_exact.hpp"
 #include "gl/gl_scene_parts.hpp"
 #include "raster/cube_map.hpp"
@@ -56,6 +57,11 @@ const std::vector<uint8_t>& GlScene::exact_pixels() const { return exact_->pixel
 
 void GlScene::set_texture_level0(bool on) { parts_->texture_level0 = on; }
 const GpuTimings& GlScene::timings() const { return parts_->timings; }
+
+const GlABufferBuilder& GlScene::abuffer_builder() {
+  if (!abuffer_) abuffer_ = std::make_unique<GlABufferBuilder>();
+  return *abuffer_;
+}
 bool GlScene::soup_pinned() const { return parts_->buffers.pinned(); }
 bool GlScene::triangle_ids() const { return parts_->buffers.triangle_ids(); }
 double GlScene::near_distance() const { return parts_->buffers.near_distance(); }

@@ -20,6 +20,7 @@
 
 namespace abcube {
 
+class GlABufferBuilder;
 class GlExactCamera;
 struct GlSceneParts;
 
@@ -100,12 +101,16 @@ class GlScene {
   double near_distance() const;
   int max_size() const;
 
+  // The A-buffers' compute passes (gl_abuffer.hpp), compiled on first use and kept with the
+  // scene, so that the renders of one upload compile them once.
+  const GlABufferBuilder& abuffer_builder();
   // The techniques' shared parts, for the passes outside this class (gl_shadow_probe.hpp).
   GlSceneParts& parts() { return *parts_; }
 
  private:
   std::unique_ptr<GlSceneParts> parts_;
   std::unique_ptr<GlExactCamera> exact_;
+  std::unique_ptr<GlABufferBuilder> abuffer_;
   int camera_layers_ = 0;
   bool camera_layers_capped_ = false;
 };

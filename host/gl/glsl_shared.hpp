@@ -39,9 +39,16 @@ constexpr unsigned VOLUME_CAPS_BINDING = 6;
 constexpr unsigned OBJECT_IDS_BINDING = 8;
 constexpr unsigned MATERIAL_IDS_BINDING = 9;
 
-// Storage buffer bindings of the GPU cube A-buffer's compute passes (gl_abuffer.cpp,
+// Storage buffer bindings of the GPU A-buffer's compute passes (gl_abuffer.cpp,
 // abuffer_*.comp): after the scene's, so that a build leaves the scene's bindings alone. The
 // scan (abuffer_scan.comp) runs on blocks of ABUFFER_SCAN_BLOCK values, one workgroup each.
+// Each invocation's work is bounded, because Mesa's llvmpipe ends a shader invocation's loops,
+// silently, after 65535 iterations in all (gallivm's LP_MAX_TGSI_LOOP_ITERATIONS): the count
+// and fill passes walk a triangle's pixels in tiles of ABUFFER_TILE x ABUFFER_TILE, an
+// invocation a tile (64 tiles a workgroup: a small triangle's tile does not hold a workgroup
+// of mostly idle invocations), and the finish pass sorts and merges lists of up to
+// ABUFFER_GPU_LIST_MAX fragments, leaving longer ones to the CPU's finish
+// (finish_fragment_list).
 constexpr unsigned ABUFFER_SETUPS_BINDING = 10;
 constexpr unsigned ABUFFER_VIEWS_BINDING = 11;
 constexpr unsigned ABUFFER_OFFSETS_BINDING = 12;
@@ -51,7 +58,10 @@ constexpr unsigned ABUFFER_TRIANGLES_BINDING = 15;
 constexpr unsigned ABUFFER_STATS_BINDING = 16;
 constexpr unsigned ABUFFER_SCAN_VALUES_BINDING = 17;
 constexpr unsigned ABUFFER_SCAN_SUMS_BINDING = 18;
+constexpr unsigned ABUFFER_ITEMS_BINDING = 19;
 constexpr unsigned ABUFFER_SCAN_BLOCK = 512;
+constexpr int ABUFFER_TILE = 8;
+constexpr unsigned ABUFFER_GPU_LIST_MAX = 64;
 
 // Image units of the per-group colour pass (camera_groups.frag): the sample grid it blends
 // into, and the camera's per-pixel colour and weight.

@@ -70,7 +70,7 @@ void compare_cube(const SceneData& scene, int n, int threads, GlScene& gl, Cross
     ABufferOptions gpu_options = options;
     gpu_options.reserved_bytes += stats.bytes_total;
     const Clock::time_point t1 = Clock::now();
-    const CubeABuffer gpu_cube = build_cube_abuffer_gl(scene, scene.camera.position, n, gpu_options);
+    const CubeABuffer gpu_cube = gl.abuffer_builder().cube(scene, scene.camera.position, n, gpu_options);
     r->gpu_abuffer_ms = ms_since(t1);
     r->lists = compare_lists(cube, gpu_cube);
   }
@@ -114,12 +114,25 @@ void compare_cube(const SceneData& scene, int n, int threads, GlScene& gl, Cross
   }
 }
 
+// The GPU's build of the camera's lists against `cpu` (built with `options`, holding
+// `cpu_bytes`), budgeted with the CPU's held beside it, and freed.
+void compare_camera_lists(const SceneData& scene, GlScene& gl, const ABuffer& cpu, ABufferOptions options,
+                          uint64_t cpu_bytes, CrosscheckResult* r) {
+  options.reserved_bytes += cpu_bytes;
+  const Clock::time_point t0 = Clock::now();
+  const ABuffer gpu = gl.abuffer_builder().camera(scene, options);
+  r->gpu_camera_abuffer_ms = ms_since(t0);
+  r->camera_lists = compare_lists(cpu, gpu);
+}
+
 void compare_camera(const SceneData& scene, int threads, GlScene& gl, CrosscheckResult* r) {
   const Image gpu = gl.camera_color(scene.camera);
   ABufferOptions options;
   options.threads = threads;
   options.near_distance = gl.near_distance();
-  const ABuffer camera = build_camera_abuffer(scene, options);
+  ABufferStats stats;
+  const ABuffer camera = build_camera_abuffer(scene, options, &stats);
+  compare_camera_lists(scene, gl, camera, options, stats.bytes_total, r);
   ResolveOptions ro;
   ro.threads = threads;
   const Image cpu =
@@ -345,6 +358,7 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   fail(r.sample_agreement < tol.sample_agreement_min, "camera sample agreement");
   fail(r.volumes.interior_share() < tol.volumes_agreement_min, "shadow volumes against the tracer");
   fail(!r.lists.within_bounds(), "GPU A-buffer lists");
+  fail(!r.camera_lists.within_bounds(), "GPU camera A-buffer lists");
   r.pass = r.failures.empty();
   return r;
 }
@@ -377,6 +391,8 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
   using nlohmann::json;
   return json{{"abuffer_lists", lists_json(r.lists)},
               {"gpu_abuffer_ms", r.gpu_abuffer_ms},
+              {"camera_abuffer_lists", lists_json(r.camera_lists)},
+              {"gpu_camera_abuffer_ms", r.gpu_camera_abuffer_ms},
               {"cube",
                {{"texels", r.texels},
                 {"both_covered", r.both_covered},

@@ -92,6 +92,8 @@ struct CrosscheckResult {
   // fails beyond LIST_DEPTH_REL and LIST_NORMAL_STEPS, or on any other difference.
   ListComparison lists;
   double gpu_abuffer_ms = 0;
+  ListComparison camera_lists;  // the same for the camera's A-buffer
+  double gpu_camera_abuffer_ms = 0;
   double gpu_ms = 0, cpu_ms = 0;  // prepass vs cube A-buffer build
   uint64_t fragments = 0;
   bool pass = false;
