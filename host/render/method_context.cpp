@@ -1,6 +1,9 @@
 #include "render/method_context.hpp"
 
+#include "base/error.hpp"
 #include "base/timer.hpp"
+#include "gl/gl_abuffer.hpp"
+#include "gl/gl_passes.hpp"
 
 namespace abcube {
 
@@ -10,12 +13,31 @@ MapShadingOptions map_shading_options(const MethodContext& mc) {
   return options;
 }
 
+namespace {
+
+// The GL builder of `mc`'s scene when the request builds its A-buffers on GL, else null.
+const GlABufferBuilder* gl_builder(const MethodContext& mc) {
+  if (!mc.request.abuffers_on_gl) return nullptr;
+  ABCUBE_CHECK(mc.gl_scene != nullptr, "A-buffers on GL without the scene on GL");
+  return &mc.gl_scene->abuffer_builder();
+}
+
+}  // namespace
+
+ABuffer build_camera_abuffer(const MethodContext& mc, const ABufferOptions& options, ABufferStats* stats) {
+  const GlABufferBuilder* gl = gl_builder(mc);
+  return gl ? gl->camera(mc.scene, options, stats) : build_camera_abuffer(mc.scene, options, stats);
+}
+
 CubeMap build_cube_map(const MethodContext& mc, int n, const ABufferOptions& options, const RayTracer* reference,
                        const MapShadingOptions& shading) {
   CubeMap m;
   m.n = n;
   Clock::time_point t0 = Clock::now();
-  m.cube = std::make_unique<CubeABuffer>(build_cube_abuffer(mc.scene, mc.scene.camera.position, n, options, &m.stats));
+  const GlABufferBuilder* gl = gl_builder(mc);
+  const glm::dvec3& centre = mc.scene.camera.position;
+  m.cube = std::make_unique<CubeABuffer>(gl ? gl->cube(mc.scene, centre, n, options, &m.stats)
+                                            : build_cube_abuffer(mc.scene, centre, n, options, &m.stats));
   m.build_ms = ms_since(t0);
   t0 = Clock::now();
   m.shader = std::make_unique<MapShader>(mc.scene, *m.cube, shading, reference, &mc.cache);

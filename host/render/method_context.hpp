@@ -32,6 +32,9 @@ struct RenderRequest {
   MapShadingOptions map;       // the map searches: variant, mode, refinement, refraction, lookup, plan
   ExactCameraOptions gpu;      // the GPU's exact camera pass (gl_types.hpp)
   bool target_pilots = false;  // --target-db picks the cube map's N and shading by pilots
+  // The camera's and the cube's A-buffers built by GL compute shaders (gl_abuffer.hpp) on
+  // MethodContext::gl_scene's context, not by the CPU core: the same lists.
+  bool abuffers_on_gl = false;
   std::vector<std::string> aovs;
 };
 
@@ -69,11 +72,13 @@ struct CubeMap {
   double build_ms = 0, setup_ms = 0;
   std::unique_ptr<MapShader> shader;
 };
+// The camera's A-buffer: build_camera_abuffer, or its GL twin where request.abuffers_on_gl.
+ABuffer build_camera_abuffer(const MethodContext& mc, const ABufferOptions& options, ABufferStats* stats);
 // The map searches' options for this render (request.map, and --plan everything's walks).
 MapShadingOptions map_shading_options(const MethodContext& mc);
-// The cube A-buffer around the camera at `n`, within `options`' memory budget, and its
-// shader with `shading`. `reference` (optional): the tracer the searches' ray errors are
-// measured against.
+// The cube A-buffer around the camera at `n` (built on GL where request.abuffers_on_gl),
+// within `options`' memory budget, and its shader with `shading`. `reference` (optional): the
+// tracer the searches' ray errors are measured against.
 CubeMap build_cube_map(const MethodContext& mc, int n, const ABufferOptions& options, const RayTracer* reference,
                        const MapShadingOptions& shading);
 

@@ -17,6 +17,7 @@ std::unique_ptr<RenderMethod> make_map_method(MapVariant variant);
 std::unique_ptr<RenderMethod> make_raytrace_method();
 std::unique_ptr<RenderMethod> make_gpu_method();
 std::unique_ptr<RenderMethod> make_hybrid_method();
+std::unique_ptr<RenderMethod> make_gpu_abuffer_method();
 
 namespace {
 
@@ -55,6 +56,7 @@ Registry& registry() {
     add(r, make_raytrace_method());
     add(r, make_gpu_method());
     add(r, make_hybrid_method());
+    add(r, make_gpu_abuffer_method());
     return true;
   }();
   (void)built_in;

@@ -132,7 +132,7 @@ printf '{"scene": "cornell.json", "out": "g/1.png", "method": "raytrace"}\n{"sce
 "$ABCUBE" batch badvalue.jsonl > /dev/null 2> err; status=$?
 check "bad value: exit 2" [ $status -eq 2 ]
 check "bad value: nothing rendered" [ ! -e g/1.png ]
-check "bad value: named by line and key" grep -q 'badvalue.jsonl:2: "method": must be one of abuffer, zbuffer, envmap, raytrace, gpu, hybrid, got "photon"' err
+check "bad value: named by line and key" grep -q 'badvalue.jsonl:2: "method": must be one of abuffer, zbuffer, envmap, raytrace, gpu, hybrid, gpu_abuffer, got "photon"' err
 printf '{"scene": "cornell.json", "out": "g/1.png", "cube_rez": 64}\n' > typo.jsonl
 "$ABCUBE" batch typo.jsonl > /dev/null 2> err; status=$?
 check "unknown key: exit 2" [ $status -eq 2 ]

@@ -207,7 +207,7 @@ expect_warning usemtl_long 'mmmmmmmm"... (200000 bytes) not found'
 # ---- Bad command lines ------------------------------------------------------------------
 
 expect_rejected unknown_option "--frobnicate" render "$GOOD" --method gpu --gl none --frobnicate
-expect_rejected bad_method "--method: must be one of abuffer, zbuffer, envmap, raytrace, gpu, hybrid, got \"photon\"" render "$GOOD" --method photon --gl none
+expect_rejected bad_method "--method: must be one of abuffer, zbuffer, envmap, raytrace, gpu, hybrid, gpu_abuffer, got \"photon\"" render "$GOOD" --method photon --gl none
 expect_rejected bad_cube_res "--cube-res" render "$GOOD" --method gpu --gl none --cube-res 0
 expect_rejected unknown_command "frobnicate" frobnicate "$GOOD"
 

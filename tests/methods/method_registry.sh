@@ -67,7 +67,7 @@ check "names the readers ($(cat err))" grep -q -- "--samples: not used by method
 "$BIN" render "$SCENE" --method normals --search thesis --gl none -o x.png 2> err
 check "--search with normals: exit 2" test $? -eq 2
 check "an option it does not read ($(cat err))" grep -q -- "--search: not used by method normals (read by abuffer" err
-check "its name in --help" bash -c "'$BIN' render --help | grep -q 'abuffer | zbuffer | envmap | raytrace | gpu | hybrid | normals'"
+check "its name in --help" bash -c "'$BIN' render --help | grep -q 'abuffer | zbuffer | envmap | raytrace | gpu | hybrid | gpu_abuffer | normals'"
 
 # A scene file's render.method.
 /usr/bin/python3 -c 'import json, sys
@@ -85,7 +85,7 @@ check "the batch's image is render's" cmp b.png n.png
 # The program without the unit does not know it.
 "$PLAIN" render "$SCENE" --method normals --gl none -o x.png 2> err
 check "abcube alone: exit 2" test $? -eq 2
-check "abcube alone names its methods ($(cat err))" grep -q -- "--method: must be one of abuffer, zbuffer, envmap, raytrace, gpu, hybrid, got \"normals\"" err
+check "abcube alone names its methods ($(cat err))" grep -q -- "--method: must be one of abuffer, zbuffer, envmap, raytrace, gpu, hybrid, gpu_abuffer, got \"normals\"" err
 
 # Python, through the module built with the unit.
 if [[ -n $PYDIR ]]; then

@@ -73,7 +73,7 @@ def test_the_table_is_whole():
     for option in TABLE:
         assert option["flag"].startswith("--") and option["help"] and option["default"], option
         for method in option["methods"]:
-            assert method in ("abuffer", "zbuffer", "envmap", "raytrace", "gpu", "hybrid"), option
+            assert method in ("abuffer", "zbuffer", "envmap", "raytrace", "gpu", "hybrid", "gpu_abuffer"), option
     # the options the documents promise
     for key in ["method", "cube_res", "max_depth", "width", "height", "size", "fov_y", "camera_position", "look_at",
                 "set", "search", "gpu_shadows", "aovs", "timeout", "threads", "max_memory"]:

@@ -27,6 +27,7 @@ CASES = {
     "raytrace_target_db": ["--method", "raytrace", "--size", "48x36", "--target-db", "30", "--gl", "none"],
     "gpu": ["--method", "gpu", *SMALL, "--gl", "osmesa"],
     "hybrid": ["--method", "hybrid", *SMALL, "--gl", "osmesa"],
+    "gpu_abuffer": ["--method", "gpu_abuffer", *SMALL, "--gl", "osmesa"],
 }
 
 

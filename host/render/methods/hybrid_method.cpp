@@ -8,6 +8,7 @@
 #include "base/timer.hpp"
 #include "raster/edge_ties.hpp"
 #include "reference/raytrace.hpp"
+#include "gl/gl_context.hpp"
 #include "gl/gl_passes.hpp"
 #include "render/method.hpp"
 #include "render/render_methods.hpp"
@@ -56,7 +57,11 @@ size_t trace_edge_ties(MethodContext& mc, const std::vector<uint8_t>& on_gpu, Im
 json render_cpu_pixels(MethodContext& mc, const std::vector<uint8_t>* only, Image* image) {
   json cpu_stats, out;
   RenderRecord cpu_record;
-  MethodContext cpu_mc{mc.scene, mc.cache, mc.request, cpu_stats, cpu_record, mc.progress, nullptr, {}, mc.fallback};
+  // On a hardware GPU its A-buffers are built there (gl_abuffer.hpp, the same lists as the
+  // CPU core's); on Mesa's software GL the CPU core builds them faster.
+  RenderRequest request = mc.request;
+  request.abuffers_on_gl = !software_renderer(mc.record.gl_renderer);
+  MethodContext cpu_mc{mc.scene, mc.cache, request, cpu_stats, cpu_record, mc.progress, mc.gl_scene, {}, mc.fallback};
   const Image part = render_map_method(cpu_mc, only);
   if (only) {
     copy_pixels(part, *only, image);
@@ -67,6 +72,7 @@ json render_cpu_pixels(MethodContext& mc, const std::vector<uint8_t>* only, Imag
   for (const char* key : {"plan", "cube_abuffer", "abuffer", "searches"}) {
     if (cpu_stats.contains(key)) out[key] = cpu_stats[key];
   }
+  out["abuffers_built_on"] = request.abuffers_on_gl ? "gpu" : "cpu";
   return out;
 }
 

@@ -32,7 +32,7 @@ Image render_abuffer_local(MethodContext& mc, const std::vector<uint8_t>* only) 
   const RenderRequest& r = mc.request;
   ABufferStats s;
   Clock::time_point t0 = Clock::now();
-  const ABuffer camera = build_camera_abuffer(scene, r.abuffer, &s);
+  const ABuffer camera = build_camera_abuffer(mc, r.abuffer, &s);
   const double build_ms = ms_since(t0);
   ResolveOptions ro;
   ro.threads = r.abuffer.threads;
@@ -97,7 +97,7 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   ABufferStats as;
   const Clock::time_point camera_start = Clock::now();
   pass_progress(mc, "camera A-buffer", 0.0);
-  const ABuffer camera = build_camera_abuffer(scene, r.abuffer, &as);
+  const ABuffer camera = build_camera_abuffer(mc, r.abuffer, &as);
   pass_progress(mc, "camera A-buffer", 1.0);
   const double camera_ms = ms_since(camera_start);
   ABufferOptions cube_options = r.abuffer;

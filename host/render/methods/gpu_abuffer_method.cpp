@@ -1,0 +1,42 @@
+// The gpu_abuffer method: the abuffer method with its camera's and cube's A-buffers built by
+// GL compute shaders (gl/gl_abuffer.hpp), the same lists as the CPU core's; the searches,
+// the shading and the resolve run on the CPU over them. Its options are abuffer's.
+#include <memory>
+
+#include "render/method.hpp"
+#include "render/render_methods.hpp"
+
+namespace abcube {
+
+std::unique_ptr<RenderMethod> make_map_method(MapVariant variant);  // map_methods.cpp
+
+namespace {
+
+class GpuABufferMethod : public RenderMethod {
+ public:
+  GpuABufferMethod() : abuffer_(make_map_method(MapVariant::abuffer)) {}
+  std::string name() const override { return "gpu_abuffer"; }
+  std::string summary() const override {
+    return "abuffer with its A-buffers built on the GPU by compute shaders (the same lists), searched on the CPU";
+  }
+  std::vector<std::string> reads() const override { return abuffer_->reads(); }
+  void read_options(const RenderOptions& options, const SceneData& view, RenderRequest* request) const override {
+    abuffer_->read_options(options, view, request);
+    request->abuffers_on_gl = true;
+  }
+  bool needs_gl() const override { return true; }
+  Image render(MethodContext& mc) const override {
+    Image image = render_map_method(mc);
+    mc.stats["plan"]["abuffers_built_on"] = "gpu";  // as hybrid's "cpu" object says it
+    return image;
+  }
+
+ private:
+  std::unique_ptr<RenderMethod> abuffer_;
+};
+
+}  // namespace
+
+std::unique_ptr<RenderMethod> make_gpu_abuffer_method() { return std::make_unique<GpuABufferMethod>(); }
+
+}  // namespace abcube
