@@ -109,7 +109,7 @@ case $kind in
     # tests are chosen by GTEST_FILTER patterns, the others by ctest's regular expressions.
     gtest_repeats='RendererApi.HundredEglRenderersInARow:ResourcesApi.ThreeHundredRendersHoldNoMore'
     gtest_repeats+=':SearchHierarchyHalves/*:TargetDb.FinerMeshesThanTheTexelsMoveNUpWhereItShadesForLess'
-    gtest_repeats+=':Scenes/MethodsAgainstReference.*/cornell.json:Raytrace.EmbreeTracerMatchesThePreEmbreeImagesOnEveryRepositoryScene'
+    gtest_repeats+=':Scenes/MethodsAgainstReference.*/cornell:Raytrace.EmbreeTracerMatchesThePreEmbreeImagesOnEveryRepositoryScene'
     gtest_repeats+=':Pov.RepositoryScenesMatchOnTheSharedModel'
     repeats='hard\.generated|cli\.flat_mirrors|cli\.gpu_shading|cli\.determinism|cli\.golden_cli|install\.consumer'
     if [[ $kind == asan-all ]]; then  # every test but the package's layout

@@ -317,7 +317,12 @@ TEST_P(MethodsAgainstReference, AbufferIsClosestToTheExactImage) {
 
 INSTANTIATE_TEST_SUITE_P(Scenes, MethodsAgainstReference,
                          ::testing::Values(MethodCase{"hidden_point.json", 128, 44.6, 1.0},
-                                           MethodCase{"cornell.json", 96, 34.2, 1.0}));
+                                           MethodCase{"cornell.json", 96, 34.2, 1.0}),
+                         // named by the scene ("/cornell"), so that a filter can name it
+                         [](const ::testing::TestParamInfo<MethodCase>& info) {
+                           const std::string file = info.param.scene;
+                           return file.substr(0, file.find('.'));
+                         });
 
 }  // namespace
 }  // namespace abcube
