@@ -9,8 +9,11 @@
 # found, the GPU rows say "no device":
 #   1. abcube info: the EGL devices found, GL_RENDERER and the driver's version
 #   2. the GL tests (the bundle's test_gl, on EGL and OSMesa)
-#   3. crosscheck of every repository scene, with the tolerances used on llvmpipe
-#   4. the race: raytrace, abuffer, gpu and hybrid at 640x480 and 1920x1080, per-pass times
+#   3. crosscheck of every repository scene, with the tolerances used on llvmpipe, the GPU's
+#      A-buffer lists against the CPU's among them
+#   4. the race: raytrace, abuffer, gpu, hybrid and gpu_abuffer at 640x480 and 1920x1080,
+#      per-pass times
+#   4b. gpu_abuffer against abuffer on every repository scene: the same bytes, build times
 #   5. the cube passes and the A-buffer build at N = 512, 1024, 2048, 4096
 #   6. 1000 renders in one process (abcube batch): time per render and peak memory
 # A section that fails is reported as failed and the check goes on; the exit status is 1
@@ -116,7 +119,7 @@ say ""
 say "| size | method | path | total ms | passes (ms) |"
 say "|---|---|---|---|---|"
 for size in $SIZES; do
-  for method in raytrace abuffer gpu hybrid; do
+  for method in raytrace abuffer gpu hybrid gpu_abuffer; do
     for p in $(paths); do
       label=${p%%:*}; gl=${p#*:}
       [ "$method" = raytrace ] || [ "$method" = abuffer ] && [ "$label" = gpu ] && continue
@@ -128,8 +131,32 @@ for size in $SIZES; do
       passes=$(sed -n '/"timings_ms"/,/}/p' "$stats" | grep -v timings_ms | tr -d ' "},' | awk -F: 'NF == 2 {printf "%s%s %.0f", sep, $1, $2; sep = ", "}')
       say "| $size | $method | $label | $(json_ms "$stats" total) | $passes |"
     done
-    if [ $device = none ] && { [ $method = gpu ] || [ $method = hybrid ]; }; then say "| $size | $method | gpu | no device | |"; fi
+    if [ $device = none ] && [ $method != raytrace ] && [ $method != abuffer ]; then say "| $size | $method | gpu | no device | |"; fi
   done
+done
+say ""
+
+# 4b. gpu_abuffer against abuffer: the A-buffers built by the GPU must give abuffer's image.
+say "## 4b. gpu_abuffer against abuffer (${SIZES%% *}, N = 512)"
+say ""
+say "| scene | path | the same bytes | camera A-buffer ms (CPU) | cube A-buffer ms (CPU) |"
+say "|---|---|---|---|---|"
+for scene in "$SCENES"/*.json; do
+  name=$(basename "$scene" .json)
+  if over_budget; then say "| $name | | skipped: over the time budget | | |"; continue; fi
+  "$A" render "$scene" -o "$OUT/ab_cpu.exr" --size "${SIZES%% *}" --cube-res 512 --method abuffer \
+    --stats "$OUT/ab_cpu.json" > "$OUT/ab.log" 2>&1 || { failures=$((failures + 1)); say "| $name | cpu | **failed** | | |"; continue; }
+  for p in $(paths); do
+    label=${p%%:*}; gl=${p#*:}
+    if ! "$A" render "$scene" -o "$OUT/ab_gpu.exr" --size "${SIZES%% *}" --cube-res 512 --method gpu_abuffer --gl "$gl" \
+        --stats "$OUT/ab_gpu.json" > "$OUT/ab.log" 2>&1; then
+      failures=$((failures + 1)); say "| $name | $label | **failed** ($(tail -n 1 "$OUT/ab.log")) | | |"; continue
+    fi
+    same=yes
+    cmp -s "$OUT/ab_cpu.exr" "$OUT/ab_gpu.exr" || same="no: $("$A" compare "$OUT/ab_gpu.exr" "$OUT/ab_cpu.exr" | tr '\n' ' ')"
+    say "| $name | $label | $same | $(json_ms "$OUT/ab_gpu.json" camera_abuffer) ($(json_ms "$OUT/ab_cpu.json" camera_abuffer)) | $(json_ms "$OUT/ab_gpu.json" cube_abuffer) ($(json_ms "$OUT/ab_cpu.json" cube_abuffer)) |"
+  done
+  [ $device = none ] && say "| $name | gpu | no device | | |"
 done
 say ""
 
