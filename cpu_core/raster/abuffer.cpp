@@ -386,10 +386,15 @@ CubeABuffer build_cube_abuffer(const SceneData& scene, const glm::dvec3& centre,
   // back before the searches' own structures are built, so that they do not stay resident
   // through the render's peak (bench/memory.py measures it).
   release_free_memory();
+  return cube_of_faces(n, centre, near, std::move(faces));
+}
+
+CubeABuffer cube_of_faces(int n, const glm::dvec3& centre, double near_distance, std::vector<ABuffer> faces) {
+  ABCUBE_CHECK(faces.size() == CUBE_FACES, "cube_of_faces: six faces");
   CubeABuffer cube;
   cube.n = n;
   cube.centre = centre;
-  cube.near_distance = near;
+  cube.near_distance = near_distance;
   for (size_t f = 0; f < faces.size(); ++f) cube.faces[f] = std::move(faces[f]);
   return cube;
 }

@@ -126,6 +126,8 @@ uint32_t finish_fragment_list(const TriangleSoup& soup, const ABufferOptions& op
 // distance chosen (abuffer_near_distance).
 std::vector<RasterView> cube_build_views(const char* what, const SceneData& scene, const glm::dvec3& centre, int n,
                                          const ABufferOptions& options);
+// A cube build's result from its six faces' lists (cube_build_views' order).
+CubeABuffer cube_of_faces(int n, const glm::dvec3& centre, double near_distance, std::vector<ABuffer> faces);
 // The near distance a build around `centre` uses: options.near_distance, or when 0 the
 // default for the farthest vertex. Throws InputError for a bad option.
 double abuffer_near_distance(const SceneData& scene, const glm::dvec3& centre, const ABufferOptions& options);

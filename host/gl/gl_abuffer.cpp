@@ -428,13 +428,7 @@ CubeABuffer GlABufferBuilder::cube(const SceneData& scene, const glm::dvec3& cen
   const double near = set.rasters.front().near_distance;
   const std::vector<uint8_t> faces_of = triangle_cube_faces(*scene.triangles, centre, options.threads);
   set.views_of = &faces_of;
-  std::vector<ABuffer> faces = build_views_gl(*programs_, scene, set, options, stats);
-  CubeABuffer cube;
-  cube.n = n;
-  cube.centre = centre;
-  cube.near_distance = near;
-  for (size_t f = 0; f < faces.size(); ++f) cube.faces[f] = std::move(faces[f]);
-  return cube;
+  return cube_of_faces(n, centre, near, build_views_gl(*programs_, scene, set, options, stats));
 }
 
 ABuffer GlABufferBuilder::camera(const SceneData& scene, const ABufferOptions& options, ABufferStats* stats) const {
