@@ -1,12 +1,12 @@
 // The A-buffers built by GL compute shaders: a second implementation of build_cube_abuffer and
 // build_camera_abuffer (cpu_core/raster/abuffer.hpp), with the same lists. The CPU sets up
 // each visible (triangle, view) pair (setup_triangle); the GPU counts each pixel's fragments
-// (one workgroup a pair), turns the counts into list offsets (a prefix sum), fills every list
-// with its fragments' masks and geometry, then sorts, merges and caps each list (one
-// invocation a pixel). The shaders (shaders/abuffer_*.comp) repeat the CPU raster's
-// double-precision arithmetic operation for operation, so a GL whose doubles round as IEEE 754
-// says gives the CPU's lists bit for bit; docs/design/gpu-abuffer.md has the layout and its
-// memory bound.
+// (an invocation an 8 x 8 tile of a pair's pixels), turns the counts into list offsets (a
+// prefix sum), fills every list with its fragments' masks and geometry, then sorts, merges
+// and caps each list (an invocation a pixel; a list too long for that is finished on the
+// CPU). The shaders (shaders/abuffer_*.comp) repeat the CPU raster's double-precision
+// arithmetic operation for operation, so a GL whose doubles round as IEEE 754 says gives the
+// CPU's lists bit for bit; docs/design/gpu-abuffer.md has the layout and its memory bound.
 #pragma once
 #include <memory>
 
