@@ -39,17 +39,12 @@ struct Result {
 };
 
 // The command line: every option with its default and unit in --help.
-void add_options(CLI::App& app, Options& o) {
-  show_defaults(app);
-  app.add_option("scenes", o.scenes, "scene files (SCENE.json...)")->required();
-  app.add_option("--sizes", o.sizes, "cube resolutions N, texels per face edge (comma-separated)")
-      ->delimiter(',')
-      ->allow_extra_args(false)
-      ->check(CLI::Range(1, 65536));
-  app.add_option("--runs", o.runs, "runs per configuration (median, min and max reported)")
-      ->check(CLI::Range(1, 1000000));
-  app.add_option("--threads", o.threads, "worker threads (0 = every core)")->check(CLI::Range(0, 4096));
-  app.add_flag("--camera", o.camera, "also the camera view's A-buffer at the scene's image size (pixels)");
+void add_options(BenchCommandLine& line, Options& o) {
+  line.files("scenes", o.scenes, "scene files (SCENE.json...)");
+  line.numbers("--sizes", o.sizes, "cube resolutions N, texels per face edge (comma-separated)", 1, 65536);
+  line.number("--runs", o.runs, "runs per configuration (median, min and max reported)", 1, 1000000);
+  line.number("--threads", o.threads, "worker threads (0 = every core)", 0, 4096);
+  line.flag("--camera", o.camera, "also the camera view's A-buffer at the scene's image size (pixels)");
 }
 
 // One configuration, in this process: `size` 0 means the camera view.

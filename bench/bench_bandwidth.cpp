@@ -22,11 +22,10 @@ struct Options {
   int reps = 5;
 };
 
-void add_options(CLI::App& app, Options& o) {
-  show_defaults(app);
-  app.add_option("--mib", o.mib, "MiB per array (three arrays)")->check(CLI::Range(8, 8192));
-  app.add_option("--threads", o.threads, "threads")->check(CLI::Range(1, 256));
-  app.add_option("--reps", o.reps, "repetitions, best taken")->check(CLI::Range(1, 1000));
+void add_options(BenchCommandLine& line, Options& o) {
+  line.number("--mib", o.mib, "MiB per array (three arrays)", 8, 8192);
+  line.number("--threads", o.threads, "threads", 1, 256);
+  line.number("--reps", o.reps, "repetitions, best taken", 1, 1000);
 }
 
 template <class Kernel>

@@ -43,15 +43,12 @@ struct Options {
   std::string isa = "default";
 };
 
-void add_options(CLI::App& app, Options& o) {
-  show_defaults(app);
-  app.add_option("scenes", o.scenes, "scene files (SCENE.json...)")->required();
-  app.add_option("--spp", o.spp, "camera samples per pixel: 32 (the 4x8 A-buffer positions) or 1 (centre)")
-      ->check(CLI::IsMember({1, MASK_SAMPLES}));
-  app.add_option("--width", o.width, "image width in pixels, the height scaled with it; 0 = the scene's")
-      ->check(CLI::Range(0, 65536));
-  app.add_option("--isa", o.isa, "Embree's instruction set")
-      ->check(CLI::IsMember({"default", "sse4.2", "avx2", "avx512"}));
+void add_options(BenchCommandLine& line, Options& o) {
+  line.files("scenes", o.scenes, "scene files (SCENE.json...)");
+  line.choice("--spp", o.spp, "camera samples per pixel: 32 (the 4x8 A-buffer positions) or 1 (centre)",
+              {1, MASK_SAMPLES});
+  line.number("--width", o.width, "image width in pixels, the height scaled with it; 0 = the scene's", 0, 65536);
+  line.choice("--isa", o.isa, "Embree's instruction set", {"default", "sse4.2", "avx2", "avx512"});
 }
 
 // Embree's float triangles over the soup's vertices (copied: Embree reads 16 bytes per vertex).

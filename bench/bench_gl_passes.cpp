@@ -38,18 +38,12 @@ struct Options {
 };
 
 // The command line: every option with its default and unit in --help.
-void add_options(CLI::App& app, Options& o) {
-  show_defaults(app);
-  app.add_option("scene", o.scene, "scene file (SCENE.json)")->required();
-  app.add_option("--sizes", o.sizes, "cube resolutions N, texels per face edge (comma-separated)")
-      ->delimiter(',')
-      ->allow_extra_args(false)
-      ->check(CLI::Range(1, 65536));
-  app.add_option("--runs", o.runs, "runs per N (median, min and max reported)")->check(CLI::Range(1, 1000));
-  app.add_option("--gl", o.gl, "GL path")
-      ->check(CLI::IsMember({"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"}));
-  app.add_option("--error-samples", o.error_samples, "texel-centre rays checked against the exact tracer")
-      ->check(CLI::Range(0, 100000000));
+void add_options(BenchCommandLine& line, Options& o) {
+  line.file("scene", o.scene, "scene file (SCENE.json)");
+  line.numbers("--sizes", o.sizes, "cube resolutions N, texels per face edge (comma-separated)", 1, 65536);
+  line.number("--runs", o.runs, "runs per N (median, min and max reported)", 1, 1000);
+  line.choice("--gl", o.gl, "GL path", {"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"});
+  line.number("--error-samples", o.error_samples, "texel-centre rays checked against the exact tracer", 0, 100000000);
 }
 
 struct Spread {

@@ -44,20 +44,16 @@ struct Options {
 };
 
 // The command line: every option with its default and unit in --help.
-void add_options(CLI::App& app, Options& o) {
-  show_defaults(app);
-  app.add_option("--renders", o.renders, "renders per method through one Renderer")->check(CLI::Range(1, 100000000));
-  app.add_option("--methods", o.methods, "methods measured (comma-separated)")
-      ->delimiter(',')
-      ->allow_extra_args(false)
-      ->check(CLI::IsMember({"abuffer", "zbuffer", "envmap", "raytrace", "gpu"}));
-  app.add_option("--gl", o.gl, "the Renderer's and the processes' GL path (gpu)")
-      ->check(CLI::IsMember({"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"}));
-  app.add_option("--size", o.size, "image width and height, pixels")->check(CLI::Range(1, 4096));
-  app.add_option("--processes", o.processes, "`abcube render` processes per method (0 = none)")
-      ->check(CLI::Range(0, 100000));
-  app.add_option("--threads", o.threads, "worker threads per render (0 = every core)")->check(CLI::Range(0, 4096));
-  app.add_option("--abcube", o.program, "the abcube program the processes run");
+void add_options(BenchCommandLine& line, Options& o) {
+  line.number("--renders", o.renders, "renders per method through one Renderer", 1, 100000000);
+  line.choices("--methods", o.methods, "methods measured (comma-separated)",
+               {"abuffer", "zbuffer", "envmap", "raytrace", "gpu"});
+  line.choice("--gl", o.gl, "the Renderer's and the processes' GL path (gpu)",
+              {"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"});
+  line.number("--size", o.size, "image width and height, pixels", 1, 4096);
+  line.number("--processes", o.processes, "`abcube render` processes per method (0 = none)", 0, 100000);
+  line.number("--threads", o.threads, "worker threads per render (0 = every core)", 0, 4096);
+  line.text("--abcube", o.program, "the abcube program the processes run");
 }
 
 using Clock = std::chrono::steady_clock;

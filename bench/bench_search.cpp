@@ -50,31 +50,18 @@ struct Options {
 };
 
 // The command line: every option with its default and unit in --help.
-void add_options(CLI::App& app, Options& o) {
-  show_defaults(app);
-  app.add_option("scenes", o.scenes, "scene files (SCENE.json...)")->required();
-  app.add_option("--sizes", o.sizes, "cube resolutions N, texels per face edge (comma-separated)")
-      ->delimiter(',')
-      ->allow_extra_args(false)
-      ->check(CLI::Range(1, 65536));
-  app.add_option("--modes", o.modes, "search modes (comma-separated)")
-      ->delimiter(',')
-      ->allow_extra_args(false)
-      ->check(CLI::IsMember({"crossing", "thesis"}));
-  app.add_option("--kinds", o.kinds, "searches measured (comma-separated)")
-      ->delimiter(',')
-      ->allow_extra_args(false)
-      ->check(CLI::IsMember({"reflection", "shadow"}));
-  app.add_option("--hierarchy", o.hierarchy, "hierarchical skip off (the plain walk) and/or on (comma-separated)")
-      ->delimiter(',')
-      ->allow_extra_args(false)
-      ->check(CLI::IsMember({"off", "on"}));
-  app.add_option("--layers", o.layers, "map layers searched")->check(CLI::IsMember({"all", "nearest"}));
-  app.add_option("--merge", o.merge, "merge the cube A-buffer's fragments as the renderer does")
-      ->check(CLI::IsMember({"on", "off"}));
-  app.add_option("--runs", o.runs, "timed runs per row (median, min and max reported)")->check(CLI::Range(1, 1000000));
-  app.add_option("--rays", o.rays, "rays per scene and kind")->check(CLI::Range(1, 1000000000));
-  app.add_option("--seed", o.seed, "seed of the random pixel samples");
+void add_options(BenchCommandLine& line, Options& o) {
+  line.files("scenes", o.scenes, "scene files (SCENE.json...)");
+  line.numbers("--sizes", o.sizes, "cube resolutions N, texels per face edge (comma-separated)", 1, 65536);
+  line.choices("--modes", o.modes, "search modes (comma-separated)", {"crossing", "thesis"});
+  line.choices("--kinds", o.kinds, "searches measured (comma-separated)", {"reflection", "shadow"});
+  line.choices("--hierarchy", o.hierarchy, "hierarchical skip off (the plain walk) and/or on (comma-separated)",
+               {"off", "on"});
+  line.choice("--layers", o.layers, "map layers searched", {"all", "nearest"});
+  line.choice("--merge", o.merge, "merge the cube A-buffer's fragments as the renderer does", {"on", "off"});
+  line.number("--runs", o.runs, "timed runs per row (median, min and max reported)", 1, 1000000);
+  line.number("--rays", o.rays, "rays per scene and kind", 1, 1000000000);
+  line.number("--seed", o.seed, "seed of the random pixel samples");
 }
 
 // A reflection ray and the exact answer for it.
@@ -247,7 +234,7 @@ void print_row(const std::string& scene, int n, SearchMode mode, const std::stri
 }
 
 int run(const Options& o) {
-  // The command line's names (checked by CLI11) as the search's enums.
+  // The command line's names (checked by BenchCommandLine) as the search's enums.
   std::vector<SearchMode> modes;
   for (const std::string& name : o.modes) {
     SearchMode m;

@@ -47,29 +47,23 @@ struct Options {
 };
 
 // The command line: every option with its default and unit in --help.
-void add_options(CLI::App& app, Options& o) {
-  show_defaults(app);
-  app.add_option("--renders", o.renders, "renders of phase 1 (one Renderer)")->check(CLI::Range(1, 100000000));
-  app.add_option("--every", o.every, "renders between two memory and descriptor samples")
-      ->check(CLI::Range(1, 100000000));
-  app.add_option("--gl", o.gl, "the Renderer's GL path (gpu renders)")
-      ->check(CLI::IsMember({"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"}));
-  app.add_option("--methods", o.methods, "methods cycled through, one per render (comma-separated)")
-      ->delimiter(',')
-      ->allow_extra_args(false)
-      ->check(CLI::IsMember({"abuffer", "zbuffer", "envmap", "raytrace", "gpu"}));
-  app.add_option("--recreate", o.recreate, "renders of phase 2 (a new Renderer each; 0 = skip it)")
-      ->check(CLI::Range(0, 100000000));
-  app.add_option("--new-scene-every", o.new_scene_every, "renders between two new Scenes (0 = one Scene)")
-      ->check(CLI::Range(0, 100000000));
-  app.add_option("--threads", o.threads, "worker threads per render (0 = every core)")->check(CLI::Range(0, 4096));
-  app.add_option("--width", o.width, "image width, pixels")->check(CLI::Range(1, 4096));
-  app.add_option("--height", o.height, "image height, pixels")->check(CLI::Range(1, 4096));
-  app.add_option("--cube-res", o.cube_res, "cube resolution N, texels per face edge")->check(CLI::Range(1, 4096));
-  app.add_option("--timeout-every", o.timeout_every,
-                 "every K-th render of phase 1 is 8x larger under --timeout-ms and must time out (0 = none)")
-      ->check(CLI::Range(0, 100000000));
-  app.add_option("--timeout-ms", o.timeout_ms, "time limit of those renders, ms")->check(CLI::Range(0.001, 1e9));
+void add_options(BenchCommandLine& line, Options& o) {
+  line.number("--renders", o.renders, "renders of phase 1 (one Renderer)", 1, 100000000);
+  line.number("--every", o.every, "renders between two memory and descriptor samples", 1, 100000000);
+  line.choice("--gl", o.gl, "the Renderer's GL path (gpu renders)",
+              {"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"});
+  line.choices("--methods", o.methods, "methods cycled through, one per render (comma-separated)",
+               {"abuffer", "zbuffer", "envmap", "raytrace", "gpu"});
+  line.number("--recreate", o.recreate, "renders of phase 2 (a new Renderer each; 0 = skip it)", 0, 100000000);
+  line.number("--new-scene-every", o.new_scene_every, "renders between two new Scenes (0 = one Scene)", 0, 100000000);
+  line.number("--threads", o.threads, "worker threads per render (0 = every core)", 0, 4096);
+  line.number("--width", o.width, "image width, pixels", 1, 4096);
+  line.number("--height", o.height, "image height, pixels", 1, 4096);
+  line.number("--cube-res", o.cube_res, "cube resolution N, texels per face edge", 1, 4096);
+  line.number("--timeout-every", o.timeout_every,
+              "every K-th render of phase 1 is 8x larger under --timeout-ms and must time out (0 = none)", 0,
+              100000000);
+  line.number("--timeout-ms", o.timeout_ms, "time limit of those renders, ms", 0.001, 1e9);
 }
 
 struct Sample {
