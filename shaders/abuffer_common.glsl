@@ -59,11 +59,6 @@ ivec4 setup_tile(Setup s, uint tile) {
 double sample_dx(int k) { return (double(k % MASK_COLUMNS) + 0.5lf) / double(MASK_COLUMNS); }
 double sample_dy(int k) { return (double(k / MASK_COLUMNS) + 0.5lf) / double(MASK_ROWS); }
 
-double dot3(dvec3 a, dvec3 b) {
-  precise double d = a.x * b.x + a.y * b.y + a.z * b.z;
-  return d;
-}
-
 // Unnormalised direction through pixel point (x, y): glm's mat3 * vec3, row by row.
 dvec3 view_direction(View v, double x, double y) {
   precise dvec3 d;

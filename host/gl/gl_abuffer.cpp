@@ -13,6 +13,7 @@
 #include "base/error.hpp"
 #include "base/parallel.hpp"
 #include "base/timer.hpp"
+#include "gl/gl_compute.hpp"
 #include "gl/gl_program.hpp"
 #include "gl/glsl_shared.hpp"
 #include "raster/cube_map.hpp"
@@ -119,45 +120,6 @@ ViewSetups set_up_view(const TriangleSoup& soup, const uint8_t* views_of, const 
     }
   }
   return out;
-}
-
-// A storage buffer, deleted with its owner.
-class GlBuffer {
- public:
-  GlBuffer(uint64_t bytes, const void* data) {
-    glCreateBuffers(1, &id_);
-    glNamedBufferData(id_, static_cast<GLsizeiptr>(std::max<uint64_t>(bytes, 4)), data, GL_DYNAMIC_COPY);
-    check_gl("GPU A-buffer: a storage buffer");
-  }
-  ~GlBuffer() { glDeleteBuffers(1, &id_); }
-  GlBuffer(const GlBuffer&) = delete;
-  GlBuffer& operator=(const GlBuffer&) = delete;
-
-  GLuint id() const { return id_; }
-  void bind(unsigned binding) const { glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, id_); }
-  void zero() const { glClearNamedBufferData(id_, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr); }
-  template <class T>
-  std::vector<T> read(size_t count) const {
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    std::vector<T> out(count);
-    if (count > 0) glGetNamedBufferSubData(id_, 0, static_cast<GLsizeiptr>(count * sizeof(T)), out.data());
-    check_gl("GPU A-buffer: reading a buffer back");
-    return out;
-  }
-
- private:
-  GLuint id_ = 0;
-};
-
-// Runs `groups` workgroups of the current program `p`, in rows of at most 65535 (the
-// dispatch's guaranteed width), each program reading its index as flat_group().
-void dispatch(const GlProgram& p, uint64_t groups) {
-  if (groups == 0) return;
-  const uint64_t row = std::min<uint64_t>(groups, 65535), rows = (groups + row - 1) / row;
-  if (rows > 65535) throw RuntimeFailure("GPU A-buffer: " + std::to_string(groups) + " workgroups in one dispatch");
-  glUniform1ui(p.uniform("groups_per_row"), static_cast<GLuint>(row));
-  glDispatchCompute(static_cast<GLuint>(row), static_cast<GLuint>(rows), 1);
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
 // The exclusive prefix sum of `count` values of `values`, in place (abuffer_scan.comp, a
@@ -269,10 +231,10 @@ struct GpuRun {
 }  // namespace
 
 struct GlABufferBuilder::Programs {
-  GlProgram count{std::vector<const char*>{"abuffer_common.glsl", "abuffer_count.comp"}};
+  GlProgram count{std::vector<const char*>{"double_math.glsl", "abuffer_common.glsl", "abuffer_count.comp"}};
   GlProgram scan{std::vector<const char*>{"abuffer_scan.comp"}};
-  GlProgram fill{std::vector<const char*>{"abuffer_common.glsl", "abuffer_fill.comp"}};
-  GlProgram finish{std::vector<const char*>{"abuffer_common.glsl", "abuffer_finish.comp"}};
+  GlProgram fill{std::vector<const char*>{"double_math.glsl", "abuffer_common.glsl", "abuffer_fill.comp"}};
+  GlProgram finish{std::vector<const char*>{"double_math.glsl", "abuffer_common.glsl", "abuffer_finish.comp"}};
 };
 
 namespace {
@@ -411,12 +373,7 @@ std::vector<ABuffer> build_views_gl(const GlABufferBuilder::Programs& programs, 
 }  // namespace
 
 GlABufferBuilder::GlABufferBuilder() {
-  GLint bindings = 0;
-  glGetIntegerv(GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS, &bindings);
-  if (bindings <= static_cast<GLint>(ABUFFER_ITEMS_BINDING)) {
-    throw RuntimeFailure("GPU A-buffer: the GL offers " + std::to_string(bindings) + " storage buffer bindings, " +
-                         std::to_string(ABUFFER_ITEMS_BINDING + 1) + " needed");
-  }
+  require_storage_bindings("GPU A-buffer", ABUFFER_ITEMS_BINDING);
   programs_ = std::make_unique<Programs>();
 }
 GlABufferBuilder::~GlABufferBuilder() = default;
