@@ -68,6 +68,9 @@ class CubeWalk {
   // leaving texels out cannot change where it stops.
   bool can_jump() const { return cap_ >= default_cap(n_); }
 
+  // The texels a walk reports at most when max_texels is 0: 16 n + 64.
+  static uint32_t default_cap(int n) { return 16u * static_cast<uint32_t>(n > 1 ? n : 1) + 64u; }
+
   bool aborted() const { return aborted_; }
   uint32_t texels() const { return texels_; }  // reported so far
   // The skipped parameter interval (gap_begin < gap_end) or an empty one.
@@ -75,7 +78,6 @@ class CubeWalk {
   double gap_end() const { return gap_end_; }
 
  private:
-  static uint32_t default_cap(int n) { return 16u * static_cast<uint32_t>(n > 1 ? n : 1) + 64u; }
   bool start_face();                              // the next face segment of the current run; false at the end
   bool on_face();                                 // a face segment started (the current or the next); false at the end
   void start_texel_on_face();                     // entry texel and first crossings of the face segment

@@ -21,8 +21,9 @@ namespace abcube {
 namespace {
 
 constexpr const char* CROSSCHECK_COVERS =
-    "covers: visibility (cube texels, camera samples), the cube's and the camera's A-buffer lists, direct shading of "
-    "interior pixels, hard shadows; not covered: reflections, refractions, antialiased edges (abcube report compares "
+    "covers: visibility (cube texels, camera samples), the cube's and the camera's A-buffer lists, the cube walks of "
+    "shadow and reflection rays, direct shading of interior pixels, hard shadows; not covered: reflections, "
+    "refractions, antialiased edges (abcube report compares "
     "whole images with the exact tracer)";
 
 // A GPU build's lists against the CPU's: the counts, then each class of difference found.
@@ -76,6 +77,9 @@ struct CrosscheckCommand {
                 r.tied_agree);
     print_lists("GPU cube A-buffer lists", r.lists, r.gpu_abuffer_ms);
     print_lists("GPU camera A-buffer lists", r.camera_lists, r.gpu_camera_abuffer_ms);
+    std::printf("GPU cube walks: %zu of %zu rays identical, %llu texels (%.1f ms)%s%s\n", r.walks.identical,
+                r.walks.rays, static_cast<unsigned long long>(r.walks.texels), r.gpu_walks_ms,
+                r.walks.example.empty() ? "" : "; first difference: ", r.walks.example.c_str());
     std::printf("camera interior pixels: %zu of %zu, RMSE %.2e (<= %.0e), max abs %.2e (<= %.2e)\n", r.interior_pixels,
                 r.pixels, r.interior_rmse, tol.interior_rmse, r.interior_max_abs, tol.interior_max_abs);
     std::printf(

@@ -59,6 +59,12 @@ constexpr unsigned ABUFFER_STATS_BINDING = 16;
 constexpr unsigned ABUFFER_SCAN_VALUES_BINDING = 17;
 constexpr unsigned ABUFFER_SCAN_SUMS_BINDING = 18;
 constexpr unsigned ABUFFER_ITEMS_BINDING = 19;
+// The GPU's cube walks (gl_cube_walks.cpp, cube_walks.comp): the rays, the texels walked,
+// each ray's count, and each ray's first texel in the fill pass.
+constexpr unsigned CUBE_WALK_RAYS_BINDING = 20;
+constexpr unsigned CUBE_WALK_TEXELS_BINDING = 21;
+constexpr unsigned CUBE_WALK_COUNTS_BINDING = 22;
+constexpr unsigned CUBE_WALK_OFFSETS_BINDING = 23;
 constexpr unsigned ABUFFER_SCAN_BLOCK = 512;
 constexpr int ABUFFER_TILE = 8;
 constexpr unsigned ABUFFER_GPU_LIST_MAX = 64;

@@ -17,6 +17,7 @@
 #include "shading/fragment_texture.hpp"
 #include "shading/resolve.hpp"
 #include "gl/gl_abuffer.hpp"
+#include "gl/gl_cube_walks.hpp"
 #include "gl/gl_shadow_probe.hpp"
 #include "material/shading.hpp"
 #include "base/timer.hpp"
@@ -112,6 +113,42 @@ void compare_cube(const SceneData& scene, int n, int threads, GlScene& gl, Cross
     r->distance_median_rel = percentile(rel, 0.5);
     r->same_object = static_cast<double>(same) / static_cast<double>(rel.size());
   }
+}
+
+// The searches' rays, for the walks' cross-check: from the centroids of up to
+// CROSSCHECK_WALK_TRIANGLES triangles spread over the scene (relative to the centre), the
+// segment to each light (a shadow ray's walk) and the ray reflecting the view from the
+// centre about the triangle's plane (a reflection ray's).
+std::vector<WalkRay> crosscheck_walk_rays(const SceneData& scene, const glm::dvec3& centre) {
+  constexpr size_t CROSSCHECK_WALK_TRIANGLES = 1024;
+  const TriangleSoup& soup = *scene.triangles;
+  const size_t count = soup.triangle_count();
+  const size_t stride = std::max<size_t>(1, (count + CROSSCHECK_WALK_TRIANGLES - 1) / CROSSCHECK_WALK_TRIANGLES);
+  std::vector<WalkRay> rays;
+  for (size_t t = 0; t < count; t += stride) {
+    const glm::dvec3 a(soup.positions[3 * t]), b(soup.positions[3 * t + 1]), c(soup.positions[3 * t + 2]);
+    const glm::dvec3 w = (a + b + c) / 3.0 - centre;
+    const glm::dvec3 normal = glm::cross(b - a, c - a);
+    const double w_len = glm::length(w), n_len = glm::length(normal);
+    if (!(w_len > 0.0) || !(n_len > 0.0) || !std::isfinite(w_len)) continue;
+    rays.push_back({w, glm::reflect(w / w_len, normal / n_len), std::numeric_limits<double>::infinity(), 0.0});
+    for (const PointLight& light : scene.lights) {
+      const glm::dvec3 to_light = light.position - centre - w;
+      const double l = glm::length(to_light);
+      if (l > 0.0 && std::isfinite(l)) rays.push_back({w, to_light / l, l, 0.0});
+    }
+  }
+  return rays;
+}
+
+// The GPU's cube walks of those rays against CubeWalk's, ray by ray.
+void compare_cube_walks(const SceneData& scene, int n, CrosscheckResult* r) {
+  const std::vector<WalkRay> rays = crosscheck_walk_rays(scene, scene.camera.position);
+  const std::vector<RayWalk> cpu = cpu_cube_walks(rays, n);
+  const Clock::time_point t0 = Clock::now();
+  const std::vector<RayWalk> gpu = GlCubeWalks().walk(rays, n);
+  r->gpu_walks_ms = ms_since(t0);
+  r->walks = compare_walks(cpu, gpu);
 }
 
 // The GPU's build of the camera's lists against `cpu` (built with `options`, holding
@@ -339,6 +376,7 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   compare_cube(scene, n, threads, gl, &r);
   compare_camera(scene, threads, gl, &r);
   compare_shadows(scene, n, threads, gl, &r);
+  compare_cube_walks(scene, n, &r);
   const double mismatch = r.texels ? static_cast<double>(r.gpu_only + r.cpu_only) / static_cast<double>(r.texels) : 0.0;
   auto fail = [&r](bool bad, const std::string& what) {
     if (bad) r.failures += (r.failures.empty() ? "" : "; ") + what;
@@ -359,6 +397,7 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   fail(r.volumes.interior_share() < tol.volumes_agreement_min, "shadow volumes against the tracer");
   fail(!r.lists.within_bounds(), "GPU A-buffer lists");
   fail(!r.camera_lists.within_bounds(), "GPU camera A-buffer lists");
+  fail(r.walks.identical != r.walks.rays, "GPU cube walks");
   r.pass = r.failures.empty();
   return r;
 }
@@ -393,6 +432,12 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
               {"gpu_abuffer_ms", r.gpu_abuffer_ms},
               {"camera_abuffer_lists", lists_json(r.camera_lists)},
               {"gpu_camera_abuffer_ms", r.gpu_camera_abuffer_ms},
+              {"cube_walks",
+               {{"rays", r.walks.rays},
+                {"identical", r.walks.identical},
+                {"texels", r.walks.texels},
+                {"first_difference", r.walks.example},
+                {"gpu_ms", r.gpu_walks_ms}}},
               {"cube",
                {{"texels", r.texels},
                 {"both_covered", r.both_covered},

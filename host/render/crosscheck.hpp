@@ -9,6 +9,7 @@
 
 #include "raster/abuffer.hpp"
 #include "raster/abuffer_compare.hpp"
+#include "gl/gl_cube_walks.hpp"
 #include "gl/gl_passes.hpp"
 #include "scene/scene_data.hpp"
 
@@ -94,6 +95,11 @@ struct CrosscheckResult {
   double gpu_abuffer_ms = 0;
   ListComparison camera_lists;  // the same for the camera's A-buffer
   double gpu_camera_abuffer_ms = 0;
+  // The cube walks of the searches' rays (shadow segments to the lights and reflection rays
+  // from points on the triangles) on the GPU against CubeWalk's, texel for texel and bit for
+  // bit (gl_cube_walks.hpp): it fails on any difference.
+  WalkComparison walks;
+  double gpu_walks_ms = 0;
   double gpu_ms = 0, cpu_ms = 0;  // prepass vs cube A-buffer build
   uint64_t fragments = 0;
   bool pass = false;

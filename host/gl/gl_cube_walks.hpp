@@ -1,0 +1,72 @@
+// The cube walk on the GPU: CubeWalk's plain walk (cpu_core/search/cube_walk.hpp) run by a
+// GL compute shader (shaders/cube_walk.glsl), an invocation a ray, the first brick of the
+// searches on the GPU. Its expressions are the CPU's in double precision, operation for
+// operation, so that a GL whose doubles round as IEEE 754 says walks the same texels with
+// the same intervals bit for bit: compare_walks says where they differ.
+#pragma once
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "search/cube_walk.hpp"
+
+namespace abcube {
+
+// A ray to walk: CubeWalk's arguments (w relative to the centre, d unit).
+struct WalkRay {
+  glm::dvec3 w{0.0}, d{0.0, 0.0, 1.0};
+  double l_max = std::numeric_limits<double>::infinity();
+  double skip_radius = 0.0;
+};
+
+// A ray's walk: its texels in order, and whether the cap stopped it.
+struct RayWalk {
+  std::vector<WalkTexel> texels;
+  bool aborted = false;
+};
+
+// The compiled passes, on the GL context current when it was made (GL 4.5 core with storage
+// buffer binding CUBE_WALK_OFFSETS_BINDING), which must stay current for its life: a count
+// pass walks every ray for its length, a fill pass walks them again to write their texels,
+// in batches whose texels take at most 64 MiB on the GPU.
+class GlCubeWalks {
+ public:
+  GlCubeWalks();
+  ~GlCubeWalks();
+  GlCubeWalks(const GlCubeWalks&) = delete;
+  GlCubeWalks& operator=(const GlCubeWalks&) = delete;
+
+  // Every ray's walk on an n x n map, each capped at max_texels (0: CubeWalk's default).
+  // Throws InputError on a ray CubeWalk refuses (d not unit, w not finite), on n < 1, and
+  // on a cap above GPU_WALK_MAX_TEXELS.
+  std::vector<RayWalk> walk(const std::vector<WalkRay>& rays, int n, uint32_t max_texels = 0) const;
+
+  struct Program;
+
+ private:
+  std::unique_ptr<Program> program_;
+};
+
+// The largest cap a GPU walk takes: Mesa's llvmpipe ends an invocation's loops, silently,
+// after 65535 iterations in all, and a walk's loop runs once a texel (CubeWalk's default cap
+// reaches it at n = 4092).
+constexpr uint32_t GPU_WALK_MAX_TEXELS = 60000;
+
+// The same rays walked by CubeWalk on the CPU.
+std::vector<RayWalk> cpu_cube_walks(const std::vector<WalkRay>& rays, int n, uint32_t max_texels = 0);
+
+// How two sets of walks of the same rays agree: walks identical texel for texel (face, i,
+// j, after_gap and both ends of the interval bit for bit); else the first differing ray.
+struct WalkComparison {
+  size_t rays = 0, identical = 0;
+  uint64_t texels = 0;  // in the first set
+  long first_differing = -1;
+  std::string example;  // the first difference, in words
+};
+WalkComparison compare_walks(const std::vector<RayWalk>& a, const std::vector<RayWalk>& b);
+
+}  // namespace abcube
