@@ -4,9 +4,11 @@
 // without its error. Beside it, the CPU cube A-buffer build of the same faces (every
 // fragment of every surface) and its ratio to the GPU prepass, and the same A-buffer built by
 // GL compute shaders (gl_abuffer.hpp) with the share of its lists identical to the CPU's.
+// Then the searches' cube walks of the scene's rays (gl_cube_walks.hpp scene_walk_rays) on the
+// GPU and by CubeWalk on one CPU thread, with the share of walks identical.
 //
 //   bench_gl_passes SCENE.json [--sizes 256,512,1024] [--runs 5] [--gl auto|egl|osmesa]
-//                   [--error-samples 20000]
+//                   [--error-samples 20000] [--walk-triangles 4096]
 #include <algorithm>
 #include <cstdio>
 #include <random>
@@ -22,6 +24,7 @@
 #include "base/error.hpp"
 #include "gl/gl_abuffer.hpp"
 #include "gl/gl_context.hpp"
+#include "gl/gl_cube_walks.hpp"
 #include "gl/gl_passes.hpp"
 #include "reference/raytrace.hpp"
 #include "scene/scene_load.hpp"
@@ -35,6 +38,7 @@ struct Options {
   int runs = 5;
   std::string gl = "auto";
   int error_samples = 20000;
+  int walk_triangles = 4096;
 };
 
 // The command line: every option with its default and unit in --help.
@@ -44,6 +48,8 @@ void add_options(BenchCommandLine& line, Options& o) {
   line.number("--runs", o.runs, "runs per N (median, min and max reported)", 1, 1000);
   line.choice("--gl", o.gl, "GL path", {"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"});
   line.number("--error-samples", o.error_samples, "texel-centre rays checked against the exact tracer", 0, 100000000);
+  line.number("--walk-triangles", o.walk_triangles, "triangles whose search rays are walked (0 = no walks)", 0,
+              100000000);
 }
 
 struct Spread {
@@ -85,6 +91,37 @@ PrepassError prepass_error(const SceneData& scene, const RayTracer& rt, const Cu
   e.max_rel = percentile(rel, 1.0);
   e.same_object = static_cast<double>(same) / static_cast<double>(rel.size());
   return e;
+}
+
+// The searches' cube walks of the scene's rays at each N: GPU against one CPU thread.
+void print_walks(const SceneData& scene, const Options& o) {
+  const std::vector<WalkRay> rays =
+      scene_walk_rays(scene, scene.camera.position, static_cast<size_t>(o.walk_triangles));
+  const GlCubeWalks gpu;
+  std::printf(
+      "\n%zu search rays (shadow segments and reflections from %d triangles at most)\n\n"
+      "| N | texels walked | GPU walks ms | CPU walks ms (1 thread) | GPU Mtexels/s | CPU Mtexels/s | walks "
+      "identical |\n|---|---|---|---|---|---|---|\n",
+      rays.size(), o.walk_triangles);
+  for (int n : o.sizes) {
+    std::vector<double> gpu_ms, cpu_ms;
+    std::vector<RayWalk> on_gpu, on_cpu;
+    for (int r = 0; r < o.runs; ++r) {
+      Clock::time_point t0 = Clock::now();
+      on_gpu = gpu.walk(rays, n);
+      gpu_ms.push_back(ms_since(t0));
+      t0 = Clock::now();
+      on_cpu = cpu_cube_walks(rays, n);
+      cpu_ms.push_back(ms_since(t0));
+    }
+    const WalkComparison c = compare_walks(on_cpu, on_gpu);
+    const Spread g = spread(gpu_ms), cp = spread(cpu_ms);
+    const double mtexels = static_cast<double>(c.texels) * 1e-3;
+    std::printf("| %d | %llu | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1f | %.1f | %zu of %zu |\n", n,
+                static_cast<unsigned long long>(c.texels), g.median, g.lo, g.hi, cp.median, cp.lo, cp.hi,
+                mtexels / g.median, mtexels / cp.median, c.identical, c.rays);
+    std::fflush(stdout);
+  }
 }
 
 int run(const Options& o) {
@@ -148,6 +185,7 @@ int run(const Options& o) {
         static_cast<unsigned long long>(lists.lists));
     std::fflush(stdout);
   }
+  if (o.walk_triangles > 0) print_walks(scene, o);
   return 0;
 }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <sstream>
 
 #include "base/error.hpp"
@@ -127,6 +128,27 @@ std::vector<RayWalk> GlCubeWalks::walk(const std::vector<WalkRay>& rays, int n, 
     first = end;
   }
   return out;
+}
+
+std::vector<WalkRay> scene_walk_rays(const SceneData& scene, const glm::dvec3& centre, size_t max_triangles) {
+  const TriangleSoup& soup = *scene.triangles;
+  const size_t count = soup.triangle_count();
+  const size_t stride = std::max<size_t>(1, (count + max_triangles - 1) / std::max<size_t>(1, max_triangles));
+  std::vector<WalkRay> rays;
+  for (size_t t = 0; t < count; t += stride) {
+    const glm::dvec3 a(soup.positions[3 * t]), b(soup.positions[3 * t + 1]), c(soup.positions[3 * t + 2]);
+    const glm::dvec3 w = (a + b + c) / 3.0 - centre;
+    const glm::dvec3 normal = glm::cross(b - a, c - a);
+    const double w_len = glm::length(w), n_len = glm::length(normal);
+    if (!(w_len > 0.0) || !(n_len > 0.0) || !std::isfinite(w_len)) continue;
+    rays.push_back({w, glm::reflect(w / w_len, normal / n_len), std::numeric_limits<double>::infinity(), 0.0});
+    for (const PointLight& light : scene.lights) {
+      const glm::dvec3 to_light = light.position - centre - w;
+      const double l = glm::length(to_light);
+      if (l > 0.0 && std::isfinite(l)) rays.push_back({w, to_light / l, l, 0.0});
+    }
+  }
+  return rays;
 }
 
 std::vector<RayWalk> cpu_cube_walks(const std::vector<WalkRay>& rays, int n, uint32_t max_texels) {

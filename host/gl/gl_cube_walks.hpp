@@ -12,6 +12,7 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/scene_data.hpp"
 #include "search/cube_walk.hpp"
 
 namespace abcube {
@@ -55,6 +56,12 @@ class GlCubeWalks {
 // after 65535 iterations in all, and a walk's loop runs once a texel (CubeWalk's default cap
 // reaches it at n = 4092).
 constexpr uint32_t GPU_WALK_MAX_TEXELS = 60000;
+
+// A scene's search rays, for the walks' cross-checks and benchmarks: from the centroids of up
+// to `max_triangles` triangles spread over the scene (relative to `centre`), the segment to
+// each light (a shadow ray's walk) and the ray reflecting the view from the centre about the
+// triangle's plane (a reflection ray's). Degenerate triangles give none.
+std::vector<WalkRay> scene_walk_rays(const SceneData& scene, const glm::dvec3& centre, size_t max_triangles);
 
 // The same rays walked by CubeWalk on the CPU.
 std::vector<RayWalk> cpu_cube_walks(const std::vector<WalkRay>& rays, int n, uint32_t max_texels = 0);

@@ -115,35 +115,11 @@ void compare_cube(const SceneData& scene, int n, int threads, GlScene& gl, Cross
   }
 }
 
-// The searches' rays, for the walks' cross-check: from the centroids of up to
-// CROSSCHECK_WALK_TRIANGLES triangles spread over the scene (relative to the centre), the
-// segment to each light (a shadow ray's walk) and the ray reflecting the view from the
-// centre about the triangle's plane (a reflection ray's).
-std::vector<WalkRay> crosscheck_walk_rays(const SceneData& scene, const glm::dvec3& centre) {
-  constexpr size_t CROSSCHECK_WALK_TRIANGLES = 1024;
-  const TriangleSoup& soup = *scene.triangles;
-  const size_t count = soup.triangle_count();
-  const size_t stride = std::max<size_t>(1, (count + CROSSCHECK_WALK_TRIANGLES - 1) / CROSSCHECK_WALK_TRIANGLES);
-  std::vector<WalkRay> rays;
-  for (size_t t = 0; t < count; t += stride) {
-    const glm::dvec3 a(soup.positions[3 * t]), b(soup.positions[3 * t + 1]), c(soup.positions[3 * t + 2]);
-    const glm::dvec3 w = (a + b + c) / 3.0 - centre;
-    const glm::dvec3 normal = glm::cross(b - a, c - a);
-    const double w_len = glm::length(w), n_len = glm::length(normal);
-    if (!(w_len > 0.0) || !(n_len > 0.0) || !std::isfinite(w_len)) continue;
-    rays.push_back({w, glm::reflect(w / w_len, normal / n_len), std::numeric_limits<double>::infinity(), 0.0});
-    for (const PointLight& light : scene.lights) {
-      const glm::dvec3 to_light = light.position - centre - w;
-      const double l = glm::length(to_light);
-      if (l > 0.0 && std::isfinite(l)) rays.push_back({w, to_light / l, l, 0.0});
-    }
-  }
-  return rays;
-}
-
-// The GPU's cube walks of those rays against CubeWalk's, ray by ray.
+// The GPU's cube walks of the scene's search rays (scene_walk_rays, from up to
+// CROSSCHECK_WALK_TRIANGLES triangles) against CubeWalk's, ray by ray.
+constexpr size_t CROSSCHECK_WALK_TRIANGLES = 1024;
 void compare_cube_walks(const SceneData& scene, int n, CrosscheckResult* r) {
-  const std::vector<WalkRay> rays = crosscheck_walk_rays(scene, scene.camera.position);
+  const std::vector<WalkRay> rays = scene_walk_rays(scene, scene.camera.position, CROSSCHECK_WALK_TRIANGLES);
   const std::vector<RayWalk> cpu = cpu_cube_walks(rays, n);
   const Clock::time_point t0 = Clock::now();
   const std::vector<RayWalk> gpu = GlCubeWalks().walk(rays, n);
