@@ -53,8 +53,8 @@ class GlCubeWalks {
 };
 
 // The largest cap a GPU walk takes: Mesa's llvmpipe ends an invocation's loops, silently,
-// after 65535 iterations in all, and a walk's loop runs once a texel (CubeWalk's default cap
-// reaches it at n = 4092).
+// after 65535 iterations in all, and a walk's loop runs once a texel, and a few times more a
+// face. CubeWalk's default cap, 16 n + 64, is within it up to n = 3746.
 constexpr uint32_t GPU_WALK_MAX_TEXELS = 60000;
 
 // A scene's search rays, for the walks' cross-checks and benchmarks: from the centroids of up
