@@ -104,6 +104,10 @@ void print_walks(const SceneData& scene, const Options& o) {
       "identical |\n|---|---|---|---|---|---|---|\n",
       rays.size(), o.walk_triangles);
   for (int n : o.sizes) {
+    if (!gpu_walks_at(n)) {
+      std::printf("| %d | not walked: the cap is above the GPU's %u texels | | | | | |\n", n, GPU_WALK_MAX_TEXELS);
+      continue;
+    }
     std::vector<double> gpu_ms, cpu_ms;
     std::vector<RayWalk> on_gpu, on_cpu;
     for (int r = 0; r < o.runs; ++r) {

@@ -30,6 +30,10 @@ double walk_l;
 uint walk_texels, walk_iterations;
 bool walk_aborted, walk_done;
 
+// std::max and std::min exactly (GLSL's leave the sign of a zero and NaN to the GL).
+double std_max(double a, double b) { return a < b ? b : a; }
+double std_min(double a, double b) { return b < a ? b : a; }
+
 // The face envelope's line k at l: F_k . X(l) = c_k + l s_k.
 double envelope_c(int k) { return (k & 1) == 0 ? walk_w[k >> 1] : -walk_w[k >> 1]; }
 double envelope_s(int k) { return (k & 1) == 0 ? walk_d[k >> 1] : -walk_d[k >> 1]; }
@@ -55,7 +59,7 @@ void envelope_next(int cur, double l, double end, out double face_end, out int n
   for (int k = 0; k < 6; ++k) {
     if (!(envelope_s(k) > envelope_s(cur))) continue;
     precise double cross_at = (envelope_c(cur) - envelope_c(k)) / (envelope_s(k) - envelope_s(cur));
-    double meet = max(l, cross_at);
+    double meet = std_max(l, cross_at);
     if (!(meet < end)) continue;
     if (next < 0 || meet < face_end || (meet == face_end && envelope_s(k) > envelope_s(next))) {
       face_end = meet;
@@ -91,7 +95,7 @@ void walk_begin(dvec3 w, dvec3 d, int n, double l_max, double skip_radius, uint 
     return;
   }
   precise double pass = centre_pass_rel * length3(w);
-  double r = max(skip_radius, pass);
+  double r = std_max(skip_radius, pass);
   precise double lc = -dot3(w, d);
   double h = length3(cross3(w, d));
   double la = inf(), lb = inf();
@@ -107,8 +111,8 @@ void walk_begin(dvec3 w, dvec3 d, int n, double l_max, double skip_radius, uint 
     walk_run_count = 1;
     return;
   }
-  walk_gap_begin = max(la, 0.0lf);
-  walk_gap_end = min(lb, l_max);
+  walk_gap_begin = std_max(la, 0.0lf);
+  walk_gap_end = std_min(lb, l_max);
   if (la > 0.0lf) {
     walk_run_begin[walk_run_count] = 0.0lf;
     walk_run_end[walk_run_count] = la;
@@ -138,7 +142,7 @@ double walk_raw_crossing(int axis, int boundary) {
 void walk_next_crossing(int axis) {
   int k = walk_step[axis] > 0 ? walk_ij[axis] + 1 : walk_ij[axis];
   walk_next_l[axis] =
-      (walk_step[axis] == 0 || k < 1 || k > walk_n - 1) ? inf() : max(walk_l, walk_raw_crossing(axis, k));
+      (walk_step[axis] == 0 || k < 1 || k > walk_n - 1) ? inf() : std_max(walk_l, walk_raw_crossing(axis, k));
 }
 
 void walk_start_texel_on_face() {
@@ -196,37 +200,39 @@ bool walk_on_face() {
   return true;
 }
 
-// CubeWalk::next: the next texel (face, i, j) and its interval (l0, l1), and whether it is
-// the first after the skipped ball; false when the walk is over (or aborted).
-bool walk_next(out ivec3 texel, out dvec2 interval, out bool after_gap) {
-  for (;;) {
-    if (!walk_on_face()) return false;
-    if (++walk_iterations > walk_cap) {
-      walk_aborted = true;
-      walk_done = true;
-      return false;
-    }
-    double l_exit = min(min(walk_next_l[0], walk_next_l[1]), walk_face_end);
-    ivec3 t = ivec3(walk_face, walk_ij[0], walk_ij[1]);
-    double l0 = walk_l;
-    if (l_exit >= walk_face_end) {
-      walk_face_active = false;
-    } else {
-      bool step_s = walk_next_l[0] == l_exit, step_t = walk_next_l[1] == l_exit;
-      walk_l = l_exit;
-      if (step_s) walk_ij[0] += walk_step[0];
-      if (step_t) walk_ij[1] += walk_step[1];
-      if (step_s) walk_next_crossing(0);
-      if (step_t) walk_next_crossing(1);
-    }
-    if (l_exit > l0) {
-      after_gap = walk_gap_pending;
-      walk_gap_pending = false;
-      ++walk_texels;
-      texel = t;
-      interval = dvec2(l0, l_exit);
-      return true;
-    }
+// One pass of CubeWalk::next's loop: 1 with the next texel (face, i, j), its interval (l0,
+// l1) and whether it is the first after the skipped ball; 0 when this pass reported nothing
+// (a texel of zero length); -1 when the walk is over (or aborted). A step, not a loop, so that
+// the caller's loop is the only one a texel: llvmpipe counts an invocation's loop iterations,
+// nested ones included, against one limit.
+int walk_step_once(out ivec3 texel, out dvec2 interval, out bool after_gap) {
+  texel = ivec3(0);
+  interval = dvec2(0.0lf);
+  after_gap = false;
+  if (!walk_on_face()) return -1;
+  if (++walk_iterations > walk_cap) {
+    walk_aborted = true;
+    walk_done = true;
+    return -1;
   }
-  return false;
+  double l_exit = std_min(std_min(walk_next_l[0], walk_next_l[1]), walk_face_end);
+  ivec3 t = ivec3(walk_face, walk_ij[0], walk_ij[1]);
+  double l0 = walk_l;
+  if (l_exit >= walk_face_end) {
+    walk_face_active = false;
+  } else {
+    bool step_s = walk_next_l[0] == l_exit, step_t = walk_next_l[1] == l_exit;
+    walk_l = l_exit;
+    if (step_s) walk_ij[0] += walk_step[0];
+    if (step_t) walk_ij[1] += walk_step[1];
+    if (step_s) walk_next_crossing(0);
+    if (step_t) walk_next_crossing(1);
+  }
+  if (!(l_exit > l0)) return 0;
+  after_gap = walk_gap_pending;
+  walk_gap_pending = false;
+  ++walk_texels;
+  texel = t;
+  interval = dvec2(l0, l_exit);
+  return 1;
 }

@@ -77,9 +77,16 @@ struct CrosscheckCommand {
                 r.tied_agree);
     print_lists("GPU cube A-buffer lists", r.lists, r.gpu_abuffer_ms);
     print_lists("GPU camera A-buffer lists", r.camera_lists, r.gpu_camera_abuffer_ms);
-    std::printf("GPU cube walks: %zu of %zu rays identical, %llu texels (%.1f ms)%s%s\n", r.walks.identical,
-                r.walks.rays, static_cast<unsigned long long>(r.walks.texels), r.gpu_walks_ms,
-                r.walks.example.empty() ? "" : "; first difference: ", r.walks.example.c_str());
+    if (!r.walks_skipped.empty()) {
+      std::printf("GPU cube walks: %s\n", r.walks_skipped.c_str());
+    } else {
+      std::printf(
+          "GPU cube walks: %zu of %zu rays identical, %zu within rounding, %zu differing, %llu texels "
+          "(%.1f ms)%s%s\n",
+          r.walks.identical, r.walks.rays, r.walks.within_rounding, r.walks.differing,
+          static_cast<unsigned long long>(r.walks.texels), r.gpu_walks_ms,
+          r.walks.example.empty() ? "" : "; first not identical: ", r.walks.example.c_str());
+    }
     std::printf("camera interior pixels: %zu of %zu, RMSE %.2e (<= %.0e), max abs %.2e (<= %.2e)\n", r.interior_pixels,
                 r.pixels, r.interior_rmse, tol.interior_rmse, r.interior_max_abs, tol.interior_max_abs);
     std::printf(

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
@@ -33,9 +34,50 @@ void check_ray(const WalkRay& r, size_t index) {
   const auto finite = [](const glm::dvec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
   };
-  if (!finite(r.w) || !(std::fabs(glm::length(r.d) - 1.0) < 1e-6)) {
+  if (!finite(r.w) || !(std::fabs(glm::length(r.d) - 1.0) < 1e-6) || std::isnan(r.l_max) ||
+      !std::isfinite(r.skip_radius)) {
     throw InputError("GPU cube walk: ray " + std::to_string(index) +
-                     " has a non-finite origin or a direction not unit");
+                     " has a non-finite origin, a direction not unit, a NaN end or a non-finite skipped radius");
+  }
+}
+
+void set_walk_uniforms(const GlProgram& p, int n, uint32_t cap) {
+  p.use();
+  for (int f = 0; f < CUBE_FACES; ++f) {
+    const CubeFaceBasis& b = cube_face_basis(f);
+    const std::string at = "[" + std::to_string(f) + "]";
+    glUniform3d(p.uniform(("face_forward" + at).c_str()), b.forward.x, b.forward.y, b.forward.z);
+    glUniform3d(p.uniform(("face_s_axis" + at).c_str()), b.s_axis.x, b.s_axis.y, b.s_axis.z);
+    glUniform3d(p.uniform(("face_t_axis" + at).c_str()), b.t_axis.x, b.t_axis.y, b.t_axis.z);
+  }
+  glUniform1d(p.uniform("centre_pass_rel"), CENTRE_PASS_REL);
+  glUniform1i(p.uniform("face_resolution"), n);
+  glUniform1ui(p.uniform("walk_cap_texels"), cap);
+}
+
+// The walks of rays [first, end) of a chunk (its first ray `chunk` of the whole), from the
+// fill pass's texels (`all`, ray k's from offsets[k - first]) and both passes' counts and
+// flags (4 words a ray), into out[first, end).
+void unpack_batch(const std::vector<GpuTexel>& all, const std::vector<uint32_t>& walked,
+                  const std::vector<uint32_t>& filled, const std::vector<uint32_t>& offsets, size_t first, size_t end,
+                  RayWalk* out, size_t chunk) {
+  for (size_t k = first; k < end; ++k) {
+    // Both passes must have ended their walk (flag 2) with the same count: a GL that stops a
+    // shader's loops early (llvmpipe past its iteration limit) fails here, not silently.
+    const uint32_t count = walked[4 * k], flags = walked[4 * k + 1];
+    if (!(flags & 2u) || filled[4 * k + 2] != count || filled[4 * k + 3] != flags) {
+      throw RuntimeFailure("GPU cube walk: the GL ended ray " + std::to_string(chunk + k) +
+                           "'s walk early (a loop limit?)");
+    }
+    RayWalk& w = out[k];
+    w.aborted = (flags & 1u) != 0;
+    const GpuTexel* g = all.data() + offsets[k - first];
+    for (uint32_t t = 0; t < count; ++t, ++g) {
+      WalkTexel texel;
+      texel.face = g->face, texel.i = g->i, texel.j = g->j, texel.l0 = g->l0, texel.l1 = g->l1;
+      texel.after_gap = g->after_gap != 0;
+      w.texels.push_back(texel);
+    }
   }
 }
 
@@ -67,19 +109,7 @@ std::vector<RayWalk> GlCubeWalks::walk(const std::vector<WalkRay>& rays, int n, 
   std::vector<RayWalk> out(rays.size());
   if (rays.empty()) return out;
   const GlProgram& p = program_->program;
-  p.use();
-  for (int f = 0; f < CUBE_FACES; ++f) {
-    const CubeFaceBasis& b = cube_face_basis(f);
-    const std::string at = "[" + std::to_string(f) + "]";
-    glUniform3d(p.uniform(("face_forward" + at).c_str()), b.forward.x, b.forward.y, b.forward.z);
-    glUniform3d(p.uniform(("face_s_axis" + at).c_str()), b.s_axis.x, b.s_axis.y, b.s_axis.z);
-    glUniform3d(p.uniform(("face_t_axis" + at).c_str()), b.t_axis.x, b.t_axis.y, b.t_axis.z);
-  }
-  glUniform1d(p.uniform("centre_pass_rel"), CENTRE_PASS_REL);
-  glUniform1i(p.uniform("face_resolution"), n);
-  glUniform1ui(p.uniform("walk_cap_texels"), cap);
-  const GlBuffer ray_buffer(packed.size() * sizeof(GpuRay), packed.data());
-  ray_buffer.bind(CUBE_WALK_RAYS_BINDING);
+  set_walk_uniforms(p, n, cap);
   const auto run = [&](bool fill, size_t first, size_t count) {
     p.use();
     glUniform1i(p.uniform("fill"), fill ? 1 : 0);
@@ -88,44 +118,40 @@ std::vector<RayWalk> GlCubeWalks::walk(const std::vector<WalkRay>& rays, int n, 
     dispatch(p, (count + 63) / 64);
     check_gl("GPU cube walk");
   };
-  // The count pass: every ray's texels and cap.
-  const GlBuffer counts(rays.size() * 2 * sizeof(uint32_t), nullptr);
-  counts.bind(CUBE_WALK_COUNTS_BINDING);
-  counts.bind(CUBE_WALK_TEXELS_BINDING);  // not touched by the count pass, but bound
-  counts.bind(CUBE_WALK_OFFSETS_BINDING);
-  run(false, 0, rays.size());
-  const std::vector<uint32_t> walked = counts.read<uint32_t>(2 * rays.size());
-  // The fill pass, in batches of rays whose texels take at most WALK_BATCH_BYTES (one ray's
-  // at least).
+  // The rays go in chunks (their storage blocks well under the 128 MiB a GL must offer); in
+  // each, the count pass, then the fill pass in batches of rays whose texels take at most
+  // WALK_BATCH_BYTES (one ray's at least).
+  constexpr size_t RAY_CHUNK = size_t{1} << 18;
   constexpr uint64_t WALK_BATCH_BYTES = uint64_t{64} << 20;
-  for (size_t first = 0; first < rays.size();) {
-    std::vector<uint32_t> offsets;
-    uint64_t texel_count = 0;
-    size_t end = first;
-    while (end < rays.size() &&
-           (end == first || (texel_count + walked[2 * end]) * sizeof(GpuTexel) <= WALK_BATCH_BYTES)) {
-      offsets.push_back(static_cast<uint32_t>(texel_count));
-      texel_count += walked[2 * end];
-      ++end;
-    }
-    const GlBuffer offset_buffer(offsets.size() * sizeof(uint32_t), offsets.data());
-    const GlBuffer texels(texel_count * sizeof(GpuTexel), nullptr);
-    offset_buffer.bind(CUBE_WALK_OFFSETS_BINDING);
-    texels.bind(CUBE_WALK_TEXELS_BINDING);
-    run(true, first, end - first);
-    const std::vector<GpuTexel> all = texels.read<GpuTexel>(texel_count);
-    for (size_t k = first; k < end; ++k) {
-      RayWalk& w = out[k];
-      w.aborted = walked[2 * k + 1] != 0;
-      const GpuTexel* g = all.data() + offsets[k - first];
-      for (uint32_t t = 0; t < walked[2 * k]; ++t, ++g) {
-        WalkTexel texel;
-        texel.face = g->face, texel.i = g->i, texel.j = g->j, texel.l0 = g->l0, texel.l1 = g->l1;
-        texel.after_gap = g->after_gap != 0;
-        w.texels.push_back(texel);
+  for (size_t chunk = 0; chunk < rays.size(); chunk += RAY_CHUNK) {
+    const size_t chunk_rays = std::min(RAY_CHUNK, rays.size() - chunk);
+    const GlBuffer ray_buffer(chunk_rays * sizeof(GpuRay), packed.data() + chunk);
+    const GlBuffer counts(chunk_rays * 4 * sizeof(uint32_t), nullptr);
+    ray_buffer.bind(CUBE_WALK_RAYS_BINDING);
+    counts.bind(CUBE_WALK_COUNTS_BINDING);
+    counts.bind(CUBE_WALK_TEXELS_BINDING);  // not touched by the count pass, but bound
+    counts.bind(CUBE_WALK_OFFSETS_BINDING);
+    run(false, 0, chunk_rays);
+    const std::vector<uint32_t> walked = counts.read<uint32_t>(4 * chunk_rays);
+    for (size_t first = 0; first < chunk_rays;) {
+      std::vector<uint32_t> offsets;
+      uint64_t texel_count = 0;
+      size_t end = first;
+      while (end < chunk_rays &&
+             (end == first || (texel_count + walked[4 * end]) * sizeof(GpuTexel) <= WALK_BATCH_BYTES)) {
+        offsets.push_back(static_cast<uint32_t>(texel_count));
+        texel_count += walked[4 * end];
+        ++end;
       }
+      const GlBuffer offset_buffer(offsets.size() * sizeof(uint32_t), offsets.data());
+      const GlBuffer texels(texel_count * sizeof(GpuTexel), nullptr);
+      offset_buffer.bind(CUBE_WALK_OFFSETS_BINDING);
+      texels.bind(CUBE_WALK_TEXELS_BINDING);
+      run(true, first, end - first);
+      unpack_batch(texels.read<GpuTexel>(texel_count), walked, counts.read<uint32_t>(4 * end), offsets, first, end,
+                   out.data() + chunk, chunk);
+      first = end;
     }
-    first = end;
   }
   return out;
 }
@@ -163,42 +189,61 @@ std::vector<RayWalk> cpu_cube_walks(const std::vector<WalkRay>& rays, int n, uin
   return out;
 }
 
+namespace {
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Within WALK_ROUNDING_REL of each other (the same infinity included).
+bool within_rounding(double a, double b) {
+  return a == b || std::fabs(a - b) <= WALK_ROUNDING_REL * std::max(std::fabs(a), std::fabs(b));
+}
+
+}  // namespace
+
 WalkComparison compare_walks(const std::vector<RayWalk>& a, const std::vector<RayWalk>& b) {
   WalkComparison c;
   c.rays = a.size();
-  const auto differ = [&](size_t r, const std::string& what) {
-    if (c.first_differing < 0) {
-      c.first_differing = static_cast<long>(r);
-      c.example = "ray " + std::to_string(r) + ": " + what;
-    }
-  };
   for (size_t r = 0; r < a.size(); ++r) {
     c.texels += a[r].texels.size();
-    if (r >= b.size()) {
-      differ(r, "missing from the second set");
-      continue;
-    }
     const std::vector<WalkTexel>& x = a[r].texels;
-    const std::vector<WalkTexel>& y = b[r].texels;
-    const auto same_texel = [](const WalkTexel& p, const WalkTexel& q) {
-      return p.face == q.face && p.i == q.i && p.j == q.j && p.after_gap == q.after_gap && p.l0 == q.l0 && p.l1 == q.l1;
-    };
+    const std::vector<WalkTexel>& y = r < b.size() ? b[r].texels : x;
+    const bool walks_alike = r < b.size() && a[r].aborted == b[r].aborted && x.size() == y.size();
+    // The first texel that differs in its place or bits, and whether every one is at the
+    // same place with both ends within rounding.
     size_t k = 0;
-    while (k < x.size() && k < y.size() && same_texel(x[k], y[k])) ++k;
-    if (k == x.size() && k == y.size() && a[r].aborted == b[r].aborted) {
+    bool rounding = walks_alike;
+    for (size_t t = 0; walks_alike && t < x.size(); ++t) {
+      const WalkTexel &p = x[t], &q = y[t];
+      const bool place = p.face == q.face && p.i == q.i && p.j == q.j && p.after_gap == q.after_gap;
+      const bool bits = place && same_bits(p.l0, q.l0) && same_bits(p.l1, q.l1);
+      if (bits && k == t) ++k;
+      rounding = rounding && place && within_rounding(p.l0, q.l0) && within_rounding(p.l1, q.l1);
+    }
+    if (walks_alike && k == x.size()) {
       ++c.identical;
       continue;
     }
+    if (rounding) {
+      ++c.within_rounding;
+    } else {
+      ++c.differing;
+    }
+    if (!c.example.empty()) continue;
     std::ostringstream what;
     what.precision(17);
-    what << x.size() << " texels" << (a[r].aborted ? " (aborted)" : "") << " against " << y.size()
-         << (b[r].aborted ? " (aborted)" : "");
-    if (k < x.size() && k < y.size()) {
-      const WalkTexel &p = x[k], &q = y[k];
-      what << "; texel " << k << ": face " << p.face << " (" << p.i << ", " << p.j << ") l [" << p.l0 << ", " << p.l1
-           << "] against face " << q.face << " (" << q.i << ", " << q.j << ") l [" << q.l0 << ", " << q.l1 << "]";
+    what << "ray " << r << (rounding ? " (within rounding): " : ": ");
+    if (r >= b.size()) {
+      what << "missing from the second set";
+    } else {
+      what << x.size() << " texels" << (a[r].aborted ? " (aborted)" : "") << " against " << y.size()
+           << (b[r].aborted ? " (aborted)" : "");
+      if (k < x.size() && k < y.size()) {
+        const WalkTexel &p = x[k], &q = y[k];
+        what << "; texel " << k << ": face " << p.face << " (" << p.i << ", " << p.j << ") l [" << p.l0 << ", " << p.l1
+             << "] against face " << q.face << " (" << q.i << ", " << q.j << ") l [" << q.l0 << ", " << q.l1 << "]";
+      }
     }
-    differ(r, what.str());
+    c.example = what.str();
   }
   return c;
 }

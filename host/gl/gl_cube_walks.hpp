@@ -52,10 +52,14 @@ class GlCubeWalks {
   std::unique_ptr<Program> program_;
 };
 
-// The largest cap a GPU walk takes: Mesa's llvmpipe ends an invocation's loops, silently,
-// after 65535 iterations in all, and a walk's loop runs once a texel, and a few times more a
-// face. CubeWalk's default cap, 16 n + 64, is within it up to n = 3746.
-constexpr uint32_t GPU_WALK_MAX_TEXELS = 60000;
+// The largest cap a GPU walk takes. Mesa's llvmpipe ends an invocation's loops, silently,
+// after 65535 iterations in all, and it counts more than one a texel (the compiler turns a
+// function's early returns into loops of their own): walks of 24000 texels were cut short
+// there and walks of 16000 were not. A walk cut short is refused (RuntimeFailure), never
+// returned short. CubeWalk's default cap, 16 n + 64, is within this bound up to n = 996.
+constexpr uint32_t GPU_WALK_MAX_TEXELS = 16000;
+// Whether a walk of an n x n map at CubeWalk's default cap runs on the GPU.
+inline bool gpu_walks_at(int n) { return n >= 1 && CubeWalk::default_cap(n) <= GPU_WALK_MAX_TEXELS; }
 
 // A scene's search rays, for the walks' cross-checks and benchmarks: from the centroids of up
 // to `max_triangles` triangles spread over the scene (relative to `centre`), the segment to
@@ -66,13 +70,19 @@ std::vector<WalkRay> scene_walk_rays(const SceneData& scene, const glm::dvec3& c
 // The same rays walked by CubeWalk on the CPU.
 std::vector<RayWalk> cpu_cube_walks(const std::vector<WalkRay>& rays, int n, uint32_t max_texels = 0);
 
-// How two sets of walks of the same rays agree: walks identical texel for texel (face, i,
-// j, after_gap and both ends of the interval bit for bit); else the first differing ray.
+// How two sets of walks of the same rays agree, ray by ray, in three classes:
+// - identical: the same texels in the same order (face, i, j, after_gap), both ends of every
+//   interval the same bits, the same cap;
+// - within rounding: the same texels and cap, every end within WALK_ROUNDING_REL of the
+//   other's: what a GL whose double divisions and square roots round otherwise than IEEE 754
+//   may move (GLSL promises them only single precision);
+// - differing: anything else (another texel, another count, the cap).
+// `example` gives the first ray not identical, in words.
+constexpr double WALK_ROUNDING_REL = 1e-12;
 struct WalkComparison {
-  size_t rays = 0, identical = 0;
+  size_t rays = 0, identical = 0, within_rounding = 0, differing = 0;
   uint64_t texels = 0;  // in the first set
-  long first_differing = -1;
-  std::string example;  // the first difference, in words
+  std::string example;
 };
 WalkComparison compare_walks(const std::vector<RayWalk>& a, const std::vector<RayWalk>& b);
 

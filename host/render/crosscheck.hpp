@@ -96,10 +96,12 @@ struct CrosscheckResult {
   ListComparison camera_lists;  // the same for the camera's A-buffer
   double gpu_camera_abuffer_ms = 0;
   // The cube walks of the searches' rays (shadow segments to the lights and reflection rays
-  // from points on the triangles) on the GPU against CubeWalk's, texel for texel and bit for
-  // bit (gl_cube_walks.hpp): it fails on any difference.
+  // from points on the triangles) on the GPU against CubeWalk's, texel for texel
+  // (gl_cube_walks.hpp compare_walks): it fails on any walk differing beyond rounding. Not
+  // compared where N is above what a GPU walk takes (gpu_walks_at).
   WalkComparison walks;
   double gpu_walks_ms = 0;
+  std::string walks_skipped;      // why the walks were not compared ("" when they were)
   double gpu_ms = 0, cpu_ms = 0;  // prepass vs cube A-buffer build
   uint64_t fragments = 0;
   bool pass = false;

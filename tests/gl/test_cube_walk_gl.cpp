@@ -96,6 +96,9 @@ TEST(CubeWalkGl, CapStopsBothAlike) {
   size_t aborted = 0;
   for (const RayWalk& w : walks) aborted += w.aborted ? 1 : 0;
   EXPECT_GT(aborted, 0u);
+  // Walks as long as a GPU walk may be (N = 10000 at the largest cap): llvmpipe's loop limit
+  // is not reached, and the cap stops both alike.
+  expect_same_walks(random_rays(4, 40), 10000, GPU_WALK_MAX_TEXELS, "longest walks");
 }
 
 TEST(CubeWalkGl, RefusesWhatTheCpuRefusesAndCapsAboveTheGpusBound) {
@@ -106,31 +109,53 @@ TEST(CubeWalkGl, RefusesWhatTheCpuRefusesAndCapsAboveTheGpusBound) {
   EXPECT_THROW(gpu.walk(one, 64, GPU_WALK_MAX_TEXELS + 1), InputError);
   EXPECT_THROW(gpu.walk({{glm::dvec3(1, 0, 0), glm::dvec3(0, 2, 0), INF, 0.0}}, 64), InputError);
   EXPECT_THROW(gpu.walk({{glm::dvec3(NAN, 0, 0), glm::dvec3(0, 1, 0), INF, 0.0}}, 64), InputError);
+  EXPECT_THROW(gpu.walk({{glm::dvec3(1, 0, 0), glm::dvec3(0, 1, 0), NAN, 0.0}}, 64), InputError);
+  EXPECT_THROW(gpu.walk({{glm::dvec3(1, 0, 0), glm::dvec3(0, 1, 0), INF, NAN}}, 64), InputError);
   EXPECT_TRUE(gpu.walk({}, 64).empty());
+  // The largest N whose default cap a GPU walk takes, and the next.
+  EXPECT_TRUE(gpu_walks_at(996));
+  EXPECT_FALSE(gpu_walks_at(997));
+  EXPECT_FALSE(gpu_walks_at(0));
+  EXPECT_THROW(gpu.walk(one, 997), InputError);
 }
 
-// compare_walks names what differs: a bound moved by one ulp, a texel missing, a cap.
-TEST(CubeWalkGl, ComparisonNamesTheFirstDifference) {
+// compare_walks' classes: a bound moved by one ulp is within rounding, a zero's sign is not
+// the same bits, a texel missing or a cap differs.
+TEST(CubeWalkGl, ComparisonSortsAndNamesTheDifferences) {
   const std::vector<RayWalk> cpu = cpu_cube_walks(rule_rays(), 16);
   ASSERT_GT(cpu.size(), 3u);
-  EXPECT_EQ(compare_walks(cpu, cpu).identical, cpu.size());
-  long r = 0;  // a ray of a few texels
-  while (static_cast<size_t>(r) < cpu.size() && cpu[static_cast<size_t>(r)].texels.size() < 3) ++r;
-  ASSERT_LT(static_cast<size_t>(r), cpu.size());
-  const size_t k = static_cast<size_t>(r);
+  WalkComparison c = compare_walks(cpu, cpu);
+  EXPECT_EQ(c.identical, cpu.size());
+  EXPECT_TRUE(c.example.empty());
+  size_t k = 0;  // a ray of a few texels
+  while (k < cpu.size() && cpu[k].texels.size() < 3) ++k;
+  ASSERT_LT(k, cpu.size());
   std::vector<RayWalk> moved = cpu;
-  WalkTexel& t = moved[k].texels[1];
-  t.l1 = std::nextafter(t.l1, INF);
-  WalkComparison c = compare_walks(cpu, moved);
+  moved[k].texels[1].l1 = std::nextafter(moved[k].texels[1].l1, INF);
+  c = compare_walks(cpu, moved);
   EXPECT_EQ(c.identical, cpu.size() - 1);
-  EXPECT_EQ(c.first_differing, r);
+  EXPECT_EQ(c.within_rounding, 1u);
+  EXPECT_EQ(c.differing, 0u);
+  EXPECT_NE(c.example.find("ray " + std::to_string(k) + " (within rounding): "), std::string::npos) << c.example;
   EXPECT_NE(c.example.find("texel 1:"), std::string::npos) << c.example;
+  std::vector<RayWalk> signed_zero = cpu;
+  RayWalk& from_zero = signed_zero[0];
+  ASSERT_EQ(from_zero.texels[0].l0, 0.0);
+  from_zero.texels[0].l0 = -0.0;
+  c = compare_walks(cpu, signed_zero);
+  EXPECT_EQ(c.identical, cpu.size() - 1);
+  EXPECT_EQ(c.within_rounding, 1u);
   std::vector<RayWalk> shorter = cpu;
   shorter[k].texels.pop_back();
   shorter[k].aborted = true;
   c = compare_walks(cpu, shorter);
-  EXPECT_EQ(c.first_differing, r);
+  EXPECT_EQ(c.differing, 1u);
   EXPECT_NE(c.example.find("(aborted)"), std::string::npos) << c.example;
+  std::vector<RayWalk> elsewhere = cpu;
+  elsewhere[k].texels[2].i += 1;
+  c = compare_walks(cpu, elsewhere);
+  EXPECT_EQ(c.differing, 1u);
+  EXPECT_NE(c.example.find("texel 2:"), std::string::npos) << c.example;
 }
 
 }  // namespace
