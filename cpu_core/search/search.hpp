@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -275,6 +276,47 @@ struct ShadowResult {
   uint32_t mesh_triangles = 0;
   uint32_t threshold_rejections = 0;  // candidates refused by the tolerance / theta_max
 };
+
+// One search's ray, relative to the cube centre: what its walk and its tests take.
+struct SearchRay {
+  glm::dvec3 w{0.0}, d{0.0};                               // origin and unit direction
+  double l_max = std::numeric_limits<double>::infinity();  // end of the ray (shadow segments)
+  double self = 0;               // self offset in world units (SELF-HITS, docs/design/search.md)
+  double self_tolerance = 0;     // nearest tolerance candidate accepted, world units (SELF-HITS)
+  bool restrict_object = false;  // refraction exit: only `object` and what may lie inside it
+  uint32_t object = 0;
+  bool side = true;  // SearchOptions::side_structure
+};
+
+// The rays the searches below walk: reflection_search's for (w, r), refraction_exit_search's
+// for (w, t, object_id), shadow_search's for (p, light_position) (the segment; false, and no
+// search, when p is the light).
+SearchRay reflection_ray(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& r,
+                         const SearchOptions& options = {});
+SearchRay refraction_exit_ray(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& t, uint32_t object_id,
+                              const SearchOptions& options = {});
+bool shadow_ray(const SearchContext& ctx, const glm::dvec3& p, const glm::dvec3& light_position,
+                const SearchOptions& options, SearchRay* out);
+
+// CANDIDATES (docs/design/search.md): the fragments a search's walk hands to its crossing or
+// thesis test, over the ray's whole walk (as if no answer ended it), in the order the walk
+// meets them: those that pass the layer choice, the object restriction, the z-interval test
+// (thesis 7.5) and the own-surface test. Each names the walk's texel (its place in the walk,
+// CubeWalk's order) and the fragment (its index in the face's A-buffer). The BLOCK BOUNDS and
+// the HIERARCHICAL SKIP pass only texels none of whose fragments could pass, so they change
+// none of it; the GPU's scan (host/gl/gl_cube_scan.hpp) is held to it.
+struct ScanCandidate {
+  uint32_t texel = 0;  // the walk's texel: 0 for the first it walks
+  uint32_t face = 0;
+  uint32_t fragment = 0;  // index into cube.faces[face].fragments
+  bool operator==(const ScanCandidate& o) const { return texel == o.texel && face == o.face && fragment == o.fragment; }
+};
+struct CandidateScan {
+  std::vector<ScanCandidate> candidates;
+  uint32_t texels = 0;   // texels walked
+  bool aborted = false;  // the walk's cap stopped it
+};
+CandidateScan scan_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options = {});
 
 // Reflection (or any secondary ray seen from outside): the first surface along the ray
 // W + l R, l > 0 (W world space on the reflecting surface, R unit).

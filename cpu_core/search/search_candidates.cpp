@@ -219,17 +219,4 @@ SearchResult finish(const SearchContext& ctx, const SearchRay& q, const Candidat
   return r;
 }
 
-SearchRay make_query(const SearchContext& ctx, const glm::dvec3& w_world, const glm::dvec3& dir,
-                     const SearchOptions& o) {
-  ABCUBE_CHECK(std::fabs(glm::length(dir) - 1.0) < 1e-6, "search direction must be unit");
-  SearchRay q;
-  q.w = w_world - ctx.cube().centre;
-  q.d = dir;
-  const double texel = texel_size_at(q.w, ctx.cube().n);
-  q.self = self_offset_texels(o) * texel;
-  q.self_tolerance = 2.0 * o.tolerance_texels * texel;
-  q.side = o.side_structure;
-  return q;
-}
-
 }  // namespace abcube::detail

@@ -1,6 +1,6 @@
-// Internal to the search stage (search.hpp): what its files share. One search's ray,
-// the walk's counts, one fragment's answer (a candidate), the mesh refinement's answer, and
-// the functions one file defines for the others. Not part of the stage's API.
+// Internal to the search stage (search.hpp): what its files share. The walk's counts, one fragment's answer (a
+// candidate), the mesh refinement's answer, and the functions one file defines for the others. Not part of the stage's
+// API.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -73,17 +73,6 @@ inline const SearchContext::Sphere& bounding_sphere(Memo<SearchContext::Sphere>&
                                                     uint32_t tri) {
   return spheres.get(tri, [&] { return ctx.compute_bounding_sphere(tri); });
 }
-
-// One search's ray, relative to the cube centre.
-struct SearchRay {
-  glm::dvec3 w{0.0}, d{0.0};     // origin and unit direction
-  double l_max = INF;            // end of the ray (shadow segments)
-  double self = 0;               // self offset in world units (SELF-HITS, docs/design/search.md)
-  double self_tolerance = 0;     // nearest tolerance candidate accepted, world units (SELF-HITS)
-  bool restrict_object = false;  // refraction exit: only `object` and what may lie inside it
-  uint32_t object = 0;
-  bool side = true;  // SearchOptions::side_structure
-};
 
 // May a surface of `object` answer this ray? Any, unless it is a refraction exit from inside
 // q.object: then that object's own surfaces and those of the objects whose bounding boxes
@@ -181,9 +170,5 @@ SideCrossing nearest_side_crossing(const SearchContext& ctx, const SearchRay& q,
 // structure, a zero-area surface met before it turns it into a zero-area miss.
 SearchResult finish(const SearchContext& ctx, const SearchRay& q, const Candidate* best, MissReason miss,
                     const ScanCounts& counts);
-
-// The ray of a search from W (world space) along unit `dir`, with the self offsets of `o`.
-SearchRay make_query(const SearchContext& ctx, const glm::dvec3& w_world, const glm::dvec3& dir,
-                     const SearchOptions& o);
 
 }  // namespace abcube::detail

@@ -11,6 +11,20 @@ namespace abcube {
 
 namespace {
 
+// The ray of a search from W (world space) along unit `dir`, with the self offsets of `o`.
+SearchRay make_query(const SearchContext& ctx, const glm::dvec3& w_world, const glm::dvec3& dir,
+                     const SearchOptions& o) {
+  ABCUBE_CHECK(std::fabs(glm::length(dir) - 1.0) < 1e-6, "search direction must be unit");
+  SearchRay q;
+  q.w = w_world - ctx.cube().centre;
+  q.d = dir;
+  const double texel = texel_size_at(q.w, ctx.cube().n);
+  q.self = self_offset_texels(o) * texel;
+  q.self_tolerance = 2.0 * o.tolerance_texels * texel;
+  q.side = o.side_structure;
+  return q;
+}
+
 using namespace detail;
 
 // Crossing mode: the first crossing, exact ones first (docs/design/search.md).
@@ -150,27 +164,45 @@ bool blocks(const SearchContext& ctx, const SearchRay& q, uint32_t tri, const gl
 
 }  // namespace
 
+SearchRay reflection_ray(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& r,
+                         const SearchOptions& options) {
+  return make_query(ctx, w, r, options);
+}
+
+SearchRay refraction_exit_ray(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& t, uint32_t object_id,
+                              const SearchOptions& options) {
+  SearchRay q = make_query(ctx, w, t, options);
+  q.restrict_object = true;
+  q.object = object_id;
+  return q;
+}
+
+bool shadow_ray(const SearchContext& ctx, const glm::dvec3& p, const glm::dvec3& light_position,
+                const SearchOptions& options, SearchRay* out) {
+  const glm::dvec3 seg = light_position - p;
+  const double len = glm::length(seg);
+  if (!(len > 0.0)) return false;
+  *out = make_query(ctx, p, seg / len, options);
+  out->l_max = len;
+  return true;
+}
+
 SearchResult reflection_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& r,
                                const SearchOptions& options) {
-  return search_ray(ctx, make_query(ctx, w, r, options), options);
+  return search_ray(ctx, reflection_ray(ctx, w, r, options), options);
 }
 
 SearchResult refraction_exit_search(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& t,
                                     uint32_t object_id, const SearchOptions& options) {
-  SearchRay q = make_query(ctx, w, t, options);
-  q.restrict_object = true;
-  q.object = object_id;
-  return search_ray(ctx, q, options);
+  return search_ray(ctx, refraction_exit_ray(ctx, w, t, object_id, options), options);
 }
 
 ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const glm::dvec3& light_position,
                            const SearchOptions& options, uint32_t known_blocker) {
   ShadowResult res;
-  const glm::dvec3 seg = light_position - p;
-  const double len = glm::length(seg);
-  if (!(len > 0.0)) return res;
-  SearchRay q = make_query(ctx, p, seg / len, options);
-  q.l_max = len;
+  SearchRay q;
+  if (!shadow_ray(ctx, p, light_position, options, &q)) return res;
+  const double len = q.l_max;
   if (known_blocker != NO_TRIANGLE && options.known_blockers && options.side_structure &&
       options.mode == SearchMode::crossing && options.layers == SearchLayers::all &&
       blocks(ctx, q, known_blocker, light_position)) {
@@ -222,6 +254,20 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
   res.fragments_tested = counts.fragments;
   res.candidates = counts.candidates;
   return res;
+}
+
+CandidateScan scan_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options) {
+  CandidateScan out;
+  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3&, const SearchContext::Plane&) {
+    const std::vector<Fragment>& face = ctx.cube().faces[static_cast<size_t>(t.face)].fragments;
+    out.candidates.push_back({out.texels, static_cast<uint32_t>(t.face), static_cast<uint32_t>(&f - face.data())});
+  };
+  const auto after_texel = [&](const WalkTexel&, uint32_t index) {
+    out.texels = index + 1;
+    return true;
+  };
+  out.aborted = scan(ctx, q, options, on_fragment, after_texel, [] { return false; }).aborted;
+  return out;
 }
 
 }  // namespace abcube

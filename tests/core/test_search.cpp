@@ -719,6 +719,34 @@ TEST(Search, StatsCountEveryRay) {
   EXPECT_FALSE(parse_search_mode("march", &mode));
 }
 
+// scan_candidates: the fragments a search tests, in the walk's order. Where none is accepted
+// (the thesis mode with a zero angle walks to the end), the search counts exactly those,
+// whatever its skips over empty texels stepped past.
+TEST(Search, ScanCandidatesAreTheFragmentsASearchTests) {
+  const auto world = make_world(room_scene(), 32);
+  const SearchContext& ctx = *world->ctx;
+  SearchOptions none;
+  none.mode = SearchMode::thesis;
+  none.theta_max = 1e-9;
+  size_t total = 0;
+  for (int k = 0; k < 10; ++k) {
+    const dvec3 w(-0.8 + 0.15 * k, 0.1, -2);
+    const dvec3 r = glm::normalize(dvec3(0.1 * k - 0.5, 0.2, 1));
+    const SearchResult res = reflection_search(ctx, w, r, none);
+    const CandidateScan scan = scan_candidates(ctx, reflection_ray(ctx, w, r, none), none);
+    EXPECT_EQ(res.candidates, scan.candidates.size()) << k;
+    EXPECT_FALSE(scan.aborted);
+    for (size_t c = 0; c < scan.candidates.size(); ++c) {
+      const ScanCandidate& x = scan.candidates[c];
+      EXPECT_LT(x.texel, scan.texels);
+      EXPECT_LT(x.fragment, ctx.cube().faces[x.face].fragments.size());
+      if (c > 0) EXPECT_GE(x.texel, scan.candidates[c - 1].texel);
+    }
+    total += scan.candidates.size();
+  }
+  EXPECT_GT(total, 10u);
+}
+
 // MESH REFINEMENT (search.hpp): the crossing search checks a candidate against the mesh
 // around its fragment's triangle, so a ray passing within a texel of a silhouette or of a
 // crease is no longer taken for a crossing. Each test runs the same rays with
