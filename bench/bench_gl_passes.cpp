@@ -5,7 +5,9 @@
 // fragment of every surface) and its ratio to the GPU prepass, and the same A-buffer built by
 // GL compute shaders (gl_abuffer.hpp) with the share of its lists identical to the CPU's.
 // Then the searches' cube walks of the scene's rays (gl_cube_walks.hpp scene_walk_rays) on the
-// GPU and by CubeWalk on one CPU thread, with the share of walks identical.
+// GPU and by CubeWalk on one CPU thread, with the share of walks identical; and the searches'
+// candidates in the cube A-buffer (gl_cube_scan.hpp scene_search_rays) on the GPU and by
+// scan_candidates on one CPU thread, with the share of rays whose candidates are identical.
 //
 //   bench_gl_passes SCENE.json [--sizes 256,512,1024] [--runs 5] [--gl auto|egl|osmesa]
 //                   [--error-samples 20000] [--walk-triangles 4096]
@@ -24,6 +26,7 @@
 #include "base/error.hpp"
 #include "gl/gl_abuffer.hpp"
 #include "gl/gl_context.hpp"
+#include "gl/gl_cube_scan.hpp"
 #include "gl/gl_cube_walks.hpp"
 #include "gl/gl_passes.hpp"
 #include "reference/raytrace.hpp"
@@ -48,8 +51,8 @@ void add_options(BenchCommandLine& line, Options& o) {
   line.number("--runs", o.runs, "runs per N (median, min and max reported)", 1, 1000);
   line.choice("--gl", o.gl, "GL path", {"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"});
   line.number("--error-samples", o.error_samples, "texel-centre rays checked against the exact tracer", 0, 100000000);
-  line.number("--walk-triangles", o.walk_triangles, "triangles whose search rays are walked (0 = no walks)", 0,
-              100000000);
+  line.number("--walk-triangles", o.walk_triangles, "triangles whose search rays are walked and scanned (0 = neither)",
+              0, 100000000);
 }
 
 struct Spread {
@@ -128,6 +131,47 @@ void print_walks(const SceneData& scene, const Options& o) {
   }
 }
 
+// The searches' candidates in the CPU's cube A-buffer at each N: GPU against one CPU thread.
+// The GPU's time is the scan's (walks, z-interval tests, reading the candidates back); the
+// lists' upload is its own column.
+void print_candidates(const SceneData& scene, const Options& o) {
+  std::printf(
+      "\n| N | search rays | candidates | texels walked | GPU upload ms | GPU scan ms | CPU scan ms (1 thread) | "
+      "rays identical |\n|---|---|---|---|---|---|---|---|\n");
+  for (int n : o.sizes) {
+    if (!gpu_walks_at(n)) {
+      std::printf("| %d | not scanned: the walk's cap is above the GPU's %u texels | | | | | | |\n", n,
+                  GPU_WALK_MAX_TEXELS);
+      continue;
+    }
+    const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, n);
+    const SearchContext ctx(scene, cube);
+    const std::vector<SearchRay> rays = scene_search_rays(ctx, static_cast<size_t>(o.walk_triangles));
+    std::vector<double> upload_ms, gpu_ms, cpu_ms;
+    std::vector<CandidateScan> on_gpu, on_cpu;
+    for (int r = 0; r < o.runs; ++r) {
+      Clock::time_point t0 = Clock::now();
+      const GlCandidateScan gpu(ctx);
+      upload_ms.push_back(ms_since(t0));
+      t0 = Clock::now();
+      on_gpu = gpu.scan(rays);
+      gpu_ms.push_back(ms_since(t0));
+      t0 = Clock::now();
+      on_cpu.clear();
+      for (const SearchRay& q : rays) on_cpu.push_back(scan_candidates(ctx, q));
+      cpu_ms.push_back(ms_since(t0));
+    }
+    const CandidateComparison c = compare_candidate_scans(on_cpu, on_gpu);
+    uint64_t texels = 0;
+    for (const CandidateScan& s : on_cpu) texels += s.texels;
+    const Spread u = spread(upload_ms), g = spread(gpu_ms), cp = spread(cpu_ms);
+    std::printf("| %d | %zu | %llu | %llu | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %zu of %zu |\n",
+                n, rays.size(), static_cast<unsigned long long>(c.candidates), static_cast<unsigned long long>(texels),
+                u.median, u.lo, u.hi, g.median, g.lo, g.hi, cp.median, cp.lo, cp.hi, c.identical, c.rays);
+    std::fflush(stdout);
+  }
+}
+
 int run(const Options& o) {
   const SceneData scene = load_scene(o.scene);
   GlChoice choice = GlChoice::automatic;
@@ -189,7 +233,10 @@ int run(const Options& o) {
         static_cast<unsigned long long>(lists.lists));
     std::fflush(stdout);
   }
-  if (o.walk_triangles > 0) print_walks(scene, o);
+  if (o.walk_triangles > 0) {
+    print_walks(scene, o);
+    print_candidates(scene, o);
+  }
   return 0;
 }
 

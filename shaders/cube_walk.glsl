@@ -5,6 +5,13 @@
 // (double_math.glsl), so that a GL whose doubles round as IEEE 754 says walks the CPU's texels
 // with the CPU's intervals bit for bit. One walk an invocation: its state is global.
 
+// A texel of a walk as cube_walks.comp writes it and cube_scan.comp reads it: (face, i, j,
+// after_gap) and [l0, l1].
+struct WalkTexelOut {
+  ivec4 texel;
+  dvec2 interval;
+};
+
 // The cube's face bases (cube_map.hpp cube_face_basis), set from the C++ definition.
 uniform dvec3 face_forward[6];
 uniform dvec3 face_s_axis[6];

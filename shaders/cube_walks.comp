@@ -13,11 +13,6 @@ struct WalkRay {
   dvec4 w_lmax;
   dvec4 d_skip;
 };
-// A texel of a walk: (face, i, j, after_gap) and [l0, l1].
-struct WalkTexelOut {
-  ivec4 texel;
-  dvec2 interval;
-};
 
 layout(std430, binding = CUBE_WALK_RAYS_BINDING) readonly buffer Rays { WalkRay rays[]; };
 layout(std430, binding = CUBE_WALK_TEXELS_BINDING) writeonly buffer Texels { WalkTexelOut texels[]; };

@@ -22,7 +22,8 @@ namespace {
 
 constexpr const char* CROSSCHECK_COVERS =
     "covers: visibility (cube texels, camera samples), the cube's and the camera's A-buffer lists, the cube walks of "
-    "shadow and reflection rays, direct shading of interior pixels, hard shadows; not covered: reflections, "
+    "shadow and reflection rays, the searches' candidates in the cube A-buffer, direct shading of interior pixels, "
+    "hard shadows; not covered: reflections, "
     "refractions, antialiased edges (abcube report compares "
     "whole images with the exact tracer)";
 
@@ -86,6 +87,10 @@ struct CrosscheckCommand {
           r.walks.identical, r.walks.rays, r.walks.within_rounding, r.walks.differing,
           static_cast<unsigned long long>(r.walks.texels), r.gpu_walks_ms,
           r.walks.example.empty() ? "" : "; first not identical: ", r.walks.example.c_str());
+      std::printf("GPU search candidates: %zu of %zu rays identical, %zu differing, %llu candidates (%.1f ms)%s%s\n",
+                  r.candidates.identical, r.candidates.rays, r.candidates.differing,
+                  static_cast<unsigned long long>(r.candidates.candidates), r.gpu_candidates_ms,
+                  r.candidates.example.empty() ? "" : "; first differing: ", r.candidates.example.c_str());
     }
     std::printf("camera interior pixels: %zu of %zu, RMSE %.2e (<= %.0e), max abs %.2e (<= %.2e)\n", r.interior_pixels,
                 r.pixels, r.interior_rmse, tol.interior_rmse, r.interior_max_abs, tol.interior_max_abs);

@@ -55,28 +55,16 @@ void set_walk_uniforms(const GlProgram& p, int n, uint32_t cap) {
   glUniform1ui(p.uniform("walk_cap_texels"), cap);
 }
 
-// The walks of rays [first, end) of a chunk (its first ray `chunk` of the whole), from the
-// fill pass's texels (`all`, ray k's from offsets[k - first]) and both passes' counts and
-// flags (4 words a ray), into out[first, end).
-void unpack_batch(const std::vector<GpuTexel>& all, const std::vector<uint32_t>& walked,
-                  const std::vector<uint32_t>& filled, const std::vector<uint32_t>& offsets, size_t first, size_t end,
-                  RayWalk* out, size_t chunk) {
+// Both passes must have ended every walk of rays [first, end) of a chunk (flag 2) with the same
+// count: a GL that stops a shader's loops early (llvmpipe past its iteration limit) fails
+// here, not silently. `walked` and `filled` hold both passes' counts and flags (4 words a ray).
+void check_batch(const std::vector<uint32_t>& walked, const std::vector<uint32_t>& filled, size_t first, size_t end,
+                 size_t chunk) {
   for (size_t k = first; k < end; ++k) {
-    // Both passes must have ended their walk (flag 2) with the same count: a GL that stops a
-    // shader's loops early (llvmpipe past its iteration limit) fails here, not silently.
     const uint32_t count = walked[4 * k], flags = walked[4 * k + 1];
     if (!(flags & 2u) || filled[4 * k + 2] != count || filled[4 * k + 3] != flags) {
       throw RuntimeFailure("GPU cube walk: the GL ended ray " + std::to_string(chunk + k) +
                            "'s walk early (a loop limit?)");
-    }
-    RayWalk& w = out[k];
-    w.aborted = (flags & 1u) != 0;
-    const GpuTexel* g = all.data() + offsets[k - first];
-    for (uint32_t t = 0; t < count; ++t, ++g) {
-      WalkTexel texel;
-      texel.face = g->face, texel.i = g->i, texel.j = g->j, texel.l0 = g->l0, texel.l1 = g->l1;
-      texel.after_gap = g->after_gap != 0;
-      w.texels.push_back(texel);
     }
   }
 }
@@ -93,7 +81,8 @@ GlCubeWalks::GlCubeWalks() {
 }
 GlCubeWalks::~GlCubeWalks() = default;
 
-std::vector<RayWalk> GlCubeWalks::walk(const std::vector<WalkRay>& rays, int n, uint32_t max_texels) const {
+void GlCubeWalks::walk_batches(const std::vector<WalkRay>& rays, int n, uint32_t max_texels,
+                               const std::function<void(const Batch&)>& visit) const {
   if (n < 1) throw InputError("GPU cube walk: n must be >= 1, got " + std::to_string(n));
   const uint32_t cap = max_texels ? max_texels : CubeWalk::default_cap(n);
   if (cap > GPU_WALK_MAX_TEXELS) {
@@ -106,12 +95,9 @@ std::vector<RayWalk> GlCubeWalks::walk(const std::vector<WalkRay>& rays, int n, 
     packed[k] = {{rays[k].w.x, rays[k].w.y, rays[k].w.z, rays[k].l_max},
                  {rays[k].d.x, rays[k].d.y, rays[k].d.z, rays[k].skip_radius}};
   }
-  std::vector<RayWalk> out(rays.size());
-  if (rays.empty()) return out;
   const GlProgram& p = program_->program;
-  set_walk_uniforms(p, n, cap);
   const auto run = [&](bool fill, size_t first, size_t count) {
-    p.use();
+    set_walk_uniforms(p, n, cap);
     glUniform1i(p.uniform("fill"), fill ? 1 : 0);
     glUniform1ui(p.uniform("first_ray"), static_cast<GLuint>(first));
     glUniform1ui(p.uniform("ray_count"), static_cast<GLuint>(count));
@@ -121,59 +107,94 @@ std::vector<RayWalk> GlCubeWalks::walk(const std::vector<WalkRay>& rays, int n, 
   // The rays go in chunks (their storage blocks well under the 128 MiB a GL must offer); in
   // each, the count pass, then the fill pass in batches of rays whose texels take at most
   // WALK_BATCH_BYTES (one ray's at least).
-  constexpr size_t RAY_CHUNK = size_t{1} << 18;
   constexpr uint64_t WALK_BATCH_BYTES = uint64_t{64} << 20;
-  for (size_t chunk = 0; chunk < rays.size(); chunk += RAY_CHUNK) {
-    const size_t chunk_rays = std::min(RAY_CHUNK, rays.size() - chunk);
+  for (size_t chunk = 0; chunk < rays.size(); chunk += WALK_RAY_CHUNK) {
+    const size_t chunk_rays = std::min(WALK_RAY_CHUNK, rays.size() - chunk);
     const GlBuffer ray_buffer(chunk_rays * sizeof(GpuRay), packed.data() + chunk);
     const GlBuffer counts(chunk_rays * 4 * sizeof(uint32_t), nullptr);
-    ray_buffer.bind(CUBE_WALK_RAYS_BINDING);
-    counts.bind(CUBE_WALK_COUNTS_BINDING);
+    const auto bind = [&] {
+      ray_buffer.bind(CUBE_WALK_RAYS_BINDING);
+      counts.bind(CUBE_WALK_COUNTS_BINDING);
+    };
+    bind();
     counts.bind(CUBE_WALK_TEXELS_BINDING);  // not touched by the count pass, but bound
     counts.bind(CUBE_WALK_OFFSETS_BINDING);
     run(false, 0, chunk_rays);
     const std::vector<uint32_t> walked = counts.read<uint32_t>(4 * chunk_rays);
     for (size_t first = 0; first < chunk_rays;) {
-      std::vector<uint32_t> offsets;
-      uint64_t texel_count = 0;
+      Batch batch;
+      batch.chunk = chunk;
+      batch.first = first;
       size_t end = first;
       while (end < chunk_rays &&
-             (end == first || (texel_count + walked[4 * end]) * sizeof(GpuTexel) <= WALK_BATCH_BYTES)) {
-        offsets.push_back(static_cast<uint32_t>(texel_count));
-        texel_count += walked[4 * end];
+             (end == first || (batch.texel_count + walked[4 * end]) * sizeof(GpuTexel) <= WALK_BATCH_BYTES)) {
+        batch.offsets.push_back(static_cast<uint32_t>(batch.texel_count));
+        batch.texel_count += walked[4 * end];
         ++end;
       }
-      const GlBuffer offset_buffer(offsets.size() * sizeof(uint32_t), offsets.data());
-      const GlBuffer texels(texel_count * sizeof(GpuTexel), nullptr);
+      batch.end = end;
+      const GlBuffer offset_buffer(batch.offsets.size() * sizeof(uint32_t), batch.offsets.data());
+      const GlBuffer texels(batch.texel_count * sizeof(GpuTexel), nullptr);
+      bind();  // a visit may have bound others
       offset_buffer.bind(CUBE_WALK_OFFSETS_BINDING);
       texels.bind(CUBE_WALK_TEXELS_BINDING);
       run(true, first, end - first);
-      unpack_batch(texels.read<GpuTexel>(texel_count), walked, counts.read<uint32_t>(4 * end), offsets, first, end,
-                   out.data() + chunk, chunk);
+      const std::vector<uint32_t> filled = counts.read<uint32_t>(4 * end);
+      check_batch(walked, filled, first, end, chunk);
+      batch.counts = &walked;
+      batch.texels = &texels;
+      batch.offset_buffer = &offset_buffer;
+      visit(batch);
       first = end;
     }
   }
+}
+
+std::vector<RayWalk> GlCubeWalks::walk(const std::vector<WalkRay>& rays, int n, uint32_t max_texels) const {
+  std::vector<RayWalk> out(rays.size());
+  walk_batches(rays, n, max_texels, [&](const Batch& b) {
+    const std::vector<GpuTexel> all = b.texels->read<GpuTexel>(b.texel_count);
+    for (size_t k = b.first; k < b.end; ++k) {
+      RayWalk& w = out[b.chunk + k];
+      const uint32_t count = (*b.counts)[4 * k];
+      w.aborted = ((*b.counts)[4 * k + 1] & 1u) != 0;
+      const GpuTexel* g = all.data() + b.offsets[k - b.first];
+      for (uint32_t t = 0; t < count; ++t, ++g) {
+        WalkTexel texel;
+        texel.face = g->face, texel.i = g->i, texel.j = g->j, texel.l0 = g->l0, texel.l1 = g->l1;
+        texel.after_gap = g->after_gap != 0;
+        w.texels.push_back(texel);
+      }
+    }
+  });
   return out;
 }
 
-std::vector<WalkRay> scene_walk_rays(const SceneData& scene, const glm::dvec3& centre, size_t max_triangles) {
-  const TriangleSoup& soup = *scene.triangles;
+void for_spread_triangles(const TriangleSoup& soup, size_t max_triangles,
+                          const std::function<void(size_t, const glm::dvec3&, const glm::dvec3&)>& visit) {
   const size_t count = soup.triangle_count();
   const size_t stride = std::max<size_t>(1, (count + max_triangles - 1) / std::max<size_t>(1, max_triangles));
-  std::vector<WalkRay> rays;
   for (size_t t = 0; t < count; t += stride) {
     const glm::dvec3 a(soup.positions[3 * t]), b(soup.positions[3 * t + 1]), c(soup.positions[3 * t + 2]);
-    const glm::dvec3 w = (a + b + c) / 3.0 - centre;
     const glm::dvec3 normal = glm::cross(b - a, c - a);
-    const double w_len = glm::length(w), n_len = glm::length(normal);
-    if (!(w_len > 0.0) || !(n_len > 0.0) || !std::isfinite(w_len)) continue;
-    rays.push_back({w, glm::reflect(w / w_len, normal / n_len), std::numeric_limits<double>::infinity(), 0.0});
+    const double n_len = glm::length(normal);
+    if (n_len > 0.0 && std::isfinite(n_len)) visit(t, (a + b + c) / 3.0, normal / n_len);
+  }
+}
+
+std::vector<WalkRay> scene_walk_rays(const SceneData& scene, const glm::dvec3& centre, size_t max_triangles) {
+  std::vector<WalkRay> rays;
+  for_spread_triangles(*scene.triangles, max_triangles, [&](size_t, const glm::dvec3& x, const glm::dvec3& normal) {
+    const glm::dvec3 w = x - centre;
+    const double w_len = glm::length(w);
+    if (!(w_len > 0.0) || !std::isfinite(w_len)) return;
+    rays.push_back({w, glm::reflect(w / w_len, normal), std::numeric_limits<double>::infinity(), 0.0});
     for (const PointLight& light : scene.lights) {
       const glm::dvec3 to_light = light.position - centre - w;
       const double l = glm::length(to_light);
       if (l > 0.0 && std::isfinite(l)) rays.push_back({w, to_light / l, l, 0.0});
     }
-  }
+  });
   return rays;
 }
 

@@ -5,6 +5,7 @@
 // the same intervals bit for bit: compare_walks says where they differ.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -16,6 +17,11 @@
 #include "search/cube_walk.hpp"
 
 namespace abcube {
+
+class GlBuffer;
+
+// Rays a chunk of a GPU walk: their storage blocks stay well under the 128 MiB a GL must offer.
+constexpr size_t WALK_RAY_CHUNK = size_t{1} << 18;
 
 // A ray to walk: CubeWalk's arguments (w relative to the centre, d unit).
 struct WalkRay {
@@ -46,6 +52,23 @@ class GlCubeWalks {
   // on a cap above GPU_WALK_MAX_TEXELS.
   std::vector<RayWalk> walk(const std::vector<WalkRay>& rays, int n, uint32_t max_texels = 0) const;
 
+  // The walks left on the GPU, for a pass that reads them there (gl_cube_scan.hpp): the rays
+  // go in chunks of WALK_RAY_CHUNK, and each chunk's fill pass in batches; visit() is called
+  // once a batch, its texels bound at CUBE_WALK_TEXELS_BINDING (cube_walk.glsl's
+  // WalkTexelOut) and its offsets at CUBE_WALK_OFFSETS_BINDING. Every walk of a batch has
+  // been checked ended by both passes. The same refusals as walk().
+  struct Batch {
+    size_t chunk = 0;           // the chunk's first ray
+    size_t first = 0, end = 0;  // the batch's rays, chunk + [first, end)
+    uint64_t texel_count = 0;
+    std::vector<uint32_t> offsets;                  // ray chunk + first + k's first texel in the batch
+    const std::vector<uint32_t>* counts = nullptr;  // per chunk ray: (count, flags, -, -); flag 1: the cap stopped it
+    const GlBuffer* texels = nullptr;
+    const GlBuffer* offset_buffer = nullptr;
+  };
+  void walk_batches(const std::vector<WalkRay>& rays, int n, uint32_t max_texels,
+                    const std::function<void(const Batch&)>& visit) const;
+
   struct Program;
 
  private:
@@ -66,6 +89,11 @@ inline bool gpu_walks_at(int n) { return n >= 1 && CubeWalk::default_cap(n) <= G
 // each light (a shadow ray's walk) and the ray reflecting the view from the centre about the
 // triangle's plane (a reflection ray's). Degenerate triangles give none.
 std::vector<WalkRay> scene_walk_rays(const SceneData& scene, const glm::dvec3& centre, size_t max_triangles);
+
+// Calls visit(triangle, centroid, unit normal) for up to `max_triangles` of the soup's
+// triangles, spread evenly over it, skipping degenerate ones.
+void for_spread_triangles(const TriangleSoup& soup, size_t max_triangles,
+                          const std::function<void(size_t, const glm::dvec3&, const glm::dvec3&)>& visit);
 
 // The same rays walked by CubeWalk on the CPU.
 std::vector<RayWalk> cpu_cube_walks(const std::vector<WalkRay>& rays, int n, uint32_t max_texels = 0);

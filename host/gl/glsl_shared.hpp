@@ -65,6 +65,15 @@ constexpr unsigned CUBE_WALK_RAYS_BINDING = 20;
 constexpr unsigned CUBE_WALK_TEXELS_BINDING = 21;
 constexpr unsigned CUBE_WALK_COUNTS_BINDING = 22;
 constexpr unsigned CUBE_WALK_OFFSETS_BINDING = 23;
+// The GPU's candidate scan (gl_cube_scan.cpp, cube_scan.comp), which reads a batch of walks
+// at the two bindings above: the searches' rays, the cube's lists and fragments, the
+// triangles' planes, their objects with the restriction rows, and the candidates found.
+constexpr unsigned CUBE_SCAN_RAYS_BINDING = 24;
+constexpr unsigned CUBE_SCAN_LISTS_BINDING = 25;
+constexpr unsigned CUBE_SCAN_FRAGMENTS_BINDING = 26;
+constexpr unsigned CUBE_SCAN_PLANES_BINDING = 27;
+constexpr unsigned CUBE_SCAN_OBJECTS_BINDING = 28;
+constexpr unsigned CUBE_SCAN_CANDIDATES_BINDING = 29;
 constexpr unsigned ABUFFER_SCAN_BLOCK = 512;
 constexpr int ABUFFER_TILE = 8;
 constexpr unsigned ABUFFER_GPU_LIST_MAX = 64;

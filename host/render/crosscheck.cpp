@@ -52,6 +52,21 @@ bool interior_pixel(const SceneData& scene, const ABuffer& camera, const RayTrac
          hit.triangle == list[0].triangle();
 }
 
+// The GPU's candidates for the searches' rays (scene_search_rays, from up to
+// CROSSCHECK_WALK_TRIANGLES triangles) in `cube` against the CPU's, ray by ray.
+constexpr size_t CROSSCHECK_WALK_TRIANGLES = 1024;
+void compare_candidates(const SceneData& scene, const CubeABuffer& cube, CrosscheckResult* r) {
+  if (!gpu_walks_at(cube.n)) return;  // compare_cube_walks says why
+  const SearchContext ctx(scene, cube);
+  const std::vector<SearchRay> rays = scene_search_rays(ctx, CROSSCHECK_WALK_TRIANGLES);
+  std::vector<CandidateScan> cpu;
+  for (const SearchRay& q : rays) cpu.push_back(scan_candidates(ctx, q));
+  const Clock::time_point t0 = Clock::now();
+  const std::vector<CandidateScan> gpu = GlCandidateScan(ctx).scan(rays);
+  r->gpu_candidates_ms = ms_since(t0);
+  r->candidates = compare_candidate_scans(cpu, gpu);
+}
+
 void compare_cube(const SceneData& scene, int n, int threads, GlScene& gl, CrosscheckResult* r) {
   CubeImage gpu;
   CubeIds gpu_ids;
@@ -75,6 +90,7 @@ void compare_cube(const SceneData& scene, int n, int threads, GlScene& gl, Cross
     r->gpu_abuffer_ms = ms_since(t1);
     r->lists = compare_lists(cube, gpu_cube);
   }
+  compare_candidates(scene, cube, r);
   const NearestLayer cpu = nearest_layer(cube, *scene.triangles);
 
   std::vector<double> rel;
@@ -117,7 +133,6 @@ void compare_cube(const SceneData& scene, int n, int threads, GlScene& gl, Cross
 
 // The GPU's cube walks of the scene's search rays (scene_walk_rays, from up to
 // CROSSCHECK_WALK_TRIANGLES triangles) against CubeWalk's, ray by ray.
-constexpr size_t CROSSCHECK_WALK_TRIANGLES = 1024;
 void compare_cube_walks(const SceneData& scene, int n, CrosscheckResult* r) {
   if (!gpu_walks_at(n)) {
     r->walks_skipped = "not compared at N = " + std::to_string(n) + ": a walk's cap is above the GPU's " +
@@ -379,6 +394,7 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   fail(!r.lists.within_bounds(), "GPU A-buffer lists");
   fail(!r.camera_lists.within_bounds(), "GPU camera A-buffer lists");
   fail(r.walks.differing > 0, "GPU cube walks");
+  fail(r.candidates.differing > 0, "GPU search candidates");
   r.pass = r.failures.empty();
   return r;
 }
@@ -422,6 +438,14 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
                 {"first_not_identical", r.walks.example},
                 {"not_compared", r.walks_skipped},
                 {"gpu_ms", r.gpu_walks_ms}}},
+              {"search_candidates",
+               {{"rays", r.candidates.rays},
+                {"identical", r.candidates.identical},
+                {"differing", r.candidates.differing},
+                {"candidates", r.candidates.candidates},
+                {"first_differing", r.candidates.example},
+                {"not_compared", r.walks_skipped},
+                {"gpu_ms", r.gpu_candidates_ms}}},
               {"cube",
                {{"texels", r.texels},
                 {"both_covered", r.both_covered},

@@ -9,6 +9,7 @@
 
 #include "raster/abuffer.hpp"
 #include "raster/abuffer_compare.hpp"
+#include "gl/gl_cube_scan.hpp"
 #include "gl/gl_cube_walks.hpp"
 #include "gl/gl_passes.hpp"
 #include "scene/scene_data.hpp"
@@ -101,7 +102,13 @@ struct CrosscheckResult {
   // compared where N is above what a GPU walk takes (gpu_walks_at).
   WalkComparison walks;
   double gpu_walks_ms = 0;
-  std::string walks_skipped;      // why the walks were not compared ("" when they were)
+  std::string walks_skipped;  // why the walks were not compared ("" when they were)
+  // The searches' candidates (reflection rays, shadow segments, refraction exits) found on
+  // the GPU in the CPU's cube A-buffer against the CPU's (gl_cube_scan.hpp
+  // compare_candidate_scans): it fails on any ray differing. Not compared where the walks
+  // are not.
+  CandidateComparison candidates;
+  double gpu_candidates_ms = 0;
   double gpu_ms = 0, cpu_ms = 0;  // prepass vs cube A-buffer build
   uint64_t fragments = 0;
   bool pass = false;

@@ -1,9 +1,13 @@
 // Shared by the GL tests: one context per process, chosen by ABCUBE_TEST_GL
 // (egl, osmesa, ...; ctest runs every GL test once per API), and hand-built scenes.
 #pragma once
+#include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -24,6 +28,38 @@ inline GlContext& test_context() {
     return c;
   }();
   return *ctx;
+}
+
+// In the checked builds (ABCUBE_CHECKED_BUILD, tools/sanitize.sh) the same code runs on the
+// repository's scenes alone, from their cameras: the sanitizers check code, not scenes.
+inline bool checked_build() {
+  const char* v = std::getenv("ABCUBE_CHECKED_BUILD");
+  return v != nullptr && std::string(v) == "1";
+}
+
+// The repository's scenes and, but in the checked builds, the kept hard cases and crosscheck
+// regressions, sorted.
+inline std::vector<std::string> scene_files() {
+  std::vector<std::string> files;
+  std::vector<const char*> dirs{"/scenes"};
+  if (!checked_build()) dirs.insert(dirs.end(), {"/tests/hard/regressions", "/tests/cli/crosscheck_regressions"});
+  for (const char* dir : dirs) {
+    for (const auto& e : std::filesystem::directory_iterator(std::string(ABCUBE_SOURCE_DIR) + dir)) {
+      if (e.path().extension() == ".json") files.push_back(e.path().string());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// The cubes a GL test builds for a kept scene: from its camera at N = 24 and, but in the checked
+// builds, from a point off it at N = 41 (a centre no vertex is aligned with).
+inline std::vector<std::pair<glm::dvec3, int>> cube_views(const SceneData& scene) {
+  const glm::dvec3 eye = scene.camera.position;
+  const glm::dvec3 off = eye + 0.37 * (scene.camera.look_at - eye) + glm::dvec3(0.01, -0.02, 0.03);
+  std::vector<std::pair<glm::dvec3, int>> views{{eye, 24}, {off, 41}};
+  if (checked_build()) views.pop_back();
+  return views;
 }
 
 inline uint32_t add_material(SceneData& s, glm::dvec3 color, double ambient = 1.0) {

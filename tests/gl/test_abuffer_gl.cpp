@@ -36,26 +36,6 @@ void expect_same_lists(const CubeABuffer& cpu, const CubeABuffer& gpu, const std
   EXPECT_GT(c.fragments, 0u) << what;
 }
 
-// In the checked builds (ABCUBE_CHECKED_BUILD, tools/sanitize.sh) the same code runs on the
-// repository's scenes alone, from their cameras: the sanitizers check code, not scenes.
-bool checked_build() {
-  const char* v = std::getenv("ABCUBE_CHECKED_BUILD");
-  return v != nullptr && std::string(v) == "1";
-}
-
-std::vector<std::string> scene_files() {
-  std::vector<std::string> files;
-  std::vector<const char*> dirs{"/scenes"};
-  if (!checked_build()) dirs.insert(dirs.end(), {"/tests/hard/regressions", "/tests/cli/crosscheck_regressions"});
-  for (const char* dir : dirs) {
-    for (const auto& e : std::filesystem::directory_iterator(std::string(ABCUBE_SOURCE_DIR) + dir)) {
-      if (e.path().extension() == ".json") files.push_back(e.path().string());
-    }
-  }
-  std::sort(files.begin(), files.end());
-  return files;
-}
-
 // The counters both builds keep alike.
 void expect_same_stats(const ABufferStats& cs, const ABufferStats& gs, const std::string& what) {
   EXPECT_EQ(cs.raw_fragments, gs.raw_fragments) << what;
@@ -74,15 +54,11 @@ void expect_same_stats(const ABufferStats& cs, const ABufferStats& gs, const std
 TEST(AbufferGl, ListsAreTheCpuCoresOnEveryKeptScene) {
   test::test_context();
   const GlABufferBuilder builder;
-  const std::vector<std::string> files = scene_files();
-  ASSERT_GE(files.size(), checked_build() ? 5u : 15u);
+  const std::vector<std::string> files = test::scene_files();
+  ASSERT_GE(files.size(), test::checked_build() ? 5u : 15u);
   for (const std::string& file : files) {
     const SceneData scene = load_scene(file);
-    const glm::dvec3 eye = scene.camera.position;
-    const glm::dvec3 off = eye + 0.37 * (scene.camera.look_at - eye) + glm::dvec3(0.01, -0.02, 0.03);
-    std::vector<std::pair<glm::dvec3, int>> views{{eye, 24}, {off, 41}};
-    if (checked_build()) views.pop_back();
-    for (const auto& [centre, n] : views) {
+    for (const auto& [centre, n] : test::cube_views(scene)) {
       ABufferStats cs, gs;
       const CubeABuffer cpu = build_cube_abuffer(scene, centre, n, {}, &cs);
       const CubeABuffer gpu = builder.cube(scene, centre, n, {}, &gs);
@@ -117,7 +93,7 @@ void expect_camera_lists(const GlABufferBuilder& builder, SceneData scene, int w
 TEST(AbufferGl, CameraListsAreTheCpuCoresOnEveryKeptScene) {
   test::test_context();
   const GlABufferBuilder builder;
-  std::vector<std::string> files = scene_files();
+  std::vector<std::string> files = test::scene_files();
   for (const auto& e : std::filesystem::directory_iterator(std::string(ABCUBE_SOURCE_DIR) + "/scenes/models")) {
     if (e.path().extension() == ".json") files.push_back(e.path().string());
   }

@@ -1,0 +1,274 @@
+#include "gl/gl_cube_scan.hpp"
+
+#include <glad/gl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <utility>
+
+#include "base/error.hpp"
+#include "gl/gl_compute.hpp"
+#include "gl/gl_cube_walks.hpp"
+#include "gl/gl_program.hpp"
+#include "gl/glsl_shared.hpp"
+
+namespace abcube {
+
+namespace {
+
+// shaders/cube_scan.comp's ScanRay in std430 (a dvec4 member: 32-byte aligned, size a
+// multiple of 32).
+struct GpuScanRay {
+  double w_lmax[4];
+  double d_self[4];
+  uint32_t object_row[4];
+  uint32_t pad[4];
+};
+static_assert(sizeof(GpuScanRay) == 96, "must match shaders/cube_scan.comp");
+static_assert(sizeof(Fragment) == 20, "cube_scan.comp reads fragments as 20 bytes");
+constexpr uint32_t NO_ROW = 0xffffffffu;
+
+uint64_t max_block_bytes() {
+  GLint64 block = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
+  return static_cast<uint64_t>(block);
+}
+
+}  // namespace
+
+struct GlCandidateScan::Buffers {
+  GlProgram program{std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "cube_scan.comp"}};
+  GlCubeWalks walks;
+  std::unique_ptr<GlBuffer> lists, fragments, planes;
+  std::vector<uint32_t> objects;     // per triangle its object
+  std::vector<uint32_t> face_first;  // each face's first fragment in `fragments`, then the total
+};
+
+GlCandidateScan::GlCandidateScan(const SearchContext& ctx) : ctx_(&ctx) {
+  require_storage_bindings("GPU candidate scan", CUBE_SCAN_CANDIDATES_BINDING);
+  buffers_ = std::make_unique<Buffers>();
+  Buffers& b = *buffers_;
+  const CubeABuffer& cube = ctx.cube();
+  const size_t face_texels = static_cast<size_t>(cube.n) * static_cast<size_t>(cube.n);
+  std::vector<uint32_t> lists(CUBE_FACES * face_texels + 1);
+  uint64_t total = 0;
+  for (int f = 0; f < CUBE_FACES; ++f) {
+    const ABuffer& face = cube.faces[static_cast<size_t>(f)];
+    b.face_first.push_back(static_cast<uint32_t>(total));
+    for (size_t p = 0; p < face_texels; ++p) {
+      const uint32_t length = face.offsets[p + 1] - face.offsets[p];
+      if (length > GPU_SCAN_MAX_LIST) {
+        throw RuntimeFailure("GPU candidate scan: a list of " + std::to_string(length) + " fragments, above the " +
+                             std::to_string(GPU_SCAN_MAX_LIST) + " one invocation reads");
+      }
+      lists[static_cast<size_t>(f) * face_texels + p] = static_cast<uint32_t>(total + face.offsets[p]);
+    }
+    total += face.fragments.size();
+  }
+  b.face_first.push_back(static_cast<uint32_t>(total));
+  lists.back() = static_cast<uint32_t>(total);
+  if (total * sizeof(Fragment) > max_block_bytes() || total > 0xffffffffu) {
+    throw RuntimeFailure("GPU candidate scan: the lists' " + std::to_string(total * sizeof(Fragment)) +
+                         " bytes exceed the GL's GL_MAX_SHADER_STORAGE_BLOCK_SIZE " +
+                         std::to_string(max_block_bytes()) + "; lower N");
+  }
+  b.lists = std::make_unique<GlBuffer>(lists.size() * sizeof(uint32_t), lists.data());
+  b.fragments = std::make_unique<GlBuffer>(total * sizeof(Fragment), nullptr);
+  for (int f = 0; f < CUBE_FACES; ++f) {
+    const std::vector<Fragment>& frags = cube.faces[static_cast<size_t>(f)].fragments;
+    if (frags.empty()) continue;
+    glNamedBufferSubData(b.fragments->id(),
+                         static_cast<GLintptr>(b.face_first[static_cast<size_t>(f)] * sizeof(Fragment)),
+                         static_cast<GLsizeiptr>(frags.size() * sizeof(Fragment)), frags.data());
+  }
+  const TriangleSoup& soup = *ctx.scene().triangles;
+  std::vector<double> planes(4 * soup.triangle_count());
+  for (uint32_t t = 0; t < static_cast<uint32_t>(soup.triangle_count()); ++t) {
+    const SearchContext::Plane p = ctx.plane(t);
+    planes[4 * t] = p.normal.x, planes[4 * t + 1] = p.normal.y, planes[4 * t + 2] = p.normal.z;
+    planes[4 * t + 3] = p.offset;
+  }
+  b.planes = std::make_unique<GlBuffer>(planes.size() * sizeof(double), planes.data());
+  b.objects = soup.object_id;
+  check_gl("GPU candidate scan: uploading the lists");
+}
+
+GlCandidateScan::~GlCandidateScan() = default;
+
+namespace {
+
+// The rows of the restricted rays' objects (Media::bounds_meet), appended to `objects`: one
+// row a distinct object, a bit an object of the scene. Sets each ray's row.
+void add_restriction_rows(const SearchContext& ctx, const std::vector<SearchRay>& rays, std::vector<GpuScanRay>* packed,
+                          std::vector<uint32_t>* objects, uint32_t* row_words) {
+  const uint32_t count = static_cast<uint32_t>(ctx.scene().objects.size());
+  *row_words = (count + 31) / 32;
+  std::map<uint32_t, uint32_t> row_of;
+  for (size_t k = 0; k < rays.size(); ++k) {
+    if (!rays[k].restrict_object) continue;
+    const auto [at, added] = row_of.emplace(rays[k].object, static_cast<uint32_t>(row_of.size()));
+    (*packed)[k].object_row[1] = at->second;
+    if (!added) continue;
+    const size_t first = objects->size();
+    objects->resize(first + *row_words, 0u);
+    for (uint32_t o = 0; o < count; ++o) {
+      if (ctx.media().bounds_meet(o, rays[k].object)) (*objects)[first + o / 32] |= 1u << (o % 32);
+    }
+  }
+}
+
+// Batch b's candidates, read back from (texel of the batch, fragment of all) pairs, into
+// out[b.chunk + b.first ...]: in the walk's order (texel, then the list's).
+void unpack_candidates(std::vector<std::pair<uint32_t, uint32_t>> found, const GlCubeWalks::Batch& b,
+                       const std::vector<uint32_t>& face_first, CandidateScan* out) {
+  std::sort(found.begin(), found.end());
+  for (const auto& [texel, fragment] : found) {
+    const size_t k =
+        static_cast<size_t>(std::upper_bound(b.offsets.begin(), b.offsets.end(), texel) - b.offsets.begin()) - 1;
+    const size_t face =
+        static_cast<size_t>(std::upper_bound(face_first.begin(), face_first.end(), fragment) - face_first.begin()) - 1;
+    out[b.chunk + b.first + k].candidates.push_back(
+        {texel - b.offsets[k], static_cast<uint32_t>(face), fragment - face_first[face]});
+  }
+}
+
+}  // namespace
+
+std::vector<CandidateScan> GlCandidateScan::scan(const std::vector<SearchRay>& rays,
+                                                 const SearchOptions& options) const {
+  if (options.layers != SearchLayers::all) {
+    throw InputError("GPU candidate scan: the nearest layer (Z-buffer searches) is scanned on the CPU only");
+  }
+  const Buffers& b = *buffers_;
+  const CubeABuffer& cube = ctx_->cube();
+  std::vector<WalkRay> walk_rays(rays.size());
+  std::vector<GpuScanRay> packed(rays.size());
+  for (size_t k = 0; k < rays.size(); ++k) {
+    const SearchRay& q = rays[k];
+    walk_rays[k] = {q.w, q.d, q.l_max, cube.near_distance};
+    packed[k] = {{q.w.x, q.w.y, q.w.z, q.l_max}, {q.d.x, q.d.y, q.d.z, q.self}, {q.object, NO_ROW, 0, 0}, {}};
+  }
+  std::vector<uint32_t> objects = b.objects;
+  const uint32_t rows_at = static_cast<uint32_t>(objects.size());
+  uint32_t row_words = 0;
+  add_restriction_rows(*ctx_, rays, &packed, &objects, &row_words);
+  const GlBuffer object_buffer(objects.size() * sizeof(uint32_t), objects.data());
+  const GlProgram& p = b.program;
+  std::vector<CandidateScan> out(rays.size());
+  b.walks.walk_batches(walk_rays, cube.n, options.max_texels, [&](const GlCubeWalks::Batch& batch) {
+    for (size_t k = batch.first; k < batch.end; ++k) {
+      out[batch.chunk + k].texels = (*batch.counts)[4 * k];
+      out[batch.chunk + k].aborted = ((*batch.counts)[4 * k + 1] & 1u) != 0;
+    }
+    if (batch.texel_count == 0) return;
+    const GlBuffer ray_buffer((batch.end - batch.first) * sizeof(GpuScanRay),
+                              packed.data() + batch.chunk + batch.first);
+    // Room for a candidate a texel, then for as many as the first try found.
+    uint64_t room = batch.texel_count;
+    for (;;) {
+      const uint64_t bytes = 8 * (room + 1);
+      if (bytes > max_block_bytes()) {
+        throw RuntimeFailure("GPU candidate scan: " + std::to_string(room) +
+                             " candidates in one batch, above the GL's GL_MAX_SHADER_STORAGE_BLOCK_SIZE");
+      }
+      const GlBuffer found(bytes, nullptr);
+      found.zero();
+      p.use();
+      ray_buffer.bind(CUBE_SCAN_RAYS_BINDING);
+      b.lists->bind(CUBE_SCAN_LISTS_BINDING);
+      b.fragments->bind(CUBE_SCAN_FRAGMENTS_BINDING);
+      b.planes->bind(CUBE_SCAN_PLANES_BINDING);
+      object_buffer.bind(CUBE_SCAN_OBJECTS_BINDING);
+      found.bind(CUBE_SCAN_CANDIDATES_BINDING);
+      batch.texels->bind(CUBE_WALK_TEXELS_BINDING);
+      batch.offset_buffer->bind(CUBE_WALK_OFFSETS_BINDING);
+      glUniform1ui(p.uniform("first_ray"), 0u);
+      glUniform1ui(p.uniform("ray_count"), static_cast<GLuint>(batch.end - batch.first));
+      glUniform1ui(p.uniform("texel_count"), static_cast<GLuint>(batch.texel_count));
+      glUniform1i(p.uniform("face_resolution"), cube.n);
+      glUniform1ui(p.uniform("rows_at"), rows_at);
+      glUniform1ui(p.uniform("row_words"), row_words);
+      glUniform1ui(p.uniform("candidate_room"), static_cast<GLuint>(room));
+      dispatch(p, (batch.texel_count + 63) / 64);
+      check_gl("GPU candidate scan");
+      const uint32_t count = found.read<uint32_t>(1)[0];
+      if (count > room) {
+        room = count;
+        continue;
+      }
+      const std::vector<uint32_t> words = found.read<uint32_t>(2 + 2 * static_cast<size_t>(count));
+      std::vector<std::pair<uint32_t, uint32_t>> pairs(count);
+      for (uint32_t c = 0; c < count; ++c) pairs[c] = {words[2 + 2 * c], words[3 + 2 * c]};
+      unpack_candidates(std::move(pairs), batch, b.face_first, out.data());
+      return;
+    }
+  });
+  return out;
+}
+
+std::vector<SearchRay> scene_search_rays(const SearchContext& ctx, size_t max_triangles, const SearchOptions& options) {
+  const SceneData& scene = ctx.scene();
+  const TriangleSoup& soup = *scene.triangles;
+  std::vector<SearchRay> rays;
+  for_spread_triangles(soup, max_triangles, [&](size_t t, const glm::dvec3& x, const glm::dvec3& normal) {
+    const glm::dvec3 view = x - scene.camera.position;
+    const double view_len = glm::length(view);
+    if (!(view_len > 0.0) || !std::isfinite(view_len)) return;
+    const glm::dvec3 dir = view / view_len;
+    rays.push_back(reflection_ray(ctx, x, glm::reflect(dir, normal), options));
+    for (const PointLight& light : scene.lights) {
+      SearchRay q;
+      if (shadow_ray(ctx, x, light.position, options, &q)) rays.push_back(q);
+    }
+    if (scene.materials[soup.material_id[t]].transmit > 0.0) {
+      rays.push_back(refraction_exit_ray(ctx, x, dir, soup.object_id[t], options));
+    }
+  });
+  return rays;
+}
+
+CandidateComparison compare_candidate_scans(const std::vector<CandidateScan>& a, const std::vector<CandidateScan>& b) {
+  CandidateComparison c;
+  c.rays = a.size();
+  for (size_t r = 0; r < a.size(); ++r) {
+    c.candidates += a[r].candidates.size();
+    if (r < b.size() && a[r].texels == b[r].texels && a[r].aborted == b[r].aborted &&
+        a[r].candidates == b[r].candidates) {
+      ++c.identical;
+      continue;
+    }
+    ++c.differing;
+    if (!c.example.empty()) continue;
+    std::ostringstream what;
+    what << "ray " << r << ": ";
+    if (r >= b.size()) {
+      what << "missing from the second set";
+    } else {
+      what << a[r].candidates.size() << " candidates in " << a[r].texels << " texels"
+           << (a[r].aborted ? " (aborted)" : "") << " against " << b[r].candidates.size() << " in " << b[r].texels
+           << (b[r].aborted ? " (aborted)" : "");
+      const auto& x = a[r].candidates;
+      const auto& y = b[r].candidates;
+      const size_t k = static_cast<size_t>(std::mismatch(x.begin(), x.end(), y.begin(), y.end()).first - x.begin());
+      if (k < x.size() || k < y.size()) {
+        what << "; candidate " << k << ": ";
+        const auto put = [&](const std::vector<ScanCandidate>& v) {
+          if (k < v.size()) {
+            what << "texel " << v[k].texel << " face " << v[k].face << " fragment " << v[k].fragment;
+          } else {
+            what << "none";
+          }
+        };
+        put(x);
+        what << " against ";
+        put(y);
+      }
+    }
+    c.example = what.str();
+  }
+  return c;
+}
+
+}  // namespace abcube

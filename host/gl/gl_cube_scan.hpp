@@ -1,0 +1,66 @@
+// The searches' candidates on the GPU: the z-interval test of thesis 7.5 over the cube
+// A-buffer's lists, along the texels each ray's walk crosses (GlCubeWalks, left on the GPU),
+// with the object restriction and the own-surface test: scan_candidates
+// (cpu_core/search/search.hpp) run by a GL compute shader (shaders/cube_scan.comp), an
+// invocation a texel walked. Its expressions are the CPU's in double precision, so that a GL
+// whose doubles round as IEEE 754 says finds the CPU's candidates exactly:
+// compare_candidate_scans says where they differ.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "search/search.hpp"
+
+namespace abcube {
+
+// The lists, the triangles' planes and objects of one SearchContext, uploaded once, and the
+// compiled pass, on the GL context current when it was made (GL 4.5 core with storage buffer
+// binding CUBE_SCAN_CANDIDATES_BINDING), which must stay current for its life. The context
+// must outlive it.
+class GlCandidateScan {
+ public:
+  // Throws RuntimeFailure when the GL cannot hold the lists in one storage block, or a list
+  // is longer than GPU_SCAN_MAX_LIST.
+  explicit GlCandidateScan(const SearchContext& ctx);
+  ~GlCandidateScan();
+  GlCandidateScan(const GlCandidateScan&) = delete;
+  GlCandidateScan& operator=(const GlCandidateScan&) = delete;
+
+  // Every ray's scan_candidates(ctx, ray, options). Throws InputError for the nearest layer
+  // (options.layers: the Z-buffer's choice is the CPU's alone), for a walk cap above
+  // GPU_WALK_MAX_TEXELS and on a ray GlCubeWalks refuses.
+  std::vector<CandidateScan> scan(const std::vector<SearchRay>& rays, const SearchOptions& options = {}) const;
+
+  struct Buffers;
+
+ private:
+  const SearchContext* ctx_;
+  std::unique_ptr<Buffers> buffers_;
+};
+
+// The longest list the GPU's scan reads: an invocation reads one texel's list, and Mesa's
+// llvmpipe ends an invocation's loops, silently, after 65535 passes in all.
+constexpr uint32_t GPU_SCAN_MAX_LIST = 60000;
+
+// A scene's search rays as the searches make them (reflection_ray, shadow_ray,
+// refraction_exit_ray), for the cross-checks and benchmarks: from the centroids of up to
+// `max_triangles` triangles spread over the scene, the reflection of the ray from the camera
+// about the triangle's plane, the segment to each light, and, on a triangle whose material
+// transmits, the camera's ray carried on into its object (a refraction exit). Degenerate
+// triangles give none.
+std::vector<SearchRay> scene_search_rays(const SearchContext& ctx, size_t max_triangles,
+                                         const SearchOptions& options = {});
+
+// How two sets of scans of the same rays agree, ray by ray: identical (the same candidates in
+// the same order, the same texels walked and cap) or differing. `example` gives the first ray
+// that differs, in words.
+struct CandidateComparison {
+  size_t rays = 0, identical = 0, differing = 0;
+  uint64_t candidates = 0;  // in the first set
+  std::string example;
+};
+CandidateComparison compare_candidate_scans(const std::vector<CandidateScan>& a, const std::vector<CandidateScan>& b);
+
+}  // namespace abcube

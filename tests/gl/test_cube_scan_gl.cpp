@@ -1,0 +1,177 @@
+// The searches' candidates found on the GPU (host/gl/gl_cube_scan.hpp) against the CPU core's
+// (search/search.hpp scan_candidates): the same fragments of the same texels in the same
+// order, ray by ray, on every kept scene, for the searches' own rays (reflections, shadow
+// segments, refraction exits restricted to their object), for the self offsets of both
+// modes, and with walks the cap stops.
+#include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "base/error.hpp"
+#include "gl/gl_cube_scan.hpp"
+#include "gl/gl_cube_walks.hpp"
+#include "gl_test_support.hpp"
+#include "raster/abuffer.hpp"
+#include "scene/scene_load.hpp"
+
+namespace abcube {
+namespace {
+
+// The searches' rays of `ctx`'s scene, and as many more from random points of the scene's
+// triangles in random directions, half of them restricted to the triangle's object.
+std::vector<SearchRay> rays_of(const SearchContext& ctx, const SearchOptions& o, unsigned seed) {
+  std::vector<SearchRay> rays = scene_search_rays(ctx, 200, o);
+  const TriangleSoup& soup = *ctx.scene().triangles;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0), s(-1.0, 1.0);
+  const size_t count = rays.size();
+  for (size_t k = 0; k < count && soup.triangle_count() > 0; ++k) {
+    const size_t t = static_cast<size_t>(rng() % soup.triangle_count());
+    double a = u(rng), b = u(rng);
+    if (a + b > 1.0) a = 1.0 - a, b = 1.0 - b;
+    const glm::dvec3 p0(soup.positions[3 * t]), p1(soup.positions[3 * t + 1]), p2(soup.positions[3 * t + 2]);
+    const glm::dvec3 x = p0 + a * (p1 - p0) + b * (p2 - p0);
+    glm::dvec3 d(s(rng), s(rng), s(rng));
+    if (!(glm::length(d) > 1e-3)) continue;
+    d = glm::normalize(d);
+    rays.push_back(k % 2 ? refraction_exit_ray(ctx, x, d, soup.object_id[t], o) : reflection_ray(ctx, x, d, o));
+  }
+  return rays;
+}
+
+// Cornell's cube A-buffer at N from its camera, and its search context.
+struct Cornell {
+  explicit Cornell(int n)
+      : scene(load_scene(std::string(ABCUBE_SOURCE_DIR) + "/scenes/cornell.json")),
+        cube(build_cube_abuffer(scene, scene.camera.position, n)),
+        ctx(scene, cube) {}
+  const SceneData scene;
+  const CubeABuffer cube;
+  const SearchContext ctx;
+};
+
+size_t restricted(const std::vector<SearchRay>& rays) {
+  size_t k = 0;
+  for (const SearchRay& q : rays) k += q.restrict_object ? 1 : 0;
+  return k;
+}
+
+std::vector<CandidateScan> cpu_scans(const SearchContext& ctx, const std::vector<SearchRay>& rays,
+                                     const SearchOptions& o) {
+  std::vector<CandidateScan> out;
+  for (const SearchRay& q : rays) out.push_back(scan_candidates(ctx, q, o));
+  return out;
+}
+
+// Every repository scene and kept hard case (nested glass, coplanar ties, thin features,
+// kilometre scales), from its camera and from a point off it, at two resolutions, with the
+// crossing mode's self offset and the thesis mode's.
+TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
+  test::test_context();
+  uint64_t candidates = 0;
+  size_t restricted_rays = 0;
+  for (const std::string& file : test::scene_files()) {
+    const SceneData scene = load_scene(file);
+    for (const auto& [centre, n] : test::cube_views(scene)) {
+      const CubeABuffer cube = build_cube_abuffer(scene, centre, n);
+      const SearchContext ctx(scene, cube);
+      const GlCandidateScan gpu(ctx);
+      for (const SearchMode mode : {SearchMode::crossing, SearchMode::thesis}) {
+        SearchOptions o;
+        o.mode = mode;
+        const std::vector<SearchRay> rays = rays_of(ctx, o, static_cast<unsigned>(n));
+        const CandidateComparison c = compare_candidate_scans(cpu_scans(ctx, rays, o), gpu.scan(rays, o));
+        const std::string what = std::filesystem::path(file).filename().string() + " at N = " + std::to_string(n) +
+                                 " (" + search_mode_name(mode) + ")";
+        EXPECT_EQ(c.identical, rays.size()) << what << ": " << c.example;
+        candidates += c.candidates;
+        restricted_rays += restricted(rays);
+      }
+    }
+  }
+  EXPECT_GT(candidates, 10000u);
+  EXPECT_GT(restricted_rays, 1000u);
+}
+
+// Walks the cap stops (the candidates up to it), and a batch with no texel at all.
+TEST(CubeScanGl, CappedWalksAndEmptyBatchesAsTheCpu) {
+  test::test_context();
+  const Cornell cornell(32);
+  const SearchContext& ctx = cornell.ctx;
+  const GlCandidateScan gpu(ctx);
+  SearchOptions o;
+  o.max_texels = 6;
+  const std::vector<SearchRay> rays = rays_of(ctx, o, 7);
+  const std::vector<CandidateScan> cpu = cpu_scans(ctx, rays, o);
+  const CandidateComparison c = compare_candidate_scans(cpu, gpu.scan(rays, o));
+  EXPECT_EQ(c.identical, rays.size()) << c.example;
+  size_t aborted = 0;
+  for (const CandidateScan& s : cpu) aborted += s.aborted ? 1 : 0;
+  EXPECT_GT(aborted, rays.size() / 2);
+  EXPECT_GT(c.candidates, 0u);
+  // A shadow segment too short to leave its first texel's neighbourhood, and no ray at all.
+  SearchRay q;
+  ASSERT_TRUE(shadow_ray(ctx, cornell.scene.lights[0].position + glm::dvec3(0, -1e-3, 0),
+                         cornell.scene.lights[0].position, {}, &q));
+  EXPECT_EQ(compare_candidate_scans(cpu_scans(ctx, {q}, {}), gpu.scan({q})).identical, 1u);
+  EXPECT_TRUE(gpu.scan({}).empty());
+}
+
+TEST(CubeScanGl, RefusesTheNearestLayerAndCapsAboveTheGpusBound) {
+  test::test_context();
+  const Cornell cornell(16);
+  const SearchContext& ctx = cornell.ctx;
+  const GlCandidateScan gpu(ctx);
+  const std::vector<SearchRay> rays = scene_search_rays(ctx, 4);
+  ASSERT_FALSE(rays.empty());
+  SearchOptions nearest;
+  nearest.layers = SearchLayers::nearest;
+  EXPECT_THROW(gpu.scan(rays, nearest), InputError);
+  SearchOptions capped;
+  capped.max_texels = GPU_WALK_MAX_TEXELS + 1;
+  EXPECT_THROW(gpu.scan(rays, capped), InputError);
+}
+
+// compare_candidate_scans' two classes: a candidate missing, moved to another texel or
+// another fragment, or the walk's length or cap differing, is a ray differing, named.
+TEST(CubeScanGl, ComparisonNamesTheFirstDifference) {
+  const Cornell cornell(16);
+  const SearchContext& ctx = cornell.ctx;
+  const std::vector<SearchRay> rays = scene_search_rays(ctx, 64);
+  const std::vector<CandidateScan> cpu = cpu_scans(ctx, rays, {});
+  CandidateComparison c = compare_candidate_scans(cpu, cpu);
+  EXPECT_EQ(c.identical, cpu.size());
+  EXPECT_TRUE(c.example.empty());
+  size_t k = 0;  // a ray with two candidates at least
+  while (k < cpu.size() && cpu[k].candidates.size() < 2) ++k;
+  ASSERT_LT(k, cpu.size());
+  const auto differs = [&](std::vector<CandidateScan> other, const std::string& expected) {
+    const CandidateComparison d = compare_candidate_scans(cpu, other);
+    EXPECT_EQ(d.differing, 1u) << expected;
+    EXPECT_EQ(d.identical, cpu.size() - 1) << expected;
+    EXPECT_NE(d.example.find("ray " + std::to_string(k) + ": "), std::string::npos) << d.example;
+    EXPECT_NE(d.example.find(expected), std::string::npos) << d.example;
+  };
+  std::vector<CandidateScan> other = cpu;
+  other[k].candidates.erase(other[k].candidates.begin() + 1);
+  differs(other, "candidate 1: ");
+  other = cpu;
+  other[k].candidates[1].texel += 1;
+  differs(other, "candidate 1: texel");
+  other = cpu;
+  other[k].candidates[0].fragment += 1;
+  differs(other, "candidate 0: ");
+  other = cpu;
+  other[k].aborted = !other[k].aborted;
+  differs(other, "(aborted)");
+  other = cpu;
+  other.pop_back();
+  k = cpu.size() - 1;
+  differs(other, "missing from the second set");
+}
+
+}  // namespace
+}  // namespace abcube
