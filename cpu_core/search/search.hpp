@@ -50,6 +50,8 @@ bool parse_search_refine(const std::string& s, SearchRefine* out);  // "mesh" | 
 // past its first candidate under theta_max.
 constexpr int CROSSING_WINDOW_TEXELS = 2;
 constexpr int THESIS_WINDOW_TEXELS = 2;
+// A refined point this close to its triangle (in texels) is on it: rounding, not tolerance.
+constexpr double ON_TRIANGLE_TEXELS = 1e-6;
 // Default self offsets per mode, in texels at W (SELF-HITS, docs/design/search.md).
 constexpr double SELF_OFFSET_CROSSING_TEXELS = 1e-3;
 constexpr double SELF_OFFSET_THESIS_TEXELS = 0.5;
@@ -302,14 +304,25 @@ bool shadow_ray(const SearchContext& ctx, const glm::dvec3& p, const glm::dvec3&
 // thesis test, over the ray's whole walk (as if no answer ended it), in the order the walk
 // meets them: those that pass the layer choice, the object restriction, the z-interval test
 // (thesis 7.5) and the own-surface test. Each names the walk's texel (its place in the walk,
-// CubeWalk's order) and the fragment (its index in the face's A-buffer). The BLOCK BOUNDS and
-// the HIERARCHICAL SKIP pass only texels none of whose fragments could pass, so they change
-// none of it; the GPU's scan (host/gl/gl_cube_scan.hpp) is held to it.
+// CubeWalk's order) and the fragment (its index in the face's A-buffer), with the answer of
+// MODE crossing's test before any MESH REFINEMENT: where the ray meets the fragment's plane
+// inside its texel (tested), at which l, how far from the triangle in texels (outside), on it
+// to rounding (exact), and accepted (valid: within options.tolerance_texels, and past the
+// self tolerance unless exact). The BLOCK BOUNDS and the HIERARCHICAL SKIP pass only texels
+// none of whose fragments could pass, so they change none of it; the GPU's scan
+// (host/gl/gl_cube_scan.hpp) is held to it.
 struct ScanCandidate {
   uint32_t texel = 0;  // the walk's texel: 0 for the first it walks
   uint32_t face = 0;
   uint32_t fragment = 0;  // index into cube.faces[face].fragments
-  bool operator==(const ScanCandidate& o) const { return texel == o.texel && face == o.face && fragment == o.fragment; }
+  bool tested = false, exact = false, valid = false;
+  double l = std::numeric_limits<double>::infinity();  // where tested, else +inf
+  double outside = 0;                                  // where tested, else 0
+  // The same fragment of the same texel, with the same verdicts.
+  bool same_place(const ScanCandidate& o) const {
+    return texel == o.texel && face == o.face && fragment == o.fragment && tested == o.tested && exact == o.exact &&
+           valid == o.valid;
+  }
 };
 struct CandidateScan {
   std::vector<ScanCandidate> candidates;

@@ -16,8 +16,6 @@
 namespace abcube::detail {
 
 constexpr double INF = std::numeric_limits<double>::infinity();
-// A refined point this close to its triangle (in texels) is on it: rounding, not tolerance.
-constexpr double ON_TRIANGLE_TEXELS = 1e-6;
 
 // MEMO. The refinement asks for the same triangles' geometry again and again: neighbouring
 // rays refine on the same patch, and a flood meets each triangle from up to three sides, so

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "base/error.hpp"
 #include "reference/triangle_test.hpp"
 #include "search/search_scan.hpp"
 #include "material/shading.hpp"
@@ -258,9 +259,14 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
 
 CandidateScan scan_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options) {
   CandidateScan out;
-  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3&, const SearchContext::Plane&) {
+  SearchOptions plane = options;
+  plane.refine = SearchRefine::plane;
+  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3&,
+                               const SearchContext::Plane& p) {
     const std::vector<Fragment>& face = ctx.cube().faces[static_cast<size_t>(t.face)].fragments;
-    out.candidates.push_back({out.texels, static_cast<uint32_t>(t.face), static_cast<uint32_t>(&f - face.data())});
+    const Candidate c = crossing_candidate(ctx, q, plane, t, f, p);
+    out.candidates.push_back({out.texels, static_cast<uint32_t>(t.face), static_cast<uint32_t>(&f - face.data()),
+                              c.tested, c.exact, c.valid, c.l, c.outside});
   };
   const auto after_texel = [&](const WalkTexel&, uint32_t index) {
     out.texels = index + 1;

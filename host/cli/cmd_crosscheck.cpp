@@ -27,6 +27,30 @@ constexpr const char* CROSSCHECK_COVERS =
     "refractions, antialiased edges (abcube report compares "
     "whole images with the exact tracer)";
 
+// The searches' pieces run on the GPU (the walks, the candidates) against the CPU's.
+void print_searches(const CrosscheckResult& r) {
+  if (!r.walks_skipped.empty()) {
+    std::printf("GPU cube walks: %s\n", r.walks_skipped.c_str());
+  } else {
+    std::printf(
+        "GPU cube walks: %zu of %zu rays identical, %zu within rounding, %zu differing, %llu texels "
+        "(%.1f ms)%s%s\n",
+        r.walks.identical, r.walks.rays, r.walks.within_rounding, r.walks.differing,
+        static_cast<unsigned long long>(r.walks.texels), r.gpu_walks_ms,
+        r.walks.example.empty() ? "" : "; first not identical: ", r.walks.example.c_str());
+    if (!r.candidates_skipped.empty()) {
+      std::printf("GPU search candidates: %s\n", r.candidates_skipped.c_str());
+    } else {
+      std::printf(
+          "GPU search candidates: %zu of %zu rays identical, %zu within rounding, %zu differing, %llu candidates "
+          "(%.1f ms)%s%s\n",
+          r.candidates.identical, r.candidates.rays, r.candidates.within_rounding, r.candidates.differing,
+          static_cast<unsigned long long>(r.candidates.candidates), r.gpu_candidates_ms,
+          r.candidates.example.empty() ? "" : "; first not identical: ", r.candidates.example.c_str());
+    }
+  }
+}
+
 // A GPU build's lists against the CPU's: the counts, then each class of difference found.
 void print_lists(const char* what, const ListComparison& c, double ms) {
   std::printf("%s: %llu of %llu identical, fragments %llu of %llu (%.1f ms)\n", what,
@@ -78,20 +102,7 @@ struct CrosscheckCommand {
                 r.tied_agree);
     print_lists("GPU cube A-buffer lists", r.lists, r.gpu_abuffer_ms);
     print_lists("GPU camera A-buffer lists", r.camera_lists, r.gpu_camera_abuffer_ms);
-    if (!r.walks_skipped.empty()) {
-      std::printf("GPU cube walks: %s\n", r.walks_skipped.c_str());
-    } else {
-      std::printf(
-          "GPU cube walks: %zu of %zu rays identical, %zu within rounding, %zu differing, %llu texels "
-          "(%.1f ms)%s%s\n",
-          r.walks.identical, r.walks.rays, r.walks.within_rounding, r.walks.differing,
-          static_cast<unsigned long long>(r.walks.texels), r.gpu_walks_ms,
-          r.walks.example.empty() ? "" : "; first not identical: ", r.walks.example.c_str());
-      std::printf("GPU search candidates: %zu of %zu rays identical, %zu differing, %llu candidates (%.1f ms)%s%s\n",
-                  r.candidates.identical, r.candidates.rays, r.candidates.differing,
-                  static_cast<unsigned long long>(r.candidates.candidates), r.gpu_candidates_ms,
-                  r.candidates.example.empty() ? "" : "; first differing: ", r.candidates.example.c_str());
-    }
+    print_searches(r);
     std::printf("camera interior pixels: %zu of %zu, RMSE %.2e (<= %.0e), max abs %.2e (<= %.2e)\n", r.interior_pixels,
                 r.pixels, r.interior_rmse, tol.interior_rmse, r.interior_max_abs, tol.interior_max_abs);
     std::printf(

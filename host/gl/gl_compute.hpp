@@ -63,4 +63,14 @@ inline void require_storage_bindings(const char* what, unsigned highest) {
   }
 }
 
+// Throws RuntimeFailure naming `what` unless one compute shader may use `count` storage blocks.
+inline void require_compute_blocks(const char* what, int count) {
+  GLint blocks = 0;
+  glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &blocks);
+  if (blocks < count) {
+    throw RuntimeFailure(std::string(what) + ": the GL offers a compute shader " + std::to_string(blocks) +
+                         " storage blocks, " + std::to_string(count) + " needed");
+  }
+}
+
 }  // namespace abcube

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <sstream>
 #include <utility>
@@ -24,9 +25,15 @@ struct GpuScanRay {
   double w_lmax[4];
   double d_self[4];
   uint32_t object_row[4];
-  uint32_t pad[4];
+  double self_tolerance[2];
 };
-static_assert(sizeof(GpuScanRay) == 96, "must match shaders/cube_scan.comp");
+// Its CandidateOut, after the count and a pad word.
+struct GpuCandidate {
+  uint32_t texel, fragment, flags, pad;
+  double l, outside;
+};
+static_assert(sizeof(GpuScanRay) == 96 && sizeof(GpuCandidate) == 32, "must match shaders/cube_scan.comp");
+constexpr uint64_t CANDIDATES_AT = 8;  // bytes before the first candidate
 static_assert(sizeof(Fragment) == 20, "cube_scan.comp reads fragments as 20 bytes");
 constexpr uint32_t NO_ROW = 0xffffffffu;
 
@@ -36,18 +43,28 @@ uint64_t max_block_bytes() {
   return static_cast<uint64_t>(block);
 }
 
+// Throws RuntimeFailure unless `bytes` of `what` fit one storage block.
+void check_block(const char* what, uint64_t bytes) {
+  if (bytes > max_block_bytes()) {
+    throw RuntimeFailure(std::string("GPU candidate scan: ") + what + " take " + std::to_string(bytes) +
+                         " bytes, above the GL's GL_MAX_SHADER_STORAGE_BLOCK_SIZE " +
+                         std::to_string(max_block_bytes()) + "; lower N or scan on the CPU");
+  }
+}
+
 }  // namespace
 
 struct GlCandidateScan::Buffers {
   GlProgram program{std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "cube_scan.comp"}};
   GlCubeWalks walks;
-  std::unique_ptr<GlBuffer> lists, fragments, planes;
+  std::unique_ptr<GlBuffer> lists, fragments, planes, positions;
   std::vector<uint32_t> objects;     // per triangle its object
   std::vector<uint32_t> face_first;  // each face's first fragment in `fragments`, then the total
 };
 
 GlCandidateScan::GlCandidateScan(const SearchContext& ctx) : ctx_(&ctx) {
-  require_storage_bindings("GPU candidate scan", CUBE_SCAN_CANDIDATES_BINDING);
+  require_storage_bindings("GPU candidate scan", CUBE_SCAN_POSITIONS_BINDING);
+  require_compute_blocks("GPU candidate scan", 9);
   buffers_ = std::make_unique<Buffers>();
   Buffers& b = *buffers_;
   const CubeABuffer& cube = ctx.cube();
@@ -69,11 +86,8 @@ GlCandidateScan::GlCandidateScan(const SearchContext& ctx) : ctx_(&ctx) {
   }
   b.face_first.push_back(static_cast<uint32_t>(total));
   lists.back() = static_cast<uint32_t>(total);
-  if (total * sizeof(Fragment) > max_block_bytes() || total > 0xffffffffu) {
-    throw RuntimeFailure("GPU candidate scan: the lists' " + std::to_string(total * sizeof(Fragment)) +
-                         " bytes exceed the GL's GL_MAX_SHADER_STORAGE_BLOCK_SIZE " +
-                         std::to_string(max_block_bytes()) + "; lower N");
-  }
+  check_block("the lists' offsets", lists.size() * sizeof(uint32_t));
+  check_block("the fragments", total * sizeof(Fragment));
   b.lists = std::make_unique<GlBuffer>(lists.size() * sizeof(uint32_t), lists.data());
   b.fragments = std::make_unique<GlBuffer>(total * sizeof(Fragment), nullptr);
   for (int f = 0; f < CUBE_FACES; ++f) {
@@ -90,7 +104,10 @@ GlCandidateScan::GlCandidateScan(const SearchContext& ctx) : ctx_(&ctx) {
     planes[4 * t] = p.normal.x, planes[4 * t + 1] = p.normal.y, planes[4 * t + 2] = p.normal.z;
     planes[4 * t + 3] = p.offset;
   }
+  check_block("the triangles' planes", planes.size() * sizeof(double));
+  check_block("the triangles' vertices", soup.positions.size() * sizeof(glm::vec3));
   b.planes = std::make_unique<GlBuffer>(planes.size() * sizeof(double), planes.data());
+  b.positions = std::make_unique<GlBuffer>(soup.positions.size() * sizeof(glm::vec3), soup.positions.data());
   b.objects = soup.object_id;
   check_gl("GPU candidate scan: uploading the lists");
 }
@@ -119,25 +136,86 @@ void add_restriction_rows(const SearchContext& ctx, const std::vector<SearchRay>
   }
 }
 
-// Batch b's candidates, read back from (texel of the batch, fragment of all) pairs, into
+// Batch b's candidates, read back with the batch's texel and the fragment of all, into
 // out[b.chunk + b.first ...]: in the walk's order (texel, then the list's).
-void unpack_candidates(std::vector<std::pair<uint32_t, uint32_t>> found, const GlCubeWalks::Batch& b,
+void unpack_candidates(std::vector<GpuCandidate> found, const GlCubeWalks::Batch& b,
                        const std::vector<uint32_t>& face_first, CandidateScan* out) {
-  std::sort(found.begin(), found.end());
-  for (const auto& [texel, fragment] : found) {
+  std::sort(found.begin(), found.end(), [](const GpuCandidate& x, const GpuCandidate& y) {
+    return x.texel != y.texel ? x.texel < y.texel : x.fragment < y.fragment;
+  });
+  for (const GpuCandidate& g : found) {
+    const uint32_t texel = g.texel, fragment = g.fragment;
     const size_t k =
         static_cast<size_t>(std::upper_bound(b.offsets.begin(), b.offsets.end(), texel) - b.offsets.begin()) - 1;
     const size_t face =
         static_cast<size_t>(std::upper_bound(face_first.begin(), face_first.end(), fragment) - face_first.begin()) - 1;
-    out[b.chunk + b.first + k].candidates.push_back(
-        {texel - b.offsets[k], static_cast<uint32_t>(face), fragment - face_first[face]});
+    out[b.chunk + b.first + k].candidates.push_back({texel - b.offsets[k], static_cast<uint32_t>(face),
+                                                     fragment - face_first[face], (g.flags & 1u) != 0,
+                                                     (g.flags & 2u) != 0, (g.flags & 4u) != 0, g.l, g.outside});
   }
 }
 
 }  // namespace
 
-std::vector<CandidateScan> GlCandidateScan::scan(const std::vector<SearchRay>& rays,
-                                                 const SearchOptions& options) const {
+namespace {
+
+// What a batch's pass reads beside the uploaded scene: its rays, the objects with their
+// restriction rows, and the search's tolerance.
+struct BatchInputs {
+  const GlBuffer* rays;
+  const GlBuffer* objects;
+  uint32_t rows_at, row_words;
+  double tolerance_texels;
+};
+
+// The candidates of one batch of walks, in the order found: a pass with room for `room`
+// candidates, then, when it found more, one with room for all.
+std::vector<GpuCandidate> scan_batch(const GlCandidateScan::Buffers& b, const CubeABuffer& cube, const BatchInputs& in,
+                                     const GlCubeWalks::Batch& batch, uint64_t room) {
+  const GlProgram& p = b.program;
+  for (;;) {
+    const uint64_t bytes = CANDIDATES_AT + sizeof(GpuCandidate) * room;
+    check_block("one batch's candidates", bytes);
+    const GlBuffer found(bytes, nullptr);
+    found.zero();
+    p.use();
+    in.rays->bind(CUBE_SCAN_RAYS_BINDING);
+    b.lists->bind(CUBE_SCAN_LISTS_BINDING);
+    b.fragments->bind(CUBE_SCAN_FRAGMENTS_BINDING);
+    b.planes->bind(CUBE_SCAN_PLANES_BINDING);
+    in.objects->bind(CUBE_SCAN_OBJECTS_BINDING);
+    b.positions->bind(CUBE_SCAN_POSITIONS_BINDING);
+    found.bind(CUBE_SCAN_CANDIDATES_BINDING);
+    batch.texels->bind(CUBE_WALK_TEXELS_BINDING);
+    batch.offset_buffer->bind(CUBE_WALK_OFFSETS_BINDING);
+    glUniform1ui(p.uniform("first_ray"), 0u);
+    glUniform1ui(p.uniform("ray_count"), static_cast<GLuint>(batch.end - batch.first));
+    glUniform1ui(p.uniform("texel_count"), static_cast<GLuint>(batch.texel_count));
+    glUniform1i(p.uniform("face_resolution"), cube.n);
+    glUniform1ui(p.uniform("rows_at"), in.rows_at);
+    glUniform1ui(p.uniform("row_words"), in.row_words);
+    glUniform1ui(p.uniform("candidate_room"), static_cast<GLuint>(room));
+    glUniform3d(p.uniform("centre"), cube.centre.x, cube.centre.y, cube.centre.z);
+    glUniform1d(p.uniform("tolerance_texels"), in.tolerance_texels);
+    glUniform1d(p.uniform("on_triangle_texels"), ON_TRIANGLE_TEXELS);
+    dispatch(p, (batch.texel_count + 63) / 64);
+    check_gl("GPU candidate scan");
+    const uint32_t count = found.read<uint32_t>(1)[0];
+    if (count > room) {
+      room = count;
+      continue;
+    }
+    const std::vector<unsigned char> read = found.read<unsigned char>(CANDIDATES_AT + sizeof(GpuCandidate) * count);
+    std::vector<GpuCandidate> candidates(count);
+    if (count > 0) std::memcpy(candidates.data(), read.data() + CANDIDATES_AT, sizeof(GpuCandidate) * count);
+    return candidates;
+  }
+}
+
+}  // namespace
+
+std::vector<CandidateScan> GlCandidateScan::scan(const std::vector<SearchRay>& rays, const SearchOptions& options,
+                                                 const ScanBatching& batching) const {
   if (options.layers != SearchLayers::all) {
     throw InputError("GPU candidate scan: the nearest layer (Z-buffer searches) is scanned on the CPU only");
   }
@@ -148,63 +226,33 @@ std::vector<CandidateScan> GlCandidateScan::scan(const std::vector<SearchRay>& r
   for (size_t k = 0; k < rays.size(); ++k) {
     const SearchRay& q = rays[k];
     walk_rays[k] = {q.w, q.d, q.l_max, cube.near_distance};
-    packed[k] = {{q.w.x, q.w.y, q.w.z, q.l_max}, {q.d.x, q.d.y, q.d.z, q.self}, {q.object, NO_ROW, 0, 0}, {}};
+    packed[k] = {{q.w.x, q.w.y, q.w.z, q.l_max},
+                 {q.d.x, q.d.y, q.d.z, q.self},
+                 {q.object, NO_ROW, 0, 0},
+                 {q.self_tolerance, 0.0}};
   }
   std::vector<uint32_t> objects = b.objects;
   const uint32_t rows_at = static_cast<uint32_t>(objects.size());
   uint32_t row_words = 0;
   add_restriction_rows(*ctx_, rays, &packed, &objects, &row_words);
+  check_block("the objects and their restriction rows", objects.size() * sizeof(uint32_t));
   const GlBuffer object_buffer(objects.size() * sizeof(uint32_t), objects.data());
-  const GlProgram& p = b.program;
   std::vector<CandidateScan> out(rays.size());
-  b.walks.walk_batches(walk_rays, cube.n, options.max_texels, [&](const GlCubeWalks::Batch& batch) {
-    for (size_t k = batch.first; k < batch.end; ++k) {
-      out[batch.chunk + k].texels = (*batch.counts)[4 * k];
-      out[batch.chunk + k].aborted = ((*batch.counts)[4 * k + 1] & 1u) != 0;
-    }
-    if (batch.texel_count == 0) return;
-    const GlBuffer ray_buffer((batch.end - batch.first) * sizeof(GpuScanRay),
-                              packed.data() + batch.chunk + batch.first);
-    // Room for a candidate a texel, then for as many as the first try found.
-    uint64_t room = batch.texel_count;
-    for (;;) {
-      const uint64_t bytes = 8 * (room + 1);
-      if (bytes > max_block_bytes()) {
-        throw RuntimeFailure("GPU candidate scan: " + std::to_string(room) +
-                             " candidates in one batch, above the GL's GL_MAX_SHADER_STORAGE_BLOCK_SIZE");
-      }
-      const GlBuffer found(bytes, nullptr);
-      found.zero();
-      p.use();
-      ray_buffer.bind(CUBE_SCAN_RAYS_BINDING);
-      b.lists->bind(CUBE_SCAN_LISTS_BINDING);
-      b.fragments->bind(CUBE_SCAN_FRAGMENTS_BINDING);
-      b.planes->bind(CUBE_SCAN_PLANES_BINDING);
-      object_buffer.bind(CUBE_SCAN_OBJECTS_BINDING);
-      found.bind(CUBE_SCAN_CANDIDATES_BINDING);
-      batch.texels->bind(CUBE_WALK_TEXELS_BINDING);
-      batch.offset_buffer->bind(CUBE_WALK_OFFSETS_BINDING);
-      glUniform1ui(p.uniform("first_ray"), 0u);
-      glUniform1ui(p.uniform("ray_count"), static_cast<GLuint>(batch.end - batch.first));
-      glUniform1ui(p.uniform("texel_count"), static_cast<GLuint>(batch.texel_count));
-      glUniform1i(p.uniform("face_resolution"), cube.n);
-      glUniform1ui(p.uniform("rows_at"), rows_at);
-      glUniform1ui(p.uniform("row_words"), row_words);
-      glUniform1ui(p.uniform("candidate_room"), static_cast<GLuint>(room));
-      dispatch(p, (batch.texel_count + 63) / 64);
-      check_gl("GPU candidate scan");
-      const uint32_t count = found.read<uint32_t>(1)[0];
-      if (count > room) {
-        room = count;
-        continue;
-      }
-      const std::vector<uint32_t> words = found.read<uint32_t>(2 + 2 * static_cast<size_t>(count));
-      std::vector<std::pair<uint32_t, uint32_t>> pairs(count);
-      for (uint32_t c = 0; c < count; ++c) pairs[c] = {words[2 + 2 * c], words[3 + 2 * c]};
-      unpack_candidates(std::move(pairs), batch, b.face_first, out.data());
-      return;
-    }
-  });
+  b.walks.walk_batches(
+      walk_rays, cube.n, options.max_texels,
+      [&](const GlCubeWalks::Batch& batch) {
+        for (size_t k = batch.first; k < batch.end; ++k) {
+          out[batch.chunk + k].texels = (*batch.counts)[4 * k];
+          out[batch.chunk + k].aborted = ((*batch.counts)[4 * k + 1] & 1u) != 0;
+        }
+        if (batch.texel_count == 0) return;
+        const GlBuffer ray_buffer((batch.end - batch.first) * sizeof(GpuScanRay),
+                                  packed.data() + batch.chunk + batch.first);
+        const BatchInputs in{&ray_buffer, &object_buffer, rows_at, row_words, options.tolerance_texels};
+        unpack_candidates(scan_batch(b, cube, in, batch, batching.first_room ? batching.first_room : batch.texel_count),
+                          batch, b.face_first, out.data());
+      },
+      batching.batch_bytes);
   return out;
 }
 
@@ -229,45 +277,68 @@ std::vector<SearchRay> scene_search_rays(const SearchContext& ctx, size_t max_tr
   return rays;
 }
 
+namespace {
+
+// The first candidate of x and y not identical (bits), and whether every one is at the same
+// place with the same verdicts and values within rounding.
+size_t first_not_identical(const std::vector<ScanCandidate>& x, const std::vector<ScanCandidate>& y, bool* rounding) {
+  size_t k = 0;
+  *rounding = x.size() == y.size();
+  for (size_t c = 0; c < std::min(x.size(), y.size()); ++c) {
+    const bool place = x[c].same_place(y[c]);
+    if (k == c && place && same_bits(x[c].l, y[c].l) && same_bits(x[c].outside, y[c].outside)) ++k;
+    *rounding = *rounding && place && within_rounding(x[c].l, y[c].l) && within_rounding(x[c].outside, y[c].outside);
+  }
+  return k;
+}
+
+void put_candidate(std::ostringstream& what, const std::vector<ScanCandidate>& v, size_t k) {
+  if (k >= v.size()) {
+    what << "none";
+    return;
+  }
+  const ScanCandidate& c = v[k];
+  what << "texel " << c.texel << " face " << c.face << " fragment " << c.fragment;
+  if (c.tested)
+    what << " l " << c.l << " outside " << c.outside << (c.valid ? " valid" : "") << (c.exact ? " exact" : "");
+}
+
+}  // namespace
+
 CandidateComparison compare_candidate_scans(const std::vector<CandidateScan>& a, const std::vector<CandidateScan>& b) {
   CandidateComparison c;
   c.rays = a.size();
   for (size_t r = 0; r < a.size(); ++r) {
     c.candidates += a[r].candidates.size();
-    if (r < b.size() && a[r].texels == b[r].texels && a[r].aborted == b[r].aborted &&
-        a[r].candidates == b[r].candidates) {
+    const bool walks_alike = r < b.size() && a[r].texels == b[r].texels && a[r].aborted == b[r].aborted;
+    bool rounding = false;
+    const size_t k = walks_alike ? first_not_identical(a[r].candidates, b[r].candidates, &rounding) : 0;
+    if (walks_alike && rounding && k == a[r].candidates.size()) {
       ++c.identical;
       continue;
     }
-    ++c.differing;
+    rounding = walks_alike && rounding;
+    ++(rounding ? c.within_rounding : c.differing);
     if (!c.example.empty()) continue;
     std::ostringstream what;
-    what << "ray " << r << ": ";
+    what.precision(17);
+    what << "ray " << r << (rounding ? " (within rounding): " : ": ");
     if (r >= b.size()) {
       what << "missing from the second set";
     } else {
       what << a[r].candidates.size() << " candidates in " << a[r].texels << " texels"
            << (a[r].aborted ? " (aborted)" : "") << " against " << b[r].candidates.size() << " in " << b[r].texels
            << (b[r].aborted ? " (aborted)" : "");
-      const auto& x = a[r].candidates;
-      const auto& y = b[r].candidates;
-      const size_t k = static_cast<size_t>(std::mismatch(x.begin(), x.end(), y.begin(), y.end()).first - x.begin());
-      if (k < x.size() || k < y.size()) {
+      if (k < a[r].candidates.size() || k < b[r].candidates.size()) {
         what << "; candidate " << k << ": ";
-        const auto put = [&](const std::vector<ScanCandidate>& v) {
-          if (k < v.size()) {
-            what << "texel " << v[k].texel << " face " << v[k].face << " fragment " << v[k].fragment;
-          } else {
-            what << "none";
-          }
-        };
-        put(x);
+        put_candidate(what, a[r].candidates, k);
         what << " against ";
-        put(y);
+        put_candidate(what, b[r].candidates, k);
       }
     }
     c.example = what.str();
   }
+  count_extra_rays(a.size(), b.size(), &c);
   return c;
 }
 

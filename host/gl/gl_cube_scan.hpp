@@ -3,7 +3,7 @@
 // with the object restriction and the own-surface test: scan_candidates
 // (cpu_core/search/search.hpp) run by a GL compute shader (shaders/cube_scan.comp), an
 // invocation a texel walked. Its expressions are the CPU's in double precision, so that a GL
-// whose doubles round as IEEE 754 says finds the CPU's candidates exactly:
+// whose doubles round as IEEE 754 says finds the CPU's candidates, and their crossings, exactly:
 // compare_candidate_scans says where they differ.
 #pragma once
 #include <cstdint>
@@ -11,9 +11,18 @@
 #include <string>
 #include <vector>
 
+#include "gl/gl_cube_walks.hpp"
 #include "search/search.hpp"
 
 namespace abcube {
+
+// How GlCandidateScan::scan cuts its work: the walks' batches hold at most batch_bytes of
+// texels, and a batch's first try has room for first_room candidates (0: one a texel walked);
+// the pass runs again with room for all it found when they are more.
+struct ScanBatching {
+  uint64_t batch_bytes = WALK_BATCH_BYTES;
+  uint64_t first_room = 0;
+};
 
 // The lists, the triangles' planes and objects of one SearchContext, uploaded once, and the
 // compiled pass, on the GL context current when it was made (GL 4.5 core with storage buffer
@@ -21,8 +30,9 @@ namespace abcube {
 // must outlive it.
 class GlCandidateScan {
  public:
-  // Throws RuntimeFailure when the GL cannot hold the lists in one storage block, or a list
-  // is longer than GPU_SCAN_MAX_LIST.
+  // Throws RuntimeFailure when the GL cannot hold the lists, the fragments, the triangles'
+  // planes or their vertices in one storage block each, or a list is longer than
+  // GPU_SCAN_MAX_LIST.
   explicit GlCandidateScan(const SearchContext& ctx);
   ~GlCandidateScan();
   GlCandidateScan(const GlCandidateScan&) = delete;
@@ -30,8 +40,11 @@ class GlCandidateScan {
 
   // Every ray's scan_candidates(ctx, ray, options). Throws InputError for the nearest layer
   // (options.layers: the Z-buffer's choice is the CPU's alone), for a walk cap above
-  // GPU_WALK_MAX_TEXELS and on a ray GlCubeWalks refuses.
-  std::vector<CandidateScan> scan(const std::vector<SearchRay>& rays, const SearchOptions& options = {}) const;
+  // GPU_WALK_MAX_TEXELS and on a ray GlCubeWalks refuses; RuntimeFailure when the objects'
+  // restriction rows or one batch's candidates exceed a storage block.
+  // `batching` sets how the work is cut, not what it finds.
+  std::vector<CandidateScan> scan(const std::vector<SearchRay>& rays, const SearchOptions& options = {},
+                                  const ScanBatching& batching = {}) const;
 
   struct Buffers;
 
@@ -53,11 +66,15 @@ constexpr uint32_t GPU_SCAN_MAX_LIST = 60000;
 std::vector<SearchRay> scene_search_rays(const SearchContext& ctx, size_t max_triangles,
                                          const SearchOptions& options = {});
 
-// How two sets of scans of the same rays agree, ray by ray: identical (the same candidates in
-// the same order, the same texels walked and cap) or differing. `example` gives the first ray
-// that differs, in words.
+// How two sets of scans of the same rays agree, ray by ray, in three classes:
+// - identical: the same candidates in the same order with the same verdicts, their l and
+//   outside the same bits, the same texels walked and cap;
+// - within rounding: the same but for an l or an outside within WALK_ROUNDING_REL of the
+//   other's (what a GL's double division and square root may move);
+// - differing: anything else.
+// `example` gives the first ray not identical, in words.
 struct CandidateComparison {
-  size_t rays = 0, identical = 0, differing = 0;
+  size_t rays = 0, identical = 0, within_rounding = 0, differing = 0;
   uint64_t candidates = 0;  // in the first set
   std::string example;
 };

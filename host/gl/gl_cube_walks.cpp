@@ -82,7 +82,7 @@ GlCubeWalks::GlCubeWalks() {
 GlCubeWalks::~GlCubeWalks() = default;
 
 void GlCubeWalks::walk_batches(const std::vector<WalkRay>& rays, int n, uint32_t max_texels,
-                               const std::function<void(const Batch&)>& visit) const {
+                               const std::function<void(const Batch&)>& visit, uint64_t batch_bytes) const {
   if (n < 1) throw InputError("GPU cube walk: n must be >= 1, got " + std::to_string(n));
   const uint32_t cap = max_texels ? max_texels : CubeWalk::default_cap(n);
   if (cap > GPU_WALK_MAX_TEXELS) {
@@ -106,8 +106,7 @@ void GlCubeWalks::walk_batches(const std::vector<WalkRay>& rays, int n, uint32_t
   };
   // The rays go in chunks (their storage blocks well under the 128 MiB a GL must offer); in
   // each, the count pass, then the fill pass in batches of rays whose texels take at most
-  // WALK_BATCH_BYTES (one ray's at least).
-  constexpr uint64_t WALK_BATCH_BYTES = uint64_t{64} << 20;
+  // batch_bytes (one ray's at least).
   for (size_t chunk = 0; chunk < rays.size(); chunk += WALK_RAY_CHUNK) {
     const size_t chunk_rays = std::min(WALK_RAY_CHUNK, rays.size() - chunk);
     const GlBuffer ray_buffer(chunk_rays * sizeof(GpuRay), packed.data() + chunk);
@@ -127,7 +126,7 @@ void GlCubeWalks::walk_batches(const std::vector<WalkRay>& rays, int n, uint32_t
       batch.first = first;
       size_t end = first;
       while (end < chunk_rays &&
-             (end == first || (batch.texel_count + walked[4 * end]) * sizeof(GpuTexel) <= WALK_BATCH_BYTES)) {
+             (end == first || (batch.texel_count + walked[4 * end]) * sizeof(GpuTexel) <= batch_bytes)) {
         batch.offsets.push_back(static_cast<uint32_t>(batch.texel_count));
         batch.texel_count += walked[4 * end];
         ++end;
@@ -210,17 +209,6 @@ std::vector<RayWalk> cpu_cube_walks(const std::vector<WalkRay>& rays, int n, uin
   return out;
 }
 
-namespace {
-
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
-
-// Within WALK_ROUNDING_REL of each other (the same infinity included).
-bool within_rounding(double a, double b) {
-  return a == b || std::fabs(a - b) <= WALK_ROUNDING_REL * std::max(std::fabs(a), std::fabs(b));
-}
-
-}  // namespace
-
 WalkComparison compare_walks(const std::vector<RayWalk>& a, const std::vector<RayWalk>& b) {
   WalkComparison c;
   c.rays = a.size();
@@ -266,6 +254,7 @@ WalkComparison compare_walks(const std::vector<RayWalk>& a, const std::vector<Ra
     }
     c.example = what.str();
   }
+  count_extra_rays(a.size(), b.size(), &c);
   return c;
 }
 

@@ -4,7 +4,10 @@
 // operation, so that a GL whose doubles round as IEEE 754 says walks the same texels with
 // the same intervals bit for bit: compare_walks says where they differ.
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -22,6 +25,8 @@ class GlBuffer;
 
 // Rays a chunk of a GPU walk: their storage blocks stay well under the 128 MiB a GL must offer.
 constexpr size_t WALK_RAY_CHUNK = size_t{1} << 18;
+// The texels a batch of GPU walks holds at most, in bytes: 2 Mi texels.
+constexpr uint64_t WALK_BATCH_BYTES = uint64_t{64} << 20;
 
 // A ray to walk: CubeWalk's arguments (w relative to the centre, d unit).
 struct WalkRay {
@@ -53,7 +58,8 @@ class GlCubeWalks {
   std::vector<RayWalk> walk(const std::vector<WalkRay>& rays, int n, uint32_t max_texels = 0) const;
 
   // The walks left on the GPU, for a pass that reads them there (gl_cube_scan.hpp): the rays
-  // go in chunks of WALK_RAY_CHUNK, and each chunk's fill pass in batches; visit() is called
+  // go in chunks of WALK_RAY_CHUNK, and each chunk's fill pass in batches of rays whose texels
+  // take at most batch_bytes (one ray's at least); visit() is called
   // once a batch, its texels bound at CUBE_WALK_TEXELS_BINDING (cube_walk.glsl's
   // WalkTexelOut) and its offsets at CUBE_WALK_OFFSETS_BINDING. Every walk of a batch has
   // been checked ended by both passes. The same refusals as walk().
@@ -67,7 +73,7 @@ class GlCubeWalks {
     const GlBuffer* offset_buffer = nullptr;
   };
   void walk_batches(const std::vector<WalkRay>& rays, int n, uint32_t max_texels,
-                    const std::function<void(const Batch&)>& visit) const;
+                    const std::function<void(const Batch&)>& visit, uint64_t batch_bytes = WALK_BATCH_BYTES) const;
 
   struct Program;
 
@@ -107,11 +113,26 @@ std::vector<RayWalk> cpu_cube_walks(const std::vector<WalkRay>& rays, int n, uin
 // - differing: anything else (another texel, another count, the cap).
 // `example` gives the first ray not identical, in words.
 constexpr double WALK_ROUNDING_REL = 1e-12;
+inline bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+// Within WALK_ROUNDING_REL of each other (the same infinity included).
+inline bool within_rounding(double a, double b) {
+  return a == b || std::fabs(a - b) <= WALK_ROUNDING_REL * std::max(std::fabs(a), std::fabs(b));
+}
 struct WalkComparison {
   size_t rays = 0, identical = 0, within_rounding = 0, differing = 0;
   uint64_t texels = 0;  // in the first set
   std::string example;
 };
 WalkComparison compare_walks(const std::vector<RayWalk>& a, const std::vector<RayWalk>& b);
+
+// The rays a second set of `b` results has beyond the first's `a`, counted differing (and
+// named, where no ray was yet).
+template <class Comparison>
+void count_extra_rays(size_t a, size_t b, Comparison* c) {
+  if (b <= a) return;
+  c->rays = b;
+  c->differing += b - a;
+  if (c->example.empty()) c->example = "the second set has " + std::to_string(b - a) + " rays more";
+}
 
 }  // namespace abcube

@@ -733,13 +733,26 @@ TEST(Search, ScanCandidatesAreTheFragmentsASearchTests) {
     const dvec3 w(-0.8 + 0.15 * k, 0.1, -2);
     const dvec3 r = glm::normalize(dvec3(0.1 * k - 0.5, 0.2, 1));
     const SearchResult res = reflection_search(ctx, w, r, none);
-    const CandidateScan scan = scan_candidates(ctx, reflection_ray(ctx, w, r, none), none);
+    const SearchRay q = reflection_ray(ctx, w, r, none);
+    const CandidateScan scan = scan_candidates(ctx, q, none);
     EXPECT_EQ(res.candidates, scan.candidates.size()) << k;
     EXPECT_FALSE(scan.aborted);
+    // Each candidate is a fragment of the list of the texel the walk visits at its place.
+    const CubeABuffer& cube = ctx.cube();
+    CubeWalk walk(q.w, q.d, cube.n, q.l_max, cube.near_distance);
+    std::vector<WalkTexel> texels;
+    WalkTexel t;
+    while (walk.next(&t)) texels.push_back(t);
+    ASSERT_EQ(texels.size(), scan.texels);
     for (size_t c = 0; c < scan.candidates.size(); ++c) {
       const ScanCandidate& x = scan.candidates[c];
-      EXPECT_LT(x.texel, scan.texels);
-      EXPECT_LT(x.fragment, ctx.cube().faces[x.face].fragments.size());
+      ASSERT_LT(x.texel, scan.texels);
+      const WalkTexel& at = texels[x.texel];
+      EXPECT_EQ(x.face, static_cast<uint32_t>(at.face));
+      const ABuffer& face = cube.faces[x.face];
+      const size_t list = static_cast<size_t>(at.j) * static_cast<size_t>(cube.n) + static_cast<size_t>(at.i);
+      EXPECT_GE(x.fragment, face.offsets[list]);
+      EXPECT_LT(x.fragment, face.offsets[list + 1]);
       if (c > 0) EXPECT_GE(x.texel, scan.candidates[c - 1].texel);
     }
     total += scan.candidates.size();

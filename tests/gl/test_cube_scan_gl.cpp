@@ -1,8 +1,11 @@
 // The searches' candidates found on the GPU (host/gl/gl_cube_scan.hpp) against the CPU core's
 // (search/search.hpp scan_candidates): the same fragments of the same texels in the same
-// order, ray by ray, on every kept scene, for the searches' own rays (reflections, shadow
+// order with the same crossings, ray by ray, on every kept scene, for the searches' own rays (reflections, shadow
 // segments, refraction exits restricted to their object), for the self offsets of both
 // modes, and with walks the cap stops.
+#include <array>
+#include <cmath>
+#include <cstddef>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -73,6 +76,9 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
   test::test_context();
   uint64_t candidates = 0;
   size_t restricted_rays = 0;
+  // Candidates by their crossing's verdicts: untested; tested only; tested and valid or exact;
+  // all three.
+  std::array<uint64_t, 4> verdicts{};
   for (const std::string& file : test::scene_files()) {
     const SceneData scene = load_scene(file);
     for (const auto& [centre, n] : test::cube_views(scene)) {
@@ -83,21 +89,30 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
         SearchOptions o;
         o.mode = mode;
         const std::vector<SearchRay> rays = rays_of(ctx, o, static_cast<unsigned>(n));
-        const CandidateComparison c = compare_candidate_scans(cpu_scans(ctx, rays, o), gpu.scan(rays, o));
+        const std::vector<CandidateScan> cpu = cpu_scans(ctx, rays, o);
+        const CandidateComparison c = compare_candidate_scans(cpu, gpu.scan(rays, o));
         const std::string what = std::filesystem::path(file).filename().string() + " at N = " + std::to_string(n) +
                                  " (" + search_mode_name(mode) + ")";
         EXPECT_EQ(c.identical, rays.size()) << what << ": " << c.example;
         candidates += c.candidates;
         restricted_rays += restricted(rays);
+        for (const CandidateScan& scan : cpu) {
+          for (const ScanCandidate& x : scan.candidates) {
+            ++verdicts[(x.tested ? 1 : 0) + (x.exact ? 1 : 0) + (x.valid ? 1 : 0)];
+          }
+        }
       }
     }
   }
   EXPECT_GT(candidates, 10000u);
   EXPECT_GT(restricted_rays, 1000u);
+  for (const uint64_t v : verdicts) EXPECT_GT(v, 100u);
 }
 
-// Walks the cap stops (the candidates up to it), and a batch with no texel at all.
-TEST(CubeScanGl, CappedWalksAndEmptyBatchesAsTheCpu) {
+// Walks the cap stops (the candidates up to it); the work cut in batches of a few rays, each
+// first given room for one candidate (so that each pass runs again); walks of no texel at all
+// (segments inside the ball the map does not hold) among the others, and a batch of them alone.
+TEST(CubeScanGl, CappedWalksSmallBatchesAndEmptyWalksAsTheCpu) {
   test::test_context();
   const Cornell cornell(32);
   const SearchContext& ctx = cornell.ctx;
@@ -105,18 +120,30 @@ TEST(CubeScanGl, CappedWalksAndEmptyBatchesAsTheCpu) {
   SearchOptions o;
   o.max_texels = 6;
   const std::vector<SearchRay> rays = rays_of(ctx, o, 7);
-  const std::vector<CandidateScan> cpu = cpu_scans(ctx, rays, o);
-  const CandidateComparison c = compare_candidate_scans(cpu, gpu.scan(rays, o));
+  std::vector<CandidateScan> cpu = cpu_scans(ctx, rays, o);
+  CandidateComparison c = compare_candidate_scans(cpu, gpu.scan(rays, o));
   EXPECT_EQ(c.identical, rays.size()) << c.example;
   size_t aborted = 0;
   for (const CandidateScan& s : cpu) aborted += s.aborted ? 1 : 0;
   EXPECT_GT(aborted, rays.size() / 2);
   EXPECT_GT(c.candidates, 0u);
-  // A shadow segment too short to leave its first texel's neighbourhood, and no ray at all.
-  SearchRay q;
-  ASSERT_TRUE(shadow_ray(ctx, cornell.scene.lights[0].position + glm::dvec3(0, -1e-3, 0),
-                         cornell.scene.lights[0].position, {}, &q));
-  EXPECT_EQ(compare_candidate_scans(cpu_scans(ctx, {q}, {}), gpu.scan({q})).identical, 1u);
+
+  std::vector<SearchRay> mixed = scene_search_rays(ctx, 64);
+  const glm::dvec3 centre = ctx.cube().centre;
+  const double inside = 0.25 * ctx.cube().near_distance;
+  SearchRay empty;
+  ASSERT_TRUE(shadow_ray(ctx, centre + glm::dvec3(inside, 0, 0), centre + glm::dvec3(0, inside, 0), {}, &empty));
+  for (size_t k = 0; k < mixed.size(); k += 5) mixed.insert(mixed.begin() + static_cast<std::ptrdiff_t>(k), empty);
+  cpu = cpu_scans(ctx, mixed, {});
+  ScanBatching small;
+  small.batch_bytes = 2048;  // 64 texels
+  small.first_room = 1;
+  c = compare_candidate_scans(cpu, gpu.scan(mixed, {}, small));
+  EXPECT_EQ(c.identical, mixed.size()) << c.example;
+  EXPECT_EQ(cpu[0].texels, 0u);
+  EXPECT_GT(c.candidates, mixed.size());
+  c = compare_candidate_scans(cpu_scans(ctx, {empty, empty}, {}), gpu.scan({empty, empty}, {}, small));
+  EXPECT_EQ(c.identical, 2u) << c.example;
   EXPECT_TRUE(gpu.scan({}).empty());
 }
 
@@ -135,8 +162,9 @@ TEST(CubeScanGl, RefusesTheNearestLayerAndCapsAboveTheGpusBound) {
   EXPECT_THROW(gpu.scan(rays, capped), InputError);
 }
 
-// compare_candidate_scans' two classes: a candidate missing, moved to another texel or
-// another fragment, or the walk's length or cap differing, is a ray differing, named.
+// compare_candidate_scans' classes: an l or outside moved by an ulp is within rounding; a
+// candidate missing, moved to another texel or fragment, or with another verdict, or the
+// walk's length or cap differing, is a ray differing; each named.
 TEST(CubeScanGl, ComparisonNamesTheFirstDifference) {
   const Cornell cornell(16);
   const SearchContext& ctx = cornell.ctx;
@@ -145,8 +173,8 @@ TEST(CubeScanGl, ComparisonNamesTheFirstDifference) {
   CandidateComparison c = compare_candidate_scans(cpu, cpu);
   EXPECT_EQ(c.identical, cpu.size());
   EXPECT_TRUE(c.example.empty());
-  size_t k = 0;  // a ray with two candidates at least
-  while (k < cpu.size() && cpu[k].candidates.size() < 2) ++k;
+  size_t k = 0;  // a ray with two candidates at least, the first tested
+  while (k < cpu.size() && (cpu[k].candidates.size() < 2 || !cpu[k].candidates[0].tested)) ++k;
   ASSERT_LT(k, cpu.size());
   const auto differs = [&](std::vector<CandidateScan> other, const std::string& expected) {
     const CandidateComparison d = compare_candidate_scans(cpu, other);
@@ -164,6 +192,15 @@ TEST(CubeScanGl, ComparisonNamesTheFirstDifference) {
   other = cpu;
   other[k].candidates[0].fragment += 1;
   differs(other, "candidate 0: ");
+  other = cpu;
+  other[k].candidates[0].valid = !other[k].candidates[0].valid;
+  differs(other, "candidate 0: ");
+  other = cpu;
+  other[k].candidates[0].l = std::nextafter(other[k].candidates[0].l, 0.0);
+  c = compare_candidate_scans(cpu, other);
+  EXPECT_EQ(c.within_rounding, 1u);
+  EXPECT_EQ(c.differing, 0u);
+  EXPECT_NE(c.example.find("ray " + std::to_string(k) + " (within rounding): "), std::string::npos) << c.example;
   other = cpu;
   other[k].aborted = !other[k].aborted;
   differs(other, "(aborted)");
