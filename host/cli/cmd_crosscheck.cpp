@@ -27,28 +27,26 @@ constexpr const char* CROSSCHECK_COVERS =
     "refractions, antialiased edges (abcube report compares "
     "whole images with the exact tracer)";
 
+// One of the searches' pieces run on the GPU against the CPU's, ray by ray: why it was not
+// compared, or its classes, the count of `unit` in the CPU's results and the GPU's time.
+template <class Comparison>
+void print_rays(const char* what, const std::string& skipped, const Comparison& c, uint64_t count, const char* unit,
+                double ms) {
+  if (!skipped.empty()) {
+    std::printf("%s: %s\n", what, skipped.c_str());
+    return;
+  }
+  std::printf("%s: %zu of %zu rays identical, %zu within rounding, %zu differing, %llu %s (%.1f ms)%s%s\n", what,
+              c.identical, c.rays, c.within_rounding, c.differing, static_cast<unsigned long long>(count), unit, ms,
+              c.example.empty() ? "" : "; first not identical: ", c.example.c_str());
+}
+
 // The searches' pieces run on the GPU (the walks, the candidates) against the CPU's.
 void print_searches(const CrosscheckResult& r) {
-  if (!r.walks_skipped.empty()) {
-    std::printf("GPU cube walks: %s\n", r.walks_skipped.c_str());
-  } else {
-    std::printf(
-        "GPU cube walks: %zu of %zu rays identical, %zu within rounding, %zu differing, %llu texels "
-        "(%.1f ms)%s%s\n",
-        r.walks.identical, r.walks.rays, r.walks.within_rounding, r.walks.differing,
-        static_cast<unsigned long long>(r.walks.texels), r.gpu_walks_ms,
-        r.walks.example.empty() ? "" : "; first not identical: ", r.walks.example.c_str());
-    if (!r.candidates_skipped.empty()) {
-      std::printf("GPU search candidates: %s\n", r.candidates_skipped.c_str());
-    } else {
-      std::printf(
-          "GPU search candidates: %zu of %zu rays identical, %zu within rounding, %zu differing, %llu candidates "
-          "(%.1f ms)%s%s\n",
-          r.candidates.identical, r.candidates.rays, r.candidates.within_rounding, r.candidates.differing,
-          static_cast<unsigned long long>(r.candidates.candidates), r.gpu_candidates_ms,
-          r.candidates.example.empty() ? "" : "; first not identical: ", r.candidates.example.c_str());
-    }
-  }
+  print_rays("GPU cube walks", r.walks_skipped, r.walks, r.walks.texels, "texels", r.gpu_walks_ms);
+  if (!r.walks_skipped.empty()) return;
+  print_rays("GPU search candidates", r.candidates_skipped, r.candidates, r.candidates.candidates, "candidates",
+             r.gpu_candidates_ms);
 }
 
 // A GPU build's lists against the CPU's: the counts, then each class of difference found.
