@@ -305,23 +305,25 @@ bool shadow_ray(const SearchContext& ctx, const glm::dvec3& p, const glm::dvec3&
 // meets them: those that pass the layer choice, the object restriction, the z-interval test
 // (thesis 7.5) and the own-surface test. Each names the walk's texel (its place in the walk,
 // CubeWalk's order) and the fragment (its index in the face's A-buffer), with the answer of
-// MODE crossing's test before any MESH REFINEMENT: where the ray meets the fragment's plane
-// inside its texel (tested), at which l, how far from the triangle in texels (outside), on it
-// to rounding (exact), and accepted (valid: within options.tolerance_texels, and past the
-// self tolerance unless exact). The BLOCK BOUNDS and the HIERARCHICAL SKIP pass only texels
-// none of whose fragments could pass, so they change none of it; the GPU's scan
-// (host/gl/gl_cube_scan.hpp) is held to it.
+// MODE crossing's test for it, MESH REFINEMENT included where options.refine asks: where the
+// ray meets a surface there (tested), at which l, how far from the triangle in texels
+// (outside), on it to rounding (exact), accepted (valid), which triangle and facing, and the
+// triangles the refinement tested. The BLOCK BOUNDS pass only texels none of whose fragments
+// could pass, so they change none of it; the GPU's scan (host/gl/gl_cube_scan.hpp) is held
+// to it.
 struct ScanCandidate {
   uint32_t texel = 0;  // the walk's texel: 0 for the first it walks
   uint32_t face = 0;
   uint32_t fragment = 0;  // index into cube.faces[face].fragments
-  bool tested = false, exact = false, valid = false;
-  double l = std::numeric_limits<double>::infinity();  // where tested, else +inf
-  double outside = 0;                                  // where tested, else 0
-  // The same fragment of the same texel, with the same verdicts.
+  bool tested = false, exact = false, valid = false, back_face = false;
+  uint32_t triangle = 0;  // the surface found: the fragment's, or the one the refinement crossed
+  double l = std::numeric_limits<double>::infinity();
+  double outside = 0;
+  uint32_t mesh_triangles = 0;
+  // The same fragment of the same texel, with the same verdicts and triangle.
   bool same_place(const ScanCandidate& o) const {
     return texel == o.texel && face == o.face && fragment == o.fragment && tested == o.tested && exact == o.exact &&
-           valid == o.valid;
+           valid == o.valid && back_face == o.back_face && triangle == o.triangle && mesh_triangles == o.mesh_triangles;
   }
 };
 struct CandidateScan {

@@ -259,14 +259,12 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
 
 CandidateScan scan_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options) {
   CandidateScan out;
-  SearchOptions plane = options;
-  plane.refine = SearchRefine::plane;
   const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3&,
                                const SearchContext::Plane& p) {
     const std::vector<Fragment>& face = ctx.cube().faces[static_cast<size_t>(t.face)].fragments;
-    const Candidate c = crossing_candidate(ctx, q, plane, t, f, p);
+    const Candidate c = crossing_candidate(ctx, q, options, t, f, p);
     out.candidates.push_back({out.texels, static_cast<uint32_t>(t.face), static_cast<uint32_t>(&f - face.data()),
-                              c.tested, c.exact, c.valid, c.l, c.outside});
+                              c.tested, c.exact, c.valid, c.back_face, c.triangle, c.l, c.outside, c.mesh_triangles});
   };
   const auto after_texel = [&](const WalkTexel&, uint32_t index) {
     out.texels = index + 1;

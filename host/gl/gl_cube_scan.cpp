@@ -27,13 +27,15 @@ struct GpuScanRay {
   uint32_t object_row[4];
   double self_tolerance[2];
 };
-// Its CandidateOut, after the count and a pad word.
+// Its CandidateOut, after the count and three pad words (the array is 16-byte aligned).
 struct GpuCandidate {
-  uint32_t texel, fragment, flags, pad;
+  uint32_t texel, fragment, ray, id;
   double l, outside;
+  double interval[2];
+  uint32_t flags, triangle, mesh_tested, pad;
 };
-static_assert(sizeof(GpuScanRay) == 96 && sizeof(GpuCandidate) == 32, "must match shaders/cube_scan.comp");
-constexpr uint64_t CANDIDATES_AT = 8;  // bytes before the first candidate
+static_assert(sizeof(GpuScanRay) == 96 && sizeof(GpuCandidate) == 64, "must match shaders/scan_common.glsl");
+constexpr uint64_t CANDIDATES_AT = 16;  // bytes before the first candidate
 static_assert(sizeof(Fragment) == 20, "cube_scan.comp reads fragments as 20 bytes");
 constexpr uint32_t NO_ROW = 0xffffffffu;
 
@@ -55,16 +57,19 @@ void check_block(const char* what, uint64_t bytes) {
 }  // namespace
 
 struct GlCandidateScan::Buffers {
-  GlProgram program{std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "cube_scan.comp"}};
+  GlProgram program{
+      std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "scan_common.glsl", "cube_scan.comp"}};
+  GlProgram refine{std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "scan_common.glsl",
+                                            "mesh_refine.glsl", "cube_refine.comp"}};
   GlCubeWalks walks;
-  std::unique_ptr<GlBuffer> lists, fragments, planes, positions;
+  std::unique_ptr<GlBuffer> lists, fragments, planes, positions, neighbours;
   std::vector<uint32_t> objects;     // per triangle its object
   std::vector<uint32_t> face_first;  // each face's first fragment in `fragments`, then the total
 };
 
 GlCandidateScan::GlCandidateScan(const SearchContext& ctx) : ctx_(&ctx) {
   require_storage_bindings("GPU candidate scan", CUBE_SCAN_POSITIONS_BINDING);
-  require_compute_blocks("GPU candidate scan", 9);
+  require_compute_blocks("GPU candidate scan", 8);
   buffers_ = std::make_unique<Buffers>();
   Buffers& b = *buffers_;
   const CubeABuffer& cube = ctx.cube();
@@ -108,6 +113,12 @@ GlCandidateScan::GlCandidateScan(const SearchContext& ctx) : ctx_(&ctx) {
   check_block("the triangles' vertices", soup.positions.size() * sizeof(glm::vec3));
   b.planes = std::make_unique<GlBuffer>(planes.size() * sizeof(double), planes.data());
   b.positions = std::make_unique<GlBuffer>(soup.positions.size() * sizeof(glm::vec3), soup.positions.data());
+  std::vector<uint32_t> neighbours(3 * soup.triangle_count());
+  for (uint32_t t = 0; t < static_cast<uint32_t>(soup.triangle_count()); ++t) {
+    for (int k = 0; k < 3; ++k) neighbours[3 * t + static_cast<uint32_t>(k)] = ctx.neighbour(t, k);
+  }
+  check_block("the triangles' neighbours", neighbours.size() * sizeof(uint32_t));
+  b.neighbours = std::make_unique<GlBuffer>(neighbours.size() * sizeof(uint32_t), neighbours.data());
   b.objects = soup.object_id;
   check_gl("GPU candidate scan: uploading the lists");
 }
@@ -149,9 +160,9 @@ void unpack_candidates(std::vector<GpuCandidate> found, const GlCubeWalks::Batch
         static_cast<size_t>(std::upper_bound(b.offsets.begin(), b.offsets.end(), texel) - b.offsets.begin()) - 1;
     const size_t face =
         static_cast<size_t>(std::upper_bound(face_first.begin(), face_first.end(), fragment) - face_first.begin()) - 1;
-    out[b.chunk + b.first + k].candidates.push_back({texel - b.offsets[k], static_cast<uint32_t>(face),
-                                                     fragment - face_first[face], (g.flags & 1u) != 0,
-                                                     (g.flags & 2u) != 0, (g.flags & 4u) != 0, g.l, g.outside});
+    out[b.chunk + b.first + k].candidates.push_back(
+        {texel - b.offsets[k], static_cast<uint32_t>(face), fragment - face_first[face], (g.flags & 1u) != 0,
+         (g.flags & 2u) != 0, (g.flags & 4u) != 0, (g.flags & 8u) != 0, g.triangle, g.l, g.outside, g.mesh_tested});
   }
 }
 
@@ -166,7 +177,26 @@ struct BatchInputs {
   const GlBuffer* objects;
   uint32_t rows_at, row_words;
   double tolerance_texels;
+  bool refine_mesh;
 };
+
+// Each found candidate's crossing test (cube_refine.comp), in place.
+void run_crossing_tests(const GlCandidateScan::Buffers& b, const CubeABuffer& cube, const BatchInputs& in,
+                        const GlBuffer& found, uint32_t count) {
+  const GlProgram& p = b.refine;
+  p.use();
+  in.rays->bind(CUBE_SCAN_RAYS_BINDING);
+  found.bind(CUBE_SCAN_CANDIDATES_BINDING);
+  b.positions->bind(CUBE_SCAN_POSITIONS_BINDING);
+  b.neighbours->bind(CUBE_REFINE_NEIGHBOURS_BINDING);
+  glUniform3d(p.uniform("centre"), cube.centre.x, cube.centre.y, cube.centre.z);
+  glUniform1i(p.uniform("face_resolution"), cube.n);
+  glUniform1d(p.uniform("on_triangle_texels"), ON_TRIANGLE_TEXELS);
+  glUniform1d(p.uniform("tolerance_texels"), in.tolerance_texels);
+  glUniform1i(p.uniform("refine_mesh"), in.refine_mesh ? 1 : 0);
+  dispatch(p, (count + 63) / 64);
+  check_gl("GPU candidates' crossing tests");
+}
 
 // The candidates of one batch of walks, in the order found: a pass with room for `room`
 // candidates, then, when it found more, one with room for all.
@@ -184,7 +214,6 @@ std::vector<GpuCandidate> scan_batch(const GlCandidateScan::Buffers& b, const Cu
     b.fragments->bind(CUBE_SCAN_FRAGMENTS_BINDING);
     b.planes->bind(CUBE_SCAN_PLANES_BINDING);
     in.objects->bind(CUBE_SCAN_OBJECTS_BINDING);
-    b.positions->bind(CUBE_SCAN_POSITIONS_BINDING);
     found.bind(CUBE_SCAN_CANDIDATES_BINDING);
     batch.texels->bind(CUBE_WALK_TEXELS_BINDING);
     batch.offset_buffer->bind(CUBE_WALK_OFFSETS_BINDING);
@@ -195,9 +224,6 @@ std::vector<GpuCandidate> scan_batch(const GlCandidateScan::Buffers& b, const Cu
     glUniform1ui(p.uniform("rows_at"), in.rows_at);
     glUniform1ui(p.uniform("row_words"), in.row_words);
     glUniform1ui(p.uniform("candidate_room"), static_cast<GLuint>(room));
-    glUniform3d(p.uniform("centre"), cube.centre.x, cube.centre.y, cube.centre.z);
-    glUniform1d(p.uniform("tolerance_texels"), in.tolerance_texels);
-    glUniform1d(p.uniform("on_triangle_texels"), ON_TRIANGLE_TEXELS);
     dispatch(p, (batch.texel_count + 63) / 64);
     check_gl("GPU candidate scan");
     const uint32_t count = found.read<uint32_t>(1)[0];
@@ -205,6 +231,7 @@ std::vector<GpuCandidate> scan_batch(const GlCandidateScan::Buffers& b, const Cu
       room = count;
       continue;
     }
+    run_crossing_tests(b, cube, in, found, count);
     const std::vector<unsigned char> read = found.read<unsigned char>(CANDIDATES_AT + sizeof(GpuCandidate) * count);
     std::vector<GpuCandidate> candidates(count);
     if (count > 0) std::memcpy(candidates.data(), read.data() + CANDIDATES_AT, sizeof(GpuCandidate) * count);
@@ -248,7 +275,8 @@ std::vector<CandidateScan> GlCandidateScan::scan(const std::vector<SearchRay>& r
         if (batch.texel_count == 0) return;
         const GlBuffer ray_buffer((batch.end - batch.first) * sizeof(GpuScanRay),
                                   packed.data() + batch.chunk + batch.first);
-        const BatchInputs in{&ray_buffer, &object_buffer, rows_at, row_words, options.tolerance_texels};
+        const BatchInputs in{&ray_buffer, &object_buffer,           rows_at,
+                             row_words,   options.tolerance_texels, options.refine == SearchRefine::mesh};
         unpack_candidates(scan_batch(b, cube, in, batch, batching.first_room ? batching.first_room : batch.texel_count),
                           batch, b.face_first, out.data());
       },

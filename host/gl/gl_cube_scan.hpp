@@ -1,10 +1,11 @@
 // The searches' candidates on the GPU: the z-interval test of thesis 7.5 over the cube
 // A-buffer's lists, along the texels each ray's walk crosses (GlCubeWalks, left on the GPU),
-// with the object restriction and the own-surface test: scan_candidates
-// (cpu_core/search/search.hpp) run by a GL compute shader (shaders/cube_scan.comp), an
-// invocation a texel walked. Its expressions are the CPU's in double precision, so that a GL
-// whose doubles round as IEEE 754 says finds the CPU's candidates, and their crossings, exactly:
-// compare_candidate_scans says where they differ.
+// with the object restriction and the own-surface test, then each candidate's crossing test
+// with its MESH REFINEMENT: scan_candidates (cpu_core/search/search.hpp) run by two GL
+// compute passes, an invocation a texel walked (shaders/cube_scan.comp), then an invocation a
+// candidate (shaders/cube_refine.comp, mesh_refine.glsl). Their expressions are the CPU's in
+// double precision, so that a GL whose doubles round as IEEE 754 says finds the CPU's
+// candidates and crossings exactly: compare_candidate_scans says where they differ.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -24,14 +25,14 @@ struct ScanBatching {
   uint64_t first_room = 0;
 };
 
-// The lists, the triangles' planes and objects of one SearchContext, uploaded once, and the
-// compiled pass, on the GL context current when it was made (GL 4.5 core with storage buffer
-// binding CUBE_SCAN_CANDIDATES_BINDING), which must stay current for its life. The context
-// must outlive it.
+// The lists and the triangles' planes, objects, vertices and edge neighbours of one
+// SearchContext, uploaded once, and the compiled passes, on the GL context current when it
+// was made (GL 4.5 core with storage buffer binding CUBE_SCAN_POSITIONS_BINDING), which must
+// stay current for its life. The context must outlive it.
 class GlCandidateScan {
  public:
-  // Throws RuntimeFailure when the GL cannot hold the lists, the fragments, the triangles'
-  // planes or their vertices in one storage block each, or a list is longer than
+  // Throws RuntimeFailure when the GL cannot hold the lists, the fragments, or the triangles'
+  // planes, vertices or neighbours in one storage block each, or a list is longer than
   // GPU_SCAN_MAX_LIST.
   explicit GlCandidateScan(const SearchContext& ctx);
   ~GlCandidateScan();

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "base/samples.hpp"
+#include "search/search.hpp"
 
 namespace abcube {
 
@@ -68,8 +69,7 @@ constexpr unsigned CUBE_WALK_OFFSETS_BINDING = 23;
 // The GPU's candidate scan (gl_cube_scan.cpp, cube_scan.comp), which reads a batch of walks
 // at the two bindings above: the searches' rays, the cube's lists and fragments, the
 // triangles' planes, their objects with the restriction rows, the candidates found, and the
-// triangles' vertices: nine blocks in one shader (GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS is 8
-// at GL 4.3's least; llvmpipe and NVIDIA offer more, and the scan checks).
+// triangles' vertices.
 constexpr unsigned CUBE_SCAN_RAYS_BINDING = 24;
 constexpr unsigned CUBE_SCAN_LISTS_BINDING = 25;
 constexpr unsigned CUBE_SCAN_FRAGMENTS_BINDING = 26;
@@ -77,6 +77,12 @@ constexpr unsigned CUBE_SCAN_PLANES_BINDING = 27;
 constexpr unsigned CUBE_SCAN_OBJECTS_BINDING = 28;
 constexpr unsigned CUBE_SCAN_CANDIDATES_BINDING = 29;
 constexpr unsigned CUBE_SCAN_POSITIONS_BINDING = 30;
+// The crossing test's pass (cube_refine.comp, mesh_refine.glsl) reads the rays, the
+// candidates and the vertices at the bindings above, and the triangles' edge neighbours at
+// the lists' binding, which it does not read; the MESH REFINEMENT's bounds are the CPU's.
+constexpr unsigned CUBE_REFINE_NEIGHBOURS_BINDING = CUBE_SCAN_LISTS_BINDING;
+constexpr unsigned GPU_REFINE_MAX_STEPS = static_cast<unsigned>(REFINE_MAX_STEPS);
+constexpr unsigned GPU_REFINE_MAX_TRIANGLES = static_cast<unsigned>(REFINE_MAX_TRIANGLES);
 constexpr unsigned ABUFFER_SCAN_BLOCK = 512;
 constexpr int ABUFFER_TILE = 8;
 constexpr unsigned ABUFFER_GPU_LIST_MAX = 64;

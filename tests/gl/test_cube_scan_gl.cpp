@@ -1,8 +1,9 @@
 // The searches' candidates found on the GPU (host/gl/gl_cube_scan.hpp) against the CPU core's
 // (search/search.hpp scan_candidates): the same fragments of the same texels in the same
-// order with the same crossings, ray by ray, on every kept scene, for the searches' own rays (reflections, shadow
-// segments, refraction exits restricted to their object), for the self offsets of both
-// modes, and with walks the cap stops.
+// order, each with the same crossing test and MESH REFINEMENT, ray by ray, on every kept
+// scene, for the searches' own rays (reflections, shadow segments, refraction exits
+// restricted to their object), for the self offsets of both modes, and with walks the cap
+// stops.
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -79,6 +80,9 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
   // Candidates by their crossing's verdicts: untested; tested only; tested and valid or exact;
   // all three.
   std::array<uint64_t, 4> verdicts{};
+  // MESH REFINEMENT: candidates refined, found crossing another triangle of the mesh, and
+  // found passing the mesh by.
+  uint64_t refined = 0, crossed_elsewhere = 0, passed_by = 0;
   for (const std::string& file : test::scene_files()) {
     const SceneData scene = load_scene(file);
     for (const auto& [centre, n] : test::cube_views(scene)) {
@@ -99,6 +103,10 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
         for (const CandidateScan& scan : cpu) {
           for (const ScanCandidate& x : scan.candidates) {
             ++verdicts[(x.tested ? 1 : 0) + (x.exact ? 1 : 0) + (x.valid ? 1 : 0)];
+            const uint32_t own = cube.faces[x.face].fragments[x.fragment].triangle();
+            refined += x.mesh_triangles > 0 ? 1 : 0;
+            crossed_elsewhere += x.valid && x.triangle != own ? 1 : 0;
+            passed_by += x.mesh_triangles > 0 && std::isinf(x.outside) ? 1 : 0;
           }
         }
       }
@@ -107,6 +115,9 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
   EXPECT_GT(candidates, 10000u);
   EXPECT_GT(restricted_rays, 1000u);
   for (const uint64_t v : verdicts) EXPECT_GT(v, 100u);
+  EXPECT_GT(refined, 1000u);
+  EXPECT_GT(crossed_elsewhere, 100u);
+  EXPECT_GT(passed_by, 100u);
 }
 
 // Walks the cap stops (the candidates up to it); the work cut in batches of a few rays, each
