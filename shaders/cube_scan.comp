@@ -93,7 +93,9 @@ void main() {
     if (own_surface(planes[triangle], w, d, r.d_self.w)) continue;
     uint slot = atomicAdd(candidate_count, 1u);
     if (slot < candidate_room) {
-      candidates[slot] = CandidateOut(index, k, lo, f.id, inf(), 0.0lf, t.interval, 0u, 0u, 0u, 0u);
+      double before_l1 = index > offsets[lo] ? texels[index - 1u].interval.y : -inf();
+      uint ij = uint(t.texel.y) | (uint(t.texel.z) << 16);
+      candidates[slot] = CandidateOut(index, k, lo, f.id, inf(), 0.0lf, t.interval, 0u, 0u, 0u, ij, before_l1, 0.0lf);
     }
   }
 }

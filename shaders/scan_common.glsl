@@ -11,15 +11,17 @@ struct ScanRay {
   dvec2 self_tolerance;
 };
 // A candidate. The scan writes the batch's texel, the fragment, the ray (in the batch), the
-// fragment's triangle and facing (id), and the texel's interval; the crossing test adds its
-// answer: flags (1 tested, 2 exact, 4 valid, 8 the surface found is a back face), l, the
-// distance from the triangle in texels, the triangle found and the triangles the mesh
-// refinement tested.
+// fragment's triangle and facing (id), the texel's interval, its place on its face (i | j <<
+// 16) and the end of the texel the walk crossed before (-inf for the first); the crossing
+// test adds its answer: flags (1 tested, 2 exact, 4 valid, 8 the surface found is a back
+// face), l, the distance from the triangle in texels, the triangle found and the triangles
+// the mesh refinement tested.
 struct CandidateOut {
   uint texel, fragment, ray, id;
   double l, outside;
   dvec2 interval;
-  uint flags, triangle, mesh_tested, pad;
+  uint flags, triangle, mesh_tested, ij;
+  double before_l1, pad;
 };
 
 layout(std430, binding = CUBE_SCAN_RAYS_BINDING) readonly buffer Rays { ScanRay rays[]; };

@@ -315,6 +315,9 @@ struct ScanCandidate {
   uint32_t texel = 0;  // the walk's texel: 0 for the first it walks
   uint32_t face = 0;
   uint32_t fragment = 0;  // index into cube.faces[face].fragments
+  int i = 0, j = 0;       // the texel on its face
+  double l1 = 0;          // the end of the ray's interval in the texel
+  double before_l1 = 0;   // the end of the texel walked before it (-inf for the first)
   bool tested = false, exact = false, valid = false, back_face = false;
   uint32_t triangle = 0;  // the surface found: the fragment's, or the one the refinement crossed
   double l = std::numeric_limits<double>::infinity();
@@ -322,8 +325,9 @@ struct ScanCandidate {
   uint32_t mesh_triangles = 0;
   // The same fragment of the same texel, with the same verdicts and triangle.
   bool same_place(const ScanCandidate& o) const {
-    return texel == o.texel && face == o.face && fragment == o.fragment && tested == o.tested && exact == o.exact &&
-           valid == o.valid && back_face == o.back_face && triangle == o.triangle && mesh_triangles == o.mesh_triangles;
+    return texel == o.texel && face == o.face && fragment == o.fragment && i == o.i && j == o.j && tested == o.tested &&
+           exact == o.exact && valid == o.valid && back_face == o.back_face && triangle == o.triangle &&
+           mesh_triangles == o.mesh_triangles;
   }
 };
 struct CandidateScan {
@@ -332,6 +336,20 @@ struct CandidateScan {
   bool aborted = false;  // the walk's cap stopped it
 };
 CandidateScan scan_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options = {});
+
+// The search of ray q (reflection_search's, or refraction_exit_search's for a restricted ray).
+SearchResult search_along(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options = {});
+
+// The same search's answer from q's candidates (scan_candidates', or the GPU's): the crossing
+// mode's choice among them and THE SIDE STRUCTURE, the code search_along runs on its own walk,
+// so the answer is search_along's (same_answer) but for the walk's counts of texels, nodes
+// and fragments read, which a list of candidates does not hold (left 0). The crossing mode over
+// all layers only (InputError otherwise).
+SearchResult search_from_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options,
+                                    const CandidateScan& scan);
+// Whether an answer from candidates is the walked search's: same_answer but for the walk's
+// counts of texels, nodes and fragments read.
+bool same_found(const SearchResult& walked, const SearchResult& from_candidates);
 
 // Reflection (or any secondary ray seen from outside): the first surface along the ray
 // W + l R, l > 0 (W world space on the reflecting surface, R unit).

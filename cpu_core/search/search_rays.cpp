@@ -28,36 +28,56 @@ SearchRay make_query(const SearchContext& ctx, const glm::dvec3& w_world, const 
 
 using namespace detail;
 
-// Crossing mode: the first crossing, exact ones first (docs/design/search.md).
-SearchResult search_crossing(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o) {
-  Candidate exact, near;
-  bool rejected = false;
-  int64_t first = -1;
-  uint32_t mesh_triangles = 0;
-  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3&,
-                               const SearchContext::Plane& p) {
-    const Candidate c = crossing_candidate(ctx, q, o, t, f, p);
-    mesh_triangles += c.mesh_triangles;
+// Crossing mode's choice among a ray's candidates, in the walk's order (docs/design/search.md):
+// an exact crossing before a near one, the first crossing of each, THE TIE RULE
+// (scene/tie_rule.hpp) at the same distance; the walk goes CROSSING_WINDOW_TEXELS texels past
+// the first texel with an accepted candidate, and on while a texel ends before the best. The
+// search's walk and search_from_candidates both feed it.
+class CrossingChoice {
+ public:
+  CrossingChoice(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o) : ctx_(ctx), q_(q), o_(o) {}
+  void take(const Candidate& c) {
+    mesh_triangles_ += c.mesh_triangles;
     if (!c.valid) {
-      rejected = rejected || (c.tested && c.outside > o.tolerance_texels);
+      rejected_ = rejected_ || (c.tested && c.outside > o_.tolerance_texels);
       return;
     }
-    Candidate& best = c.exact ? exact : near;
-    // The first crossing; at the same distance THE TIE RULE (scene/tie_rule.hpp) picks.
-    if (!best.fragment || seen_before(*ctx.scene().triangles, q.d, {c.triangle, c.l}, {best.triangle, best.l}))
+    Candidate& best = c.exact ? exact_ : near_;
+    if (!best.fragment || seen_before(*ctx_.scene().triangles, q_.d, {c.triangle, c.l}, {best.triangle, best.l}))
       best = c;
-  };
-  const auto after_texel = [&](const WalkTexel& t, uint32_t index) {
-    const double best_l = std::min(exact.l, near.l);
+  }
+  // After the walk's texel `index`, which ends at l1: keep walking?
+  bool after_texel(double l1, uint32_t index) {
+    const double best_l = std::min(exact_.l, near_.l);
     if (best_l == INF) return true;
-    if (first < 0) first = index;
-    return index < first + CROSSING_WINDOW_TEXELS || t.l1 <= best_l;
-  };
-  ScanCounts counts = scan(ctx, q, o, on_fragment, after_texel, [&] { return first < 0; });
-  counts.mesh_triangles = mesh_triangles;
-  const Candidate& best = exact.fragment ? exact : near;
-  return finish(ctx, q, best.fragment ? &best : nullptr,
-                rejected ? MissReason::threshold_rejection : MissReason::no_crossing, counts);
+    if (first_ < 0) first_ = index;
+    return index < first_ + CROSSING_WINDOW_TEXELS || l1 <= best_l;
+  }
+  bool found() const { return first_ >= 0; }
+  SearchResult answer(ScanCounts counts) const {
+    counts.mesh_triangles = mesh_triangles_;
+    const Candidate& best = exact_.fragment ? exact_ : near_;
+    return finish(ctx_, q_, best.fragment ? &best : nullptr,
+                  rejected_ ? MissReason::threshold_rejection : MissReason::no_crossing, counts);
+  }
+
+ private:
+  const SearchContext& ctx_;
+  const SearchRay& q_;
+  const SearchOptions& o_;
+  Candidate exact_, near_;
+  bool rejected_ = false;
+  int64_t first_ = -1;
+  uint32_t mesh_triangles_ = 0;
+};
+
+// Crossing mode: the first crossing, exact ones first (docs/design/search.md).
+SearchResult search_crossing(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o) {
+  CrossingChoice choice(ctx, q, o);
+  const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3&,
+                               const SearchContext::Plane& p) { choice.take(crossing_candidate(ctx, q, o, t, f, p)); };
+  const auto after_texel = [&](const WalkTexel& t, uint32_t index) { return choice.after_texel(t.l1, index); };
+  return choice.answer(scan(ctx, q, o, on_fragment, after_texel, [&] { return !choice.found(); }));
 }
 
 // Thesis mode: the smallest angle over the first candidates under theta_max
@@ -259,19 +279,65 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
 
 CandidateScan scan_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options) {
   CandidateScan out;
+  double before_l1 = -INF;  // the end of the texel before the current one
   const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3&,
                                const SearchContext::Plane& p) {
     const std::vector<Fragment>& face = ctx.cube().faces[static_cast<size_t>(t.face)].fragments;
     const Candidate c = crossing_candidate(ctx, q, options, t, f, p);
-    out.candidates.push_back({out.texels, static_cast<uint32_t>(t.face), static_cast<uint32_t>(&f - face.data()),
-                              c.tested, c.exact, c.valid, c.back_face, c.triangle, c.l, c.outside, c.mesh_triangles});
+    out.candidates.push_back({out.texels, static_cast<uint32_t>(t.face), static_cast<uint32_t>(&f - face.data()), t.i,
+                              t.j, t.l1, before_l1, c.tested, c.exact, c.valid, c.back_face, c.triangle, c.l, c.outside,
+                              c.mesh_triangles});
   };
-  const auto after_texel = [&](const WalkTexel&, uint32_t index) {
+  const auto after_texel = [&](const WalkTexel& t, uint32_t index) {
     out.texels = index + 1;
+    before_l1 = t.l1;
     return true;
   };
   out.aborted = scan(ctx, q, options, on_fragment, after_texel, [] { return false; }).aborted;
   return out;
+}
+
+SearchResult search_along(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options) {
+  return search_ray(ctx, q, options);
+}
+
+SearchResult search_from_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options,
+                                    const CandidateScan& scan) {
+  if (options.mode != SearchMode::crossing || options.layers != SearchLayers::all) {
+    throw InputError("search_from_candidates: the crossing mode over all layers only");
+  }
+  CrossingChoice choice(ctx, q, options);
+  ScanCounts counts;
+  counts.aborted = scan.aborted;
+  const std::vector<ScanCandidate>& list = scan.candidates;
+  int64_t last = -1;  // the last texel whose after_texel was asked
+  // The texels without candidates are asked through the one before the next candidate's: the
+  // texels' ends grow along the walk, so if any of them stops the walk, that one does.
+  const auto walk_on = [&](double l1, uint32_t index) {
+    last = index;
+    if (choice.after_texel(l1, index)) return true;
+    counts.aborted = false;  // stopped by the choice, not by the cap
+    return false;
+  };
+  for (size_t k = 0; k < list.size();) {
+    const uint32_t texel = list[k].texel;
+    if (static_cast<int64_t>(texel) > last + 1 && !walk_on(list[k].before_l1, texel - 1)) break;
+    for (; k < list.size() && list[k].texel == texel; ++k) {
+      const ScanCandidate& s = list[k];
+      Candidate c;
+      c.valid = s.valid, c.exact = s.exact, c.tested = s.tested;
+      c.l = s.l, c.outside = s.outside, c.angle = 0.0;
+      c.x = q.w + s.l * q.d;  // as crossing_candidate computes it
+      c.fragment = &ctx.cube().faces[s.face].fragments[s.fragment];
+      c.triangle = s.triangle, c.back_face = s.back_face;
+      c.texel = {static_cast<int>(s.face), s.i, s.j};
+      c.mesh_triangles = s.mesh_triangles;
+      choice.take(c);
+      ++counts.candidates;
+    }
+    if (!walk_on(list[k - 1].l1, texel)) break;
+  }
+  return choice.answer(counts);
 }
 
 }  // namespace abcube

@@ -47,6 +47,10 @@ void print_searches(const CrosscheckResult& r) {
   if (!r.walks_skipped.empty()) return;
   print_rays("GPU search candidates", r.candidates_skipped, r.candidates, r.candidates.candidates, "candidates",
              r.gpu_candidates_ms);
+  if (!r.candidates_skipped.empty()) return;
+  const CrosscheckResult::Answers& a = r.answers;
+  std::printf("GPU search answers (reflections, refraction exits): %zu of %zu the CPU's search's, %zu hits%s%s\n",
+              a.same, a.rays, a.hits, a.example.empty() ? "" : "; first not: ", a.example.c_str());
 }
 
 // A GPU build's lists against the CPU's: the counts, then each class of difference found.

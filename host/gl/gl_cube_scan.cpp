@@ -32,9 +32,10 @@ struct GpuCandidate {
   uint32_t texel, fragment, ray, id;
   double l, outside;
   double interval[2];
-  uint32_t flags, triangle, mesh_tested, pad;
+  uint32_t flags, triangle, mesh_tested, ij;
+  double before_l1, pad;
 };
-static_assert(sizeof(GpuScanRay) == 96 && sizeof(GpuCandidate) == 64, "must match shaders/scan_common.glsl");
+static_assert(sizeof(GpuScanRay) == 96 && sizeof(GpuCandidate) == 80, "must match shaders/scan_common.glsl");
 constexpr uint64_t CANDIDATES_AT = 16;  // bytes before the first candidate
 static_assert(sizeof(Fragment) == 20, "cube_scan.comp reads fragments as 20 bytes");
 constexpr uint32_t NO_ROW = 0xffffffffu;
@@ -160,9 +161,14 @@ void unpack_candidates(std::vector<GpuCandidate> found, const GlCubeWalks::Batch
         static_cast<size_t>(std::upper_bound(b.offsets.begin(), b.offsets.end(), texel) - b.offsets.begin()) - 1;
     const size_t face =
         static_cast<size_t>(std::upper_bound(face_first.begin(), face_first.end(), fragment) - face_first.begin()) - 1;
-    out[b.chunk + b.first + k].candidates.push_back(
-        {texel - b.offsets[k], static_cast<uint32_t>(face), fragment - face_first[face], (g.flags & 1u) != 0,
-         (g.flags & 2u) != 0, (g.flags & 4u) != 0, (g.flags & 8u) != 0, g.triangle, g.l, g.outside, g.mesh_tested});
+    ScanCandidate c;
+    c.texel = texel - b.offsets[k], c.face = static_cast<uint32_t>(face), c.fragment = fragment - face_first[face];
+    c.i = static_cast<int>(g.ij & 0xffffu), c.j = static_cast<int>(g.ij >> 16);
+    c.l1 = g.interval[1], c.before_l1 = g.before_l1;
+    c.tested = (g.flags & 1u) != 0, c.exact = (g.flags & 2u) != 0, c.valid = (g.flags & 4u) != 0;
+    c.back_face = (g.flags & 8u) != 0;
+    c.triangle = g.triangle, c.l = g.l, c.outside = g.outside, c.mesh_triangles = g.mesh_tested;
+    out[b.chunk + b.first + k].candidates.push_back(c);
   }
 }
 
@@ -313,9 +319,13 @@ size_t first_not_identical(const std::vector<ScanCandidate>& x, const std::vecto
   size_t k = 0;
   *rounding = x.size() == y.size();
   for (size_t c = 0; c < std::min(x.size(), y.size()); ++c) {
-    const bool place = x[c].same_place(y[c]);
-    if (k == c && place && same_bits(x[c].l, y[c].l) && same_bits(x[c].outside, y[c].outside)) ++k;
-    *rounding = *rounding && place && within_rounding(x[c].l, y[c].l) && within_rounding(x[c].outside, y[c].outside);
+    const ScanCandidate &p = x[c], &q = y[c];
+    const bool place = p.same_place(q);
+    if (k == c && place && same_bits(p.l, q.l) && same_bits(p.outside, q.outside) && same_bits(p.l1, q.l1) &&
+        same_bits(p.before_l1, q.before_l1))
+      ++k;
+    *rounding = *rounding && place && within_rounding(p.l, q.l) && within_rounding(p.outside, q.outside) &&
+                within_rounding(p.l1, q.l1) && within_rounding(p.before_l1, q.before_l1);
   }
   return k;
 }

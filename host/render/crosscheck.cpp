@@ -53,6 +53,27 @@ bool interior_pixel(const SceneData& scene, const ABuffer& camera, const RayTrac
          hit.triangle == list[0].triangle();
 }
 
+// The answers of the searches along `rays` that are not segments, from the GPU's candidates,
+// against the CPU's searches.
+void compare_answers(const SearchContext& ctx, const std::vector<SearchRay>& rays,
+                     const std::vector<CandidateScan>& gpu, CrosscheckResult::Answers* a) {
+  for (size_t k = 0; k < rays.size(); ++k) {
+    if (!std::isinf(rays[k].l_max)) continue;
+    const SearchResult walked = search_along(ctx, rays[k]);
+    const SearchResult found = search_from_candidates(ctx, rays[k], {}, gpu[k]);
+    ++a->rays;
+    a->hits += found.hit ? 1 : 0;
+    if (same_found(walked, found)) {
+      ++a->same;
+    } else if (a->example.empty()) {
+      a->example = "ray " + std::to_string(k) + ": the CPU's search " +
+                   (walked.hit ? "hits triangle " + std::to_string(walked.triangle) : std::string("misses")) +
+                   ", from the GPU's candidates " +
+                   (found.hit ? "hits triangle " + std::to_string(found.triangle) : std::string("misses"));
+    }
+  }
+}
+
 // The GPU's candidates for the searches' rays (scene_search_rays, from up to
 // CROSSCHECK_WALK_TRIANGLES triangles) in `cube` against the CPU's, ray by ray.
 constexpr size_t CROSSCHECK_WALK_TRIANGLES = 1024;
@@ -67,6 +88,7 @@ void compare_candidates(const SceneData& scene, const CubeABuffer& cube, Crossch
     const std::vector<CandidateScan> gpu = GlCandidateScan(ctx).scan(rays);
     r->gpu_candidates_ms = ms_since(t0);
     r->candidates = compare_candidate_scans(cpu, gpu);
+    compare_answers(ctx, rays, gpu, &r->answers);
   } catch (const RuntimeFailure& e) {  // a list or a buffer beyond what the GL's scan takes
     r->candidates_skipped = std::string("not compared: ") + e.what();
   }
@@ -403,6 +425,7 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   // ends within rounding; a fragment at the end of a texel's range may then pass on one side
   // only. The candidates must then agree only as well as the walks do.
   fail(r.candidates.differing > 0 && r.walks.within_rounding == 0, "GPU search candidates");
+  fail(r.answers.same < r.answers.rays && r.walks.within_rounding == 0, "GPU search answers");
   r.pass = r.failures.empty();
   return r;
 }
@@ -454,7 +477,12 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
                 {"candidates", r.candidates.candidates},
                 {"first_not_identical", r.candidates.example},
                 {"not_compared", r.walks_skipped.empty() ? r.candidates_skipped : r.walks_skipped},
-                {"gpu_ms", r.gpu_candidates_ms}}},
+                {"gpu_ms", r.gpu_candidates_ms},
+                {"answers",
+                 {{"rays", r.answers.rays},
+                  {"same", r.answers.same},
+                  {"hits", r.answers.hits},
+                  {"first_not_same", r.answers.example}}}}},
               {"cube",
                {{"texels", r.texels},
                 {"both_covered", r.both_covered},

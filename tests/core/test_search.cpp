@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "base/error.hpp"
 #include "raster/abuffer.hpp"
 #include "abuffer_testkit.hpp"
 #include "scene/camera.hpp"
@@ -758,6 +759,38 @@ TEST(Search, ScanCandidatesAreTheFragmentsASearchTests) {
     total += scan.candidates.size();
   }
   EXPECT_GT(total, 10u);
+}
+
+// search_from_candidates: the crossing search's choice fed a ray's candidates gives the
+// walked search's answer, for reflections and refraction exits, hits and misses, with the
+// side structure and under a cap that stops walks.
+TEST(Search, AnswerFromCandidatesIsTheWalkedSearchs) {
+  const auto world = make_world(room_scene(), 32);
+  const SearchContext& ctx = *world->ctx;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  size_t hits = 0, misses = 0;
+  for (const uint32_t cap : {0u, 9u}) {
+    SearchOptions o;
+    o.max_texels = cap;
+    for (int k = 0; k < 400; ++k) {
+      const dvec3 w(0.9 * u(rng), 0.9 * u(rng), -2 + 0.5 * u(rng));
+      const dvec3 d = glm::normalize(dvec3(u(rng), u(rng), u(rng)) + dvec3(0, 0, 1e-3));
+      const SearchRay q = k % 3 == 0 ? refraction_exit_ray(ctx, w, d, 0, o) : reflection_ray(ctx, w, d, o);
+      const SearchResult walked = search_along(ctx, q, o);
+      const SearchResult found = search_from_candidates(ctx, q, o, scan_candidates(ctx, q, o));
+      EXPECT_TRUE(same_found(walked, found))
+          << "ray " << k << " cap " << cap << ": hit " << walked.hit << " / " << found.hit << ", triangle "
+          << walked.triangle << " / " << found.triangle;
+      (walked.hit ? hits : misses) += 1;
+    }
+  }
+  EXPECT_GT(hits, 300u);
+  EXPECT_GT(misses, 50u);
+  SearchOptions thesis;
+  thesis.mode = SearchMode::thesis;
+  EXPECT_THROW(search_from_candidates(ctx, reflection_ray(ctx, dvec3(0, 0, -2), dvec3(0, 0, 1)), thesis, {}),
+               InputError);
 }
 
 // MESH REFINEMENT (search.hpp): the crossing search checks a candidate against the mesh

@@ -70,6 +70,22 @@ std::vector<CandidateScan> cpu_scans(const SearchContext& ctx, const std::vector
   return out;
 }
 
+// The searches' answers (search_from_candidates) from the GPU's candidates of the rays that
+// are not segments: each the walked search's (same_found). Returns the hits.
+size_t expect_same_answers(const SearchContext& ctx, const std::vector<SearchRay>& rays, const SearchOptions& o,
+                           const std::vector<CandidateScan>& on_gpu, const std::string& what) {
+  size_t hits = 0;
+  for (size_t k = 0; k < rays.size(); ++k) {
+    if (!std::isinf(rays[k].l_max)) continue;
+    const SearchResult walked = search_along(ctx, rays[k], o);
+    const SearchResult found = search_from_candidates(ctx, rays[k], o, on_gpu[k]);
+    EXPECT_TRUE(same_found(walked, found)) << what << ": ray " << k << " hit " << walked.hit << " / " << found.hit
+                                           << ", triangle " << walked.triangle << " / " << found.triangle;
+    hits += walked.hit ? 1 : 0;
+  }
+  return hits;
+}
+
 // Every repository scene and kept hard case (nested glass, coplanar ties, thin features,
 // kilometre scales), from its camera and from a point off it, at two resolutions, with the
 // crossing mode's self offset and the thesis mode's.
@@ -83,6 +99,7 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
   // MESH REFINEMENT: candidates refined, found crossing another triangle of the mesh, and
   // found passing the mesh by.
   uint64_t refined = 0, crossed_elsewhere = 0, passed_by = 0;
+  size_t hits = 0;  // reflections and refraction exits answered from the GPU's candidates
   for (const std::string& file : test::scene_files()) {
     const SceneData scene = load_scene(file);
     for (const auto& [centre, n] : test::cube_views(scene)) {
@@ -94,12 +111,14 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
         o.mode = mode;
         const std::vector<SearchRay> rays = rays_of(ctx, o, static_cast<unsigned>(n));
         const std::vector<CandidateScan> cpu = cpu_scans(ctx, rays, o);
-        const CandidateComparison c = compare_candidate_scans(cpu, gpu.scan(rays, o));
+        const std::vector<CandidateScan> on_gpu = gpu.scan(rays, o);
+        const CandidateComparison c = compare_candidate_scans(cpu, on_gpu);
         const std::string what = std::filesystem::path(file).filename().string() + " at N = " + std::to_string(n) +
                                  " (" + search_mode_name(mode) + ")";
         EXPECT_EQ(c.identical, rays.size()) << what << ": " << c.example;
         candidates += c.candidates;
         restricted_rays += restricted(rays);
+        if (mode == SearchMode::crossing) hits += expect_same_answers(ctx, rays, o, on_gpu, what);
         for (const CandidateScan& scan : cpu) {
           for (const ScanCandidate& x : scan.candidates) {
             ++verdicts[(x.tested ? 1 : 0) + (x.exact ? 1 : 0) + (x.valid ? 1 : 0)];
@@ -118,6 +137,7 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
   EXPECT_GT(refined, 1000u);
   EXPECT_GT(crossed_elsewhere, 100u);
   EXPECT_GT(passed_by, 100u);
+  EXPECT_GT(hits, 5000u);
 }
 
 // Walks the cap stops (the candidates up to it); the work cut in batches of a few rays, each
