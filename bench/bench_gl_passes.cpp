@@ -12,6 +12,7 @@
 //   bench_gl_passes SCENE.json [--sizes 256,512,1024] [--runs 5] [--gl auto|egl|osmesa]
 //                   [--error-samples 20000] [--walk-triangles 4096]
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <string>
@@ -137,18 +138,20 @@ void print_walks(const SceneData& scene, const Options& o) {
 void print_candidates(const SceneData& scene, const Options& o) {
   std::printf(
       "\n| N | search rays | candidates | texels walked | GPU upload ms | GPU scan ms | CPU scan ms (1 thread) | "
-      "rays identical |\n|---|---|---|---|---|---|---|---|\n");
+      "rays identical | answers from the GPU's candidates ms (1 thread) | CPU searches ms (1 thread) | answers the "
+      "same |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (int n : o.sizes) {
     if (!gpu_walks_at(n)) {
-      std::printf("| %d | not scanned: the walk's cap is above the GPU's %u texels | | | | | | |\n", n,
+      std::printf("| %d | not scanned: the walk's cap is above the GPU's %u texels | | | | | | | | | |\n", n,
                   GPU_WALK_MAX_TEXELS);
       continue;
     }
     const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, n);
     const SearchContext ctx(scene, cube);
     const std::vector<SearchRay> rays = scene_search_rays(ctx, static_cast<size_t>(o.walk_triangles));
-    std::vector<double> upload_ms, gpu_ms, cpu_ms;
+    std::vector<double> upload_ms, gpu_ms, cpu_ms, answer_ms, search_ms;
     std::vector<CandidateScan> on_gpu, on_cpu;
+    size_t answers = 0, same = 0;
     for (int r = 0; r < o.runs; ++r) {
       Clock::time_point t0 = Clock::now();
       const GlCandidateScan gpu(ctx);
@@ -160,14 +163,32 @@ void print_candidates(const SceneData& scene, const Options& o) {
       on_cpu.clear();
       for (const SearchRay& q : rays) on_cpu.push_back(scan_candidates(ctx, q));
       cpu_ms.push_back(ms_since(t0));
+      // The searches that are not segments: from the GPU's candidates, and walked on the CPU.
+      std::vector<SearchResult> found, walked;
+      t0 = Clock::now();
+      for (size_t k = 0; k < rays.size(); ++k) {
+        if (std::isinf(rays[k].l_max)) found.push_back(search_from_candidates(ctx, rays[k], {}, on_gpu[k]));
+      }
+      answer_ms.push_back(ms_since(t0));
+      t0 = Clock::now();
+      for (const SearchRay& q : rays) {
+        if (std::isinf(q.l_max)) walked.push_back(search_along(ctx, q));
+      }
+      search_ms.push_back(ms_since(t0));
+      answers = found.size(), same = 0;
+      for (size_t k = 0; k < found.size(); ++k) same += same_found(walked[k], found[k]) ? 1 : 0;
     }
     const CandidateComparison c = compare_candidate_scans(on_cpu, on_gpu);
     uint64_t texels = 0;
     for (const CandidateScan& s : on_cpu) texels += s.texels;
-    const Spread u = spread(upload_ms), g = spread(gpu_ms), cp = spread(cpu_ms);
-    std::printf("| %d | %zu | %llu | %llu | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %zu of %zu |\n",
-                n, rays.size(), static_cast<unsigned long long>(c.candidates), static_cast<unsigned long long>(texels),
-                u.median, u.lo, u.hi, g.median, g.lo, g.hi, cp.median, cp.lo, cp.hi, c.identical, c.rays);
+    const Spread u = spread(upload_ms), g = spread(gpu_ms), cp = spread(cpu_ms), a = spread(answer_ms),
+                 w = spread(search_ms);
+    std::printf(
+        "| %d | %zu | %llu | %llu | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %zu of %zu | %.1f "
+        "[%.1f, %.1f] | %.1f [%.1f, %.1f] | %zu of %zu |\n",
+        n, rays.size(), static_cast<unsigned long long>(c.candidates), static_cast<unsigned long long>(texels),
+        u.median, u.lo, u.hi, g.median, g.lo, g.hi, cp.median, cp.lo, cp.hi, c.identical, c.rays, a.median, a.lo, a.hi,
+        w.median, w.lo, w.hi, same, answers);
     std::fflush(stdout);
   }
 }

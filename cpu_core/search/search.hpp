@@ -347,9 +347,18 @@ SearchResult search_along(const SearchContext& ctx, const SearchRay& q, const Se
 // all layers only (InputError otherwise).
 SearchResult search_from_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options,
                                     const CandidateScan& scan);
+// shadow_search's walk of segment q to the light at light_position (shadow_ray), without a
+// known blocker.
+ShadowResult shadow_along(const SearchContext& ctx, const SearchRay& q, const glm::dvec3& light_position,
+                          const SearchOptions& options = {});
+// shadow_search's answer (without a known blocker) from the candidates of its segment q to
+// the light at light_position (shadow_ray), the same way.
+ShadowResult shadow_from_candidates(const SearchContext& ctx, const SearchRay& q, const glm::dvec3& light_position,
+                                    const SearchOptions& options, const CandidateScan& scan);
 // Whether an answer from candidates is the walked search's: same_answer but for the walk's
 // counts of texels, nodes and fragments read.
 bool same_found(const SearchResult& walked, const SearchResult& from_candidates);
+bool same_found(const ShadowResult& walked, const ShadowResult& from_candidates);
 
 // Reflection (or any secondary ray seen from outside): the first surface along the ray
 // W + l R, l > 0 (W world space on the reflecting surface, R unit).

@@ -183,6 +183,63 @@ bool blocks(const SearchContext& ctx, const SearchRay& q, uint32_t tri, const gl
          side_crossing_counts(ctx, q, tri, hit.t) && !plane_holds_light(soup, tri, light);
 }
 
+// The shadow searches' choice among a segment's candidates, in the walk's order (thesis 8.3,
+// SHADOWS in docs/design/search.md): each accepted crossing before the light, not on a plane
+// through the light, and not a surface already counted, is a blocker whose transmittance
+// multiplies S_l; the walk stops once S_l is zero. Then THE SIDE STRUCTURE's blockers. The
+// search's walk and shadow_from_candidates both feed it.
+class ShadowChoice {
+ public:
+  ShadowChoice(const SearchContext& ctx, const SearchRay& q, const SearchOptions& o, const glm::dvec3& light)
+      : ctx_(ctx), q_(q), o_(o), light_(light) {}
+  bool blocked() const { return res_.blocked; }
+  void take(const Candidate& c) {
+    const double len = q_.l_max;
+    res_.mesh_triangles += c.mesh_triangles;
+    const bool thesis = o_.mode == SearchMode::thesis;
+    const bool accepted = thesis ? c.valid && c.angle <= o_.theta_max : c.valid;
+    if (!accepted || !(c.l < len)) {
+      if (c.l < len && (thesis ? c.valid : c.tested)) ++res_.threshold_rejections;
+      return;
+    }
+    const TriangleSoup& soup = *ctx_.scene().triangles;
+    if (plane_holds_light(soup, c.triangle, light_)) return;
+    if (already_counted(counted_, ctx_, o_, c)) return;
+    const uint32_t tri = c.triangle;
+    counted_.push_back({tri, soup.object_id[tri], c.back_face, c.x, c.l, !thesis && c.exact});
+    // thesis 8.3; rule "shadows" (shading.hpp): S_l is the product over the blockers.
+    const glm::dvec3 kt = blocker_transmittance(ctx_.scene().materials[soup.material_id[tri]]);
+    res_.transmittance *= kt;
+    res_.blocked = res_.transmittance == glm::dvec3(0.0);
+    if (kt == glm::dvec3(0.0)) res_.opaque_blocker = tri;
+  }
+  ShadowResult answer(const ScanCounts& counts) {
+    if (!res_.blocked) add_side_blockers(ctx_, q_, o_, light_, &counted_, &res_);
+    res_.blockers = static_cast<uint32_t>(counted_.size());
+    if (!counted_.empty()) {
+      res_.first_blocker =
+          std::min_element(counted_.begin(), counted_.end(), [](const ShadowCrossing& a, const ShadowCrossing& b) {
+            return a.l < b.l;
+          })->triangle;
+    }
+    res_.aborted = counts.aborted;
+    res_.zero_area = !q_.side && meets_zero_area(ctx_, q_, q_.l_max);
+    res_.texels_visited = counts.texels;
+    res_.nodes_skipped = counts.nodes;
+    res_.fragments_tested = counts.fragments;
+    res_.candidates = counts.candidates;
+    return res_;
+  }
+
+ private:
+  const SearchContext& ctx_;
+  const SearchRay& q_;
+  const SearchOptions& o_;
+  const glm::dvec3 light_;
+  ShadowResult res_;
+  std::vector<ShadowCrossing> counted_;
+};
+
 }  // namespace
 
 SearchRay reflection_ray(const SearchContext& ctx, const glm::dvec3& w, const glm::dvec3& r,
@@ -223,7 +280,6 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
   ShadowResult res;
   SearchRay q;
   if (!shadow_ray(ctx, p, light_position, options, &q)) return res;
-  const double len = q.l_max;
   if (known_blocker != NO_TRIANGLE && options.known_blockers && options.side_structure &&
       options.mode == SearchMode::crossing && options.layers == SearchLayers::all &&
       blocks(ctx, q, known_blocker, light_position)) {
@@ -233,48 +289,20 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
     res.first_blocker = res.opaque_blocker = known_blocker;
     return res;
   }
-  std::vector<ShadowCrossing> counted;
+  return shadow_along(ctx, q, light_position, options);
+}
+
+ShadowResult shadow_along(const SearchContext& ctx, const SearchRay& q, const glm::dvec3& light_position,
+                          const SearchOptions& options) {
+  ShadowChoice choice(ctx, q, options, light_position);
   const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3& v,
                                const SearchContext::Plane& plane) {
-    if (res.blocked) return;
-    const Candidate c = options.mode == SearchMode::thesis ? thesis_candidate(q, t, f, v, plane)
-                                                           : crossing_candidate(ctx, q, options, t, f, plane);
-    res.mesh_triangles += c.mesh_triangles;
-    const bool accepted = options.mode == SearchMode::thesis ? c.valid && c.angle <= options.theta_max : c.valid;
-    if (!accepted || !(c.l < len)) {
-      if (c.l < len && (options.mode == SearchMode::thesis ? c.valid : c.tested)) {
-        ++res.threshold_rejections;
-      }
-      return;
-    }
-    if (plane_holds_light(*ctx.scene().triangles, c.triangle, light_position)) return;
-    if (already_counted(counted, ctx, options, c)) return;
-    const uint32_t tri = c.triangle;
-    counted.push_back({tri, ctx.scene().triangles->object_id[tri], c.back_face, c.x, c.l,
-                       options.mode == SearchMode::crossing && c.exact});
-    // thesis 8.3; rule "shadows" (shading.hpp): S_l is the product over the blockers.
-    const glm::dvec3 kt = blocker_transmittance(ctx.scene().materials[ctx.scene().triangles->material_id[tri]]);
-    res.transmittance *= kt;
-    res.blocked = res.transmittance == glm::dvec3(0.0);
-    if (kt == glm::dvec3(0.0)) res.opaque_blocker = tri;
+    if (choice.blocked()) return;
+    choice.take(options.mode == SearchMode::thesis ? thesis_candidate(q, t, f, v, plane)
+                                                   : crossing_candidate(ctx, q, options, t, f, plane));
   };
-  const auto after_texel = [&](const WalkTexel&, uint32_t) { return !res.blocked; };
-  const ScanCounts counts = scan(ctx, q, options, on_fragment, after_texel, [] { return true; });
-  if (!res.blocked) add_side_blockers(ctx, q, options, light_position, &counted, &res);
-  res.blockers = static_cast<uint32_t>(counted.size());
-  if (!counted.empty()) {
-    res.first_blocker =
-        std::min_element(counted.begin(), counted.end(), [](const ShadowCrossing& a, const ShadowCrossing& b) {
-          return a.l < b.l;
-        })->triangle;
-  }
-  res.aborted = counts.aborted;
-  res.zero_area = !q.side && meets_zero_area(ctx, q, len);
-  res.texels_visited = counts.texels;
-  res.nodes_skipped = counts.nodes;
-  res.fragments_tested = counts.fragments;
-  res.candidates = counts.candidates;
-  return res;
+  const auto after_texel = [&](const WalkTexel&, uint32_t) { return !choice.blocked(); };
+  return choice.answer(scan(ctx, q, options, on_fragment, after_texel, [] { return true; }));
 }
 
 CandidateScan scan_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options) {
@@ -301,21 +329,39 @@ SearchResult search_along(const SearchContext& ctx, const SearchRay& q, const Se
   return search_ray(ctx, q, options);
 }
 
-SearchResult search_from_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options,
-                                    const CandidateScan& scan) {
+namespace {
+
+// A listed candidate as crossing_candidate gave it (the fields a choice reads).
+Candidate listed_candidate(const SearchContext& ctx, const SearchRay& q, const ScanCandidate& s) {
+  Candidate c;
+  c.valid = s.valid, c.exact = s.exact, c.tested = s.tested;
+  c.l = s.l, c.outside = s.outside, c.angle = 0.0;
+  c.x = q.w + s.l * q.d;  // as crossing_candidate computes it
+  c.fragment = &ctx.cube().faces[s.face].fragments[s.fragment];
+  c.triangle = s.triangle, c.back_face = s.back_face;
+  c.texel = {static_cast<int>(s.face), s.i, s.j};
+  c.mesh_triangles = s.mesh_triangles;
+  return c;
+}
+
+// Feeds a ray's listed candidates to a choice as its walk would: take(candidate) for each, and
+// after_texel(l1, index) -> keep walking? after each texel holding one. The texels without
+// candidates are asked through the one before the next candidate's (its end, before_l1): the
+// texels' ends grow along the walk, so if any of them stops the walk, that one does. The
+// counts of a walk stopped where the choice stops it (no texels, nodes or fragments read).
+template <class Take, class AfterTexel>
+ScanCounts replay(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options, const CandidateScan& scan,
+                  Take&& take, AfterTexel&& after_texel) {
   if (options.mode != SearchMode::crossing || options.layers != SearchLayers::all) {
-    throw InputError("search_from_candidates: the crossing mode over all layers only");
+    throw InputError("a search from candidates: the crossing mode over all layers only");
   }
-  CrossingChoice choice(ctx, q, options);
   ScanCounts counts;
   counts.aborted = scan.aborted;
   const std::vector<ScanCandidate>& list = scan.candidates;
-  int64_t last = -1;  // the last texel whose after_texel was asked
-  // The texels without candidates are asked through the one before the next candidate's: the
-  // texels' ends grow along the walk, so if any of them stops the walk, that one does.
+  int64_t last = -1;  // the last texel asked
   const auto walk_on = [&](double l1, uint32_t index) {
     last = index;
-    if (choice.after_texel(l1, index)) return true;
+    if (after_texel(l1, index)) return true;
     counts.aborted = false;  // stopped by the choice, not by the cap
     return false;
   };
@@ -323,21 +369,33 @@ SearchResult search_from_candidates(const SearchContext& ctx, const SearchRay& q
     const uint32_t texel = list[k].texel;
     if (static_cast<int64_t>(texel) > last + 1 && !walk_on(list[k].before_l1, texel - 1)) break;
     for (; k < list.size() && list[k].texel == texel; ++k) {
-      const ScanCandidate& s = list[k];
-      Candidate c;
-      c.valid = s.valid, c.exact = s.exact, c.tested = s.tested;
-      c.l = s.l, c.outside = s.outside, c.angle = 0.0;
-      c.x = q.w + s.l * q.d;  // as crossing_candidate computes it
-      c.fragment = &ctx.cube().faces[s.face].fragments[s.fragment];
-      c.triangle = s.triangle, c.back_face = s.back_face;
-      c.texel = {static_cast<int>(s.face), s.i, s.j};
-      c.mesh_triangles = s.mesh_triangles;
-      choice.take(c);
+      take(listed_candidate(ctx, q, list[k]));
       ++counts.candidates;
     }
     if (!walk_on(list[k - 1].l1, texel)) break;
   }
-  return choice.answer(counts);
+  return counts;
+}
+
+}  // namespace
+
+SearchResult search_from_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options,
+                                    const CandidateScan& scan) {
+  CrossingChoice choice(ctx, q, options);
+  return choice.answer(replay(
+      ctx, q, options, scan, [&](const Candidate& c) { choice.take(c); },
+      [&](double l1, uint32_t index) { return choice.after_texel(l1, index); }));
+}
+
+ShadowResult shadow_from_candidates(const SearchContext& ctx, const SearchRay& q, const glm::dvec3& light_position,
+                                    const SearchOptions& options, const CandidateScan& scan) {
+  ShadowChoice choice(ctx, q, options, light_position);
+  return choice.answer(replay(
+      ctx, q, options, scan,
+      [&](const Candidate& c) {
+        if (!choice.blocked()) choice.take(c);
+      },
+      [&](double, uint32_t) { return !choice.blocked(); }));
 }
 
 }  // namespace abcube

@@ -62,6 +62,14 @@ bool same_found(const SearchResult& walked, const SearchResult& from_candidates)
   return same_answer(walked, b);
 }
 
+bool same_found(const ShadowResult& walked, const ShadowResult& from_candidates) {
+  ShadowResult b = from_candidates;
+  b.texels_visited = walked.texels_visited;
+  b.nodes_skipped = walked.nodes_skipped;
+  b.fragments_tested = walked.fragments_tested;
+  return same_answer(walked, b);
+}
+
 bool same_answer(const ShadowResult& a, const ShadowResult& b) {
   return same_bits(a.transmittance, b.transmittance) && a.blocked == b.blocked && a.blockers == b.blockers &&
          a.first_blocker == b.first_blocker && a.aborted == b.aborted && a.zero_area == b.zero_area &&

@@ -49,8 +49,8 @@ void print_searches(const CrosscheckResult& r) {
              r.gpu_candidates_ms);
   if (!r.candidates_skipped.empty()) return;
   const CrosscheckResult::Answers& a = r.answers;
-  std::printf("GPU search answers (reflections, refraction exits): %zu of %zu the CPU's search's, %zu hits%s%s\n",
-              a.same, a.rays, a.hits, a.example.empty() ? "" : "; first not: ", a.example.c_str());
+  std::printf("GPU search answers: %zu of %zu the CPU's search's, %zu hits or blocked segments%s%s\n", a.same, a.rays,
+              a.found, a.example.empty() ? "" : "; first not: ", a.example.c_str());
 }
 
 // A GPU build's lists against the CPU's: the counts, then each class of difference found.

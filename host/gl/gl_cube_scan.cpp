@@ -205,10 +205,12 @@ void run_crossing_tests(const GlCandidateScan::Buffers& b, const CubeABuffer& cu
 }
 
 // The candidates of one batch of walks, in the order found: a pass with room for `room`
-// candidates, then, when it found more, one with room for all.
+// candidates (at most what one storage block holds), then, when it found more, one with room
+// for all.
 std::vector<GpuCandidate> scan_batch(const GlCandidateScan::Buffers& b, const CubeABuffer& cube, const BatchInputs& in,
                                      const GlCubeWalks::Batch& batch, uint64_t room) {
   const GlProgram& p = b.program;
+  room = std::max<uint64_t>(1, std::min(room, (max_block_bytes() - CANDIDATES_AT) / sizeof(GpuCandidate)));
   for (;;) {
     const uint64_t bytes = CANDIDATES_AT + sizeof(GpuCandidate) * room;
     check_block("one batch's candidates", bytes);
@@ -290,22 +292,27 @@ std::vector<CandidateScan> GlCandidateScan::scan(const std::vector<SearchRay>& r
   return out;
 }
 
-std::vector<SearchRay> scene_search_rays(const SearchContext& ctx, size_t max_triangles, const SearchOptions& options) {
+std::vector<SearchRay> scene_search_rays(const SearchContext& ctx, size_t max_triangles, const SearchOptions& options,
+                                         std::vector<int>* lights) {
   const SceneData& scene = ctx.scene();
   const TriangleSoup& soup = *scene.triangles;
   std::vector<SearchRay> rays;
+  const auto add = [&](const SearchRay& q, int light) {
+    rays.push_back(q);
+    if (lights) lights->push_back(light);
+  };
   for_spread_triangles(soup, max_triangles, [&](size_t t, const glm::dvec3& x, const glm::dvec3& normal) {
     const glm::dvec3 view = x - scene.camera.position;
     const double view_len = glm::length(view);
     if (!(view_len > 0.0) || !std::isfinite(view_len)) return;
     const glm::dvec3 dir = view / view_len;
-    rays.push_back(reflection_ray(ctx, x, glm::reflect(dir, normal), options));
-    for (const PointLight& light : scene.lights) {
+    add(reflection_ray(ctx, x, glm::reflect(dir, normal), options), -1);
+    for (size_t k = 0; k < scene.lights.size(); ++k) {
       SearchRay q;
-      if (shadow_ray(ctx, x, light.position, options, &q)) rays.push_back(q);
+      if (shadow_ray(ctx, x, scene.lights[k].position, options, &q)) add(q, static_cast<int>(k));
     }
     if (scene.materials[soup.material_id[t]].transmit > 0.0) {
-      rays.push_back(refraction_exit_ray(ctx, x, dir, soup.object_id[t], options));
+      add(refraction_exit_ray(ctx, x, dir, soup.object_id[t], options), -1);
     }
   });
   return rays;

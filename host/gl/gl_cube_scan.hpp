@@ -64,8 +64,9 @@ constexpr uint32_t GPU_SCAN_MAX_LIST = 60000;
 // about the triangle's plane, the segment to each light, and, on a triangle whose material
 // transmits, the camera's ray carried on into its object (a refraction exit). Degenerate
 // triangles give none.
+// `lights` (optional): per ray, the index of the light a shadow segment goes to, else -1.
 std::vector<SearchRay> scene_search_rays(const SearchContext& ctx, size_t max_triangles,
-                                         const SearchOptions& options = {});
+                                         const SearchOptions& options = {}, std::vector<int>* lights = nullptr);
 
 // How two sets of scans of the same rays agree, ray by ray, in three classes:
 // - identical: the same candidates in the same order with the same verdicts, their l and

@@ -53,23 +53,34 @@ bool interior_pixel(const SceneData& scene, const ABuffer& camera, const RayTrac
          hit.triangle == list[0].triangle();
 }
 
-// The answers of the searches along `rays` that are not segments, from the GPU's candidates,
-// against the CPU's searches.
-void compare_answers(const SearchContext& ctx, const std::vector<SearchRay>& rays,
+// The searches' answers along `rays` (a shadow segment's light in `lights`, else -1) from the
+// GPU's candidates, against the CPU's searches.
+void compare_answers(const SearchContext& ctx, const std::vector<SearchRay>& rays, const std::vector<int>& lights,
                      const std::vector<CandidateScan>& gpu, CrosscheckResult::Answers* a) {
-  for (size_t k = 0; k < rays.size(); ++k) {
-    if (!std::isinf(rays[k].l_max)) continue;
-    const SearchResult walked = search_along(ctx, rays[k]);
-    const SearchResult found = search_from_candidates(ctx, rays[k], {}, gpu[k]);
+  const auto tally = [&](bool same, bool found, size_t k, const std::string& walked, const std::string& listed) {
     ++a->rays;
-    a->hits += found.hit ? 1 : 0;
-    if (same_found(walked, found)) {
+    a->found += found ? 1 : 0;
+    if (same) {
       ++a->same;
     } else if (a->example.empty()) {
-      a->example = "ray " + std::to_string(k) + ": the CPU's search " +
-                   (walked.hit ? "hits triangle " + std::to_string(walked.triangle) : std::string("misses")) +
-                   ", from the GPU's candidates " +
-                   (found.hit ? "hits triangle " + std::to_string(found.triangle) : std::string("misses"));
+      a->example =
+          "ray " + std::to_string(k) + ": the CPU's search " + walked + ", from the GPU's candidates " + listed;
+    }
+  };
+  const auto hit = [](const SearchResult& r) {
+    return r.hit ? "hits triangle " + std::to_string(r.triangle) : std::string("misses");
+  };
+  const auto shadow = [](const ShadowResult& r) { return std::to_string(r.blockers) + " blockers"; };
+  for (size_t k = 0; k < rays.size(); ++k) {
+    if (lights[k] >= 0) {
+      const glm::dvec3 light = ctx.scene().lights[static_cast<size_t>(lights[k])].position;
+      const ShadowResult walked = shadow_along(ctx, rays[k], light);
+      const ShadowResult found = shadow_from_candidates(ctx, rays[k], light, {}, gpu[k]);
+      tally(same_found(walked, found), found.blocked, k, shadow(walked), shadow(found));
+    } else {
+      const SearchResult walked = search_along(ctx, rays[k]);
+      const SearchResult found = search_from_candidates(ctx, rays[k], {}, gpu[k]);
+      tally(same_found(walked, found), found.hit, k, hit(walked), hit(found));
     }
   }
 }
@@ -80,7 +91,8 @@ constexpr size_t CROSSCHECK_WALK_TRIANGLES = 1024;
 void compare_candidates(const SceneData& scene, const CubeABuffer& cube, CrosscheckResult* r) {
   if (!gpu_walks_at(cube.n)) return;  // compare_cube_walks says why
   const SearchContext ctx(scene, cube);
-  const std::vector<SearchRay> rays = scene_search_rays(ctx, CROSSCHECK_WALK_TRIANGLES);
+  std::vector<int> lights;
+  const std::vector<SearchRay> rays = scene_search_rays(ctx, CROSSCHECK_WALK_TRIANGLES, {}, &lights);
   std::vector<CandidateScan> cpu;
   for (const SearchRay& q : rays) cpu.push_back(scan_candidates(ctx, q));
   try {
@@ -88,7 +100,7 @@ void compare_candidates(const SceneData& scene, const CubeABuffer& cube, Crossch
     const std::vector<CandidateScan> gpu = GlCandidateScan(ctx).scan(rays);
     r->gpu_candidates_ms = ms_since(t0);
     r->candidates = compare_candidate_scans(cpu, gpu);
-    compare_answers(ctx, rays, gpu, &r->answers);
+    compare_answers(ctx, rays, lights, gpu, &r->answers);
   } catch (const RuntimeFailure& e) {  // a list or a buffer beyond what the GL's scan takes
     r->candidates_skipped = std::string("not compared: ") + e.what();
   }
@@ -481,7 +493,7 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
                 {"answers",
                  {{"rays", r.answers.rays},
                   {"same", r.answers.same},
-                  {"hits", r.answers.hits},
+                  {"hits_or_blocked", r.answers.found},
                   {"first_not_same", r.answers.example}}}}},
               {"cube",
                {{"texels", r.texels},

@@ -111,12 +111,12 @@ struct CrosscheckResult {
   CandidateComparison candidates;
   double gpu_candidates_ms = 0;
   std::string candidates_skipped;  // why not ("" when they were compared, or the walks say)
-  // The searches' answers (search_from_candidates) from the GPU's candidates, for the rays
-  // that are not segments (reflections, refraction exits), against the CPU's searches
-  // (same_found): it fails on any answer not the same, as the candidates.
+  // The searches' answers from the GPU's candidates (search_from_candidates for reflections
+  // and refraction exits, shadow_from_candidates for shadow segments) against the CPU's
+  // searches (same_found): it fails on any answer not the same, as the candidates.
   struct Answers {
-    size_t rays = 0, same = 0, hits = 0;
-    std::string example;  // the first ray not the same, in words
+    size_t rays = 0, same = 0, found = 0;  // found: a hit, or a shadow segment blocked
+    std::string example;                   // the first ray not the same, in words
   } answers;
   double gpu_ms = 0, cpu_ms = 0;  // prepass vs cube A-buffer build
   uint64_t fragments = 0;

@@ -761,15 +761,16 @@ TEST(Search, ScanCandidatesAreTheFragmentsASearchTests) {
   EXPECT_GT(total, 10u);
 }
 
-// search_from_candidates: the crossing search's choice fed a ray's candidates gives the
-// walked search's answer, for reflections and refraction exits, hits and misses, with the
-// side structure and under a cap that stops walks.
+// search_from_candidates and shadow_from_candidates: the searches' choices fed a ray's
+// candidates give the walked searches' answers, for reflections and refraction exits, hits
+// and misses, and shadow segments, blocked and lit, with the side structure and under a cap
+// that stops walks.
 TEST(Search, AnswerFromCandidatesIsTheWalkedSearchs) {
   const auto world = make_world(room_scene(), 32);
   const SearchContext& ctx = *world->ctx;
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  size_t hits = 0, misses = 0;
+  size_t hits = 0, misses = 0, blocked = 0, lit = 0;
   for (const uint32_t cap : {0u, 9u}) {
     SearchOptions o;
     o.max_texels = cap;
@@ -783,10 +784,19 @@ TEST(Search, AnswerFromCandidatesIsTheWalkedSearchs) {
           << "ray " << k << " cap " << cap << ": hit " << walked.hit << " / " << found.hit << ", triangle "
           << walked.triangle << " / " << found.triangle;
       (walked.hit ? hits : misses) += 1;
+      const dvec3 light(3 * u(rng), 3 * u(rng), 3 * u(rng));
+      SearchRay segment;
+      if (!shadow_ray(ctx, w, light, o, &segment)) continue;
+      const ShadowResult shade = shadow_along(ctx, segment, light, o);
+      EXPECT_TRUE(same_found(shade, shadow_from_candidates(ctx, segment, light, o, scan_candidates(ctx, segment, o))))
+          << "segment " << k << " cap " << cap;
+      (shade.blocked ? blocked : lit) += 1;
     }
   }
   EXPECT_GT(hits, 300u);
   EXPECT_GT(misses, 50u);
+  EXPECT_GT(blocked, 100u);
+  EXPECT_GT(lit, 100u);
   SearchOptions thesis;
   thesis.mode = SearchMode::thesis;
   EXPECT_THROW(search_from_candidates(ctx, reflection_ray(ctx, dvec3(0, 0, -2), dvec3(0, 0, 1)), thesis, {}),

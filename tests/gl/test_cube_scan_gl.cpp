@@ -26,8 +26,11 @@ namespace {
 
 // The searches' rays of `ctx`'s scene, and as many more from random points of the scene's
 // triangles in random directions, half of them restricted to the triangle's object.
-std::vector<SearchRay> rays_of(const SearchContext& ctx, const SearchOptions& o, unsigned seed) {
-  std::vector<SearchRay> rays = scene_search_rays(ctx, 200, o);
+// `lights` (optional): per ray, the light of a shadow segment, else -1.
+std::vector<SearchRay> rays_of(const SearchContext& ctx, const SearchOptions& o, unsigned seed,
+                               std::vector<int>* lights = nullptr) {
+  std::vector<int> light_of;
+  std::vector<SearchRay> rays = scene_search_rays(ctx, 200, o, &light_of);
   const TriangleSoup& soup = *ctx.scene().triangles;
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0), s(-1.0, 1.0);
@@ -42,7 +45,9 @@ std::vector<SearchRay> rays_of(const SearchContext& ctx, const SearchOptions& o,
     if (!(glm::length(d) > 1e-3)) continue;
     d = glm::normalize(d);
     rays.push_back(k % 2 ? refraction_exit_ray(ctx, x, d, soup.object_id[t], o) : reflection_ray(ctx, x, d, o));
+    light_of.push_back(-1);
   }
+  if (lights) *lights = light_of;
   return rays;
 }
 
@@ -70,20 +75,29 @@ std::vector<CandidateScan> cpu_scans(const SearchContext& ctx, const std::vector
   return out;
 }
 
-// The searches' answers (search_from_candidates) from the GPU's candidates of the rays that
-// are not segments: each the walked search's (same_found). Returns the hits.
-size_t expect_same_answers(const SearchContext& ctx, const std::vector<SearchRay>& rays, const SearchOptions& o,
-                           const std::vector<CandidateScan>& on_gpu, const std::string& what) {
-  size_t hits = 0;
+// The searches' answers from the GPU's candidates (search_from_candidates for reflections and
+// refraction exits, shadow_from_candidates for shadow segments): each the walked search's
+// (same_found). Returns the hits and the blocked segments.
+size_t expect_same_answers(const SearchContext& ctx, const std::vector<SearchRay>& rays, const std::vector<int>& lights,
+                           const SearchOptions& o, const std::vector<CandidateScan>& on_gpu, const std::string& what) {
+  size_t found_some = 0;
   for (size_t k = 0; k < rays.size(); ++k) {
-    if (!std::isinf(rays[k].l_max)) continue;
+    if (lights[k] >= 0) {
+      const glm::dvec3 light = ctx.scene().lights[static_cast<size_t>(lights[k])].position;
+      const ShadowResult walked = shadow_along(ctx, rays[k], light, o);
+      const ShadowResult found = shadow_from_candidates(ctx, rays[k], light, o, on_gpu[k]);
+      EXPECT_TRUE(same_found(walked, found))
+          << what << ": shadow ray " << k << " blockers " << walked.blockers << " / " << found.blockers;
+      found_some += walked.blocked ? 1 : 0;
+      continue;
+    }
     const SearchResult walked = search_along(ctx, rays[k], o);
     const SearchResult found = search_from_candidates(ctx, rays[k], o, on_gpu[k]);
     EXPECT_TRUE(same_found(walked, found)) << what << ": ray " << k << " hit " << walked.hit << " / " << found.hit
                                            << ", triangle " << walked.triangle << " / " << found.triangle;
-    hits += walked.hit ? 1 : 0;
+    found_some += walked.hit ? 1 : 0;
   }
-  return hits;
+  return found_some;
 }
 
 // Every repository scene and kept hard case (nested glass, coplanar ties, thin features,
@@ -99,7 +113,7 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
   // MESH REFINEMENT: candidates refined, found crossing another triangle of the mesh, and
   // found passing the mesh by.
   uint64_t refined = 0, crossed_elsewhere = 0, passed_by = 0;
-  size_t hits = 0;  // reflections and refraction exits answered from the GPU's candidates
+  size_t hits = 0;  // searches answered from the GPU's candidates with a hit or a blocker
   for (const std::string& file : test::scene_files()) {
     const SceneData scene = load_scene(file);
     for (const auto& [centre, n] : test::cube_views(scene)) {
@@ -109,7 +123,8 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
       for (const SearchMode mode : {SearchMode::crossing, SearchMode::thesis}) {
         SearchOptions o;
         o.mode = mode;
-        const std::vector<SearchRay> rays = rays_of(ctx, o, static_cast<unsigned>(n));
+        std::vector<int> lights;
+        const std::vector<SearchRay> rays = rays_of(ctx, o, static_cast<unsigned>(n), &lights);
         const std::vector<CandidateScan> cpu = cpu_scans(ctx, rays, o);
         const std::vector<CandidateScan> on_gpu = gpu.scan(rays, o);
         const CandidateComparison c = compare_candidate_scans(cpu, on_gpu);
@@ -118,7 +133,7 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
         EXPECT_EQ(c.identical, rays.size()) << what << ": " << c.example;
         candidates += c.candidates;
         restricted_rays += restricted(rays);
-        if (mode == SearchMode::crossing) hits += expect_same_answers(ctx, rays, o, on_gpu, what);
+        if (mode == SearchMode::crossing) hits += expect_same_answers(ctx, rays, lights, o, on_gpu, what);
         for (const CandidateScan& scan : cpu) {
           for (const ScanCandidate& x : scan.candidates) {
             ++verdicts[(x.tested ? 1 : 0) + (x.exact ? 1 : 0) + (x.valid ? 1 : 0)];
