@@ -54,20 +54,25 @@ bool same_answer(const SearchResult& a, const SearchResult& b) {
          a.candidates == b.candidates;
 }
 
-bool same_found(const SearchResult& walked, const SearchResult& from_candidates) {
-  SearchResult b = from_candidates;
-  b.texels_visited = walked.texels_visited;
-  b.nodes_skipped = walked.nodes_skipped;
-  b.fragments_tested = walked.fragments_tested;
-  return same_answer(walked, b);
+
+namespace {
+
+// same_answer, the walk's counts of texels, nodes and fragments read taken from `walked`.
+template <class Result>
+bool same_but_walk(const Result& walked, Result from_candidates) {
+  from_candidates.texels_visited = walked.texels_visited;
+  from_candidates.nodes_skipped = walked.nodes_skipped;
+  from_candidates.fragments_tested = walked.fragments_tested;
+  return same_answer(walked, from_candidates);
 }
 
+}  // namespace
+
+bool same_found(const SearchResult& walked, const SearchResult& from_candidates) {
+  return same_but_walk(walked, from_candidates);
+}
 bool same_found(const ShadowResult& walked, const ShadowResult& from_candidates) {
-  ShadowResult b = from_candidates;
-  b.texels_visited = walked.texels_visited;
-  b.nodes_skipped = walked.nodes_skipped;
-  b.fragments_tested = walked.fragments_tested;
-  return same_answer(walked, b);
+  return same_but_walk(walked, from_candidates);
 }
 
 bool same_answer(const ShadowResult& a, const ShadowResult& b) {

@@ -22,10 +22,9 @@ namespace {
 
 constexpr const char* CROSSCHECK_COVERS =
     "covers: visibility (cube texels, camera samples), the cube's and the camera's A-buffer lists, the cube walks of "
-    "shadow and reflection rays, the searches' candidates in the cube A-buffer, direct shading of interior pixels, "
-    "hard shadows; not covered: reflections, "
-    "refractions, antialiased edges (abcube report compares "
-    "whole images with the exact tracer)";
+    "shadow and reflection rays, the searches' candidates and answers in the cube A-buffer, direct shading of "
+    "interior pixels, hard shadows; not covered: reflected and refracted colours, antialiased edges (abcube report "
+    "compares whole images with the exact tracer)";
 
 // One of the searches' pieces run on the GPU against the CPU's, ray by ray: why it was not
 // compared, or its classes, the count of `unit` in the CPU's results and the GPU's time.
