@@ -54,7 +54,6 @@ bool same_answer(const SearchResult& a, const SearchResult& b) {
          a.candidates == b.candidates;
 }
 
-
 namespace {
 
 // same_answer, the walk's counts of texels, nodes and fragments read taken from `walked`.
