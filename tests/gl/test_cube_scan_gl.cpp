@@ -152,7 +152,7 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
   EXPECT_GT(refined, 1000u);
   EXPECT_GT(crossed_elsewhere, 100u);
   EXPECT_GT(passed_by, 100u);
-  EXPECT_GT(hits, 5000u);
+  EXPECT_GT(hits, test::checked_build() ? 2000u : 5000u);  // the checked builds: fewer scenes
 }
 
 // Walks the cap stops (the candidates up to it); the work cut in batches of a few rays, each
