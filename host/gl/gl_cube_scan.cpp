@@ -363,23 +363,16 @@ CandidateComparison compare_candidate_scans(const std::vector<CandidateScan>& a,
       continue;
     }
     rounding = walks_alike && rounding;
-    ++(rounding ? c.within_rounding : c.differing);
-    if (!c.example.empty()) continue;
     std::ostringstream what;
-    what.precision(17);
-    what << "ray " << r << (rounding ? " (within rounding): " : ": ");
-    if (r >= b.size()) {
-      what << "missing from the second set";
-    } else {
-      what << a[r].candidates.size() << " candidates in " << a[r].texels << " texels"
-           << (a[r].aborted ? " (aborted)" : "") << " against " << b[r].candidates.size() << " in " << b[r].texels
-           << (b[r].aborted ? " (aborted)" : "");
-      if (k < a[r].candidates.size() || k < b[r].candidates.size()) {
-        what << "; candidate " << k << ": ";
-        put_candidate(what, a[r].candidates, k);
-        what << " against ";
-        put_candidate(what, b[r].candidates, k);
-      }
+    if (!count_not_identical(r, rounding, r < b.size(), &c, &what)) continue;
+    what << a[r].candidates.size() << " candidates in " << a[r].texels << " texels"
+         << (a[r].aborted ? " (aborted)" : "") << " against " << b[r].candidates.size() << " in " << b[r].texels
+         << (b[r].aborted ? " (aborted)" : "");
+    if (k < a[r].candidates.size() || k < b[r].candidates.size()) {
+      what << "; candidate " << k << ": ";
+      put_candidate(what, a[r].candidates, k);
+      what << " against ";
+      put_candidate(what, b[r].candidates, k);
     }
     c.example = what.str();
   }

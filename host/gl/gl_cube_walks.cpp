@@ -232,25 +232,14 @@ WalkComparison compare_walks(const std::vector<RayWalk>& a, const std::vector<Ra
       ++c.identical;
       continue;
     }
-    if (rounding) {
-      ++c.within_rounding;
-    } else {
-      ++c.differing;
-    }
-    if (!c.example.empty()) continue;
     std::ostringstream what;
-    what.precision(17);
-    what << "ray " << r << (rounding ? " (within rounding): " : ": ");
-    if (r >= b.size()) {
-      what << "missing from the second set";
-    } else {
-      what << x.size() << " texels" << (a[r].aborted ? " (aborted)" : "") << " against " << y.size()
-           << (b[r].aborted ? " (aborted)" : "");
-      if (k < x.size() && k < y.size()) {
-        const WalkTexel &p = x[k], &q = y[k];
-        what << "; texel " << k << ": face " << p.face << " (" << p.i << ", " << p.j << ") l [" << p.l0 << ", " << p.l1
-             << "] against face " << q.face << " (" << q.i << ", " << q.j << ") l [" << q.l0 << ", " << q.l1 << "]";
-      }
+    if (!count_not_identical(r, rounding, r < b.size(), &c, &what)) continue;
+    what << x.size() << " texels" << (a[r].aborted ? " (aborted)" : "") << " against " << y.size()
+         << (b[r].aborted ? " (aborted)" : "");
+    if (k < x.size() && k < y.size()) {
+      const WalkTexel &p = x[k], &q = y[k];
+      what << "; texel " << k << ": face " << p.face << " (" << p.i << ", " << p.j << ") l [" << p.l0 << ", " << p.l1
+           << "] against face " << q.face << " (" << q.i << ", " << q.j << ") l [" << q.l0 << ", " << q.l1 << "]";
     }
     c.example = what.str();
   }

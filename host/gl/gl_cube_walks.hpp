@@ -11,6 +11,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -133,6 +134,21 @@ void count_extra_rays(size_t a, size_t b, Comparison* c) {
   c->rays = b;
   c->differing += b - a;
   if (c->example.empty()) c->example = "the second set has " + std::to_string(b - a) + " rays more";
+}
+
+// Counts ray `r`, not identical, in its class. For the first such ray it starts the example in
+// `what` ("ray r (within rounding): ") and returns true: the caller finishes it and stores it.
+// It returns false when an example was already given, or when the second set lacks the ray
+// (the example is then whole).
+template <class Comparison>
+bool count_not_identical(size_t r, bool rounding, bool in_second, Comparison* c, std::ostringstream* what) {
+  ++(rounding ? c->within_rounding : c->differing);
+  if (!c->example.empty()) return false;
+  what->precision(17);
+  *what << "ray " << r << (rounding ? " (within rounding): " : ": ");
+  if (in_second) return true;
+  c->example = what->str() + "missing from the second set";
+  return false;
 }
 
 }  // namespace abcube
