@@ -401,6 +401,11 @@ void coincident_crossings(const SearchContext& ctx, const glm::dvec3& w, const g
 // methods they reproduce, and a search of the map alone (--map-only) sees only the map.
 ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const glm::dvec3& light_position,
                            const SearchOptions& options = {}, uint32_t known_blocker = NO_TRIANGLE);
+// shadow_search's KNOWN BLOCKER alone: true, with its answer in *out, when the options take a
+// known blocker and `known_blocker` stops segment q (shadow_ray) to the light; false when the
+// segment must be walked.
+bool known_blocker_answer(const SearchContext& ctx, const SearchRay& q, const glm::dvec3& light_position,
+                          const SearchOptions& options, uint32_t known_blocker, ShadowResult* out);
 
 // Whether two searches gave the same answer bit for bit: every field but the walk's counts
 // of texels and nodes (HIERARCHICAL SKIP: on and off must agree).

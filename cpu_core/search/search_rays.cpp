@@ -280,16 +280,23 @@ ShadowResult shadow_search(const SearchContext& ctx, const glm::dvec3& p, const 
   ShadowResult res;
   SearchRay q;
   if (!shadow_ray(ctx, p, light_position, options, &q)) return res;
-  if (known_blocker != NO_TRIANGLE && options.known_blockers && options.side_structure &&
-      options.mode == SearchMode::crossing && options.layers == SearchLayers::all &&
-      blocks(ctx, q, known_blocker, light_position)) {
-    res.transmittance = glm::dvec3(0.0);
-    res.blocked = res.known_blocker = true;
-    res.blockers = 1;
-    res.first_blocker = res.opaque_blocker = known_blocker;
-    return res;
-  }
+  if (known_blocker_answer(ctx, q, light_position, options, known_blocker, &res)) return res;
   return shadow_along(ctx, q, light_position, options);
+}
+
+bool known_blocker_answer(const SearchContext& ctx, const SearchRay& q, const glm::dvec3& light_position,
+                          const SearchOptions& options, uint32_t known_blocker, ShadowResult* out) {
+  if (known_blocker == NO_TRIANGLE || !options.known_blockers || !options.side_structure ||
+      options.mode != SearchMode::crossing || options.layers != SearchLayers::all ||
+      !blocks(ctx, q, known_blocker, light_position)) {
+    return false;
+  }
+  *out = ShadowResult{};
+  out->transmittance = glm::dvec3(0.0);
+  out->blocked = out->known_blocker = true;
+  out->blockers = 1;
+  out->first_blocker = out->opaque_blocker = known_blocker;
+  return true;
 }
 
 ShadowResult shadow_along(const SearchContext& ctx, const SearchRay& q, const glm::dvec3& light_position,

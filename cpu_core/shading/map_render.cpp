@@ -423,8 +423,20 @@ class MapRender {
 Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapShader& shader, int threads,
                       MapShadingStats* stats, Image* fallback, const std::vector<uint8_t>* only, bool neighbours,
                       const std::function<void(double)>* progress) {
-  MapRender render(scene, camera, shader, fallback, only, progress);
-  return render.render(threads, neighbours, stats);
+  DeferredSearches* deferred = shader.deferred();
+  if (!deferred) return MapRender(scene, camera, shader, fallback, only, progress).render(threads, neighbours, stats);
+  // DEFERRED SEARCHES: the passes run until one asks nothing new; only its image and its
+  // figures stand.
+  for (;;) {
+    deferred->begin_pass();
+    MapShadingStats pass;
+    Image image = MapRender(scene, camera, shader, fallback, only, progress).render(threads, neighbours, &pass);
+    if (deferred->queued() == 0) {
+      if (stats) stats->merge(pass);
+      return image;
+    }
+    deferred->answer_queued();
+  }
 }
 
 }  // namespace abcube

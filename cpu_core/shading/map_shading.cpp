@@ -177,8 +177,7 @@ glm::dvec3 MapShader::shade(const Crossed& cr, const glm::dvec3& dir, int depth,
 // sum_l S_l phong_light, S_l from the shadow search (thesis 8.3).
 glm::dvec3 MapShader::visibility(const glm::dvec3& p, size_t light, MapShadingStats* stats,
                                  KnownBlockers* known) const {
-  const ShadowResult s =
-      shadow_search(*ctx_, p, scene_.lights[light].position, options_.search, known ? known->of(light) : NO_TRIANGLE);
+  const ShadowResult s = shadow(p, scene_.lights[light].position, known ? known->of(light) : NO_TRIANGLE);
   if (known) known->note(light, s.opaque_blocker);
   if (stats) stats->searches.shadow.add(s);
   return s.transmittance;
@@ -201,7 +200,7 @@ glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const 
     if (direct) direct->lit[l] = lit;
     if (!light.cast_shadows) {
       if (options_.walk_all_shadows) {
-        const ShadowResult unused = shadow_search(*ctx_, sp.point, light.position, options_.search);
+        const ShadowResult unused = shadow(sp.point, light.position, NO_TRIANGLE);
         if (stats) stats->searches.shadow.add(unused);
       }
       c += lit;
@@ -216,12 +215,22 @@ glm::dvec3 MapShader::lights(const SurfacePoint& sp, const glm::dvec3& v, const 
 
 // The search for a ray from w along dir: from inside the top medium, or in air.
 SearchResult MapShader::search(const glm::dvec3& w, const glm::dvec3& dir, const MediumStack& stack,
-                               MapShadingStats* stats) const {
+                               MapShadingStats* stats, bool defer) const {
   const bool inside = !stack.empty();
-  const SearchResult r = inside ? refraction_exit_search(*ctx_, w, dir, ctx_->media().top(stack), options_.search)
-                                : reflection_search(*ctx_, w, dir, options_.search);
+  const SearchRay q = inside ? refraction_exit_ray(*ctx_, w, dir, ctx_->media().top(stack), options_.search)
+                             : reflection_ray(*ctx_, w, dir, options_.search);
+  const SearchResult r = deferred_ && defer ? deferred_->search(q) : search_along(*ctx_, q, options_.search);
   if (stats) (inside ? stats->searches.refraction_exit : stats->searches.reflection).add(r);
   return r;
+}
+
+ShadowResult MapShader::shadow(const glm::dvec3& p, const glm::dvec3& light_position, uint32_t known_blocker) const {
+  if (!deferred_) return shadow_search(*ctx_, p, light_position, options_.search, known_blocker);
+  ShadowResult res;
+  SearchRay q;
+  if (!shadow_ray(*ctx_, p, light_position, options_.search, &q)) return res;
+  if (known_blocker_answer(*ctx_, q, light_position, options_.search, known_blocker, &res)) return res;
+  return deferred_->shadow(q, light_position);
 }
 
 // The crossing set of a found surface (media.hpp): with the surfaces crossed together with
@@ -318,7 +327,7 @@ std::vector<Ray> MapShader::transmitted_path(const glm::dvec3& origin, const glm
   Ray ray{origin, glm::normalize(dir)};
   MediumStack stack;
   while (static_cast<int>(path.size()) < max_rays) {
-    const SearchResult r = search(ray.origin, ray.dir, stack, nullptr);
+    const SearchResult r = search(ray.origin, ray.dir, stack, nullptr, false);  // answered now, whole
     if (!r.hit) break;
     const Crossed c = crossing_set(ray.origin, ray.dir, r, stack);
     if (c.itf.pass) {

@@ -22,6 +22,7 @@
 #include "io/metrics.hpp"
 #include "scene/scene_data.hpp"
 #include "reference/raytrace.hpp"
+#include "search/deferred_searches.hpp"
 #include "search/search.hpp"
 #include "material/shading.hpp"
 #include "shading/shading_plan.hpp"
@@ -219,6 +220,11 @@ class MapShader {
 
   const std::vector<LensFit>& lenses() const { return lenses_; }
   const SearchContext& context() const { return *ctx_; }
+  // DEFERRED SEARCHES (search/deferred_searches.hpp): `d` (null: none) answers every search
+  // and shadow walk of the renders that follow, and render_with_map runs its passes until
+  // none is left unanswered. It must outlive its use; its options must be this shader's.
+  void defer_searches(DeferredSearches* d) { deferred_ = d; }
+  DeferredSearches* deferred() const { return deferred_; }
   // SearchRefine::mesh (docs/design/search.md, MESH REFINEMENT): besides the crossing searches'
   // candidates, camera fragments' shading points are moved onto the surface the same way (any
   // mode).
@@ -238,8 +244,11 @@ class MapShader {
     glm::dvec3 far{0.0};
     Interface itf;
   };
-  SearchResult search(const glm::dvec3& w, const glm::dvec3& dir, const MediumStack& stack,
-                      MapShadingStats* stats) const;
+  // `defer`: the deferred searches answer it, when there are.
+  SearchResult search(const glm::dvec3& w, const glm::dvec3& dir, const MediumStack& stack, MapShadingStats* stats,
+                      bool defer = true) const;
+  // shadow_search of p to the light at light_position, or its deferred answer.
+  ShadowResult shadow(const glm::dvec3& p, const glm::dvec3& light_position, uint32_t known_blocker) const;
   Crossed crossing_set(const glm::dvec3& w, const glm::dvec3& dir, const SearchResult& r,
                        const MediumStack& stack) const;
   // `trail` (optional): the surfaces every search below this one found, hashed in order
@@ -273,6 +282,7 @@ class MapShader {
   void set_method_state();  // the search layers and envmap's texel cache, from options_.method
 
   std::shared_ptr<SearchContext> ctx_;
+  DeferredSearches* deferred_ = nullptr;
   std::vector<LensFit> lenses_;
   std::vector<int> lens_of_object_;  // index into lenses_, -1 if none
   // envmap: the resolved colour of each texel looked up so far (envmap_at).

@@ -18,13 +18,13 @@ namespace {
 
 constexpr double INF = std::numeric_limits<double>::infinity();
 
-struct Ray {
+struct WalkCase {
   glm::dvec3 w, d;
   double l_max = INF;
   double skip = 0.0;
 };
 
-std::string describe(const Ray& r, int n) {
+std::string describe(const WalkCase& r, int n) {
   std::ostringstream s;
   s.precision(17);
   s << "n=" << n << " W=(" << r.w.x << "," << r.w.y << "," << r.w.z << ") D=(" << r.d.x << "," << r.d.y << "," << r.d.z
@@ -32,7 +32,7 @@ std::string describe(const Ray& r, int n) {
   return s.str();
 }
 
-std::vector<WalkTexel> walk_all(const Ray& r, int n, bool* aborted = nullptr) {
+std::vector<WalkTexel> walk_all(const WalkCase& r, int n, bool* aborted = nullptr) {
   CubeWalk walk(r.w, r.d, n, r.l_max, r.skip);
   std::vector<WalkTexel> out;
   WalkTexel t;
@@ -82,7 +82,7 @@ bool touching(const WalkTexel& a, const WalkTexel& b, int n) {
 // Samples of the ray uniform in the angle of the arc seen from the centre: with Q the
 // closest point of the line to the centre (|Q| = h), X(l) = Q + (l - l_c) D and
 // tan(phi) = (l - l_c) / h, so phi uniform sweeps the arc uniformly.
-std::vector<double> arc_samples(const Ray& r, int count) {
+std::vector<double> arc_samples(const WalkCase& r, int count) {
   const double lc = -glm::dot(r.w, r.d);
   const double h = glm::length(glm::cross(r.w, r.d));
   std::vector<double> ls;
@@ -97,7 +97,7 @@ std::vector<double> arc_samples(const Ray& r, int count) {
 }
 
 // Every structural and sampling property of one walk.
-void check_walk(const Ray& r, int n, int samples = 4000) {
+void check_walk(const WalkCase& r, int n, int samples = 4000) {
   SCOPED_TRACE(describe(r, n));
   bool aborted = true;
   const std::vector<WalkTexel> walk = walk_all(r, n, &aborted);
@@ -166,7 +166,7 @@ TEST(CubeWalk, RandomRaysMatchDenseSampling) {
   std::uniform_real_distribution<double> u(-3, 3);
   for (const int n : {1, 2, 3, 7, 16, 64, 128}) {
     for (int k = 0; k < 60; ++k) {
-      Ray r{glm::dvec3(u(rng), u(rng), u(rng)), random_unit(rng)};
+      WalkCase r{glm::dvec3(u(rng), u(rng), u(rng)), random_unit(rng)};
       if (k % 3 == 1) r.l_max = std::fabs(u(rng)) + 0.1;  // a shadow segment
       check_walk(r, n);
     }
@@ -212,7 +212,7 @@ TEST(CubeWalk, DiagonalThroughTexelCornersStepsBothIndices) {
   // every texel corner (k/n, k/n) exactly; the crossings tie and the walk steps diagonally.
   const int n = 8;
   const glm::dvec3 d = glm::normalize(glm::dvec3(1, -1, 0));
-  const Ray r{glm::dvec3(-0.875, 0.875, 1), d, 1.75 * std::sqrt(2.0)};
+  const WalkCase r{glm::dvec3(-0.875, 0.875, 1), d, 1.75 * std::sqrt(2.0)};
   check_walk(r, n);
   const std::vector<WalkTexel> walk = walk_all(r, n);
   ASSERT_EQ(walk.size(), 8u);  // texels (k, k), k = 0..7: s = t runs from 1/16 to 15/16
@@ -283,7 +283,7 @@ TEST(CubeWalk, SkipRadiusLeavesOutTheBall) {
   int gaps = 0;
   for (int k = 0; k < 100; ++k) {
     const glm::dvec3 d = random_unit(rng);
-    const Ray r{-1.5 * d + glm::dvec3(u(rng), u(rng), u(rng)), d, INF, 0.1};
+    const WalkCase r{-1.5 * d + glm::dvec3(u(rng), u(rng), u(rng)), d, INF, 0.1};
     check_walk(r, 32);
     for (const WalkTexel& t : walk_all(r, 32)) {
       // No texel interval enters the ball |X| < 0.1 (beyond rounding).

@@ -1,0 +1,83 @@
+// DEFERRED SEARCHES: a render's searches answered in batches, from candidates another
+// scanner found (the GPU's: host/gl/gl_cube_scan.hpp), for a shader that asks one search at
+// a time. A pass of the render asks its searches here. A ray answered by an earlier batch
+// gets its answer; any other is queued and gets a stand-in (a miss; a shadow segment
+// unblocked), and the pass goes on. Between passes the queued rays are scanned together and
+// answered (search_from_candidates, shadow_from_candidates: the crossing choice the CPU's
+// own walk runs). The render runs again until a pass queues nothing: every answer of that
+// pass is then the search's own (same_found), so its image is the CPU searches' image, bit
+// for bit.
+//
+// Why this ends: the rays of a pass depend only on the answers before them (the shading is
+// a function of them, row by row). A pass's first stand-in is answered for the next pass, so
+// the prefix of true answers grows every pass; the passes are as many as the longest chain
+// of searches each asked on the answer of the last (a bounce, a quarter split on the first
+// quarters' colours, an edge pass on the points' shadows), not as many as the searches.
+// The stand-ins cost searches whose answers the last pass never asks (counted as unused).
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "search/search.hpp"
+
+namespace abcube {
+
+// Every ray's scan_candidates(ctx, ray, options), however computed.
+using CandidateScanner =
+    std::function<std::vector<CandidateScan>(const std::vector<SearchRay>&, const SearchOptions& options)>;
+
+// scan_candidates on the CPU, ray by ray (`threads` 0: every core): a scanner to check the
+// deferred searches against, with no GL.
+CandidateScanner cpu_candidate_scanner(const SearchContext& ctx, int threads);
+
+struct DeferredSearchStats {
+  uint64_t passes = 0;   // render passes run (the last one asked nothing new)
+  uint64_t batches = 0;  // scanner calls
+  uint64_t rays = 0;     // rays scanned: searches and shadow segments
+  uint64_t candidates = 0;
+  uint64_t answers_used = 0;  // answers the last pass asked for
+  double scan_ms = 0, answer_ms = 0;
+};
+
+class DeferredSearches {
+ public:
+  // The crossing mode over all layers only (search_from_candidates): InputError otherwise.
+  // `batch_rays`: the most rays one scanner call gets.
+  DeferredSearches(const SearchContext& ctx, const SearchOptions& options, CandidateScanner scanner, int threads = 0,
+                   size_t batch_rays = DEFAULT_BATCH_RAYS);
+  ~DeferredSearches();
+  DeferredSearches(const DeferredSearches&) = delete;
+  DeferredSearches& operator=(const DeferredSearches&) = delete;
+
+  // search_along(ctx, q, options): the answer when a batch gave it, else a miss, with q queued.
+  // Thread-safe within a pass.
+  SearchResult search(const SearchRay& q);
+  // shadow_along(ctx, q, light_position, options), the same way (a stand-in lets the light through).
+  ShadowResult shadow(const SearchRay& q, const glm::dvec3& light_position);
+
+  // Starts a pass: counts it and forgets which answers were asked.
+  void begin_pass();
+  // Rays queued since the last answer_queued.
+  size_t queued() const;
+  // Scans the queued rays in batches, answers them, and empties the queue. Not during a pass.
+  void answer_queued();
+  // The counts so far (answers_used: of the last pass).
+  DeferredSearchStats stats() const;
+
+  static constexpr size_t DEFAULT_BATCH_RAYS = 1u << 16;
+
+  struct Store;
+
+ private:
+  const SearchContext& ctx_;
+  SearchOptions options_;
+  CandidateScanner scanner_;
+  int threads_;
+  size_t batch_rays_;
+  std::unique_ptr<Store> store_;
+};
+
+}  // namespace abcube

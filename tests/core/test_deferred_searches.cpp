@@ -1,0 +1,127 @@
+// DEFERRED SEARCHES (search/deferred_searches.hpp): a render whose searches are answered in
+// batches from a scanner's candidates is the render whose searches walk the map themselves,
+// bit for bit, with the CPU's scan_candidates as the scanner (the GPU's is checked against it
+// in the GL tests).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "base/error.hpp"
+#include "raster/abuffer.hpp"
+#include "scene/scene_load.hpp"
+#include "search/deferred_searches.hpp"
+#include "shading/map_shading.hpp"
+
+namespace abcube {
+namespace {
+
+SceneData deferred_scene(const std::string& path, int width, int cube_n) {
+  SceneData s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/" + path);
+  const double aspect = static_cast<double>(s.camera.width) / s.camera.height;
+  s.camera.width = width;
+  s.camera.height = std::max(1, static_cast<int>(width / aspect + 0.5));
+  s.render.cube_resolution = cube_n;
+  return s;
+}
+
+// Every repository scene and kept hard case with mirrors, glass, nested media, shadows and
+// textures, under each shading plan whose passes depend on earlier answers (the quarters split
+// on the first quarters' colours, shadow and secondary edges, the sparse pass): the image and
+// the searches' counts are the CPU searches'.
+TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
+  std::vector<std::string> scenes = {"scenes/cornell.json",
+                                     "tests/hard/regressions/nested_glass_5000_78.json",
+                                     "scenes/shadows.json",
+                                     "scenes/textured.json",
+                                     "scenes/hidden_point.json",
+                                     "tests/hard/regressions/grazing_mirror_5000_121.json",
+                                     "tests/hard/regressions/light_on_surface_5000_72.json"};
+  std::vector<ShadingPlan> plans = {
+      ShadingPlan(),
+      ShadingPlan(ShadingPoints::sparse, false, false),
+      ShadingPlan(ShadingPoints::one, false, false),
+  };
+  // The checked builds (tools/sanitize.sh) check the code: mirrors, glass and shadows, the
+  // quarters and the sparse pass.
+  const char* env = std::getenv("ABCUBE_CHECKED_BUILD");
+  const bool checked = env && std::string(env) == "1";
+  if (checked) {
+    scenes.resize(2);
+    plans.resize(2);
+  }
+  uint64_t most_passes = 0, rays = 0;
+  for (const std::string& file : scenes) {
+    const SceneData s = deferred_scene(file, 48, 40);
+    const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, s.render.cube_resolution);
+    const ABuffer camera = build_camera_abuffer(s);
+    for (const ShadingPlan& plan : plans) {
+      MapShadingOptions o;
+      o.plan = plan;
+      const MapShader walked(s, cube, o);
+      MapShadingStats walked_stats, deferred_stats;
+      const Image a = render_with_map(s, camera, walked, 2, &walked_stats);
+      MapShader shader(s, cube, o);
+      DeferredSearches deferred(shader.context(), shader.options().search, cpu_candidate_scanner(shader.context(), 2),
+                                2, 97);  // many small batches
+      shader.defer_searches(&deferred);
+      const Image b = render_with_map(s, camera, shader, 2, &deferred_stats);
+      const DeferredSearchStats d = deferred.stats();
+      const std::string what = file + " plan " + std::to_string(&plan - plans.data());
+      EXPECT_EQ(a.data, b.data) << what;
+      const SearchStats &x = walked_stats.searches, &y = deferred_stats.searches;
+      EXPECT_EQ(x.reflection.rays, y.reflection.rays) << what;
+      EXPECT_EQ(x.reflection.hits, y.reflection.hits) << what;
+      EXPECT_EQ(x.refraction_exit.rays, y.refraction_exit.rays) << what;
+      EXPECT_EQ(x.shadow.rays, y.shadow.rays) << what;
+      EXPECT_EQ(x.shadow.known_blockers, y.shadow.known_blockers) << what;
+      EXPECT_EQ(y.reflection.texels, 0u) << what;  // no walk: candidates only
+      // Every search the last pass asked was answered by a batch (the known blockers' aside).
+      const uint64_t walks = x.reflection.rays + x.refraction_exit.rays + x.shadow.rays - x.shadow.known_blockers;
+      EXPECT_EQ(d.answers_used, walks) << what;
+      EXPECT_GT(d.rays, walks > 0 ? 0u : d.rays) << what;
+      std::printf("[ deferred ] %s: %llu passes, %llu rays scanned, %llu answers used\n", what.c_str(),
+                  static_cast<unsigned long long>(d.passes), static_cast<unsigned long long>(d.rays),
+                  static_cast<unsigned long long>(walks));
+      EXPECT_GE(d.passes, walks > 0 ? 2u : 1u) << what;
+      most_passes = std::max(most_passes, d.passes);
+      rays += d.rays;
+    }
+  }
+  std::printf("[ deferred ] %llu rays scanned; at most %llu passes\n", static_cast<unsigned long long>(rays),
+              static_cast<unsigned long long>(most_passes));
+  EXPECT_GT(rays, checked ? 1000u : 10000u);
+}
+
+// The crossing mode over all layers only: the thesis mode and the Z-buffer's nearest layer
+// choose otherwise than search_from_candidates.
+TEST(DeferredSearches, RefusesTheThesisModeAndTheNearestLayer) {
+  const SceneData s = deferred_scene("scenes/cornell.json", 16, 8);
+  const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, 8);
+  const MapShader shader(s, cube, MapShadingOptions{});
+  SearchOptions thesis;
+  thesis.mode = SearchMode::thesis;
+  SearchOptions nearest;
+  nearest.layers = SearchLayers::nearest;
+  const CandidateScanner scanner = cpu_candidate_scanner(shader.context(), 1);
+  EXPECT_THROW(DeferredSearches(shader.context(), thesis, scanner), InputError);
+  EXPECT_THROW(DeferredSearches(shader.context(), nearest, scanner), InputError);
+}
+
+// A scanner that answers fewer rays than it was given is refused, not read past its end.
+TEST(DeferredSearches, AScannerShortOfRaysFails) {
+  const SceneData s = deferred_scene("scenes/cornell.json", 16, 8);
+  const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, 8);
+  MapShader shader(s, cube, MapShadingOptions{});
+  DeferredSearches deferred(
+      shader.context(), shader.options().search,
+      [](const std::vector<SearchRay>& r, const SearchOptions&) { return std::vector<CandidateScan>(r.size() / 2); });
+  shader.defer_searches(&deferred);
+  const ABuffer camera = build_camera_abuffer(s);
+  EXPECT_THROW(render_with_map(s, camera, shader, 1, nullptr), RuntimeFailure);
+}
+
+}  // namespace
+}  // namespace abcube
