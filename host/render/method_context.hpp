@@ -35,6 +35,11 @@ struct RenderRequest {
   // The camera's and the cube's A-buffers built by GL compute shaders (gl_abuffer.hpp) on
   // MethodContext::gl_scene's context, not by the CPU core: the same lists.
   bool abuffers_on_gl = false;
+  // Where the map searches walk (--search-on, gpu_abuffer and hybrid): on GL compute, the
+  // DEFERRED SEARCHES over GlCandidateScan (gl_cube_scan.hpp), or on the CPU; `automatic`: GL
+  // where it is a hardware GPU and the options allow it, else the CPU.
+  enum class SearchOn { cpu, gpu, automatic };
+  SearchOn search_on = SearchOn::cpu;
   std::vector<std::string> aovs;
 };
 

@@ -117,6 +117,10 @@ void refuse_options_unused_by(const std::string& scene_method, const RenderOptio
         key, "not used by method " + method.name() + " (" +
                  (readers.empty() ? std::string("no method reads it") : "read by " + join(readers, ", ")) + ")");
   }
+  // The GPU's searches answer from candidates by the crossing mode's choice alone.
+  if (reads(method, "search_on") && options.search_on == "gpu" && options.search != "crossing") {
+    throw OptionError("search_on", "gpu takes the crossing mode only (search crossing), got search " + options.search);
+  }
 }
 
 RenderOptions without_unused_options(const RenderOptions& options, const std::string& method_name) {

@@ -370,6 +370,12 @@ void add_gpu_camera(Table& t) {
       [](RenderSetup& s, const json& v) { s.render.gpu_shading = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.gpu_shading, d.gpu_shading); },
       reset(&RenderOptions::gpu_shading));
+  add(t, {"search_on", "--search-on", OptionKind::choice, OptionScope::job, {"auto", "gpu", "cpu"}, 0, 0, d.search_on,
+       "", true,
+       "gpu_abuffer and hybrid's map searches: auto (the GPU where it is hardware) | gpu (GL compute) | cpu", {}},
+      [](RenderSetup& s, const json& v) { s.render.search_on = v.get<std::string>(); },
+      [d](const RenderSetup& s) { return unless(s.render.search_on, d.search_on); },
+      reset(&RenderOptions::search_on));
 }
 
 // Resources and limits.

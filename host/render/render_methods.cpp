@@ -37,6 +37,11 @@ void read_gpu_options(const RenderOptions& o, int max_depth, RenderRequest* r) {
   r->gpu.max_depth = max_depth;
 }
 
+void read_search_on(const RenderOptions& o, RenderRequest* r) {
+  using SearchOn = RenderRequest::SearchOn;
+  r->search_on = o.search_on == "gpu" ? SearchOn::gpu : o.search_on == "cpu" ? SearchOn::cpu : SearchOn::automatic;
+}
+
 std::vector<std::string> gpu_camera_option_keys() {
   return {"gpu_mirrors", "gpu_shadows", "gpu_max_views", "gpu_shading"};
 }

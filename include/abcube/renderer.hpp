@@ -78,7 +78,8 @@ std::vector<std::string> methods_reading(const std::string& key);
 // What each method honours (docs/methods.md): throws OptionError (an InputError) with one
 // line when `options` gives a setting that the render's method (options.method, or the
 // scene's) does not read, e.g. refraction "thick_lens" with raytrace, naming the methods
-// that read it; and for a method name no method has. `abcube render`, `abcube batch` and the
+// that read it; for a method name no method has; and for search_on "gpu" with the thesis
+// mode, which the GPU's searches do not take. `abcube render`, `abcube batch` and the
 // Python module call it before rendering; Renderer::render itself leaves such settings
 // unused, so that one RenderOptions can serve renders of several methods. The scene file's
 // own settings (render.cube_resolution, ...) are every method's defaults and never refused.

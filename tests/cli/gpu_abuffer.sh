@@ -8,6 +8,9 @@
 # difference is a wrong list, never a tolerance. Then the doors: `abcube render --method
 # gpu_abuffer` with its stats (the GL it built on, both A-buffers' figures), a scene file's
 # render.method, Python's render(method=...), and its options: abuffer's, others refused.
+# Then the same with the searches on the GPU (--search-on gpu), on fewer scenes, through the
+# command line, batch and Python (a scene file names the method alone, as for every method's
+# options).
 # In the checked builds (ABCUBE_CHECKED_BUILD, tools/sanitize.sh) the same commands run on
 # cornell and three generated scenes, and Python is left out (those builds make no module).
 # Usage (ctest runs it so): bash gpu_abuffer.sh /path/to/abcube /path/to/repo
@@ -95,6 +98,65 @@ import numpy as np
 img = abcube.Renderer().render(abcube.load_scene(sys.argv[1]), method="gpu_abuffer", width=64, height=48,
                                cube_res=48)
 assert np.array_equal(img, abcube.read_image(sys.argv[2])), "differs"' "$CORNELL" "$WORK/c.exr"
+
+# The searches on the GPU (--search-on gpu: GL's candidate scans, answered by the deferred
+# searches): repository scenes and generated hard cases with mirrors, glass, nested media and
+# shadows, small (each render runs its passes, and llvmpipe walks slowly), one batch through
+# both methods; each image abuffer's byte for byte. Then its stats, the other doors, and what
+# it refuses.
+gpu_scenes=("$REPO/scenes/cornell.json" "$REPO/scenes/shadows.json" "$REPO/scenes/textured.json"
+  "$WORK"/gen_7/nested_glass_*.json "$WORK"/gen_7/grazing_mirror_*.json)
+[ "$CHECKED" = 1 ] && gpu_scenes=("$REPO/scenes/cornell.json")
+: > "$WORK/searches.jsonl"
+for s in "${gpu_scenes[@]}"; do
+  stem=searches/$(basename "$s" .json)
+  for m in abuffer gpu; do
+    method=$([ $m = gpu ] && echo gpu_abuffer || echo abuffer)
+    on=$([ $m = gpu ] && echo ', "search_on": "gpu"')
+    echo "{\"scene\": \"$s\", \"out\": \"${stem}_$m.exr\", \"method\": \"$method\"$on, \"cube_res\": 32, \"camera\": {\"width\": 40, \"height\": 30}}" \
+      >> "$WORK/searches.jsonl"
+  done
+done
+(cd "$WORK" && "$ABCUBE" batch searches.jsonl > searches.out 2> searches.err)
+check "batch with search_on gpu exits 0 ($(grep -v warning "$WORK/searches.err" | head -2))" [ $? -eq 0 ]
+differ=0
+for s in "${gpu_scenes[@]}"; do
+  stem=$WORK/searches/$(basename "$s" .json)
+  cmp -s "${stem}_abuffer.exr" "${stem}_gpu.exr" || { differ=$((differ + 1)); echo "differs: $stem"; }
+done
+check "every image with the searches on the GPU is abuffer's, byte for byte (${#gpu_scenes[@]} scenes, $differ differ)" \
+  [ "$differ" -eq 0 ]
+check "render --search-on gpu" "$ABCUBE" render "$CORNELL" --method gpu_abuffer --search-on gpu --size 40x30 \
+  --cube-res 32 -o "$WORK/g.exr" --stats "$WORK/g.json"
+check "the batch's image" cmp "$WORK/g.exr" "$WORK/searches/cornell_gpu.exr"
+check "its stats: searches on the GPU, in passes, every answer from a scan" $PY -c 'import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["plan"]["searches_on"] == {"where": "gpu", "why": "asked: --search-on gpu"}, s["plan"]["searches_on"]
+d = s["searches"]["deferred"]
+assert d["passes"] >= 2 and d["rays"] > 1000 and d["answers_used"] > 1000, d
+assert s["timings_ms"]["gpu_search_scan"] > 0, s["timings_ms"]' "$WORK/g.json"
+check "--search-on auto on llvmpipe: the CPU, and why" bash -c "'$ABCUBE' render '$CORNELL' --method gpu_abuffer \
+  --size 40x30 --cube-res 32 -o '$WORK/u.exr' --stats '$WORK/u.json' && grep -q 'GL is software' '$WORK/u.json' &&
+  cmp '$WORK/u.exr' '$WORK/g.exr'"
+[ "$CHECKED" = 1 ] || check "Python: render(search_on=\"gpu\") is the CLI's image" \
+  env PYTHONPATH="$(dirname "$ABCUBE")/python" $PY -c 'import sys, abcube
+import numpy as np
+img = abcube.Renderer().render(abcube.load_scene(sys.argv[1]), method="gpu_abuffer", search_on="gpu", width=40,
+                               height=30, cube_res=32)
+assert np.array_equal(img, abcube.read_image(sys.argv[2])), "differs"' "$CORNELL" "$WORK/g.exr"
+refused() {  # WHAT PATTERN ARGS...: exit 2, one line matching PATTERN, no image
+  local what=$1 pattern=$2 status
+  shift 2
+  rm -f "$WORK/r.exr"
+  "$ABCUBE" render "$CORNELL" "$@" -o "$WORK/r.exr" 2> "$WORK/err"
+  status=$?
+  check "$what refused: exit 2 ($status), one line ($(cat "$WORK/err"))" \
+    bash -c "[ $status -eq 2 ] && [ \$(wc -l < '$WORK/err') -eq 1 ] && grep -q -- '$pattern' '$WORK/err' &&
+      [ ! -e '$WORK/r.exr' ]"
+}
+refused "--search-on gpu with the thesis mode" "--search-on: gpu takes the crossing mode only" --method gpu_abuffer --search-on gpu --search thesis
+refused "--search-on with abuffer" "--search-on: not used by method abuffer" --method abuffer --search-on gpu
+refused "--search-on elsewhere" "--search-on" --method gpu_abuffer --search-on gpus
 
 echo "gpu_abuffer: ${#scenes[@]} scenes; $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

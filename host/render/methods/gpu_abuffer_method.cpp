@@ -1,6 +1,7 @@
 // The gpu_abuffer method: the abuffer method with its camera's and cube's A-buffers built by
-// GL compute shaders (gl/gl_abuffer.hpp), the same lists as the CPU core's; the searches,
-// the shading and the resolve run on the CPU over them. Its options are abuffer's.
+// GL compute shaders (gl/gl_abuffer.hpp), the same lists as the CPU core's; the searches
+// walk on the GPU too where --search-on says (the DEFERRED SEARCHES over gl_cube_scan.hpp),
+// the shading and the resolve run on the CPU. Its options are abuffer's and --search-on.
 #include <memory>
 
 #include "render/method.hpp"
@@ -17,12 +18,18 @@ class GpuABufferMethod : public RenderMethod {
   GpuABufferMethod() : abuffer_(make_map_method(MapVariant::abuffer)) {}
   std::string name() const override { return "gpu_abuffer"; }
   std::string summary() const override {
-    return "abuffer with its A-buffers built on the GPU by compute shaders (the same lists), searched on the CPU";
+    return "abuffer with its A-buffers built on the GPU by compute shaders (the same lists), its searches too by "
+           "--search-on";
   }
-  std::vector<std::string> reads() const override { return abuffer_->reads(); }
+  std::vector<std::string> reads() const override {
+    std::vector<std::string> keys = abuffer_->reads();
+    keys.push_back("search_on");
+    return keys;
+  }
   void read_options(const RenderOptions& options, const SceneData& view, RenderRequest* request) const override {
     abuffer_->read_options(options, view, request);
     request->abuffers_on_gl = true;
+    read_search_on(options, request);
   }
   bool needs_gl() const override { return true; }
   Image render(MethodContext& mc) const override {

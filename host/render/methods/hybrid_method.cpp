@@ -57,6 +57,7 @@ size_t trace_edge_ties(MethodContext& mc, const std::vector<uint8_t>& on_gpu, Im
 json render_cpu_pixels(MethodContext& mc, const std::vector<uint8_t>* only, Image* image) {
   json cpu_stats, out;
   RenderRecord cpu_record;
+  cpu_record.gl_renderer = mc.record.gl_renderer;  // --search-on auto reads it
   // On a hardware GPU its A-buffers are built there (gl_abuffer.hpp, the same lists as the
   // CPU core's); on Mesa's software GL the CPU core builds them faster.
   RenderRequest request = mc.request;
@@ -158,10 +159,12 @@ class HybridMethod : public RenderMethod {
     std::vector<std::string> keys = map_option_keys();  // abuffer's, with the lens transfer
     keys.push_back("refraction");
     for (const std::string& k : gpu_camera_option_keys()) keys.push_back(k);
+    keys.push_back("search_on");
     return keys;
   }
   void read_options(const RenderOptions& options, const SceneData& view, RenderRequest* request) const override {
     read_map_options(options, MapVariant::abuffer, request);  // abuffer's searches
+    read_search_on(options, request);
     read_gpu_options(options, view.render.max_depth, request);
   }
   bool needs_gl() const override { return true; }

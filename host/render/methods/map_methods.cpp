@@ -6,8 +6,11 @@
 
 #include <glm/glm.hpp>
 
+#include "base/error.hpp"
 #include "base/parallel.hpp"
 #include "base/timer.hpp"
+#include "gl/gl_context.hpp"
+#include "gl/gl_cube_scan.hpp"
 #include "io/metrics.hpp"
 #include "reference/raytrace.hpp"
 #include "render/method.hpp"
@@ -15,6 +18,7 @@
 #include "render/stats_json.hpp"
 #include "render/target_db.hpp"
 #include "scene/plan.hpp"
+#include "search/deferred_searches.hpp"
 #include "shading/fragment_texture.hpp"
 #include "shading/resolve.hpp"
 
@@ -45,6 +49,68 @@ Image render_abuffer_local(MethodContext& mc, const std::vector<uint8_t>* only) 
   mc.record.timings_ms["resolve"] = ms_since(t0);
   mc.stats["abuffer"] = abuffer_json(s, true);
   return image;
+}
+
+// --search-on: the map searches on GL compute, GlCandidateScan's candidates answered by the
+// DEFERRED SEARCHES, set on the shader for the render; or none, the CPU walking them.
+struct GlSearches {
+  std::unique_ptr<GlCandidateScan> scan;
+  std::unique_ptr<DeferredSearches> deferred;
+  double upload_ms = 0;
+};
+
+// Where the searches walk and why, in stats["plan"]["searches_on"]; the GL's scan when there.
+GlSearches gl_searches(MethodContext& mc, MapShader& shader) {
+  using SearchOn = RenderRequest::SearchOn;
+  const RenderRequest& r = mc.request;
+  GlSearches g;
+  bool on = r.search_on == SearchOn::gpu;
+  std::string why = on ? "asked: --search-on gpu" : "asked: --search-on cpu";
+  if (r.search_on == SearchOn::automatic) {
+    why = "auto: ";
+    if (software_renderer(mc.record.gl_renderer)) {
+      why += "GL is software (" + mc.record.gl_renderer + "), where the CPU's walks are faster";
+    } else if (shader.options().search.mode != SearchMode::crossing) {
+      why += "the thesis mode's searches walk on the CPU";
+    } else {
+      on = true;
+      why += "GL is a hardware GPU";
+    }
+  }
+  if (on) {
+    const Clock::time_point t0 = Clock::now();
+    try {
+      g.scan = std::make_unique<GlCandidateScan>(shader.context());
+    } catch (const RuntimeFailure& e) {
+      if (r.search_on == SearchOn::gpu) throw;
+      on = false;
+      why += std::string(", but the GPU cannot hold the map: ") + e.what();
+    }
+    g.upload_ms = ms_since(t0);
+  }
+  if (on) {
+    const GlCandidateScan& scan = *g.scan;
+    g.deferred = std::make_unique<DeferredSearches>(
+        shader.context(), shader.options().search,
+        [&scan](const std::vector<SearchRay>& rays, const SearchOptions& o) { return scan.scan(rays, o); }, r.threads);
+    shader.defer_searches(g.deferred.get());
+  }
+  mc.stats["plan"]["searches_on"] = {{"where", on ? "gpu" : "cpu"}, {"why", why}};
+  return g;
+}
+
+// The GL searches' figures, after the render.
+void record_gl_searches(const GlSearches& g, MethodContext& mc) {
+  if (!g.deferred) return;
+  const DeferredSearchStats d = g.deferred->stats();
+  mc.stats["searches"]["deferred"] = {{"passes", d.passes},
+                                      {"batches", d.batches},
+                                      {"rays", d.rays},
+                                      {"candidates", d.candidates},
+                                      {"answers_used", d.answers_used}};
+  mc.record.timings_ms["gpu_search_upload"] = g.upload_ms;
+  mc.record.timings_ms["gpu_search_scan"] = d.scan_ms;
+  mc.record.timings_ms["search_answers"] = d.answer_ms;
 }
 
 }  // namespace
@@ -113,6 +179,7 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   stats["cube_abuffer"] = cube_abuffer_json(map.stats);
   mc.record.timings_ms["map_setup"] = map.setup_ms;
   mc.record.timings_ms["camera_abuffer"] = camera_ms;
+  const GlSearches on_gl = mc.gl_scene ? gl_searches(mc, *map.shader) : GlSearches{};
   const Clock::time_point t0 = Clock::now();
   MapShadingStats ms;
   std::function<void(double)> shading;
@@ -121,6 +188,7 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   mc.record.timings_ms["shade_and_resolve"] = ms_since(t0);
   stats["abuffer"] = abuffer_json(as, false);
   stats["searches"] = map_shading_json(ms);
+  record_gl_searches(on_gl, mc);
   if (reference) {
     const double bound = parallax_bound(map.n);
     stats["reference"]["ray_error"] = {{"rays", "reflection rays of camera-visible surfaces"},
