@@ -2,6 +2,7 @@
 // batches that answer them.
 #include "search/deferred_searches.hpp"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstring>
@@ -15,7 +16,7 @@
 
 namespace abcube {
 
-namespace {
+namespace deferred {  // named: DeferredSearches::Store holds these
 
 // A ray as the searches see it, bit for bit: its SearchRay and, for a shadow segment, the
 // light. Two rays with the same key have the same answer.
@@ -46,13 +47,17 @@ RayKey key_of(const SearchRay& q, const glm::dvec3* light) {
   return k;
 }
 
-struct Queued {
+}  // namespace deferred
+
+using deferred::key_of;
+using deferred::RayKey;
+using deferred::RayKeyHash;
+
+struct DeferredSearches::Queued {
   SearchRay ray;
   glm::dvec3 light{0.0};
   bool shadow = false;
 };
-
-}  // namespace
 
 struct DeferredSearches::Store {
   // Written only by answer_queued, between passes: a pass reads them from every thread.
@@ -61,14 +66,26 @@ struct DeferredSearches::Store {
   mutable std::mutex mutex;  // the queue's
   std::unordered_set<RayKey, RayKeyHash> queued_keys;
   std::vector<Queued> queue;
-  std::atomic<uint64_t> used{0};
+  std::atomic<uint64_t> used{0}, walked_now{0};
+  uint64_t max_bytes = 0;
   DeferredSearchStats stats;
 
-  void enqueue(const RayKey& k, const Queued& q) {
+  uint64_t held_bytes() const { return (searches.size() + shadows.size() + queue.size()) * DEFERRED_ENTRY_BYTES; }
+  // Queues q (once); false, queueing nothing, when the store has no room for it.
+  bool enqueue(const RayKey& k, const Queued& q) {
     const std::lock_guard<std::mutex> lock(mutex);
-    if (queued_keys.insert(k).second) queue.push_back(q);
+    if (queued_keys.count(k)) return true;
+    if (max_bytes > 0 && held_bytes() + DEFERRED_ENTRY_BYTES > max_bytes) return false;
+    queued_keys.insert(k);
+    queue.push_back(q);
+    stats.bytes = std::max(stats.bytes, held_bytes());
+    return true;
   }
 };
+
+// While a batch is answered its queue entries and its answers are held together.
+static_assert(sizeof(RayKey) + sizeof(SearchResult) + sizeof(DeferredSearches::Queued) + 64 <= DEFERRED_ENTRY_BYTES,
+              "DEFERRED_ENTRY_BYTES covers a ray's key, answer, queue entry and table share");
 
 CandidateScanner cpu_candidate_scanner(const SearchContext& ctx, int threads) {
   return [&ctx, threads](const std::vector<SearchRay>& rays, const SearchOptions& options) {
@@ -80,16 +97,17 @@ CandidateScanner cpu_candidate_scanner(const SearchContext& ctx, int threads) {
 }
 
 DeferredSearches::DeferredSearches(const SearchContext& ctx, const SearchOptions& options, CandidateScanner scanner,
-                                   int threads, size_t batch_rays)
+                                   const DeferredSearchOptions& deferred)
     : ctx_(ctx),
       options_(options),
       scanner_(std::move(scanner)),
-      threads_(threads),
-      batch_rays_(std::max<size_t>(batch_rays, 1)),
+      deferred_(deferred),
       store_(std::make_unique<Store>()) {
   if (options.mode != SearchMode::crossing || options.layers != SearchLayers::all) {
     throw InputError("deferred searches: the crossing mode over all layers only");
   }
+  deferred_.batch_rays = std::max<size_t>(deferred_.batch_rays, 1);
+  store_->max_bytes = deferred.max_bytes;
 }
 
 DeferredSearches::~DeferredSearches() = default;
@@ -101,8 +119,9 @@ SearchResult DeferredSearches::search(const SearchRay& q) {
     store_->used.fetch_add(1, std::memory_order_relaxed);
     return it->second;
   }
-  store_->enqueue(k, {q, glm::dvec3(0.0), false});
-  return SearchResult{};  // a miss
+  if (store_->enqueue(k, {q, glm::dvec3(0.0), false})) return SearchResult{};  // a miss
+  store_->walked_now.fetch_add(1, std::memory_order_relaxed);
+  return search_along(ctx_, q, options_);
 }
 
 ShadowResult DeferredSearches::shadow(const SearchRay& q, const glm::dvec3& light_position) {
@@ -112,13 +131,15 @@ ShadowResult DeferredSearches::shadow(const SearchRay& q, const glm::dvec3& ligh
     store_->used.fetch_add(1, std::memory_order_relaxed);
     return it->second;
   }
-  store_->enqueue(k, {q, light_position, true});
-  return ShadowResult{};  // the light let through
+  if (store_->enqueue(k, {q, light_position, true})) return ShadowResult{};  // the light let through
+  store_->walked_now.fetch_add(1, std::memory_order_relaxed);
+  return shadow_along(ctx_, q, light_position, options_);
 }
 
 void DeferredSearches::begin_pass() {
   ++store_->stats.passes;
   store_->used = 0;
+  store_->walked_now = 0;
 }
 
 size_t DeferredSearches::queued() const {
@@ -127,56 +148,84 @@ size_t DeferredSearches::queued() const {
 }
 
 void DeferredSearches::answer_queued() {
-  Store& s = *store_;
   std::vector<Queued> queue;
   {
-    const std::lock_guard<std::mutex> lock(s.mutex);
-    queue.swap(s.queue);
-    s.queued_keys.clear();
+    const std::lock_guard<std::mutex> lock(store_->mutex);
+    queue.swap(store_->queue);
+    store_->queued_keys.clear();
   }
-  std::vector<SearchRay> rays;
-  std::vector<SearchResult> found;
-  std::vector<ShadowResult> shadowed;
-  for (size_t first = 0; first < queue.size(); first += batch_rays_) {
-    const size_t count = std::min(batch_rays_, queue.size() - first);
-    rays.resize(count);
-    for (size_t k = 0; k < count; ++k) rays[k] = queue[first + k].ray;
-    Clock::time_point t0 = Clock::now();
-    const std::vector<CandidateScan> scans = scanner_(rays, options_);
-    s.stats.scan_ms += ms_since(t0);
-    if (scans.size() != count) {
-      throw RuntimeFailure("deferred searches: the scanner gave " + std::to_string(scans.size()) + " scans for " +
-                           std::to_string(count) + " rays");
+  // THE WINDOW: the rays' first texels first; a ray whose answer needs more is scanned again
+  // whole.
+  SearchOptions window = options_;
+  const uint32_t whole = options_.max_texels > 0 ? options_.max_texels : 16 * ctx_.cube().n + 64;
+  const bool windowed = deferred_.window_texels > 0 && deferred_.window_texels < whole;
+  window.max_texels = deferred_.window_texels;
+  std::vector<const Queued*> items, left;
+  for (size_t first = 0; first < queue.size(); first += deferred_.batch_rays) {
+    const size_t count = std::min(deferred_.batch_rays, queue.size() - first);
+    items.resize(count);
+    for (size_t k = 0; k < count; ++k) items[k] = &queue[first + k];
+    left.clear();
+    if (windowed) {
+      // Shadow segments end at their light, and most walk to it: whole at once.
+      std::vector<const Queued*> reflections;
+      for (const Queued* q : items) (q->shadow ? left : reflections).push_back(q);
+      const size_t shadows = left.size();
+      if (!reflections.empty()) scan_and_answer(reflections, window, &left);
+      store_->stats.rescanned += left.size() - shadows;
+      if (!left.empty()) scan_and_answer(left, options_, nullptr);
+    } else {
+      scan_and_answer(items, options_, nullptr);
     }
-    t0 = Clock::now();
-    found.assign(count, SearchResult{});
-    shadowed.assign(count, ShadowResult{});
-    parallel_for(count, thread_count(threads_, count), [&](size_t k, int) {
-      const Queued& q = queue[first + k];
-      if (q.shadow) {
-        shadowed[k] = shadow_from_candidates(ctx_, q.ray, q.light, options_, scans[k]);
-      } else {
-        found[k] = search_from_candidates(ctx_, q.ray, options_, scans[k]);
-      }
-    });
-    for (size_t k = 0; k < count; ++k) {
-      const Queued& q = queue[first + k];
-      if (q.shadow) {
-        s.shadows.emplace(key_of(q.ray, &q.light), shadowed[k]);
-      } else {
-        s.searches.emplace(key_of(q.ray, nullptr), found[k]);
-      }
-      s.stats.candidates += scans[k].candidates.size();
-    }
-    s.stats.answer_ms += ms_since(t0);
-    ++s.stats.batches;
-    s.stats.rays += count;
+    store_->stats.rays += count;
   }
+}
+
+void DeferredSearches::scan_and_answer(const std::vector<const Queued*>& items, const SearchOptions& scan_options,
+                                       std::vector<const Queued*>* left) {
+  Store& s = *store_;
+  std::vector<SearchRay> rays(items.size());
+  for (size_t k = 0; k < items.size(); ++k) rays[k] = items[k]->ray;
+  Clock::time_point t0 = Clock::now();
+  const std::vector<CandidateScan> scans = scanner_(rays, scan_options);
+  s.stats.scan_ms += ms_since(t0);
+  ++s.stats.batches;
+  if (scans.size() != items.size()) {
+    throw RuntimeFailure("deferred searches: the scanner gave " + std::to_string(scans.size()) + " scans for " +
+                         std::to_string(items.size()) + " rays");
+  }
+  t0 = Clock::now();
+  std::vector<SearchResult> found(items.size());
+  std::vector<ShadowResult> shadowed(items.size());
+  std::vector<uint8_t> complete(items.size(), 1);
+  parallel_for(items.size(), thread_count(deferred_.threads, items.size()), [&](size_t k, int) {
+    const Queued& q = *items[k];
+    bool whole = true;
+    if (q.shadow) {
+      shadowed[k] = shadow_from_candidates(ctx_, q.ray, q.light, options_, scans[k], &whole);
+    } else {
+      found[k] = search_from_candidates(ctx_, q.ray, options_, scans[k], &whole);
+    }
+    complete[k] = whole || !left ? 1 : 0;
+  });
+  for (size_t k = 0; k < items.size(); ++k) {
+    const Queued& q = *items[k];
+    s.stats.candidates += scans[k].candidates.size();
+    if (!complete[k]) {
+      left->push_back(&q);
+    } else if (q.shadow) {
+      s.shadows.emplace(key_of(q.ray, &q.light), shadowed[k]);
+    } else {
+      s.searches.emplace(key_of(q.ray, nullptr), found[k]);
+    }
+  }
+  s.stats.answer_ms += ms_since(t0);
 }
 
 DeferredSearchStats DeferredSearches::stats() const {
   DeferredSearchStats out = store_->stats;
   out.answers_used = store_->used.load();
+  out.walked_now = store_->walked_now.load();
   return out;
 }
 

@@ -25,6 +25,10 @@
 
 namespace abcube {
 
+// What one ray holds in the store: its key, its answer or its place in the queue, and the
+// hash table's share (DeferredSearchOptions::max_bytes counts these).
+constexpr uint64_t DEFERRED_ENTRY_BYTES = 512;
+
 // Every ray's scan_candidates(ctx, ray, options), however computed.
 using CandidateScanner =
     std::function<std::vector<CandidateScan>(const std::vector<SearchRay>&, const SearchOptions& options)>;
@@ -33,27 +37,44 @@ using CandidateScanner =
 // deferred searches against, with no GL.
 CandidateScanner cpu_candidate_scanner(const SearchContext& ctx, int threads);
 
+struct DeferredSearchOptions {
+  int threads = 0;               // answering the candidates; 0: every core
+  size_t batch_rays = 1u << 16;  // the most rays one scanner call gets
+  // The most bytes the answers and the queue may hold (0: no cap; DEFERRED_ENTRY_BYTES a
+  // ray). A search that would pass it is walked at once by the CPU (the same answer), so a
+  // large image's memory stays bounded and its image the same.
+  uint64_t max_bytes = 0;
+  // THE WINDOW: each batch's reflections and refraction exits are scanned over their first
+  // `window_texels` texels (0: whole walks); a ray whose answer needs texels past them
+  // (search_from_candidates' `complete`) is scanned again, whole. A reflection's answer often
+  // lies a few texels along its walk, where the GPU's scan walks to the end. Shadow segments,
+  // which mostly walk to their light, are scanned whole at once.
+  uint32_t window_texels = 0;
+};
+
 struct DeferredSearchStats {
-  uint64_t passes = 0;   // render passes run (the last one asked nothing new)
-  uint64_t batches = 0;  // scanner calls
-  uint64_t rays = 0;     // rays scanned: searches and shadow segments
+  uint64_t passes = 0;     // render passes run (the last one asked nothing new)
+  uint64_t batches = 0;    // scanner calls
+  uint64_t rays = 0;       // rays scanned: searches and shadow segments
+  uint64_t rescanned = 0;  // of those, scanned again whole past THE WINDOW
   uint64_t candidates = 0;
-  uint64_t answers_used = 0;  // answers the last pass asked for
+  uint64_t answers_used = 0;  // answers the last pass took from the batches
+  uint64_t walked_now = 0;    // searches the last pass walked on the CPU, the store full
+  uint64_t bytes = 0;         // the most the answers and the queue held
   double scan_ms = 0, answer_ms = 0;
 };
 
 class DeferredSearches {
  public:
   // The crossing mode over all layers only (search_from_candidates): InputError otherwise.
-  // `batch_rays`: the most rays one scanner call gets.
-  DeferredSearches(const SearchContext& ctx, const SearchOptions& options, CandidateScanner scanner, int threads = 0,
-                   size_t batch_rays = DEFAULT_BATCH_RAYS);
+  DeferredSearches(const SearchContext& ctx, const SearchOptions& options, CandidateScanner scanner,
+                   const DeferredSearchOptions& deferred = {});
   ~DeferredSearches();
   DeferredSearches(const DeferredSearches&) = delete;
   DeferredSearches& operator=(const DeferredSearches&) = delete;
 
-  // search_along(ctx, q, options): the answer when a batch gave it, else a miss, with q queued.
-  // Thread-safe within a pass.
+  // search_along(ctx, q, options): the answer when a batch gave it, else a miss, with q queued
+  // (or the walk's own answer when the store is full). Thread-safe within a pass.
   SearchResult search(const SearchRay& q);
   // shadow_along(ctx, q, light_position, options), the same way (a stand-in lets the light through).
   ShadowResult shadow(const SearchRay& q, const glm::dvec3& light_position);
@@ -64,19 +85,21 @@ class DeferredSearches {
   size_t queued() const;
   // Scans the queued rays in batches, answers them, and empties the queue. Not during a pass.
   void answer_queued();
-  // The counts so far (answers_used: of the last pass).
+  // The counts so far (answers_used, walked_now: of the last pass).
   DeferredSearchStats stats() const;
 
-  static constexpr size_t DEFAULT_BATCH_RAYS = 1u << 16;
-
   struct Store;
+  struct Queued;
 
  private:
+  // Scans `items` with `scan_options` and stores their answers; with `left`, the rays whose
+  // answer the scan cannot give (cut by its cap) go there instead.
+  void scan_and_answer(const std::vector<const Queued*>& items, const SearchOptions& scan_options,
+                       std::vector<const Queued*>* left);
   const SearchContext& ctx_;
   SearchOptions options_;
   CandidateScanner scanner_;
-  int threads_;
-  size_t batch_rays_;
+  DeferredSearchOptions deferred_;
   std::unique_ptr<Store> store_;
 };
 

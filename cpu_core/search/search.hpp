@@ -345,8 +345,12 @@ SearchResult search_along(const SearchContext& ctx, const SearchRay& q, const Se
 // so the answer is search_along's (same_answer) but for the walk's counts of texels, nodes
 // and fragments read, which a list of candidates does not hold (left 0). The crossing mode over
 // all layers only (InputError otherwise).
+// `complete` (optional): false when the scan's walk was cut by its cap (CandidateScan::aborted)
+// before the choice stopped: the answer might then need the texels past the cap. True: the
+// answer is the one the whole walk gives, whatever the cap (a scan of a walk's first texels
+// can so answer most rays).
 SearchResult search_from_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options,
-                                    const CandidateScan& scan);
+                                    const CandidateScan& scan, bool* complete = nullptr);
 // shadow_search's walk of segment q to the light at light_position (shadow_ray), without a
 // known blocker.
 ShadowResult shadow_along(const SearchContext& ctx, const SearchRay& q, const glm::dvec3& light_position,
@@ -354,7 +358,7 @@ ShadowResult shadow_along(const SearchContext& ctx, const SearchRay& q, const gl
 // shadow_search's answer (without a known blocker) from the candidates of its segment q to
 // the light at light_position (shadow_ray), the same way.
 ShadowResult shadow_from_candidates(const SearchContext& ctx, const SearchRay& q, const glm::dvec3& light_position,
-                                    const SearchOptions& options, const CandidateScan& scan);
+                                    const SearchOptions& options, const CandidateScan& scan, bool* complete = nullptr);
 // Whether an answer from candidates is the walked search's: same_answer but for the walk's
 // counts of texels, nodes and fragments read.
 bool same_found(const SearchResult& walked, const SearchResult& from_candidates);

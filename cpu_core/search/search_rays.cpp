@@ -387,22 +387,26 @@ ScanCounts replay(const SearchContext& ctx, const SearchRay& q, const SearchOpti
 }  // namespace
 
 SearchResult search_from_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options,
-                                    const CandidateScan& scan) {
+                                    const CandidateScan& scan, bool* complete) {
   CrossingChoice choice(ctx, q, options);
-  return choice.answer(replay(
+  const ScanCounts counts = replay(
       ctx, q, options, scan, [&](const Candidate& c) { choice.take(c); },
-      [&](double l1, uint32_t index) { return choice.after_texel(l1, index); }));
+      [&](double l1, uint32_t index) { return choice.after_texel(l1, index); });
+  if (complete) *complete = !counts.aborted;
+  return choice.answer(counts);
 }
 
 ShadowResult shadow_from_candidates(const SearchContext& ctx, const SearchRay& q, const glm::dvec3& light_position,
-                                    const SearchOptions& options, const CandidateScan& scan) {
+                                    const SearchOptions& options, const CandidateScan& scan, bool* complete) {
   ShadowChoice choice(ctx, q, options, light_position);
-  return choice.answer(replay(
+  const ScanCounts counts = replay(
       ctx, q, options, scan,
       [&](const Candidate& c) {
         if (!choice.blocked()) choice.take(c);
       },
-      [&](double, uint32_t) { return !choice.blocked(); }));
+      [&](double, uint32_t) { return !choice.blocked(); });
+  if (complete) *complete = !counts.aborted;
+  return choice.answer(counts);
 }
 
 }  // namespace abcube

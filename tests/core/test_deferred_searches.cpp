@@ -30,7 +30,8 @@ SceneData deferred_scene(const std::string& path, int width, int cube_n) {
 // Every repository scene and kept hard case with mirrors, glass, nested media, shadows and
 // textures, under each shading plan whose passes depend on earlier answers (the quarters split
 // on the first quarters' colours, shadow and secondary edges, the sparse pass): the image and
-// the searches' counts are the CPU searches'.
+// the searches' counts are the CPU searches', whether each batch is scanned whole or over its
+// rays' first texels first (THE WINDOW).
 TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
   std::vector<std::string> scenes = {"scenes/cornell.json",
                                      "tests/hard/regressions/nested_glass_5000_78.json",
@@ -52,7 +53,7 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
     scenes.resize(2);
     plans.resize(2);
   }
-  uint64_t most_passes = 0, rays = 0;
+  uint64_t most_passes = 0, rays = 0, rescanned = 0;
   for (const std::string& file : scenes) {
     const SceneData s = deferred_scene(file, 48, 40);
     const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, s.render.cube_resolution);
@@ -64,8 +65,13 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
       MapShadingStats walked_stats, deferred_stats;
       const Image a = render_with_map(s, camera, walked, 2, &walked_stats);
       MapShader shader(s, cube, o);
+      DeferredSearchOptions small;
+      small.threads = 2;
+      small.batch_rays = 97;  // many small batches
+      // THE WINDOW, short enough that many rays are scanned again whole (the sparse plan: none).
+      small.window_texels = &plan - plans.data() == 1 ? 0 : 6;
       DeferredSearches deferred(shader.context(), shader.options().search, cpu_candidate_scanner(shader.context(), 2),
-                                2, 97);  // many small batches
+                                small);
       shader.defer_searches(&deferred);
       const Image b = render_with_map(s, camera, shader, 2, &deferred_stats);
       const DeferredSearchStats d = deferred.stats();
@@ -81,18 +87,48 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
       // Every search the last pass asked was answered by a batch (the known blockers' aside).
       const uint64_t walks = x.reflection.rays + x.refraction_exit.rays + x.shadow.rays - x.shadow.known_blockers;
       EXPECT_EQ(d.answers_used, walks) << what;
+      EXPECT_EQ(d.walked_now, 0u) << what;
       EXPECT_GT(d.rays, walks > 0 ? 0u : d.rays) << what;
       std::printf("[ deferred ] %s: %llu passes, %llu rays scanned, %llu answers used\n", what.c_str(),
                   static_cast<unsigned long long>(d.passes), static_cast<unsigned long long>(d.rays),
                   static_cast<unsigned long long>(walks));
       EXPECT_GE(d.passes, walks > 0 ? 2u : 1u) << what;
       most_passes = std::max(most_passes, d.passes);
+      rescanned += d.rescanned;
       rays += d.rays;
     }
   }
-  std::printf("[ deferred ] %llu rays scanned; at most %llu passes\n", static_cast<unsigned long long>(rays),
+  std::printf("[ deferred ] %llu rays scanned (%llu again whole, past the window); at most %llu passes\n",
+              static_cast<unsigned long long>(rays), static_cast<unsigned long long>(rescanned),
               static_cast<unsigned long long>(most_passes));
   EXPECT_GT(rays, checked ? 1000u : 10000u);
+  EXPECT_GT(rescanned, rays / 20);  // THE WINDOW cut that many walks, and kept every image
+}
+
+// A store with room for a few hundred rays: the searches past it are walked at once by the
+// CPU, each pass, and the image is still the walked searches', bit for bit, in bounded memory.
+TEST(DeferredSearches, AFullStoreWalksTheRestAndKeepsTheImage) {
+  const SceneData s = deferred_scene("scenes/cornell.json", 40, 32);
+  const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, s.render.cube_resolution);
+  const ABuffer camera = build_camera_abuffer(s);
+  const MapShader walked(s, cube, MapShadingOptions{});
+  const Image a = render_with_map(s, camera, walked, 2, nullptr);
+  MapShader shader(s, cube, MapShadingOptions{});
+  DeferredSearchOptions small;
+  small.max_bytes = 300 * DEFERRED_ENTRY_BYTES;
+  DeferredSearches deferred(shader.context(), shader.options().search, cpu_candidate_scanner(shader.context(), 2),
+                            small);
+  shader.defer_searches(&deferred);
+  MapShadingStats stats;
+  const Image b = render_with_map(s, camera, shader, 2, &stats);
+  const DeferredSearchStats d = deferred.stats();
+  EXPECT_EQ(a.data, b.data);
+  EXPECT_LE(d.bytes, small.max_bytes);
+  EXPECT_GT(d.answers_used, 100u);
+  EXPECT_GT(d.walked_now, 1000u);
+  const SearchStats& x = stats.searches;
+  EXPECT_EQ(d.answers_used + d.walked_now,
+            x.reflection.rays + x.refraction_exit.rays + x.shadow.rays - x.shadow.known_blockers);
 }
 
 // The crossing mode over all layers only: the thesis mode and the Z-buffer's nearest layer

@@ -18,6 +18,7 @@
 #include "render/stats_json.hpp"
 #include "render/target_db.hpp"
 #include "scene/plan.hpp"
+#include "scene/scene_load.hpp"
 #include "search/deferred_searches.hpp"
 #include "shading/fragment_texture.hpp"
 #include "shading/resolve.hpp"
@@ -60,7 +61,8 @@ struct GlSearches {
 };
 
 // Where the searches walk and why, in stats["plan"]["searches_on"]; the GL's scan when there.
-GlSearches gl_searches(MethodContext& mc, MapShader& shader) {
+// `held_bytes`: the A-buffers' (the memory budget's share the searches may not take).
+GlSearches gl_searches(MethodContext& mc, MapShader& shader, uint64_t held_bytes) {
   using SearchOn = RenderRequest::SearchOn;
   const RenderRequest& r = mc.request;
   GlSearches g;
@@ -90,9 +92,16 @@ GlSearches gl_searches(MethodContext& mc, MapShader& shader) {
   }
   if (on) {
     const GlCandidateScan& scan = *g.scan;
+    // The answers' store takes at most half of what the render's budget leaves beside the
+    // A-buffers; searches past it walk on the CPU (the same answers).
+    const uint64_t budget = memory_budget_bytes(r.abuffer.max_memory_bytes);
+    DeferredSearchOptions d;
+    d.threads = r.threads;
+    d.max_bytes = std::max<uint64_t>(budget > held_bytes ? (budget - held_bytes) / 2 : 0, DEFERRED_ENTRY_BYTES);
+    // THE WINDOW stays off: on llvmpipe its second scans cost what the shorter walks save.
     g.deferred = std::make_unique<DeferredSearches>(
         shader.context(), shader.options().search,
-        [&scan](const std::vector<SearchRay>& rays, const SearchOptions& o) { return scan.scan(rays, o); }, r.threads);
+        [&scan](const std::vector<SearchRay>& rays, const SearchOptions& o) { return scan.scan(rays, o); }, d);
     shader.defer_searches(g.deferred.get());
   }
   mc.stats["plan"]["searches_on"] = {{"where", on ? "gpu" : "cpu"}, {"why", why}};
@@ -107,7 +116,10 @@ void record_gl_searches(const GlSearches& g, MethodContext& mc) {
                                       {"batches", d.batches},
                                       {"rays", d.rays},
                                       {"candidates", d.candidates},
-                                      {"answers_used", d.answers_used}};
+                                      {"answers_used", d.answers_used},
+                                      {"walked_now", d.walked_now},
+                                      {"rescanned", d.rescanned},
+                                      {"bytes", d.bytes}};
   mc.record.timings_ms["gpu_search_upload"] = g.upload_ms;
   mc.record.timings_ms["gpu_search_scan"] = d.scan_ms;
   mc.record.timings_ms["search_answers"] = d.answer_ms;
@@ -179,7 +191,8 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   stats["cube_abuffer"] = cube_abuffer_json(map.stats);
   mc.record.timings_ms["map_setup"] = map.setup_ms;
   mc.record.timings_ms["camera_abuffer"] = camera_ms;
-  const GlSearches on_gl = mc.gl_scene ? gl_searches(mc, *map.shader) : GlSearches{};
+  const GlSearches on_gl =
+      mc.gl_scene ? gl_searches(mc, *map.shader, as.bytes_total + map.stats.bytes_total) : GlSearches{};
   const Clock::time_point t0 = Clock::now();
   MapShadingStats ms;
   std::function<void(double)> shading;
