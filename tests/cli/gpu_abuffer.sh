@@ -152,6 +152,15 @@ check "hybrid --search-on gpu: hybrid's image with the searches on the CPU" bash
   --method hybrid --search-on gpu --size 40x30 --cube-res 32 -o '$WORK/h_gpu.exr' --stats '$WORK/h.json' &&
   '$ABCUBE' render '$CORNELL' --method hybrid --search-on cpu --size 40x30 --cube-res 32 -o '$WORK/h_cpu.exr' &&
   cmp '$WORK/h_gpu.exr' '$WORK/h_cpu.exr' && grep -q '\"where\": *\"gpu\"' '$WORK/h.json'"
+check "abcube report: gpu_abuffer with its searches on the GPU, a method beside abuffer, the same error" bash -c "
+  '$ABCUBE' report '$CORNELL' -o '$WORK/report' --methods abuffer,gpu_abuffer --search-on gpu --size 32x24 \
+    --cube-res 24 --no-crosscheck > /dev/null &&
+  $PY -c 'import json, sys
+r = json.load(open(sys.argv[1] + \"/report.json\"))
+a, g = r[\"methods\"][\"abuffer\"], r[\"methods\"][\"gpu_abuffer\"]
+assert a[\"error\"] == g[\"error\"], (a[\"error\"], g[\"error\"])
+s = json.load(open(sys.argv[1] + \"/\" + g[\"stats\"]))
+assert s[\"plan\"][\"searches_on\"][\"where\"] == \"gpu\", s[\"plan\"]' '$WORK/report'"
 refused() {  # WHAT PATTERN ARGS...: exit 2, one line matching PATTERN, no image
   local what=$1 pattern=$2 status
   shift 2
