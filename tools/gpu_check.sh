@@ -14,6 +14,7 @@
 #   4. the race: raytrace, abuffer, gpu, hybrid and gpu_abuffer at 640x480 and 1920x1080,
 #      per-pass times
 #   4b. gpu_abuffer against abuffer on every repository scene: the same bytes, build times
+#   4c. gpu_abuffer with its searches on the GPU against them on the CPU (the GPU only)
 #   5. the cube passes and the A-buffer build at N = 512, 1024, 2048, 4096
 #   6. 1000 renders in one process (abcube batch): time per render and peak memory
 # A section that fails is reported as failed and the check goes on; the exit status is 1
@@ -157,6 +158,29 @@ for scene in "$SCENES"/*.json; do
     say "| $name | $label | $same | $(json_ms "$OUT/ab_gpu.json" camera_abuffer) ($(json_ms "$OUT/ab_cpu.json" camera_abuffer)) | $(json_ms "$OUT/ab_gpu.json" cube_abuffer) ($(json_ms "$OUT/ab_cpu.json" cube_abuffer)) |"
   done
   [ $device = none ] && say "| $name | gpu | no device | | |"
+done
+say ""
+
+# 4c. The searches on the GPU: gpu_abuffer --search-on gpu against --search-on cpu, on the GPU
+# only (llvmpipe's scan of a 640x480 image takes minutes; bench/gpu_searches.py measures it).
+say "## 4c. gpu_abuffer --search-on gpu against --search-on cpu (${SIZES%% *}, N = 512)"
+say ""
+say "| scene | the same bytes | total ms, searches on the GPU | GPU scan ms | passes, rays scanned | total ms, searches on the CPU |"
+say "|---|---|---|---|---|---|"
+for scene in "$SCENES"/*.json; do
+  name=$(basename "$scene" .json)
+  if [ $device = none ]; then say "| $name | no device | | | | |"; continue; fi
+  if over_budget; then say "| $name | skipped: over the time budget | | | | |"; continue; fi
+  ok=yes
+  for on in cpu gpu; do
+    "$A" render "$scene" -o "$OUT/so_$on.exr" --size "${SIZES%% *}" --cube-res 512 --method gpu_abuffer \
+      --search-on $on --gl egl-device --stats "$OUT/so_$on.json" > "$OUT/so.log" 2>&1 || ok=no
+  done
+  if [ $ok = no ]; then failures=$((failures + 1)); say "| $name | **failed** ($(tail -n 1 "$OUT/so.log")) | | | | |"; continue; fi
+  same=yes
+  cmp -s "$OUT/so_cpu.exr" "$OUT/so_gpu.exr" || same="no: $("$A" compare "$OUT/so_gpu.exr" "$OUT/so_cpu.exr" | tr '\n' ' ')"
+  deferred=$(tr -d ' \n' < "$OUT/so_gpu.json" | sed -n 's/.*"deferred":{\([^}]*\)}.*/\1/p' | tr ',' ' ')
+  say "| $name | $same | $(json_ms "$OUT/so_gpu.json" total) | $(json_ms "$OUT/so_gpu.json" gpu_search_scan) | $deferred | $(json_ms "$OUT/so_cpu.json" total) |"
 done
 say ""
 
