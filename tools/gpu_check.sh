@@ -165,7 +165,7 @@ say ""
 # only (llvmpipe's scan of a 640x480 image takes minutes; bench/gpu_searches.py measures it).
 say "## 4c. gpu_abuffer --search-on gpu against --search-on cpu (${SIZES%% *}, N = 512)"
 say ""
-say "| scene | the same bytes | total ms, searches on the GPU | GPU scan ms | passes, rays scanned | total ms, searches on the CPU |"
+say "| scene | the same bytes | total ms, searches on the GPU | GPU scan ms | searches.deferred | total ms, searches on the CPU |"
 say "|---|---|---|---|---|---|"
 for scene in "$SCENES"/*.json; do
   name=$(basename "$scene" .json)
