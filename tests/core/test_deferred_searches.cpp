@@ -18,6 +18,12 @@
 namespace abcube {
 namespace {
 
+// The sanitizers' builds (tools/sanitize.sh sets ABCUBE_CHECKED_BUILD).
+bool checked_build() {
+  const char* env = std::getenv("ABCUBE_CHECKED_BUILD");
+  return env && std::string(env) == "1";
+}
+
 SceneData deferred_scene(const std::string& path, int width, int cube_n) {
   SceneData s = load_scene(std::string(ABCUBE_SOURCE_DIR) + "/" + path);
   const double aspect = static_cast<double>(s.camera.width) / s.camera.height;
@@ -46,16 +52,15 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
       ShadingPlan(ShadingPoints::one, false, false),
   };
   // The checked builds (tools/sanitize.sh) check the code: mirrors, glass and shadows, the
-  // quarters and the sparse pass.
-  const char* env = std::getenv("ABCUBE_CHECKED_BUILD");
-  const bool checked = env && std::string(env) == "1";
+  // quarters and the sparse pass, on fewer pixels.
+  const bool checked = checked_build();
   if (checked) {
     scenes.resize(2);
     plans.resize(2);
   }
   uint64_t most_passes = 0, rays = 0, rescanned = 0;
   for (const std::string& file : scenes) {
-    const SceneData s = deferred_scene(file, 48, 40);
+    const SceneData s = deferred_scene(file, checked ? 20 : 48, 40);
     const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, s.render.cube_resolution);
     const ABuffer camera = build_camera_abuffer(s);
     for (const ShadingPlan& plan : plans) {
@@ -108,14 +113,14 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
 // A store with room for a few hundred rays: the searches past it are walked at once by the
 // CPU, each pass, and the image is still the walked searches', bit for bit, in bounded memory.
 TEST(DeferredSearches, AFullStoreWalksTheRestAndKeepsTheImage) {
-  const SceneData s = deferred_scene("scenes/cornell.json", 40, 32);
+  const SceneData s = deferred_scene("scenes/cornell.json", checked_build() ? 20 : 40, 32);
   const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, s.render.cube_resolution);
   const ABuffer camera = build_camera_abuffer(s);
   const MapShader walked(s, cube, MapShadingOptions{});
   const Image a = render_with_map(s, camera, walked, 2, nullptr);
   MapShader shader(s, cube, MapShadingOptions{});
   DeferredSearchOptions small;
-  small.max_bytes = 300 * DEFERRED_ENTRY_BYTES;
+  small.max_bytes = (checked_build() ? 100 : 300) * DEFERRED_ENTRY_BYTES;
   DeferredSearches deferred(shader.context(), shader.options().search, cpu_candidate_scanner(shader.context(), 2),
                             small);
   shader.defer_searches(&deferred);
@@ -124,8 +129,8 @@ TEST(DeferredSearches, AFullStoreWalksTheRestAndKeepsTheImage) {
   const DeferredSearchStats d = deferred.stats();
   EXPECT_EQ(a.data, b.data);
   EXPECT_LE(d.bytes, small.max_bytes);
-  EXPECT_GT(d.answers_used, 100u);
-  EXPECT_GT(d.walked_now, 1000u);
+  EXPECT_GT(d.answers_used, 50u);
+  EXPECT_GT(d.walked_now, checked_build() ? 200u : 1000u);
   const SearchStats& x = stats.searches;
   EXPECT_EQ(d.answers_used + d.walked_now,
             x.reflection.rays + x.refraction_exit.rays + x.shadow.rays - x.shadow.known_blockers);
