@@ -9,8 +9,9 @@ The scenes: the repository's (scenes/*.json) and `--count` generated hard scenes
 (tools/hard_scenes.py, the templates cycled), all at --size and --cube-res. Each is rendered
 by `gpu_abuffer --search-on cpu` and `--search-on gpu`, interleaved, --runs times. The table
 gives the median wall time of the whole process [min, max], the median scan time of the
-GPU, the passes, the rays scanned and the answers the last pass used, and whether the two
-images are the same bytes (they must be). Writes OUT.md.
+GPU, the passes, the rays scanned, the texels their scans walked a ray, the share of scans a
+STOP HINT ended and the rays scanned again whole, the answers the last pass used, and whether
+the two images are the same bytes (they must be). Writes OUT.md.
 """
 import argparse
 import filecmp
@@ -71,9 +72,11 @@ def main():
                     scan.append(stats["timings_ms"].get("gpu_search_scan", 0.0) / 1000.0)
                     deferred = stats["searches"]["deferred"]
         same = filecmp.cmp(last["cpu"], last["gpu"], shallow=False)
+        rays = max(deferred["rays"], 1)
         rows.append((os.path.basename(scene), spread(times["cpu"]), spread(times["gpu"]),
                      f"{statistics.median(scan):.2f}", deferred["passes"], deferred["rays"],
-                     deferred["answers_used"], "yes" if same else "NO",
+                     f"{deferred['texels'] / rays:.0f}", f"{100.0 * deferred['stopped'] / rays:.0f}%",
+                     deferred["rescanned"], deferred["answers_used"], "yes" if same else "NO",
                      statistics.median(times["gpu"]) / statistics.median(times["cpu"])))
         print(rows[-1], flush=True)
     renderer = stats["gl"]["renderer"]
@@ -83,8 +86,9 @@ def main():
                 f"--runs {args.runs} --size {args.size} --cube-res {args.cube_res} --seed {args.seed} "
                 f"--count {args.count}`. Wall seconds of the whole process, median [min, max] of {args.runs} "
                 "interleaved runs; the GPU's scan time is the median of `timings_ms.gpu_search_scan`.\n\n")
-        f.write("| scene | --search-on cpu s | --search-on gpu s | GPU scan s | passes | rays scanned | answers used "
-                "| same bytes | gpu / cpu |\n|---|---|---|---|---|---|---|---|---|\n")
+        f.write("| scene | --search-on cpu s | --search-on gpu s | GPU scan s | passes | rays scanned | texels a ray "
+                "| ended by a stop hint | scanned again | answers used | same bytes | gpu / cpu |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|\n")
         for r in rows:
             f.write("| " + " | ".join(str(x) for x in r[:-1]) + f" | {r[-1]:.1f} |\n")
     print("wrote", args.out + ".md")

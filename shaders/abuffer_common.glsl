@@ -27,12 +27,6 @@ struct View {
   int width, first_pixel;  // pixels a row, and the view's first pixel in the build's pixel order
 };
 
-// A fragment as the CPU stores it (raster/abuffer.hpp Fragment, 20 bytes).
-struct Fragment {
-  float zmin, zmax;
-  uint mask, id, normal;
-};
-
 layout(std430, binding = ABUFFER_SETUPS_BINDING) readonly buffer Setups { Setup setups[]; };
 // The count and fill passes' work items: (setup, tile of its pixel bounds), an invocation each.
 layout(std430, binding = ABUFFER_ITEMS_BINDING) readonly buffer Items { uvec2 items[]; };

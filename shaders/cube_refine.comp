@@ -5,35 +5,7 @@
 layout(local_size_x = 64) in;
 
 uniform uint groups_per_row;
-uniform double tolerance_texels;  // SearchOptions::tolerance_texels
-uniform bool refine_mesh;         // SearchOptions::refine is mesh
-
-// distance_to_triangle (search_candidates.cpp): p's distance from triangle v0 v1 v2 whose
-// plane has unit normal n and offset o.
-double distance_to_triangle(dvec3 p, dvec3 v[3], dvec3 n, double o) {
-  precise double off_plane = dot3(n, p) - o;
-  precise dvec3 q = p - off_plane * n;
-  bool inside = true;
-  for (int k = 0; k < 3; ++k) {
-    precise dvec3 edge = v[(k + 1) % 3] - v[k];
-    precise dvec3 to_q = q - v[k];
-    inside = inside && dot3(cross3(edge, to_q), n) >= 0.0lf;
-  }
-  if (inside) return abs(off_plane);
-  double in_plane = inf();
-  for (int k = 0; k < 3; ++k) {
-    precise dvec3 e = v[(k + 1) % 3] - v[k];
-    double len2 = dot3(e, e);
-    precise dvec3 to_q = q - v[k];
-    precise double along = dot3(to_q, e) / len2;
-    double u = len2 > 0.0lf ? std_min(std_max(along, 0.0lf), 1.0lf) : 0.0lf;
-    precise dvec3 foot = v[k] + u * e;
-    precise dvec3 away = q - foot;
-    in_plane = std_min(in_plane, length3(away));
-  }
-  precise double squares = in_plane * in_plane + off_plane * off_plane;
-  return sqrt(squares);
-}
+uniform bool refine_mesh;  // SearchOptions::refine is mesh
 
 void answer(uint index, uint flags, double l, double outside, uint triangle, uint mesh_tested) {
   candidates[index].flags = flags;
@@ -55,25 +27,10 @@ void main() {
   uint tri = c.id & ~BACK_FACE_BIT;
   double l0 = c.interval.x, l1 = c.interval.y;
   EdgePlanes p = edge_planes(tri);  // its plane is SearchContext::plane's
-  double den = dot3(p.normal, refine_d);
-  precise double to_plane = p.offset - dot3(p.normal, refine_w);
-  precise double at = to_plane / den;
-  double l = den == 0.0lf ? inf() : at;
-  precise double slack = 1e-9lf * (abs(l) + length3(refine_w));
-  precise double lo = l0 - slack;
-  precise double hi = l1 + slack;
-  bool in_texel = den != 0.0lf && l >= refine_self && l <= refine_l_max && l >= lo && l <= hi;
-  bool tested = false, exact = false;
-  double found_l = inf(), outside = 0.0lf;
-  if (in_texel) {
-    precise dvec3 x = refine_w + l * refine_d;
-    dvec3 v[3] = dvec3[3](tri_vertex(tri, 0u), tri_vertex(tri, 1u), tri_vertex(tri, 2u));
-    precise double o = distance_to_triangle(x, v, p.normal, p.offset) / texel_size_at(x);
-    outside = o;
-    found_l = l;
-    exact = outside <= on_triangle_texels;
-    tested = true;
-  }
+  double l, outside;
+  bool tested = texel_crossing(tri, p.normal, p.offset, refine_w, refine_d, refine_self, refine_l_max, l0, l1, l, outside);
+  bool exact = tested && outside <= on_triangle_texels;
+  double found_l = tested ? l : inf();
   uint mesh_tested = 0u;
   if (!exact && refine_mesh) {
     precise double mid = 0.5lf * (l0 + l1);
@@ -92,7 +49,7 @@ void main() {
       return;
     }
     if (result == REFINED_MISS) {  // the mesh says the ray passes by: not a crossing
-      answer(index, in_texel ? 1u : 0u, found_l, inf(), 0u, mesh_tested);
+      answer(index, tested ? 1u : 0u, found_l, inf(), 0u, mesh_tested);
       return;
     }
   }

@@ -18,6 +18,8 @@ uniform dvec3 face_s_axis[6];
 uniform dvec3 face_t_axis[6];
 // CubeWalk's CENTRE_PASS_REL.
 uniform double centre_pass_rel;
+// The cube's n (texels a face side), for every pass that includes the walk.
+uniform int face_resolution;
 
 dvec3 walk_w, walk_d;
 int walk_n;

@@ -23,7 +23,6 @@ layout(std430, binding = CUBE_WALK_OFFSETS_BINDING) readonly buffer Offsets { ui
 uniform bool fill;  // false: the count pass
 uniform uint first_ray;
 uniform uint ray_count;
-uniform int face_resolution;
 uniform uint walk_cap_texels;
 uniform uint groups_per_row;
 

@@ -1,21 +1,15 @@
 // MESH REFINEMENT on the GPU (cpu_core/search/search_refine.cpp refine_on_mesh, with
-// SearchContext::compute_edge_planes and compute_bounding_sphere): the exact crossing of a
-// ray with the mesh around a fragment's triangle, first straight across the edges, then
-// breadth-first, operation for operation in double precision. The ray is set in refine_w,
-// refine_d, refine_self and refine_l_max.
+// SearchContext::compute_bounding_sphere): the exact crossing of a ray with the mesh around a
+// fragment's triangle, first straight across the edges, then breadth-first, operation for
+// operation in double precision, over triangle_geometry.glsl's triangles. The ray is set in
+// refine_w, refine_d, refine_self and refine_l_max.
 //
 // An invocation's loops are bounded well inside llvmpipe's 65535 passes: the straight walk's
 // GPU_REFINE_MAX_STEPS steps, then a flood of at most GPU_REFINE_MAX_TRIANGLES triangles, each with
 // its three neighbours, and the emptying of its set (TAKEN_SLOTS).
 
-// Per triangle its three vertices, as the scene's soup holds them (float x, y, z), and the
-// triangle across each edge (MeshNeighbours; NO_NEIGHBOUR on a border).
-layout(std430, binding = CUBE_SCAN_POSITIONS_BINDING) readonly buffer Positions { float tri_positions[]; };
+// Per triangle the triangle across each edge (MeshNeighbours; NO_NEIGHBOUR on a border).
 layout(std430, binding = CUBE_REFINE_NEIGHBOURS_BINDING) readonly buffer Neighbours { uint tri_neighbours[]; };
-
-uniform dvec3 centre;  // the cube's centre, world space
-uniform int face_resolution;
-uniform double on_triangle_texels;  // ON_TRIANGLE_TEXELS
 
 const uint NO_NEIGHBOUR = 0xffffffffu;
 const int NOT_TESTED = 3;
@@ -23,59 +17,6 @@ const int REFINED_HIT = 0, REFINED_MISS = 1, REFINED_UNKNOWN = 2;
 
 dvec3 refine_w, refine_d;
 double refine_self, refine_l_max;
-
-// SearchContext::vertex.
-dvec3 tri_vertex(uint tri, uint k) {
-  uint at = 9u * tri + 3u * k;
-  precise dvec3 v = dvec3(double(tri_positions[at]), double(tri_positions[at + 1u]), double(tri_positions[at + 2u])) -
-                    centre;
-  return v;
-}
-
-// texel_size_at (cube_walk.hpp): 2 |x|_inf / n.
-double texel_size_at(dvec3 x) {
-  double m = std_max(std_max(abs(x.x), abs(x.y)), abs(x.z));
-  precise double size = 2.0lf * m / double(face_resolution);
-  return size;
-}
-
-// SearchContext::EdgePlanes, computed as compute_edge_planes does (zero when degenerate).
-struct EdgePlanes {
-  dvec3 normal;
-  double offset;
-  dvec3 edge_normal[3];
-  double edge_offset[3];
-};
-
-EdgePlanes edge_planes(uint tri) {
-  EdgePlanes e;
-  e.normal = dvec3(0.0lf);
-  e.offset = 0.0lf;
-  for (int k = 0; k < 3; ++k) {
-    e.edge_normal[k] = dvec3(0.0lf);
-    e.edge_offset[k] = 0.0lf;
-  }
-  dvec3 v[3] = dvec3[3](tri_vertex(tri, 0u), tri_vertex(tri, 1u), tri_vertex(tri, 2u));
-  precise dvec3 ab = v[1] - v[0];
-  precise dvec3 ac = v[2] - v[0];
-  dvec3 n = cross3(ab, ac);
-  double len = length3(n);
-  if (!(len > 0.0lf && !isinf(len) && !isnan(len))) return e;
-  precise dvec3 unit = n / len;
-  e.normal = unit;
-  e.offset = dot3(unit, v[0]);
-  for (int k = 0; k < 3; ++k) {
-    precise dvec3 edge = v[(k + 1) % 3] - v[k];
-    dvec3 m = cross3(unit, edge);
-    double ml = length3(m);
-    if (ml > 0.0lf) {
-      precise dvec3 mn = m / ml;
-      e.edge_normal[k] = mn;
-    }
-    e.edge_offset[k] = dot3(e.edge_normal[k], v[k]);
-  }
-  return e;
-}
 
 // compute_bounding_sphere: (middle, radius); zero when degenerate.
 dvec4 bounding_sphere(uint tri) {

@@ -88,10 +88,12 @@ static_assert(sizeof(RayKey) + sizeof(SearchResult) + sizeof(DeferredSearches::Q
               "DEFERRED_ENTRY_BYTES covers a ray's key, answer, queue entry and table share");
 
 CandidateScanner cpu_candidate_scanner(const SearchContext& ctx, int threads) {
-  return [&ctx, threads](const std::vector<SearchRay>& rays, const SearchOptions& options) {
+  return [&ctx, threads](const std::vector<SearchRay>& rays, const SearchOptions& options,
+                         const std::vector<ScanStop>& stops) {
     std::vector<CandidateScan> out(rays.size());
-    parallel_for(rays.size(), thread_count(threads, rays.size()),
-                 [&](size_t k, int) { out[k] = scan_candidates(ctx, rays[k], options); });
+    parallel_for(rays.size(), thread_count(threads, rays.size()), [&](size_t k, int) {
+      out[k] = scan_candidates(ctx, rays[k], options, stops.empty() ? ScanStop::none : stops[k]);
+    });
     return out;
   };
 }
@@ -154,40 +156,32 @@ void DeferredSearches::answer_queued() {
     queue.swap(store_->queue);
     store_->queued_keys.clear();
   }
-  // THE WINDOW: the rays' first texels first; a ray whose answer needs more is scanned again
-  // whole.
-  SearchOptions window = options_;
-  const uint32_t whole = options_.max_texels > 0 ? options_.max_texels : 16 * ctx_.cube().n + 64;
-  const bool windowed = deferred_.window_texels > 0 && deferred_.window_texels < whole;
-  window.max_texels = deferred_.window_texels;
+  // STOP HINTS (search.hpp): each ray scanned to where its search likely stops; a ray whose
+  // answer needs more is scanned again, whole.
   std::vector<const Queued*> items, left;
   for (size_t first = 0; first < queue.size(); first += deferred_.batch_rays) {
     const size_t count = std::min(deferred_.batch_rays, queue.size() - first);
     items.resize(count);
     for (size_t k = 0; k < count; ++k) items[k] = &queue[first + k];
     left.clear();
-    if (windowed) {
-      // Shadow segments end at their light, and most walk to it: whole at once.
-      std::vector<const Queued*> reflections;
-      for (const Queued* q : items) (q->shadow ? left : reflections).push_back(q);
-      const size_t shadows = left.size();
-      if (!reflections.empty()) scan_and_answer(reflections, window, &left);
-      store_->stats.rescanned += left.size() - shadows;
-      if (!left.empty()) scan_and_answer(left, options_, nullptr);
-    } else {
-      scan_and_answer(items, options_, nullptr);
-    }
+    scan_and_answer(items, deferred_.stop_hints, deferred_.stop_hints ? &left : nullptr);
+    store_->stats.rescanned += left.size();
+    if (!left.empty()) scan_and_answer(left, false, nullptr);
     store_->stats.rays += count;
   }
 }
 
-void DeferredSearches::scan_and_answer(const std::vector<const Queued*>& items, const SearchOptions& scan_options,
+void DeferredSearches::scan_and_answer(const std::vector<const Queued*>& items, bool stop_hints,
                                        std::vector<const Queued*>* left) {
   Store& s = *store_;
   std::vector<SearchRay> rays(items.size());
-  for (size_t k = 0; k < items.size(); ++k) rays[k] = items[k]->ray;
+  std::vector<ScanStop> stops(stop_hints ? items.size() : 0);
+  for (size_t k = 0; k < items.size(); ++k) {
+    rays[k] = items[k]->ray;
+    if (stop_hints) stops[k] = items[k]->shadow ? ScanStop::shadow : ScanStop::crossing;
+  }
   Clock::time_point t0 = Clock::now();
-  const std::vector<CandidateScan> scans = scanner_(rays, scan_options);
+  const std::vector<CandidateScan> scans = scanner_(rays, options_, stops);
   s.stats.scan_ms += ms_since(t0);
   ++s.stats.batches;
   if (scans.size() != items.size()) {
@@ -211,6 +205,8 @@ void DeferredSearches::scan_and_answer(const std::vector<const Queued*>& items, 
   for (size_t k = 0; k < items.size(); ++k) {
     const Queued& q = *items[k];
     s.stats.candidates += scans[k].candidates.size();
+    s.stats.texels += scans[k].texels;
+    s.stats.stopped += scans[k].stopped ? 1 : 0;
     if (!complete[k]) {
       left->push_back(&q);
     } else if (q.shadow) {

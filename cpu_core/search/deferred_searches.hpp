@@ -29,9 +29,10 @@ namespace abcube {
 // hash table's share (DeferredSearchOptions::max_bytes counts these).
 constexpr uint64_t DEFERRED_ENTRY_BYTES = 512;
 
-// Every ray's scan_candidates(ctx, ray, options), however computed.
-using CandidateScanner =
-    std::function<std::vector<CandidateScan>(const std::vector<SearchRay>&, const SearchOptions& options)>;
+// Every ray's scan_candidates(ctx, ray, options, stops[ray]), however computed (`stops`
+// empty: ScanStop::none for all).
+using CandidateScanner = std::function<std::vector<CandidateScan>(
+    const std::vector<SearchRay>&, const SearchOptions& options, const std::vector<ScanStop>& stops)>;
 
 // scan_candidates on the CPU, ray by ray (`threads` 0: every core): a scanner to check the
 // deferred searches against, with no GL.
@@ -44,19 +45,19 @@ struct DeferredSearchOptions {
   // ray). A search that would pass it is walked at once by the CPU (the same answer), so a
   // large image's memory stays bounded and its image the same.
   uint64_t max_bytes = 0;
-  // THE WINDOW: each batch's reflections and refraction exits are scanned over their first
-  // `window_texels` texels (0: whole walks); a ray whose answer needs texels past them
-  // (search_from_candidates' `complete`) is scanned again, whole. A reflection's answer often
-  // lies a few texels along its walk, where the GPU's scan walks to the end. Shadow segments,
-  // which mostly walk to their light, are scanned whole at once.
-  uint32_t window_texels = 0;
+  // STOP HINTS (search.hpp): each batch's rays are scanned to where their search likely stops,
+  // not to the end of their walk; a ray whose answer needs more (search_from_candidates'
+  // `complete`) is scanned again, whole. Off: every walk scanned whole at once.
+  bool stop_hints = true;
 };
 
 struct DeferredSearchStats {
   uint64_t passes = 0;     // render passes run (the last one asked nothing new)
   uint64_t batches = 0;    // scanner calls
   uint64_t rays = 0;       // rays scanned: searches and shadow segments
-  uint64_t rescanned = 0;  // of those, scanned again whole past THE WINDOW
+  uint64_t stopped = 0;    // scans a STOP HINT ended before their walk's end
+  uint64_t rescanned = 0;  // rays scanned again whole, their answer past the hint
+  uint64_t texels = 0;     // texels the scans walked
   uint64_t candidates = 0;
   uint64_t answers_used = 0;  // answers the last pass took from the batches
   uint64_t walked_now = 0;    // searches the last pass walked on the CPU, the store full
@@ -92,10 +93,9 @@ class DeferredSearches {
   struct Queued;
 
  private:
-  // Scans `items` with `scan_options` and stores their answers; with `left`, the rays whose
-  // answer the scan cannot give (cut by its cap) go there instead.
-  void scan_and_answer(const std::vector<const Queued*>& items, const SearchOptions& scan_options,
-                       std::vector<const Queued*>* left);
+  // Scans `items` (with their STOP HINTS, or whole) and stores their answers; with `left`, the
+  // rays whose answer the scan cannot give (cut by a hint or the cap) go there instead.
+  void scan_and_answer(const std::vector<const Queued*>& items, bool stop_hints, std::vector<const Queued*>* left);
   const SearchContext& ctx_;
   SearchOptions options_;
   CandidateScanner scanner_;

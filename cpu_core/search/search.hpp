@@ -332,10 +332,23 @@ struct ScanCandidate {
 };
 struct CandidateScan {
   std::vector<ScanCandidate> candidates;
-  uint32_t texels = 0;   // texels walked
-  bool aborted = false;  // the walk's cap stopped it
+  uint32_t texels = 0;                                        // texels walked
+  bool aborted = false;                                       // the walk's cap stopped it
+  bool stopped = false;                                       // a STOP HINT (below) ended it
+  double last_l1 = -std::numeric_limits<double>::infinity();  // when stopped: the end of its last texel
 };
-CandidateScan scan_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options = {});
+// STOP HINTS: where a scan may end before its walk does, from the crossings on their own
+// triangle (crossing_candidate exact and valid with no MESH REFINEMENT: what a scan sees
+// without refining). ScanStop::crossing ends it where MODE crossing's search would, were
+// those its only crossings: CROSSING_WINDOW_TEXELS past the first texel holding one, at the
+// first texel that ends beyond the nearest. ScanStop::shadow ends it after the texel where
+// the segment crosses a triangle that lets no light through, before the light. A hint, not
+// the choice: a crossing refined onto the mesh, a tie, or a blocker on a plane through its
+// light can make the search read further, and search_from_candidates then says the scan is
+// not complete.
+enum class ScanStop : uint8_t { none, crossing, shadow };
+CandidateScan scan_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options = {},
+                              ScanStop stop = ScanStop::none);
 
 // The search of ray q (reflection_search's, or refraction_exit_search's for a restricted ray).
 SearchResult search_along(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options = {});
@@ -345,10 +358,9 @@ SearchResult search_along(const SearchContext& ctx, const SearchRay& q, const Se
 // so the answer is search_along's (same_answer) but for the walk's counts of texels, nodes
 // and fragments read, which a list of candidates does not hold (left 0). The crossing mode over
 // all layers only (InputError otherwise).
-// `complete` (optional): false when the scan's walk was cut by its cap (CandidateScan::aborted)
-// before the choice stopped: the answer might then need the texels past the cap. True: the
-// answer is the one the whole walk gives, whatever the cap (a scan of a walk's first texels
-// can so answer most rays).
+// `complete` (optional): false when the scan's walk was cut, by its cap (CandidateScan::aborted)
+// or by a STOP HINT (stopped), before the choice stopped: the answer might then need the
+// texels past the cut. True: the answer is the one the whole walk gives, whatever the cut.
 SearchResult search_from_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options,
                                     const CandidateScan& scan, bool* complete = nullptr);
 // shadow_search's walk of segment q to the light at light_position (shadow_ray), without a

@@ -312,9 +312,16 @@ ShadowResult shadow_along(const SearchContext& ctx, const SearchRay& q, const gl
   return choice.answer(scan(ctx, q, options, on_fragment, after_texel, [] { return true; }));
 }
 
-CandidateScan scan_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options) {
+CandidateScan scan_candidates(const SearchContext& ctx, const SearchRay& q, const SearchOptions& options,
+                              ScanStop stop) {
   CandidateScan out;
   double before_l1 = -INF;  // the end of the texel before the current one
+  // STOP HINTS (search.hpp): the first texel with a crossing on its own triangle, the nearest
+  // such crossing, and whether one blocks all light.
+  int64_t first = -1;
+  double nearest = INF;
+  bool blocked = false;
+  const TriangleSoup& soup = *ctx.scene().triangles;
   const auto on_fragment = [&](const WalkTexel& t, const Fragment& f, const glm::dvec3&,
                                const SearchContext::Plane& p) {
     const std::vector<Fragment>& face = ctx.cube().faces[static_cast<size_t>(t.face)].fragments;
@@ -322,11 +329,24 @@ CandidateScan scan_candidates(const SearchContext& ctx, const SearchRay& q, cons
     out.candidates.push_back({out.texels, static_cast<uint32_t>(t.face), static_cast<uint32_t>(&f - face.data()), t.i,
                               t.j, t.l1, before_l1, c.tested, c.exact, c.valid, c.back_face, c.triangle, c.l, c.outside,
                               c.mesh_triangles});
+    if (stop == ScanStop::none || !c.valid || !c.exact || c.mesh_triangles > 0) return;
+    if (stop == ScanStop::crossing) {
+      if (first < 0) first = out.texels;
+      nearest = std::min(nearest, c.l);
+    } else if (c.l < q.l_max) {
+      blocked =
+          blocked || blocker_transmittance(ctx.scene().materials[soup.material_id[c.triangle]]) == glm::dvec3(0.0);
+    }
   };
   const auto after_texel = [&](const WalkTexel& t, uint32_t index) {
     out.texels = index + 1;
     before_l1 = t.l1;
-    return true;
+    const bool past =
+        stop == ScanStop::crossing && first >= 0 && index >= first + CROSSING_WINDOW_TEXELS && t.l1 > nearest;
+    if (!past && !(stop == ScanStop::shadow && blocked)) return true;
+    out.stopped = true;
+    out.last_l1 = t.l1;
+    return false;
   };
   out.aborted = scan(ctx, q, options, on_fragment, after_texel, [] { return false; }).aborted;
   return out;
@@ -363,7 +383,7 @@ ScanCounts replay(const SearchContext& ctx, const SearchRay& q, const SearchOpti
     throw InputError("a search from candidates: the crossing mode over all layers only");
   }
   ScanCounts counts;
-  counts.aborted = scan.aborted;
+  counts.aborted = scan.aborted || scan.stopped;
   const std::vector<ScanCandidate>& list = scan.candidates;
   int64_t last = -1;  // the last texel asked
   const auto walk_on = [&](double l1, uint32_t index) {
@@ -374,12 +394,16 @@ ScanCounts replay(const SearchContext& ctx, const SearchRay& q, const SearchOpti
   };
   for (size_t k = 0; k < list.size();) {
     const uint32_t texel = list[k].texel;
-    if (static_cast<int64_t>(texel) > last + 1 && !walk_on(list[k].before_l1, texel - 1)) break;
+    if (static_cast<int64_t>(texel) > last + 1 && !walk_on(list[k].before_l1, texel - 1)) return counts;
     for (; k < list.size() && list[k].texel == texel; ++k) {
       take(listed_candidate(ctx, q, list[k]));
       ++counts.candidates;
     }
-    if (!walk_on(list[k - 1].l1, texel)) break;
+    if (!walk_on(list[k - 1].l1, texel)) return counts;
+  }
+  // A scan a STOP HINT ended: its last texel asked too (texels' ends grow along the walk).
+  if (scan.stopped && scan.texels > 0 && last + 1 < static_cast<int64_t>(scan.texels)) {
+    walk_on(scan.last_l1, scan.texels - 1);
   }
   return counts;
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <utility>
@@ -14,6 +15,7 @@
 #include "gl/gl_cube_walks.hpp"
 #include "gl/gl_program.hpp"
 #include "gl/glsl_shared.hpp"
+#include "material/shading.hpp"
 
 namespace abcube {
 
@@ -55,16 +57,28 @@ void check_block(const char* what, uint64_t bytes) {
   }
 }
 
+// cube_scan_walks.comp's RayScanOut.
+struct GpuRayScan {
+  uint32_t texels, flags, pad0, pad1;
+  double last_l1, pad;
+};
+static_assert(sizeof(GpuRayScan) == 32, "must match shaders/cube_scan_walks.comp");
+// Its flags.
+constexpr uint32_t SCAN_CAPPED = 1, SCAN_ENDED = 2, SCAN_STOPPED = 4, SCAN_OVER_BUDGET = 8, SCAN_LOOPS_RAN = 16;
+
 }  // namespace
 
 struct GlCandidateScan::Buffers {
-  GlProgram program{
-      std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "scan_common.glsl", "cube_scan.comp"}};
+  GlProgram walk_scan{std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "scan_common.glsl",
+                                               "triangle_geometry.glsl", "fragment.glsl", "scan_lists.glsl", "cube_scan_walks.comp"}};
+  GlProgram program{std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "scan_common.glsl",
+                                             "fragment.glsl", "scan_lists.glsl", "cube_scan.comp"}};
   GlProgram refine{std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "scan_common.glsl",
-                                            "mesh_refine.glsl", "cube_refine.comp"}};
+                                            "triangle_geometry.glsl", "mesh_refine.glsl", "cube_refine.comp"}};
   GlCubeWalks walks;
   std::unique_ptr<GlBuffer> lists, fragments, planes, positions, neighbours;
   std::vector<uint32_t> objects;     // per triangle its object
+  std::vector<uint32_t> opaque;      // bit t: triangle t lets no light through (blocker_transmittance 0)
   std::vector<uint32_t> face_first;  // each face's first fragment in `fragments`, then the total
 };
 
@@ -121,6 +135,12 @@ GlCandidateScan::GlCandidateScan(const SearchContext& ctx) : ctx_(&ctx) {
   check_block("the triangles' neighbours", neighbours.size() * sizeof(uint32_t));
   b.neighbours = std::make_unique<GlBuffer>(neighbours.size() * sizeof(uint32_t), neighbours.data());
   b.objects = soup.object_id;
+  b.opaque.assign((soup.triangle_count() + 31) / 32, 0u);
+  for (uint32_t t = 0; t < static_cast<uint32_t>(soup.triangle_count()); ++t) {
+    if (blocker_transmittance(ctx.scene().materials[soup.material_id[t]]) == glm::dvec3(0.0)) {
+      b.opaque[t / 32] |= 1u << (t % 32);
+    }
+  }
   check_gl("GPU candidate scan: uploading the lists");
 }
 
@@ -148,6 +168,21 @@ void add_restriction_rows(const SearchContext& ctx, const std::vector<SearchRay>
   }
 }
 
+// A candidate read back (its fragment: of all faces) as the walk's texel `texel` of its ray.
+ScanCandidate unpacked_candidate(const GpuCandidate& g, uint32_t texel, const std::vector<uint32_t>& face_first) {
+  const uint32_t fragment = g.fragment;
+  const size_t face =
+      static_cast<size_t>(std::upper_bound(face_first.begin(), face_first.end(), fragment) - face_first.begin()) - 1;
+  ScanCandidate c;
+  c.texel = texel, c.face = static_cast<uint32_t>(face), c.fragment = fragment - face_first[face];
+  c.i = static_cast<int>(g.ij & 0xffffu), c.j = static_cast<int>(g.ij >> 16);
+  c.l1 = g.interval[1], c.before_l1 = g.before_l1;
+  c.tested = (g.flags & 1u) != 0, c.exact = (g.flags & 2u) != 0, c.valid = (g.flags & 4u) != 0;
+  c.back_face = (g.flags & 8u) != 0;
+  c.triangle = g.triangle, c.l = g.l, c.outside = g.outside, c.mesh_triangles = g.mesh_tested;
+  return c;
+}
+
 // Batch b's candidates, read back with the batch's texel and the fragment of all, into
 // out[b.chunk + b.first ...]: in the walk's order (texel, then the list's).
 void unpack_candidates(std::vector<GpuCandidate> found, const GlCubeWalks::Batch& b,
@@ -156,19 +191,9 @@ void unpack_candidates(std::vector<GpuCandidate> found, const GlCubeWalks::Batch
     return x.texel != y.texel ? x.texel < y.texel : x.fragment < y.fragment;
   });
   for (const GpuCandidate& g : found) {
-    const uint32_t texel = g.texel, fragment = g.fragment;
     const size_t k =
-        static_cast<size_t>(std::upper_bound(b.offsets.begin(), b.offsets.end(), texel) - b.offsets.begin()) - 1;
-    const size_t face =
-        static_cast<size_t>(std::upper_bound(face_first.begin(), face_first.end(), fragment) - face_first.begin()) - 1;
-    ScanCandidate c;
-    c.texel = texel - b.offsets[k], c.face = static_cast<uint32_t>(face), c.fragment = fragment - face_first[face];
-    c.i = static_cast<int>(g.ij & 0xffffu), c.j = static_cast<int>(g.ij >> 16);
-    c.l1 = g.interval[1], c.before_l1 = g.before_l1;
-    c.tested = (g.flags & 1u) != 0, c.exact = (g.flags & 2u) != 0, c.valid = (g.flags & 4u) != 0;
-    c.back_face = (g.flags & 8u) != 0;
-    c.triangle = g.triangle, c.l = g.l, c.outside = g.outside, c.mesh_triangles = g.mesh_tested;
-    out[b.chunk + b.first + k].candidates.push_back(c);
+        static_cast<size_t>(std::upper_bound(b.offsets.begin(), b.offsets.end(), g.texel) - b.offsets.begin()) - 1;
+    out[b.chunk + b.first + k].candidates.push_back(unpacked_candidate(g, g.texel - b.offsets[k], face_first));
   }
 }
 
@@ -204,16 +229,17 @@ void run_crossing_tests(const GlCandidateScan::Buffers& b, const CubeABuffer& cu
   check_gl("GPU candidates' crossing tests");
 }
 
-// The candidates of one batch of walks, in the order found: a pass with room for `room`
-// candidates (at most what one storage block holds), then, when it found more, one with room
-// for all.
-std::vector<GpuCandidate> scan_batch(const GlCandidateScan::Buffers& b, const CubeABuffer& cube, const BatchInputs& in,
-                                     const GlCubeWalks::Batch& batch, uint64_t room) {
-  const GlProgram& p = b.program;
+// A scan pass: program p with the lists, the batch's inputs and the candidates bound, and what
+// `bind_own` binds, over `invocations` invocations; first with room for `room` candidates (at
+// most what one storage block holds), then, when it found more, with room for all. Then each
+// candidate's crossing test; the candidates read back, in the order found.
+std::vector<GpuCandidate> scan_pass(const GlCandidateScan::Buffers& b, const CubeABuffer& cube, const BatchInputs& in,
+                                    const GlProgram& p, uint64_t room, uint64_t invocations,
+                                    const std::function<void()>& bind_own) {
   room = std::max<uint64_t>(1, std::min(room, (max_block_bytes() - CANDIDATES_AT) / sizeof(GpuCandidate)));
   for (;;) {
     const uint64_t bytes = CANDIDATES_AT + sizeof(GpuCandidate) * room;
-    check_block("one batch's candidates", bytes);
+    check_block("one pass's candidates", bytes);
     const GlBuffer found(bytes, nullptr);
     found.zero();
     p.use();
@@ -223,16 +249,12 @@ std::vector<GpuCandidate> scan_batch(const GlCandidateScan::Buffers& b, const Cu
     b.planes->bind(CUBE_SCAN_PLANES_BINDING);
     in.objects->bind(CUBE_SCAN_OBJECTS_BINDING);
     found.bind(CUBE_SCAN_CANDIDATES_BINDING);
-    batch.texels->bind(CUBE_WALK_TEXELS_BINDING);
-    batch.offset_buffer->bind(CUBE_WALK_OFFSETS_BINDING);
-    glUniform1ui(p.uniform("first_ray"), 0u);
-    glUniform1ui(p.uniform("ray_count"), static_cast<GLuint>(batch.end - batch.first));
-    glUniform1ui(p.uniform("texel_count"), static_cast<GLuint>(batch.texel_count));
     glUniform1i(p.uniform("face_resolution"), cube.n);
     glUniform1ui(p.uniform("rows_at"), in.rows_at);
     glUniform1ui(p.uniform("row_words"), in.row_words);
     glUniform1ui(p.uniform("candidate_room"), static_cast<GLuint>(room));
-    dispatch(p, (batch.texel_count + 63) / 64);
+    bind_own();
+    dispatch(p, (invocations + 63) / 64);
     check_gl("GPU candidate scan");
     const uint32_t count = found.read<uint32_t>(1)[0];
     if (count > room) {
@@ -247,48 +269,151 @@ std::vector<GpuCandidate> scan_batch(const GlCandidateScan::Buffers& b, const Cu
   }
 }
 
+// The candidates of one batch of walks left on the GPU, an invocation a texel (cube_scan.comp).
+std::vector<GpuCandidate> scan_batch(const GlCandidateScan::Buffers& b, const CubeABuffer& cube, const BatchInputs& in,
+                                     const GlCubeWalks::Batch& batch, uint64_t room) {
+  const GlProgram& p = b.program;
+  return scan_pass(b, cube, in, p, room, batch.texel_count, [&] {
+    batch.texels->bind(CUBE_WALK_TEXELS_BINDING);
+    batch.offset_buffer->bind(CUBE_WALK_OFFSETS_BINDING);
+    glUniform1ui(p.uniform("first_ray"), 0u);
+    glUniform1ui(p.uniform("ray_count"), static_cast<GLuint>(batch.end - batch.first));
+    glUniform1ui(p.uniform("texel_count"), static_cast<GLuint>(batch.texel_count));
+  });
+}
+
+// The candidates of `count` rays (uploaded in `in`), each walked and scanned by one invocation
+// (cube_scan_walks.comp): per ray its walk's summary, and the candidates found.
+struct WalkingScan {
+  std::vector<GpuRayScan> rays;
+  std::vector<GpuCandidate> candidates;
+};
+WalkingScan scan_walking(const GlCandidateScan::Buffers& b, const CubeABuffer& cube, const BatchInputs& in,
+                         uint32_t cap, size_t count, uint32_t opaque_at, const ScanBatching& batching) {
+  const GlProgram& p = b.walk_scan;
+  check_block("one pass's rays", count * sizeof(GpuRayScan));
+  const GlBuffer outs(count * sizeof(GpuRayScan), nullptr);
+  WalkingScan out;
+  const uint64_t room = batching.first_room ? batching.first_room : 8 * static_cast<uint64_t>(count);
+  out.candidates = scan_pass(b, cube, in, p, room, count, [&] {
+    set_walk_uniforms(p, cube.n, cap);
+    b.positions->bind(CUBE_SCAN_POSITIONS_BINDING);
+    outs.bind(CUBE_WALK_COUNTS_BINDING);
+    glUniform1ui(p.uniform("ray_count"), static_cast<GLuint>(count));
+    glUniform1d(p.uniform("skip_radius"), cube.near_distance);
+    glUniform1ui(p.uniform("opaque_at"), opaque_at);
+    glUniform1ui(p.uniform("loop_budget"), batching.loop_budget);
+    glUniform1ui(p.uniform("one"), 1u);
+    glUniform3d(p.uniform("centre"), cube.centre.x, cube.centre.y, cube.centre.z);
+    glUniform1d(p.uniform("on_triangle_texels"), ON_TRIANGLE_TEXELS);
+    glUniform1d(p.uniform("tolerance_texels"), in.tolerance_texels);
+  });
+  out.rays = outs.read<GpuRayScan>(count);
+  return out;
+}
+
+// A walking scan's results into out[first ...]; the rays past the loop budget into `over`.
+void unpack_walking(WalkingScan found, size_t first, const std::vector<uint32_t>& face_first, CandidateScan* out,
+                    std::vector<size_t>* over) {
+  for (size_t k = 0; k < found.rays.size(); ++k) {
+    const GpuRayScan& r = found.rays[k];
+    if (!(r.flags & SCAN_LOOPS_RAN) || !(r.flags & (SCAN_ENDED | SCAN_STOPPED | SCAN_OVER_BUDGET))) {
+      throw RuntimeFailure("GPU candidate scan: the GL ended ray " + std::to_string(first + k) +
+                           "'s scan early (a loop limit?)");
+    }
+    CandidateScan& c = out[first + k];
+    if (r.flags & SCAN_OVER_BUDGET) {
+      over->push_back(first + k);
+      continue;
+    }
+    c.texels = r.texels;
+    c.aborted = (r.flags & SCAN_CAPPED) != 0;
+    c.stopped = (r.flags & SCAN_STOPPED) != 0;
+    if (c.stopped) c.last_l1 = r.last_l1;
+  }
+  std::sort(found.candidates.begin(), found.candidates.end(), [](const GpuCandidate& x, const GpuCandidate& y) {
+    if (x.ray != y.ray) return x.ray < y.ray;
+    return x.texel != y.texel ? x.texel < y.texel : x.fragment < y.fragment;
+  });
+  for (const GpuCandidate& g : found.candidates) {
+    if (found.rays[g.ray].flags & SCAN_OVER_BUDGET) continue;
+    out[first + g.ray].candidates.push_back(unpacked_candidate(g, g.texel, face_first));
+  }
+}
+
 }  // namespace
 
 std::vector<CandidateScan> GlCandidateScan::scan(const std::vector<SearchRay>& rays, const SearchOptions& options,
-                                                 const ScanBatching& batching) const {
+                                                 const ScanBatching& batching,
+                                                 const std::vector<ScanStop>& stops) const {
   if (options.layers != SearchLayers::all) {
     throw InputError("GPU candidate scan: the nearest layer (Z-buffer searches) is scanned on the CPU only");
   }
+  if (!stops.empty() && stops.size() != rays.size()) {
+    throw InputError("GPU candidate scan: " + std::to_string(stops.size()) + " stop hints for " +
+                     std::to_string(rays.size()) + " rays");
+  }
   const Buffers& b = *buffers_;
   const CubeABuffer& cube = ctx_->cube();
+  const uint32_t cap = walk_cap(cube.n, options.max_texels);
   std::vector<WalkRay> walk_rays(rays.size());
   std::vector<GpuScanRay> packed(rays.size());
   for (size_t k = 0; k < rays.size(); ++k) {
     const SearchRay& q = rays[k];
     walk_rays[k] = {q.w, q.d, q.l_max, cube.near_distance};
+    check_walk_ray(walk_rays[k], k);
     packed[k] = {{q.w.x, q.w.y, q.w.z, q.l_max},
                  {q.d.x, q.d.y, q.d.z, q.self},
-                 {q.object, NO_ROW, 0, 0},
+                 {q.object, NO_ROW, stops.empty() ? 0u : static_cast<uint32_t>(stops[k]), 0},
                  {q.self_tolerance, 0.0}};
   }
+  static_assert(static_cast<uint32_t>(ScanStop::crossing) == 1 && static_cast<uint32_t>(ScanStop::shadow) == 2,
+                "cube_scan_walks.comp's STOP_CROSSING and STOP_SHADOW");
   std::vector<uint32_t> objects = b.objects;
   const uint32_t rows_at = static_cast<uint32_t>(objects.size());
   uint32_t row_words = 0;
   add_restriction_rows(*ctx_, rays, &packed, &objects, &row_words);
-  check_block("the objects and their restriction rows", objects.size() * sizeof(uint32_t));
+  const uint32_t opaque_at = static_cast<uint32_t>(objects.size());
+  objects.insert(objects.end(), b.opaque.begin(), b.opaque.end());
+  check_block("the objects, their restriction rows and the opaque triangles", objects.size() * sizeof(uint32_t));
   const GlBuffer object_buffer(objects.size() * sizeof(uint32_t), objects.data());
   std::vector<CandidateScan> out(rays.size());
+  // An invocation a ray first; the rays past its loop budget walked, then scanned a texel an
+  // invocation, whole.
+  std::vector<size_t> walked;
+  for (size_t chunk = 0; chunk < rays.size(); chunk += WALK_RAY_CHUNK) {
+    const size_t count = std::min(WALK_RAY_CHUNK, rays.size() - chunk);
+    const GlBuffer ray_buffer(count * sizeof(GpuScanRay), packed.data() + chunk);
+    const BatchInputs in{&ray_buffer, &object_buffer,           rows_at,
+                         row_words,   options.tolerance_texels, options.refine == SearchRefine::mesh};
+    unpack_walking(scan_walking(b, cube, in, cap, count, opaque_at, batching), chunk, b.face_first, out.data(),
+                   &walked);
+  }
+  if (walked.empty()) return out;
+  std::vector<WalkRay> walk_left(walked.size());
+  std::vector<GpuScanRay> packed_left(walked.size());
+  for (size_t k = 0; k < walked.size(); ++k) {
+    walk_left[k] = walk_rays[walked[k]];
+    packed_left[k] = packed[walked[k]];
+  }
+  std::vector<CandidateScan> left(walked.size());
   b.walks.walk_batches(
-      walk_rays, cube.n, options.max_texels,
+      walk_left, cube.n, options.max_texels,
       [&](const GlCubeWalks::Batch& batch) {
         for (size_t k = batch.first; k < batch.end; ++k) {
-          out[batch.chunk + k].texels = (*batch.counts)[4 * k];
-          out[batch.chunk + k].aborted = ((*batch.counts)[4 * k + 1] & 1u) != 0;
+          left[batch.chunk + k].texels = (*batch.counts)[4 * k];
+          left[batch.chunk + k].aborted = ((*batch.counts)[4 * k + 1] & 1u) != 0;
         }
         if (batch.texel_count == 0) return;
         const GlBuffer ray_buffer((batch.end - batch.first) * sizeof(GpuScanRay),
-                                  packed.data() + batch.chunk + batch.first);
+                                  packed_left.data() + batch.chunk + batch.first);
         const BatchInputs in{&ray_buffer, &object_buffer,           rows_at,
                              row_words,   options.tolerance_texels, options.refine == SearchRefine::mesh};
         unpack_candidates(scan_batch(b, cube, in, batch, batching.first_room ? batching.first_room : batch.texel_count),
-                          batch, b.face_first, out.data());
+                          batch, b.face_first, left.data());
       },
       batching.batch_bytes);
+  for (size_t k = 0; k < walked.size(); ++k) out[walked[k]] = std::move(left[k]);
   return out;
 }
 
@@ -355,7 +480,8 @@ CandidateComparison compare_candidate_scans(const std::vector<CandidateScan>& a,
   c.rays = a.size();
   for (size_t r = 0; r < a.size(); ++r) {
     c.candidates += a[r].candidates.size();
-    const bool walks_alike = r < b.size() && a[r].texels == b[r].texels && a[r].aborted == b[r].aborted;
+    const bool walks_alike = r < b.size() && a[r].texels == b[r].texels && a[r].aborted == b[r].aborted &&
+                             a[r].stopped == b[r].stopped && same_bits(a[r].last_l1, b[r].last_l1);
     bool rounding = false;
     const size_t k = walks_alike ? first_not_identical(a[r].candidates, b[r].candidates, &rounding) : 0;
     if (walks_alike && rounding && k == a[r].candidates.size()) {

@@ -1,11 +1,14 @@
 // The searches' candidates on the GPU: the z-interval test of thesis 7.5 over the cube
-// A-buffer's lists, along the texels each ray's walk crosses (GlCubeWalks, left on the GPU),
-// with the object restriction and the own-surface test, then each candidate's crossing test
-// with its MESH REFINEMENT: scan_candidates (cpu_core/search/search.hpp) run by two GL
-// compute passes, an invocation a texel walked (shaders/cube_scan.comp), then an invocation a
-// candidate (shaders/cube_refine.comp, mesh_refine.glsl). Their expressions are the CPU's in
-// double precision, so that a GL whose doubles round as IEEE 754 says finds the CPU's
-// candidates and crossings exactly: compare_candidate_scans says where they differ.
+// A-buffer's lists, along the texels each ray's walk crosses, with the object restriction and
+// the own-surface test, then each candidate's crossing test with its MESH REFINEMENT:
+// scan_candidates (cpu_core/search/search.hpp), STOP HINTS included, run by GL compute
+// passes. An invocation a ray walks and scans its texels' lists as it goes
+// (shaders/cube_scan_walks.comp); a ray past what one invocation may loop is walked by
+// GlCubeWalks and its texels scanned an invocation a texel (shaders/cube_scan.comp). Then an
+// invocation a candidate runs its crossing test (shaders/cube_refine.comp, mesh_refine.glsl).
+// Their expressions are the CPU's in double precision, so that a GL whose doubles round as
+// IEEE 754 says finds the CPU's candidates and crossings exactly: compare_candidate_scans says
+// where they differ.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -17,12 +20,19 @@
 
 namespace abcube {
 
-// How GlCandidateScan::scan cuts its work: the walks' batches hold at most batch_bytes of
-// texels, and a batch's first try has room for first_room candidates (0: one a texel walked);
-// the pass runs again with room for all it found when they are more.
+// What one invocation of the scan that walks may loop (cube_scan_walks.comp counts its
+// loops against it): under llvmpipe's 65535.
+constexpr uint32_t GPU_SCAN_LOOP_BUDGET = 60000;
+
+// How GlCandidateScan::scan cuts its work: a pass's first try has room for first_room
+// candidates (0: eight a ray in the scan that walks, one a texel walked in the other), and
+// runs again with room for all it found when they are more; the walks left on the GPU go in
+// batches of at most batch_bytes of texels; a ray whose scan would count more than
+// loop_budget loops is walked first (0: every ray).
 struct ScanBatching {
   uint64_t batch_bytes = WALK_BATCH_BYTES;
   uint64_t first_room = 0;
+  uint32_t loop_budget = GPU_SCAN_LOOP_BUDGET;
 };
 
 // The lists and the triangles' planes, objects, vertices and edge neighbours of one
@@ -39,13 +49,14 @@ class GlCandidateScan {
   GlCandidateScan(const GlCandidateScan&) = delete;
   GlCandidateScan& operator=(const GlCandidateScan&) = delete;
 
-  // Every ray's scan_candidates(ctx, ray, options). Throws InputError for the nearest layer
-  // (options.layers: the Z-buffer's choice is the CPU's alone), for a walk cap above
-  // GPU_WALK_MAX_TEXELS and on a ray GlCubeWalks refuses; RuntimeFailure when the objects'
-  // restriction rows or one batch's candidates exceed a storage block.
+  // Every ray's scan_candidates(ctx, ray, options, stops[ray]) (`stops` empty: none). Throws
+  // InputError for the nearest layer (options.layers: the Z-buffer's choice is the CPU's
+  // alone), for a walk cap above GPU_WALK_MAX_TEXELS, on a ray GlCubeWalks refuses and on
+  // stops not one a ray; RuntimeFailure when the objects' restriction rows or one pass's
+  // candidates exceed a storage block, or the GL ended a scan early.
   // `batching` sets how the work is cut, not what it finds.
   std::vector<CandidateScan> scan(const std::vector<SearchRay>& rays, const SearchOptions& options = {},
-                                  const ScanBatching& batching = {}) const;
+                                  const ScanBatching& batching = {}, const std::vector<ScanStop>& stops = {}) const;
 
   struct Buffers;
 

@@ -30,7 +30,9 @@ struct GpuTexel {
 };
 static_assert(sizeof(GpuRay) == 64 && sizeof(GpuTexel) == 32, "must match shaders/cube_walks.comp");
 
-void check_ray(const WalkRay& r, size_t index) {
+}  // namespace
+
+void check_walk_ray(const WalkRay& r, size_t index) {
   const auto finite = [](const glm::dvec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
   };
@@ -39,6 +41,16 @@ void check_ray(const WalkRay& r, size_t index) {
     throw InputError("GPU cube walk: ray " + std::to_string(index) +
                      " has a non-finite origin, a direction not unit, a NaN end or a non-finite skipped radius");
   }
+}
+
+uint32_t walk_cap(int n, uint32_t max_texels) {
+  if (n < 1) throw InputError("GPU cube walk: n must be >= 1, got " + std::to_string(n));
+  const uint32_t cap = max_texels ? max_texels : CubeWalk::default_cap(n);
+  if (cap > GPU_WALK_MAX_TEXELS) {
+    throw InputError("GPU cube walk: a cap of " + std::to_string(cap) + " texels, above the GPU's " +
+                     std::to_string(GPU_WALK_MAX_TEXELS) + "; lower n");
+  }
+  return cap;
 }
 
 void set_walk_uniforms(const GlProgram& p, int n, uint32_t cap) {
@@ -54,6 +66,8 @@ void set_walk_uniforms(const GlProgram& p, int n, uint32_t cap) {
   glUniform1i(p.uniform("face_resolution"), n);
   glUniform1ui(p.uniform("walk_cap_texels"), cap);
 }
+
+namespace {
 
 // Both passes must have ended every walk of rays [first, end) of a chunk (flag 2) with the same
 // count: a GL that stops a shader's loops early (llvmpipe past its iteration limit) fails
@@ -83,15 +97,10 @@ GlCubeWalks::~GlCubeWalks() = default;
 
 void GlCubeWalks::walk_batches(const std::vector<WalkRay>& rays, int n, uint32_t max_texels,
                                const std::function<void(const Batch&)>& visit, uint64_t batch_bytes) const {
-  if (n < 1) throw InputError("GPU cube walk: n must be >= 1, got " + std::to_string(n));
-  const uint32_t cap = max_texels ? max_texels : CubeWalk::default_cap(n);
-  if (cap > GPU_WALK_MAX_TEXELS) {
-    throw InputError("GPU cube walk: a cap of " + std::to_string(cap) + " texels, above the GPU's " +
-                     std::to_string(GPU_WALK_MAX_TEXELS) + "; lower n");
-  }
+  const uint32_t cap = walk_cap(n, max_texels);
   std::vector<GpuRay> packed(rays.size());
   for (size_t k = 0; k < rays.size(); ++k) {
-    check_ray(rays[k], k);
+    check_walk_ray(rays[k], k);
     packed[k] = {{rays[k].w.x, rays[k].w.y, rays[k].w.z, rays[k].l_max},
                  {rays[k].d.x, rays[k].d.y, rays[k].d.z, rays[k].skip_radius}};
   }
@@ -200,7 +209,7 @@ std::vector<WalkRay> scene_walk_rays(const SceneData& scene, const glm::dvec3& c
 std::vector<RayWalk> cpu_cube_walks(const std::vector<WalkRay>& rays, int n, uint32_t max_texels) {
   std::vector<RayWalk> out(rays.size());
   for (size_t k = 0; k < rays.size(); ++k) {
-    check_ray(rays[k], k);
+    check_walk_ray(rays[k], k);
     CubeWalk walk(rays[k].w, rays[k].d, n, rays[k].l_max, rays[k].skip_radius, max_texels);
     WalkTexel t;
     while (walk.next(&t)) out[k].texels.push_back(t);

@@ -23,6 +23,7 @@
 namespace abcube {
 
 class GlBuffer;
+class GlProgram;
 
 // Rays a chunk of a GPU walk: their storage blocks stay well under the 128 MiB a GL must offer.
 constexpr size_t WALK_RAY_CHUNK = size_t{1} << 18;
@@ -88,6 +89,13 @@ class GlCubeWalks {
 // there and walks of 16000 were not. A walk cut short is refused (RuntimeFailure), never
 // returned short. CubeWalk's default cap, 16 n + 64, is within this bound up to n = 996.
 constexpr uint32_t GPU_WALK_MAX_TEXELS = 16000;
+// The cap of a GPU walk on an n x n map asked for max_texels (0: CubeWalk's default); InputError
+// on n < 1 and on a cap above GPU_WALK_MAX_TEXELS.
+uint32_t walk_cap(int n, uint32_t max_texels);
+// InputError on a ray CubeWalk refuses (d not unit, w not finite), named by its index.
+void check_walk_ray(const WalkRay& r, size_t index);
+// Sets cube_walk.glsl's uniforms of program p (made current) for walks of an n x n map, capped.
+void set_walk_uniforms(const GlProgram& p, int n, uint32_t cap);
 // Whether a walk of an n x n map at CubeWalk's default cap runs on the GPU.
 inline bool gpu_walks_at(int n) { return n >= 1 && CubeWalk::default_cap(n) <= GPU_WALK_MAX_TEXELS; }
 

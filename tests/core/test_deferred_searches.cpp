@@ -58,7 +58,7 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
     scenes.resize(2);
     plans.resize(2);
   }
-  uint64_t most_passes = 0, rays = 0, rescanned = 0;
+  uint64_t most_passes = 0, rays = 0, rescanned = 0, stopped = 0;
   for (const std::string& file : scenes) {
     const SceneData s = deferred_scene(file, checked ? 20 : 48, 40);
     const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, s.render.cube_resolution);
@@ -73,8 +73,8 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
       DeferredSearchOptions small;
       small.threads = 2;
       small.batch_rays = 97;  // many small batches
-      // THE WINDOW, short enough that many rays are scanned again whole (the sparse plan: none).
-      small.window_texels = &plan - plans.data() == 1 ? 0 : 6;
+      // STOP HINTS, but in the sparse plan (whole walks).
+      small.stop_hints = &plan - plans.data() != 1;
       DeferredSearches deferred(shader.context(), shader.options().search, cpu_candidate_scanner(shader.context(), 2),
                                 small);
       shader.defer_searches(&deferred);
@@ -100,14 +100,18 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
       EXPECT_GE(d.passes, walks > 0 ? 2u : 1u) << what;
       most_passes = std::max(most_passes, d.passes);
       rescanned += d.rescanned;
+      stopped += d.stopped;
       rays += d.rays;
     }
   }
-  std::printf("[ deferred ] %llu rays scanned (%llu again whole, past the window); at most %llu passes\n",
-              static_cast<unsigned long long>(rays), static_cast<unsigned long long>(rescanned),
-              static_cast<unsigned long long>(most_passes));
+  std::printf(
+      "[ deferred ] %llu rays scanned, %llu ended by their stop hint, %llu of them again whole; at most %llu "
+      "passes\n",
+      static_cast<unsigned long long>(rays), static_cast<unsigned long long>(stopped),
+      static_cast<unsigned long long>(rescanned), static_cast<unsigned long long>(most_passes));
   EXPECT_GT(rays, checked ? 1000u : 10000u);
-  EXPECT_GT(rescanned, rays / 20);  // THE WINDOW cut that many walks, and kept every image
+  EXPECT_GT(stopped, rays / 10);  // STOP HINTS cut that many walks, and kept every image
+  EXPECT_LT(rescanned, stopped);
 }
 
 // A store with room for a few hundred rays: the searches past it are walked at once by the
@@ -156,9 +160,10 @@ TEST(DeferredSearches, AScannerShortOfRaysFails) {
   const SceneData s = deferred_scene("scenes/cornell.json", 16, 8);
   const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, 8);
   MapShader shader(s, cube, MapShadingOptions{});
-  DeferredSearches deferred(
-      shader.context(), shader.options().search,
-      [](const std::vector<SearchRay>& r, const SearchOptions&) { return std::vector<CandidateScan>(r.size() / 2); });
+  DeferredSearches deferred(shader.context(), shader.options().search,
+                            [](const std::vector<SearchRay>& r, const SearchOptions&, const std::vector<ScanStop>&) {
+                              return std::vector<CandidateScan>(r.size() / 2);
+                            });
   shader.defer_searches(&deferred);
   const ABuffer camera = build_camera_abuffer(s);
   EXPECT_THROW(render_with_map(s, camera, shader, 1, nullptr), RuntimeFailure);

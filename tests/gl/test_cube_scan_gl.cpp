@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -69,10 +70,42 @@ size_t restricted(const std::vector<SearchRay>& rays) {
 }
 
 std::vector<CandidateScan> cpu_scans(const SearchContext& ctx, const std::vector<SearchRay>& rays,
-                                     const SearchOptions& o) {
+                                     const SearchOptions& o, const std::vector<ScanStop>& stops = {}) {
   std::vector<CandidateScan> out;
-  for (const SearchRay& q : rays) out.push_back(scan_candidates(ctx, q, o));
+  for (size_t k = 0; k < rays.size(); ++k) {
+    out.push_back(scan_candidates(ctx, rays[k], o, stops.empty() ? ScanStop::none : stops[k]));
+  }
   return out;
+}
+
+// Each ray's STOP HINT as the deferred searches give it: a shadow segment's, else a crossing's.
+std::vector<ScanStop> stops_of(const std::vector<int>& lights) {
+  std::vector<ScanStop> stops;
+  for (const int l : lights) stops.push_back(l >= 0 ? ScanStop::shadow : ScanStop::crossing);
+  return stops;
+}
+
+// The answers from scans their STOP HINTS ended: each one that search_from_candidates or
+// shadow_from_candidates calls complete is the walked search's (same_found). Returns how many
+// were complete.
+size_t expect_complete_answers(const SearchContext& ctx, const std::vector<SearchRay>& rays,
+                               const std::vector<int>& lights, const SearchOptions& o,
+                               const std::vector<CandidateScan>& scans, const std::string& what) {
+  size_t complete_ones = 0;
+  for (size_t k = 0; k < rays.size(); ++k) {
+    bool complete = false;
+    if (lights[k] >= 0) {
+      const glm::dvec3 light = ctx.scene().lights[static_cast<size_t>(lights[k])].position;
+      const ShadowResult found = shadow_from_candidates(ctx, rays[k], light, o, scans[k], &complete);
+      if (complete)
+        EXPECT_TRUE(same_found(shadow_along(ctx, rays[k], light, o), found)) << what << ": shadow ray " << k;
+    } else {
+      const SearchResult found = search_from_candidates(ctx, rays[k], o, scans[k], &complete);
+      if (complete) EXPECT_TRUE(same_found(search_along(ctx, rays[k], o), found)) << what << ": ray " << k;
+    }
+    complete_ones += complete ? 1 : 0;
+  }
+  return complete_ones;
 }
 
 // The searches' answers from the GPU's candidates (search_from_candidates for reflections and
@@ -113,7 +146,8 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
   // MESH REFINEMENT: candidates refined, found crossing another triangle of the mesh, and
   // found passing the mesh by.
   uint64_t refined = 0, crossed_elsewhere = 0, passed_by = 0;
-  size_t hits = 0;  // searches answered from the GPU's candidates with a hit or a blocker
+  size_t hits = 0;                               // searches answered from the GPU's candidates with a hit or a blocker
+  size_t hinted = 0, stopped = 0, complete = 0;  // rays scanned with STOP HINTS, ended by one, answered
   for (const std::string& file : test::scene_files()) {
     const SceneData scene = load_scene(file);
     const std::vector<std::pair<glm::dvec3, int>> views = test::cube_views(scene);
@@ -138,7 +172,17 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
         EXPECT_EQ(c.identical, rays.size()) << what << ": " << c.example;
         candidates += c.candidates;
         restricted_rays += restricted(rays);
-        if (mode == SearchMode::crossing) hits += expect_same_answers(ctx, rays, lights, o, on_gpu, what);
+        if (mode == SearchMode::crossing) {
+          hits += expect_same_answers(ctx, rays, lights, o, on_gpu, what);
+          // STOP HINTS: the same cut scans as the CPU's, and their complete answers the walked.
+          const std::vector<ScanStop> stops = stops_of(lights);
+          const std::vector<CandidateScan> cut = gpu.scan(rays, o, {}, stops);
+          const CandidateComparison h = compare_candidate_scans(cpu_scans(ctx, rays, o, stops), cut);
+          EXPECT_EQ(h.identical, rays.size()) << what << " (stop hints): " << h.example;
+          for (const CandidateScan& x : cut) stopped += x.stopped ? 1 : 0;
+          hinted += rays.size();
+          complete += expect_complete_answers(ctx, rays, lights, o, cut, what + " (stop hints)");
+        }
         for (const CandidateScan& scan : cpu) {
           for (const ScanCandidate& x : scan.candidates) {
             ++verdicts[(x.tested ? 1 : 0) + (x.exact ? 1 : 0) + (x.valid ? 1 : 0)];
@@ -158,6 +202,9 @@ TEST(CubeScanGl, CandidatesAreTheCpusOnEveryKeptScene) {
   EXPECT_GT(crossed_elsewhere, 100u);
   EXPECT_GT(passed_by, 100u);
   EXPECT_GT(hits, test::checked_build() ? 2000u : 5000u);  // the checked builds: fewer scenes
+  std::printf("[ stop hints ] %zu rays: %zu scans ended early, %zu answers complete\n", hinted, stopped, complete);
+  EXPECT_GT(stopped, hinted / 4);
+  EXPECT_GT(complete, hinted * 9 / 10);
 }
 
 // Walks the cap stops (the candidates up to it); the work cut in batches of a few rays, each
@@ -196,6 +243,31 @@ TEST(CubeScanGl, CappedWalksSmallBatchesAndEmptyWalksAsTheCpu) {
   c = compare_candidate_scans(cpu_scans(ctx, {empty, empty}, {}), gpu.scan({empty, empty}, {}, small));
   EXPECT_EQ(c.identical, 2u) << c.example;
   EXPECT_TRUE(gpu.scan({}).empty());
+
+  // The rays past the loop budget of the scan that walks go through the walks left on the GPU:
+  // every ray (budget 0), and some (a budget a few texels' worth), with and without STOP HINTS.
+  std::vector<int> lights;
+  const std::vector<SearchRay> searches = rays_of(ctx, {}, 11, &lights);
+  for (const uint32_t budget : {0u, 400u}) {
+    for (const bool hints : {false, true}) {
+      const std::vector<ScanStop> stops = hints ? stops_of(lights) : std::vector<ScanStop>{};
+      ScanBatching b;
+      b.loop_budget = budget;
+      const std::vector<CandidateScan> on_gpu = gpu.scan(searches, {}, b, stops);
+      // A ray walked first is scanned whole: the CPU's hinted scan where the GPU's stopped.
+      const std::vector<CandidateScan> whole = cpu_scans(ctx, searches, {}), cut = cpu_scans(ctx, searches, {}, stops);
+      std::vector<CandidateScan> expected;
+      size_t stopped = 0;
+      for (size_t k = 0; k < searches.size(); ++k) {
+        expected.push_back(on_gpu[k].stopped ? cut[k] : whole[k]);
+        stopped += on_gpu[k].stopped ? 1 : 0;
+      }
+      if (budget == 0 || !hints) EXPECT_EQ(stopped, 0u);
+      if (budget > 0 && hints) EXPECT_GT(stopped, 0u);
+      c = compare_candidate_scans(expected, on_gpu);
+      EXPECT_EQ(c.identical, searches.size()) << "budget " << budget << (hints ? " with hints: " : ": ") << c.example;
+    }
+  }
 }
 
 TEST(CubeScanGl, RefusesTheNearestLayerAndCapsAboveTheGpusBound) {

@@ -98,10 +98,12 @@ GlSearches gl_searches(MethodContext& mc, MapShader& shader, uint64_t held_bytes
     DeferredSearchOptions d;
     d.threads = r.threads;
     d.max_bytes = std::max<uint64_t>(budget > held_bytes ? (budget - held_bytes) / 2 : 0, DEFERRED_ENTRY_BYTES);
-    // THE WINDOW stays off: on llvmpipe its second scans cost what the shorter walks save.
     g.deferred = std::make_unique<DeferredSearches>(
         shader.context(), shader.options().search,
-        [&scan](const std::vector<SearchRay>& rays, const SearchOptions& o) { return scan.scan(rays, o); }, d);
+        [&scan](const std::vector<SearchRay>& rays, const SearchOptions& o, const std::vector<ScanStop>& stops) {
+          return scan.scan(rays, o, {}, stops);
+        },
+        d);
     shader.defer_searches(g.deferred.get());
   }
   mc.stats["plan"]["searches_on"] = {{"where", on ? "gpu" : "cpu"}, {"why", why}};
@@ -118,6 +120,8 @@ void record_gl_searches(const GlSearches& g, MethodContext& mc) {
                                       {"candidates", d.candidates},
                                       {"answers_used", d.answers_used},
                                       {"walked_now", d.walked_now},
+                                      {"texels", d.texels},
+                                      {"stopped", d.stopped},
                                       {"rescanned", d.rescanned},
                                       {"bytes", d.bytes}};
   mc.record.timings_ms["gpu_search_upload"] = g.upload_ms;
