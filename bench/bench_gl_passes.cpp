@@ -139,7 +139,8 @@ void print_candidates(const SceneData& scene, const Options& o) {
   std::printf(
       "\n| N | search rays | candidates | texels walked | GPU upload ms | GPU scan ms | CPU scan ms (1 thread) | "
       "rays identical | answers from the GPU's candidates ms (1 thread) | CPU searches ms (1 thread) | answers the "
-      "same |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "same | GPU scan with stop hints ms | texels walked with them |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (int n : o.sizes) {
     if (!gpu_walks_at(n)) {
       std::printf("| %d | not scanned: the walk's cap is above the GPU's %u texels | | | | | | | | | |\n", n,
@@ -148,8 +149,12 @@ void print_candidates(const SceneData& scene, const Options& o) {
     }
     const CubeABuffer cube = build_cube_abuffer(scene, scene.camera.position, n);
     const SearchContext ctx(scene, cube);
-    const std::vector<SearchRay> rays = scene_search_rays(ctx, static_cast<size_t>(o.walk_triangles));
-    std::vector<double> upload_ms, gpu_ms, cpu_ms, answer_ms, search_ms;
+    std::vector<int> lights;
+    const std::vector<SearchRay> rays = scene_search_rays(ctx, static_cast<size_t>(o.walk_triangles), {}, &lights);
+    std::vector<ScanStop> stops;  // STOP HINTS as the deferred searches give them
+    for (const int l : lights) stops.push_back(l >= 0 ? ScanStop::shadow : ScanStop::crossing);
+    std::vector<double> upload_ms, gpu_ms, cpu_ms, answer_ms, search_ms, hinted_ms;
+    uint64_t hinted_texels = 0;
     std::vector<CandidateScan> on_gpu, on_cpu;
     size_t answers = 0, same = 0;
     for (int r = 0; r < o.runs; ++r) {
@@ -159,6 +164,11 @@ void print_candidates(const SceneData& scene, const Options& o) {
       t0 = Clock::now();
       on_gpu = gpu.scan(rays);
       gpu_ms.push_back(ms_since(t0));
+      t0 = Clock::now();
+      const std::vector<CandidateScan> hinted = gpu.scan(rays, {}, {}, stops);
+      hinted_ms.push_back(ms_since(t0));
+      hinted_texels = 0;
+      for (const CandidateScan& s : hinted) hinted_texels += s.texels;
       t0 = Clock::now();
       on_cpu.clear();
       for (const SearchRay& q : rays) on_cpu.push_back(scan_candidates(ctx, q));
@@ -182,13 +192,13 @@ void print_candidates(const SceneData& scene, const Options& o) {
     uint64_t texels = 0;
     for (const CandidateScan& s : on_cpu) texels += s.texels;
     const Spread u = spread(upload_ms), g = spread(gpu_ms), cp = spread(cpu_ms), a = spread(answer_ms),
-                 w = spread(search_ms);
+                 w = spread(search_ms), h = spread(hinted_ms);
     std::printf(
         "| %d | %zu | %llu | %llu | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %zu of %zu | %.1f "
-        "[%.1f, %.1f] | %.1f [%.1f, %.1f] | %zu of %zu |\n",
+        "[%.1f, %.1f] | %.1f [%.1f, %.1f] | %zu of %zu | %.1f [%.1f, %.1f] | %llu |\n",
         n, rays.size(), static_cast<unsigned long long>(c.candidates), static_cast<unsigned long long>(texels),
         u.median, u.lo, u.hi, g.median, g.lo, g.hi, cp.median, cp.lo, cp.hi, c.identical, c.rays, a.median, a.lo, a.hi,
-        w.median, w.lo, w.hi, same, answers);
+        w.median, w.lo, w.hi, same, answers, h.median, h.lo, h.hi, static_cast<unsigned long long>(hinted_texels));
     std::fflush(stdout);
   }
 }
