@@ -231,10 +231,13 @@ struct GpuRun {
 }  // namespace
 
 struct GlABufferBuilder::Programs {
-  GlProgram count{std::vector<const char*>{"double_math.glsl", "fragment.glsl", "abuffer_common.glsl", "abuffer_count.comp"}};
+  GlProgram count{
+      std::vector<const char*>{"double_math.glsl", "fragment.glsl", "abuffer_common.glsl", "abuffer_count.comp"}};
   GlProgram scan{std::vector<const char*>{"abuffer_scan.comp"}};
-  GlProgram fill{std::vector<const char*>{"double_math.glsl", "fragment.glsl", "abuffer_common.glsl", "abuffer_fill.comp"}};
-  GlProgram finish{std::vector<const char*>{"double_math.glsl", "fragment.glsl", "abuffer_common.glsl", "abuffer_finish.comp"}};
+  GlProgram fill{
+      std::vector<const char*>{"double_math.glsl", "fragment.glsl", "abuffer_common.glsl", "abuffer_fill.comp"}};
+  GlProgram finish{
+      std::vector<const char*>{"double_math.glsl", "fragment.glsl", "abuffer_common.glsl", "abuffer_finish.comp"}};
 };
 
 namespace {

@@ -70,9 +70,10 @@ constexpr uint32_t SCAN_CAPPED = 1, SCAN_ENDED = 2, SCAN_STOPPED = 4, SCAN_OVER_
 
 struct GlCandidateScan::Buffers {
   GlProgram walk_scan{std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "scan_common.glsl",
-                                               "triangle_geometry.glsl", "fragment.glsl", "scan_lists.glsl", "cube_scan_walks.comp"}};
-  GlProgram program{std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "scan_common.glsl",
-                                             "fragment.glsl", "scan_lists.glsl", "cube_scan.comp"}};
+                                               "triangle_geometry.glsl", "fragment.glsl", "scan_lists.glsl",
+                                               "cube_scan_walks.comp"}};
+  GlProgram program{std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "scan_common.glsl", "fragment.glsl",
+                                             "scan_lists.glsl", "cube_scan.comp"}};
   GlProgram refine{std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "scan_common.glsl",
                                             "triangle_geometry.glsl", "mesh_refine.glsl", "cube_refine.comp"}};
   GlCubeWalks walks;
