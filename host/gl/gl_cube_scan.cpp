@@ -147,6 +147,18 @@ GlCandidateScan::GlCandidateScan(const SearchContext& ctx) : ctx_(&ctx) {
 
 GlCandidateScan::~GlCandidateScan() = default;
 
+uint64_t GlCandidateScan::upload_bytes(const SearchContext& ctx) {
+  const CubeABuffer& cube = ctx.cube();
+  uint64_t fragments = 0;
+  for (const ABuffer& face : cube.faces) fragments += face.fragments.size();
+  const uint64_t texels = static_cast<uint64_t>(CUBE_FACES) * static_cast<uint64_t>(cube.n) * cube.n;
+  const uint64_t triangles = ctx.scene().triangles->triangle_count();
+  // The offsets (uploaded from a host copy), the fragments; a triangle's plane (4 doubles, and
+  // its host copy), vertices, neighbours (and their host copy), object (host) and opaque bit.
+  return 2 * (texels + 1) * sizeof(uint32_t) + fragments * sizeof(Fragment) +
+         triangles * (2 * 4 * sizeof(double) + 9 * sizeof(float) + 2 * 3 * sizeof(uint32_t) + sizeof(uint32_t) + 1);
+}
+
 namespace {
 
 // The rows of the restricted rays' objects (Media::bounds_meet), appended to `objects`: one

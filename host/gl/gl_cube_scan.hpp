@@ -24,6 +24,11 @@ namespace abcube {
 // loops against it): under llvmpipe's 65535.
 constexpr uint32_t GPU_SCAN_LOOP_BUDGET = 60000;
 
+// What a scan holds a ray beside the upload, on the GPU and the host, with room for eight
+// candidates a ray (a batch whose rays find more takes more for them): the ray as sent, its
+// walk's summary, the candidates' room and their copies read back, and its CandidateScan.
+constexpr uint64_t GPU_SCAN_RAY_BYTES = 3072;
+
 // How GlCandidateScan::scan cuts its work: a pass's first try has room for first_room
 // candidates (0: eight a ray in the scan that walks, one a texel walked in the other), and
 // runs again with room for all it found when they are more; the walks left on the GPU go in
@@ -45,6 +50,9 @@ class GlCandidateScan {
   // planes, vertices or neighbours in one storage block each, or a list is longer than
   // GPU_SCAN_MAX_LIST.
   explicit GlCandidateScan(const SearchContext& ctx);
+  // What the constructor uploads and keeps, on the GPU and the host: the lists' offsets and
+  // fragments, the triangles' planes, vertices, neighbours, objects and opaque bits.
+  static uint64_t upload_bytes(const SearchContext& ctx);
   ~GlCandidateScan();
   GlCandidateScan(const GlCandidateScan&) = delete;
   GlCandidateScan& operator=(const GlCandidateScan&) = delete;

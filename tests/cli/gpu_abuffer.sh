@@ -142,12 +142,13 @@ import numpy as np
 img = abcube.Renderer().render(abcube.load_scene(sys.argv[1]), method="gpu_abuffer", search_on="gpu", width=40,
                                height=30, cube_res=32)
 assert np.array_equal(img, abcube.read_image(sys.argv[2])), "differs"' "$CORNELL" "$WORK/g.exr"
-check "--max-memory 8 (MiB): the answers' store full, the rest walked on the CPU, the same image" bash -c "
-  '$ABCUBE' render '$CORNELL' --method gpu_abuffer --search-on gpu --size 40x30 --cube-res 32 --max-memory 8 \
+check "--max-memory 20 (MiB): the scan's batches smaller, the answers' store full, the rest walked on the CPU, \
+the same image" bash -c "
+  '$ABCUBE' render '$CORNELL' --method gpu_abuffer --search-on gpu --size 40x30 --cube-res 32 --max-memory 20 \
     -o '$WORK/m.exr' --stats '$WORK/m.json' && cmp '$WORK/m.exr' '$WORK/g.exr' &&
   $PY -c 'import json, sys
 d = json.load(open(sys.argv[1]))[\"searches\"][\"deferred\"]
-assert d[\"walked_now\"] > 0 and d[\"bytes\"] <= 4 << 20, d' '$WORK/m.json'"
+assert d[\"walked_now\"] > 0 and d[\"bytes\"] + d[\"scan_bytes\"] <= 20 << 20, d' '$WORK/m.json'"
 check "hybrid --search-on gpu: hybrid's image with the searches on the CPU" bash -c "'$ABCUBE' render '$CORNELL' \
   --method hybrid --search-on gpu --size 40x30 --cube-res 32 -o '$WORK/h_gpu.exr' --stats '$WORK/h.json' &&
   '$ABCUBE' render '$CORNELL' --method hybrid --search-on cpu --size 40x30 --cube-res 32 -o '$WORK/h_cpu.exr' &&
@@ -174,6 +175,8 @@ refused() {  # WHAT PATTERN ARGS...: exit 2, one line matching PATTERN, no image
 refused "--search-on gpu with the thesis mode" "--search-on: gpu takes the crossing mode only" --method gpu_abuffer --search-on gpu --search thesis
 refused "--search-on with abuffer" "--search-on: not used by method abuffer" --method abuffer --search-on gpu
 refused "--search-on elsewhere" "--search-on" --method gpu_abuffer --search-on gpus
+refused "--search-on gpu in too little memory" "search scan needs .* above --max-memory 8 MiB" \
+  --method gpu_abuffer --search-on gpu --size 40x30 --cube-res 32 --max-memory 8
 
 echo "gpu_abuffer: ${#scenes[@]} scenes; $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -58,7 +58,12 @@ struct GlSearches {
   std::unique_ptr<GlCandidateScan> scan;
   std::unique_ptr<DeferredSearches> deferred;
   double upload_ms = 0;
+  uint64_t scan_bytes = 0;  // the most the scan holds: its upload and one batch
 };
+
+// The fewest rays a batch of the GPU's scan takes: below that, its dispatches and read-backs
+// cost more than the scan.
+constexpr size_t GPU_SCAN_MIN_BATCH = 1024;
 
 // Where the searches walk and why, in stats["plan"]["searches_on"]; the GL's scan when there.
 // `held_bytes`: the A-buffers' (the memory budget's share the searches may not take).
@@ -79,6 +84,26 @@ GlSearches gl_searches(MethodContext& mc, MapShader& shader, uint64_t held_bytes
       why += "GL is a hardware GPU";
     }
   }
+  // The memory budget: the rest of the render and the A-buffers, then the scan's upload, then
+  // its batches (at most a quarter of what is left) and the answers' store (half).
+  const uint64_t budget = memory_budget_bytes(r.abuffer.max_memory_bytes);
+  const uint64_t held = r.abuffer.reserved_bytes + held_bytes;
+  const uint64_t upload = on ? GlCandidateScan::upload_bytes(shader.context()) : 0;
+  const uint64_t left = budget > held + upload ? budget - held - upload : 0;
+  DeferredSearchOptions d;
+  d.batch_rays = std::min<size_t>(d.batch_rays, left / 4 / GPU_SCAN_RAY_BYTES);
+  if (on && d.batch_rays < GPU_SCAN_MIN_BATCH) {
+    ABufferOptions o = r.abuffer;
+    o.reserved_bytes = held;
+    const uint64_t need = upload + 4 * GPU_SCAN_MIN_BATCH * GPU_SCAN_RAY_BYTES;
+    try {
+      check_abuffer_budget("the GPU's search scan", need, "its upload and a batch of 1024 rays", o, budget);
+    } catch (const InputError& e) {
+      if (r.search_on == SearchOn::gpu) throw;
+      on = false;
+      why += std::string(", but the memory budget cannot hold the GPU's scan: ") + e.what();
+    }
+  }
   if (on) {
     const Clock::time_point t0 = Clock::now();
     try {
@@ -92,17 +117,18 @@ GlSearches gl_searches(MethodContext& mc, MapShader& shader, uint64_t held_bytes
   }
   if (on) {
     const GlCandidateScan& scan = *g.scan;
-    // The answers' store takes at most half of what the render's budget leaves beside the
-    // A-buffers; searches past it walk on the CPU (the same answers).
-    const uint64_t budget = memory_budget_bytes(r.abuffer.max_memory_bytes);
-    DeferredSearchOptions d;
+    // Searches past the store's room walk on the CPU (the same answers). The long way's walks
+    // (rays past the scan's loop budget) leave their texels on the GPU in batches within the
+    // batch's share.
     d.threads = r.threads;
-    d.max_bytes = std::max<uint64_t>(budget > held_bytes ? (budget - held_bytes) / 2 : 0, DEFERRED_ENTRY_BYTES);
+    d.max_bytes = std::max<uint64_t>(left / 2, DEFERRED_ENTRY_BYTES);
+    ScanBatching batching;
+    batching.batch_bytes = std::min<uint64_t>(batching.batch_bytes, d.batch_rays * GPU_SCAN_RAY_BYTES);
+    g.scan_bytes = upload + d.batch_rays * GPU_SCAN_RAY_BYTES + batching.batch_bytes;
     g.deferred = std::make_unique<DeferredSearches>(
         shader.context(), shader.options().search,
-        [&scan](const std::vector<SearchRay>& rays, const SearchOptions& o, const std::vector<ScanStop>& stops) {
-          return scan.scan(rays, o, {}, stops);
-        },
+        [&scan, batching](const std::vector<SearchRay>& rays, const SearchOptions& o,
+                          const std::vector<ScanStop>& stops) { return scan.scan(rays, o, batching, stops); },
         d);
     shader.defer_searches(g.deferred.get());
   }
@@ -114,16 +140,11 @@ GlSearches gl_searches(MethodContext& mc, MapShader& shader, uint64_t held_bytes
 void record_gl_searches(const GlSearches& g, MethodContext& mc) {
   if (!g.deferred) return;
   const DeferredSearchStats d = g.deferred->stats();
-  mc.stats["searches"]["deferred"] = {{"passes", d.passes},
-                                      {"batches", d.batches},
-                                      {"rays", d.rays},
-                                      {"candidates", d.candidates},
-                                      {"answers_used", d.answers_used},
-                                      {"walked_now", d.walked_now},
-                                      {"texels", d.texels},
-                                      {"stopped", d.stopped},
-                                      {"rescanned", d.rescanned},
-                                      {"bytes", d.bytes}};
+  mc.stats["searches"]["deferred"] = {
+      {"passes", d.passes},         {"batches", d.batches},           {"rays", d.rays},
+      {"candidates", d.candidates}, {"answers_used", d.answers_used}, {"walked_now", d.walked_now},
+      {"texels", d.texels},         {"stopped", d.stopped},           {"rescanned", d.rescanned},
+      {"bytes", d.bytes},           {"scan_bytes", g.scan_bytes}};
   mc.record.timings_ms["gpu_search_upload"] = g.upload_ms;
   mc.record.timings_ms["gpu_search_scan"] = d.scan_ms;
   mc.record.timings_ms["search_answers"] = d.answer_ms;
