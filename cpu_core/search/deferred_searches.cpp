@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cstring>
 #include <string>
 #include <unordered_map>
@@ -49,6 +48,11 @@ RayKey key_of(const SearchRay& q, const glm::dvec3* light) {
 
 }  // namespace deferred
 
+namespace {
+// What every DeferredSearches did on this thread (DeferredSearches::tally_here).
+thread_local DeferredTally tally_on_thread;
+}  // namespace
+
 using deferred::key_of;
 using deferred::RayKey;
 using deferred::RayKeyHash;
@@ -66,7 +70,6 @@ struct DeferredSearches::Store {
   mutable std::mutex mutex;  // the queue's
   std::unordered_set<RayKey, RayKeyHash> queued_keys;
   std::vector<Queued> queue;
-  std::atomic<uint64_t> used{0}, walked_now{0};
   uint64_t max_bytes = 0;
   DeferredSearchStats stats;
 
@@ -118,11 +121,14 @@ SearchResult DeferredSearches::search(const SearchRay& q) {
   const RayKey k = key_of(q, nullptr);
   const auto it = store_->searches.find(k);
   if (it != store_->searches.end()) {
-    store_->used.fetch_add(1, std::memory_order_relaxed);
+    ++tally_on_thread.used;
     return it->second;
   }
-  if (store_->enqueue(k, {q, glm::dvec3(0.0), false})) return SearchResult{};  // a miss
-  store_->walked_now.fetch_add(1, std::memory_order_relaxed);
+  if (store_->enqueue(k, {q, glm::dvec3(0.0), false})) {
+    ++tally_on_thread.stand_ins;
+    return SearchResult{};  // a miss
+  }
+  ++tally_on_thread.walked_now;
   return search_along(ctx_, q, options_);
 }
 
@@ -130,18 +136,25 @@ ShadowResult DeferredSearches::shadow(const SearchRay& q, const glm::dvec3& ligh
   const RayKey k = key_of(q, &light_position);
   const auto it = store_->shadows.find(k);
   if (it != store_->shadows.end()) {
-    store_->used.fetch_add(1, std::memory_order_relaxed);
+    ++tally_on_thread.used;
     return it->second;
   }
-  if (store_->enqueue(k, {q, light_position, true})) return ShadowResult{};  // the light let through
-  store_->walked_now.fetch_add(1, std::memory_order_relaxed);
+  if (store_->enqueue(k, {q, light_position, true})) {
+    ++tally_on_thread.stand_ins;
+    return ShadowResult{};  // the light let through
+  }
+  ++tally_on_thread.walked_now;
   return shadow_along(ctx_, q, light_position, options_);
 }
 
-void DeferredSearches::begin_pass() {
-  ++store_->stats.passes;
-  store_->used = 0;
-  store_->walked_now = 0;
+DeferredTally DeferredSearches::tally_here() { return tally_on_thread; }
+
+void DeferredSearches::begin_pass() { ++store_->stats.passes; }
+
+void DeferredSearches::note_image(uint64_t answers_used, uint64_t walked_now, uint64_t rows_shaded) {
+  store_->stats.answers_used = answers_used;
+  store_->stats.walked_now = walked_now;
+  store_->stats.rows_shaded = rows_shaded;
 }
 
 size_t DeferredSearches::queued() const {
@@ -218,11 +231,6 @@ void DeferredSearches::scan_and_answer(const std::vector<const Queued*>& items, 
   s.stats.answer_ms += ms_since(t0);
 }
 
-DeferredSearchStats DeferredSearches::stats() const {
-  DeferredSearchStats out = store_->stats;
-  out.answers_used = store_->used.load();
-  out.walked_now = store_->walked_now.load();
-  return out;
-}
+DeferredSearchStats DeferredSearches::stats() const { return store_->stats; }
 
 }  // namespace abcube

@@ -13,7 +13,7 @@
 // the prefix of true answers grows every pass; the passes are as many as the longest chain
 // of searches each asked on the answer of the last (a bounce, a quarter split on the first
 // quarters' colours, an edge pass on the points' shadows), not as many as the searches.
-// The stand-ins cost searches whose answers the last pass never asks (counted as unused).
+// The stand-ins cost searches whose answers the image never takes (counted as unused).
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -59,10 +59,21 @@ struct DeferredSearchStats {
   uint64_t rescanned = 0;  // rays scanned again whole, their answer past the hint
   uint64_t texels = 0;     // texels the scans walked
   uint64_t candidates = 0;
-  uint64_t answers_used = 0;  // answers the last pass took from the batches
-  uint64_t walked_now = 0;    // searches the last pass walked on the CPU, the store full
-  uint64_t bytes = 0;         // the most the answers and the queue held
+  // Of the searches the render's image took (note_image): those answered from the batches,
+  // and those walked on the CPU at once, the store full.
+  uint64_t answers_used = 0;
+  uint64_t walked_now = 0;
+  // The rows the passes shaded: each pass shades again only the rows that took a stand-in
+  // in the last (the edge and sparse passes' pixels aside).
+  uint64_t rows_shaded = 0;
+  uint64_t bytes = 0;  // the most the answers and the queue held
   double scan_ms = 0, answer_ms = 0;
+};
+
+// Searches answered by a DeferredSearches on one thread: with a stand-in, from a batch
+// (used), or walked at once, the store full.
+struct DeferredTally {
+  uint64_t stand_ins = 0, used = 0, walked_now = 0;
 };
 
 class DeferredSearches {
@@ -80,13 +91,21 @@ class DeferredSearches {
   // shadow_along(ctx, q, light_position, options), the same way (a stand-in lets the light through).
   ShadowResult shadow(const SearchRay& q, const glm::dvec3& light_position);
 
+  // What every DeferredSearches has done on the calling thread so far: a caller that reads
+  // it before and after some shading knows which searches that shading took, and whether it
+  // took only true answers (and would be the same in the next pass).
+  static DeferredTally tally_here();
+  // Sets the stats' answers_used and walked_now (the image's searches') and rows_shaded
+  // (render_with_map).
+  void note_image(uint64_t answers_used, uint64_t walked_now, uint64_t rows_shaded);
+
   // Starts a pass: counts it and forgets which answers were asked.
   void begin_pass();
   // Rays queued since the last answer_queued.
   size_t queued() const;
   // Scans the queued rays in batches, answers them, and empties the queue. Not during a pass.
   void answer_queued();
-  // The counts so far (answers_used, walked_now: of the last pass).
+  // The counts so far.
   DeferredSearchStats stats() const;
 
   struct Store;

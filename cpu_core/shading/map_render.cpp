@@ -11,6 +11,7 @@
 #include "io/image_io.hpp"
 #include "raster/abuffer.hpp"
 #include "raster/raster.hpp"
+#include "search/deferred_searches.hpp"
 #include "search/search.hpp"
 #include "scene/texture.hpp"
 #include "shading/fragment_texture.hpp"
@@ -73,13 +74,40 @@ struct Quarters {
   int count = 0;
 };
 
+// DEFERRED SEARCHES (search/deferred_searches.hpp): what a pass's first stage (every
+// fragment at its points, before the edge and sparse passes) left, kept for the next pass,
+// which shades again only the rows marked `redo`. A row's first stage depends on nothing
+// outside it but the searches' answers (its KNOWN BLOCKERS start afresh), so a row that took
+// no stand-in is shaded the same in the next pass, bit for bit: its pixels, what they noted
+// for the edge passes, their fallback counts and its statistics are kept instead.
+struct FirstStageRows {
+  bool kept = false;          // false: no pass yet, every row to shade
+  std::vector<uint8_t> redo;  // per row: a stand-in was taken in it
+  Image image;
+  PixelShadows seen;
+  PixelTrails trails;
+  std::vector<std::pair<uint64_t, uint64_t>> pixel_searches;
+  std::vector<MapShadingStats> row_stats;
+  std::vector<DeferredTally> row_took;  // the searches each row took (used, walked_now)
+  DeferredTally image_took;             // the whole image's, after its pass
+  uint64_t rows_shaded = 0;             // by every pass's first stage
+};
+
+// a += (after - before), for the searches taken (not the stand-ins).
+void add_taken(DeferredTally* a, const DeferredTally& before, const DeferredTally& after) {
+  a->used += after.used - before.used;
+  a->walked_now += after.walked_now - before.walked_now;
+}
+
 // One render_with_map call: its inputs, the per-worker statistics and light records, and
 // what the shadow and secondary edges' passes share.
 class MapRender {
  public:
   MapRender(const SceneData& scene, const ABuffer& camera, const MapShader& shader, Image* fallback,
-            const std::vector<uint8_t>* only, const std::function<void(double)>* progress)
-      : progress_(progress),
+            const std::vector<uint8_t>* only, const std::function<void(double)>* progress,
+            FirstStageRows* rows = nullptr)
+      : rows_(rows),
+        progress_(progress),
         scene_(scene),
         camera_(camera),
         shader_(shader),
@@ -101,6 +129,52 @@ class MapRender {
                              [](const Material& m) { return m.reflect > 0.0 || m.transmit > 0.0; });
   }
 
+  // The first stage over the rows `rows_` marks to redo (all in its first pass), the others
+  // as `rows_` kept them; then kept for the next pass. Each row shaded is marked again by
+  // whether it took a stand-in.
+  Image first_stage_kept(const WorkerPixelShader& shade, ResolveOptions ro) {
+    const int width = camera_.width(), height = camera_.height();
+    FirstStageRows& k = *rows_;
+    if (!k.kept) {
+      k.redo.assign(static_cast<size_t>(height), 1);
+      k.row_stats.assign(static_cast<size_t>(height), MapShadingStats{});
+      k.row_took.assign(static_cast<size_t>(height), DeferredTally{});
+    } else {
+      if (edges_) seen_ = k.seen, seen_.forget_rows(k.redo, width);
+      if (trails_on_) trails_ = k.trails, trails_.forget_rows(k.redo, width);
+      if (fallback_) pixel_searches_ = k.pixel_searches;
+    }
+    std::vector<uint8_t> mask(pixels_, 0);
+    for (size_t p = 0; p < pixels_; ++p) {
+      const size_t y = p / static_cast<size_t>(width);
+      if (!k.redo[y]) continue;
+      mask[p] = ro.only ? (*ro.only)[p] : 1;
+      if (fallback_) pixel_searches_[p] = {0, 0};
+    }
+    const std::vector<uint8_t> redo = k.redo;
+    for (size_t y = 0; y < redo.size(); ++y) {
+      if (!redo[y]) continue;
+      k.row_stats[y] = MapShadingStats{}, k.row_took[y] = DeferredTally{}, k.redo[y] = 0;
+      ++k.rows_shaded;
+    }
+    ro.only = &mask;
+    Image image = resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, ro);
+    if (k.kept) {
+      const size_t row = static_cast<size_t>(width) * static_cast<size_t>(image.channels);
+      for (size_t y = 0; y < redo.size(); ++y) {
+        if (redo[y]) continue;
+        std::copy_n(k.image.data.begin() + static_cast<std::ptrdiff_t>(y * row), row,
+                    image.data.begin() + static_cast<std::ptrdiff_t>(y * row));
+      }
+    }
+    k.kept = true;
+    k.image = image;
+    if (edges_) k.seen = seen_;
+    if (trails_on_) k.trails = trails_;
+    if (fallback_) k.pixel_searches = pixel_searches_;
+    return image;
+  }
+
   Image render(int threads, bool neighbours, MapShadingStats* stats) {
     ResolveOptions ro;
     ro.threads = threads;
@@ -118,15 +192,27 @@ class MapRender {
     const size_t workers = static_cast<size_t>(resolve_workers(camera_, ro));
     per_worker_.assign(workers, MapShadingStats{});
     known_.assign(workers, Known{});
+    worker_took_.assign(workers, DeferredTally{});
     worker_direct_.resize(workers);
     if (trails_on_) trails_ = PixelTrails(pixels_, workers);
     const WorkerPixelShader shade = [this](const Fragment& f, int x, int y, int worker) {
       return shade_fragment(f, x, y, worker);
     };
-    Image image = resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, ro);
+    Image image = rows_ ? first_stage_kept(shade, ro)
+                        : resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, ro);
+    first_stage_ = false;
     if (edges_ || trails_on_) second_pass(shade, ro, &image);
     if (sparse_) sparse_pass(shade, ro, &image);
+    if (rows_) {
+      DeferredTally& took = rows_->image_took;
+      took = DeferredTally{};
+      for (const DeferredTally& t : rows_->row_took) add_taken(&took, DeferredTally{}, t);
+      for (const DeferredTally& t : worker_took_) add_taken(&took, DeferredTally{}, t);
+    }
     if (stats) {
+      if (rows_) {
+        for (const MapShadingStats& s : rows_->row_stats) stats->merge(s);
+      }
       for (const MapShadingStats& s : per_worker_) stats->merge(s);
     }
     if (fallback_) {
@@ -142,7 +228,11 @@ class MapRender {
  private:
   // The fragment shaded at its covered quarters, adaptively (header, QUARTER_SPLIT_SRGB).
   ShadedFragment shade_fragment(const Fragment& f, int x, int y, int worker) {
-    MapShadingStats* s = &per_worker_[static_cast<size_t>(worker)];
+    // DEFERRED SEARCHES: the first stage's statistics by row, and whether the row took a
+    // stand-in (FirstStageRows).
+    const bool by_row = rows_ && first_stage_;
+    MapShadingStats* s = by_row ? &rows_->row_stats[static_cast<size_t>(y)] : &per_worker_[static_cast<size_t>(worker)];
+    const DeferredTally tally = rows_ ? DeferredSearches::tally_here() : DeferredTally{};
     Known& known = known_[static_cast<size_t>(worker)];
     if (known.row != y) {  // KNOWN BLOCKERS (map_shading.hpp): none carried from another row
       known.row = y;
@@ -163,6 +253,12 @@ class MapRender {
       auto& p = pixel_searches_[at];
       p.first += after.first - before.first;
       p.second += after.second - before.second;
+    }
+    if (rows_) {
+      const DeferredTally now = DeferredSearches::tally_here();
+      add_taken(by_row ? &rows_->row_took[static_cast<size_t>(y)] : &worker_took_[static_cast<size_t>(worker)], tally,
+                now);
+      if (by_row && now.stand_ins != tally.stand_ins) rows_->redo[static_cast<size_t>(y)] = 1;
     }
     return ShadedFragment{c, scene_.materials[scene_.triangles->material_id[f.triangle()]].opacity};
   }
@@ -390,6 +486,9 @@ class MapRender {
     }
   }
 
+  FirstStageRows* const rows_;  // DEFERRED SEARCHES: the first stage kept between passes
+  bool first_stage_ = true;
+  std::vector<DeferredTally> worker_took_;       // the searches the later stages took, by worker
   const std::function<void(double)>* progress_;  // the first pass's rows, when given
   const SceneData& scene_;
   const ABuffer& camera_;
@@ -426,13 +525,16 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
   DeferredSearches* deferred = shader.deferred();
   if (!deferred) return MapRender(scene, camera, shader, fallback, only, progress).render(threads, neighbours, stats);
   // DEFERRED SEARCHES: the passes run until one asks nothing new; only its image and its
-  // figures stand.
+  // figures stand. Each pass's first stage shades only the rows that took a stand-in in the
+  // last (FirstStageRows).
+  FirstStageRows rows;
   for (;;) {
     deferred->begin_pass();
     MapShadingStats pass;
-    Image image = MapRender(scene, camera, shader, fallback, only, progress).render(threads, neighbours, &pass);
+    Image image = MapRender(scene, camera, shader, fallback, only, progress, &rows).render(threads, neighbours, &pass);
     if (deferred->queued() == 0) {
       if (stats) stats->merge(pass);
+      deferred->note_image(rows.image_took.used, rows.image_took.walked_now, rows.rows_shaded);
       return image;
     }
     deferred->answer_queued();

@@ -1,5 +1,6 @@
 #include "shading/secondary_edges.hpp"
 
+#include <algorithm>
 #include <unordered_map>
 
 #include "base/samples.hpp"
@@ -42,6 +43,17 @@ std::vector<uint8_t> PixelTrails::across(int width, int height, const std::vecto
     }
   }
   return out;
+}
+
+void PixelTrails::forget_rows(const std::vector<uint8_t>& rows, int width) {
+  const auto marked = [&](size_t pixel) { return rows[pixel / static_cast<size_t>(width)] != 0; };
+  for (size_t p = 0; p < points_.size(); ++p) {
+    if (marked(p)) points_[p] = TrailSet{};
+  }
+  for (auto& worker : sides_) {
+    worker.erase(std::remove_if(worker.begin(), worker.end(), [&](const auto& e) { return marked(e.first); }),
+                 worker.end());
+  }
 }
 
 }  // namespace abcube

@@ -57,6 +57,8 @@ class PixelTrails {
   // samples on the side the two share found another: an edge between this pixel's points.
   // Pixels outside `only` (when given) get 0.
   std::vector<uint8_t> across(int width, int height, const std::vector<uint8_t>* only) const;
+  // Forgets what was noted in the rows `rows` marks (a width-wide image, a byte a row).
+  void forget_rows(const std::vector<uint8_t>& rows, int width);
 
  private:
   std::vector<TrailSet> points_;

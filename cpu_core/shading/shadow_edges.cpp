@@ -55,6 +55,14 @@ void PixelShadows::note(size_t at, const SceneData& scene, const PrimaryLights* 
   }
 }
 
+void PixelShadows::forget_rows(const std::vector<uint8_t>& rows, int width) {
+  for (size_t p = 0; p < lit.size(); ++p) {
+    if (!rows[p / static_cast<size_t>(width)]) continue;
+    lit[p] = dark[p] = 0;
+    if (!sides.empty()) sides[p] = 0;
+  }
+}
+
 std::vector<uint64_t> PixelShadows::across(int width, int height, const std::vector<uint8_t>* only) const {
   std::vector<uint64_t> out(lit.size(), 0);
   const auto at = [width](int x, int y) { return pixel_index(width, x, y); };

@@ -49,6 +49,8 @@ struct PixelShadows {
   // neighbour's points, that goes on into this pixel between its own. Pixels outside `only`
   // (when given) get 0.
   std::vector<uint64_t> across(int width, int height, const std::vector<uint8_t>* only) const;
+  // Forgets what was noted in the rows `rows` marks (a width-wide image, a byte a row).
+  void forget_rows(const std::vector<uint8_t>& rows, int width);
 };
 
 // `only` and its 4-neighbours.

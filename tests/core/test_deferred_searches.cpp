@@ -58,7 +58,7 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
     scenes.resize(2);
     plans.resize(2);
   }
-  uint64_t most_passes = 0, rays = 0, rescanned = 0, stopped = 0;
+  uint64_t most_passes = 0, rays = 0, rescanned = 0, stopped = 0, shaded_rows = 0, pass_rows = 0;
   for (const std::string& file : scenes) {
     const SceneData s = deferred_scene(file, checked ? 20 : 48, 40);
     const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, s.render.cube_resolution);
@@ -98,6 +98,12 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
                   static_cast<unsigned long long>(d.passes), static_cast<unsigned long long>(d.rays),
                   static_cast<unsigned long long>(walks));
       EXPECT_GE(d.passes, walks > 0 ? 2u : 1u) << what;
+      // Each pass after the first shades again only the rows that took a stand-in.
+      const uint64_t rows = static_cast<uint64_t>(camera.height());
+      EXPECT_GE(d.rows_shaded, rows) << what;
+      if (d.passes > 2) EXPECT_LT(d.rows_shaded, d.passes * rows) << what;
+      shaded_rows += d.rows_shaded;
+      pass_rows += d.passes * rows;
       most_passes = std::max(most_passes, d.passes);
       rescanned += d.rescanned;
       stopped += d.stopped;
@@ -112,6 +118,9 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
   EXPECT_GT(rays, checked ? 1000u : 10000u);
   EXPECT_GT(stopped, rays / 10);  // STOP HINTS cut that many walks, and kept every image
   EXPECT_LT(rescanned, stopped);
+  std::printf("[ deferred ] %llu rows shaded of the %llu the passes hold\n",
+              static_cast<unsigned long long>(shaded_rows), static_cast<unsigned long long>(pass_rows));
+  EXPECT_LT(shaded_rows, pass_rows * 3 / 4);
 }
 
 // A store with room for a few hundred rays: the searches past it are walked at once by the

@@ -140,11 +140,18 @@ GlSearches gl_searches(MethodContext& mc, MapShader& shader, uint64_t held_bytes
 void record_gl_searches(const GlSearches& g, MethodContext& mc) {
   if (!g.deferred) return;
   const DeferredSearchStats d = g.deferred->stats();
-  mc.stats["searches"]["deferred"] = {
-      {"passes", d.passes},         {"batches", d.batches},           {"rays", d.rays},
-      {"candidates", d.candidates}, {"answers_used", d.answers_used}, {"walked_now", d.walked_now},
-      {"texels", d.texels},         {"stopped", d.stopped},           {"rescanned", d.rescanned},
-      {"bytes", d.bytes},           {"scan_bytes", g.scan_bytes}};
+  mc.stats["searches"]["deferred"] = {{"passes", d.passes},
+                                      {"batches", d.batches},
+                                      {"rays", d.rays},
+                                      {"candidates", d.candidates},
+                                      {"answers_used", d.answers_used},
+                                      {"walked_now", d.walked_now},
+                                      {"rows_shaded", d.rows_shaded},
+                                      {"texels", d.texels},
+                                      {"stopped", d.stopped},
+                                      {"rescanned", d.rescanned},
+                                      {"bytes", d.bytes},
+                                      {"scan_bytes", g.scan_bytes}};
   mc.record.timings_ms["gpu_search_upload"] = g.upload_ms;
   mc.record.timings_ms["gpu_search_scan"] = d.scan_ms;
   mc.record.timings_ms["search_answers"] = d.answer_ms;
