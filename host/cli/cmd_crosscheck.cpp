@@ -50,6 +50,10 @@ void print_searches(const CrosscheckResult& r) {
   const CrosscheckResult::Answers& a = r.answers;
   std::printf("GPU search answers: %zu of %zu the CPU's search's, %zu hits or blocked segments%s%s\n", a.same, a.rays,
               a.found, a.example.empty() ? "" : "; first not: ", a.example.c_str());
+  const CrosscheckResult::SearchImages& i = r.search_images;
+  std::printf("GPU search image: %dx%d, %zu pixels over 1/255 (largest %.4f), %s (%llu passes, %.0f ms)\n", i.width,
+              i.height, i.differing, i.max_diff, i.same_bytes ? "the same bytes" : "not the same bytes",
+              static_cast<unsigned long long>(i.passes), i.ms);
 }
 
 // A GPU build's lists against the CPU's: the counts, then each class of difference found.

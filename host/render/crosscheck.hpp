@@ -118,11 +118,33 @@ struct CrosscheckResult {
     size_t rays = 0, same = 0, found = 0;  // found: a hit, or a shadow segment blocked
     std::string example;                   // the first ray not the same, in words
   } answers;
+  // One small camera image (64 pixels wide at most) rendered by the map method twice, its
+  // searches walked on the CPU, then answered from GPU candidates in deferred passes: the
+  // count of pixels apart by more than 1/255 (sRGB, any channel), the worst gap, and byte
+  // equality. Fails when over 0.1% of pixels are apart. Only where candidates are compared.
+  struct SearchImages {
+    int width = 0, height = 0;
+    uint64_t passes = 0;
+    bool same_bytes = false;
+    size_t differing = 0;
+    double max_diff = 0, ms = 0;
+  } search_images;
   double gpu_ms = 0, cpu_ms = 0;  // prepass vs cube A-buffer build
   uint64_t fragments = 0;
   bool pass = false;
   std::string failures;  // which tolerances failed, "" when pass
 };
+
+// The triangles whose searches' rays (scene_walk_rays, scene_search_rays) the crosscheck
+// walks and scans both ways.
+constexpr size_t CROSSCHECK_WALK_TRIANGLES = 1024;
+
+// The searches' part of a crosscheck over the CPU's cube A-buffer `cube` of `scene`: the
+// GPU's candidates, the answers made from them, and the image shaded with them (candidates,
+// answers, search_images in r; a GL context must be current).
+void compare_searches(const SceneData& scene, const CubeABuffer& cube, int threads, CrosscheckResult* r);
+// That part of the crosscheck's stats ("search_candidates").
+nlohmann::json search_candidates_json(const CrosscheckResult& r);
 
 // Runs both paths on `scene` (a GL context must be current) with n x n faces.
 CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const CrosscheckTolerances& tol = {});
