@@ -6,7 +6,7 @@
 #include <array>
 #include <cstring>
 #include <string>
-#include <unordered_map>
+#include <vector>
 #include <unordered_set>
 
 #include "base/error.hpp"
@@ -28,8 +28,69 @@ struct RayKeyHash {
   size_t operator()(const RayKey& k) const {
     uint64_t h = 0xcbf29ce484222325ull;
     for (const uint64_t v : k.bits) h = (h ^ v ^ (v >> 31)) * 0x100000001b3ull;
-    return static_cast<size_t>(h ^ (h >> 29));
+    // The low bits pick a table's slot: every bit of h mixed into them.
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdull;
+    return static_cast<size_t>(h ^ (h >> 33));
   }
+};
+
+// The answers by ray: open addressing over a power-of-two table of slots (a key's hash and
+// its entry's number), the entries (key beside answer) in chunks in the order stored, so that
+// a lookup reads a slot and an entry, and storing never moves an entry. Filled only between
+// passes; read by every thread during one. At most half the slots are taken.
+template <class Answer>
+class AnswerTable {
+ public:
+  const Answer* find(const RayKey& k, uint64_t h) const {
+    if (slots_.empty()) return nullptr;
+    for (size_t i = h & mask_;; i = (i + 1) & mask_) {
+      const Slot& s = slots_[i];
+      if (s.entry == 0) return nullptr;
+      if (s.hash == h && entry(s.entry - 1).key == k) return &entry(s.entry - 1).answer;
+    }
+  }
+  // Stores k's answer unless k has one.
+  void insert(const RayKey& k, uint64_t h, const Answer& a) {
+    if (find(k, h)) return;
+    if (2 * (count_ + 1) > slots_.size()) grow();
+    if (count_ % CHUNK == 0) {
+      chunks_.emplace_back();
+      chunks_.back().reserve(CHUNK);
+    }
+    chunks_.back().push_back({k, a});
+    place(h, ++count_);
+  }
+  size_t size() const { return count_; }
+
+ private:
+  static constexpr size_t CHUNK = 4096;
+  struct Slot {
+    uint64_t hash = 0;
+    uint64_t entry = 0;  // its number + 1; 0: empty
+  };
+  struct Entry {
+    RayKey key;
+    Answer answer;
+  };
+  const Entry& entry(uint64_t n) const { return chunks_[n / CHUNK][n % CHUNK]; }
+  void place(uint64_t h, uint64_t entry_plus_one) {
+    size_t i = h & mask_;
+    while (slots_[i].entry != 0) i = (i + 1) & mask_;
+    slots_[i] = {h, entry_plus_one};
+  }
+  void grow() {
+    std::vector<Slot> old(std::max<size_t>(64, 2 * slots_.size()));
+    old.swap(slots_);
+    mask_ = slots_.size() - 1;
+    for (const Slot& s : old) {
+      if (s.entry != 0) place(s.hash, s.entry);
+    }
+  }
+  std::vector<Slot> slots_;
+  size_t mask_ = 0;
+  std::vector<std::vector<Entry>> chunks_;
+  size_t count_ = 0;
 };
 
 RayKey key_of(const SearchRay& q, const glm::dvec3* light) {
@@ -53,6 +114,7 @@ namespace {
 thread_local DeferredTally tally_on_thread;
 }  // namespace
 
+using deferred::AnswerTable;
 using deferred::key_of;
 using deferred::RayKey;
 using deferred::RayKeyHash;
@@ -65,8 +127,8 @@ struct DeferredSearches::Queued {
 
 struct DeferredSearches::Store {
   // Written only by answer_queued, between passes: a pass reads them from every thread.
-  std::unordered_map<RayKey, SearchResult, RayKeyHash> searches;
-  std::unordered_map<RayKey, ShadowResult, RayKeyHash> shadows;
+  AnswerTable<SearchResult> searches;
+  AnswerTable<ShadowResult> shadows;
   mutable std::mutex mutex;  // the queue's
   std::unordered_set<RayKey, RayKeyHash> queued_keys;
   std::vector<Queued> queue;
@@ -119,10 +181,9 @@ DeferredSearches::~DeferredSearches() = default;
 
 SearchResult DeferredSearches::search(const SearchRay& q) {
   const RayKey k = key_of(q, nullptr);
-  const auto it = store_->searches.find(k);
-  if (it != store_->searches.end()) {
+  if (const SearchResult* found = store_->searches.find(k, RayKeyHash()(k))) {
     ++tally_on_thread.used;
-    return it->second;
+    return *found;
   }
   if (store_->enqueue(k, {q, glm::dvec3(0.0), false})) {
     ++tally_on_thread.stand_ins;
@@ -134,10 +195,9 @@ SearchResult DeferredSearches::search(const SearchRay& q) {
 
 ShadowResult DeferredSearches::shadow(const SearchRay& q, const glm::dvec3& light_position) {
   const RayKey k = key_of(q, &light_position);
-  const auto it = store_->shadows.find(k);
-  if (it != store_->shadows.end()) {
+  if (const ShadowResult* found = store_->shadows.find(k, RayKeyHash()(k))) {
     ++tally_on_thread.used;
-    return it->second;
+    return *found;
   }
   if (store_->enqueue(k, {q, light_position, true})) {
     ++tally_on_thread.stand_ins;
@@ -223,9 +283,11 @@ void DeferredSearches::scan_and_answer(const std::vector<const Queued*>& items, 
     if (!complete[k]) {
       left->push_back(&q);
     } else if (q.shadow) {
-      s.shadows.emplace(key_of(q.ray, &q.light), shadowed[k]);
+      const RayKey key = key_of(q.ray, &q.light);
+      s.shadows.insert(key, RayKeyHash()(key), shadowed[k]);
     } else {
-      s.searches.emplace(key_of(q.ray, nullptr), found[k]);
+      const RayKey key = key_of(q.ray, nullptr);
+      s.searches.insert(key, RayKeyHash()(key), found[k]);
     }
   }
   s.stats.answer_ms += ms_since(t0);
