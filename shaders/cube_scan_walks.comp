@@ -20,6 +20,11 @@ struct RayScanOut {
   double last_l1, pad;
 };
 layout(std430, binding = CUBE_WALK_COUNTS_BINDING) writeonly buffer Outs { RayScanOut outs[]; };
+// BLOCK BOUNDS (SearchContext): per face and block of GPU_BOUNDS_BLOCK texels a side, the
+// smallest zmin and the largest zmax of its fragments ((+inf, -inf): none), blocks_per_row
+// blocks a row. A texel whose block holds nothing in the ray's range is passed unread: no
+// fragment of it could pass, so the candidates are the same.
+layout(std430, binding = CUBE_SCAN_BLOCKS_BINDING) readonly buffer Blocks { vec2 blocks[]; };
 
 uniform uint ray_count;
 uniform uint walk_cap_texels;
@@ -28,6 +33,7 @@ uniform uint opaque_at;      // from here in objects, bit t: triangle t lets no 
 uniform uint loop_budget;
 uniform uint one;  // 1: the bound of the last loop, which the compiler cannot drop
 uniform uint groups_per_row;
+uniform int blocks_per_row;
 
 const uint STOP_NONE = 0u, STOP_CROSSING = 1u, STOP_SHADOW = 2u;
 // What a walk's step, a fragment's reading and a crossing's trial may cost against the budget:
@@ -58,13 +64,15 @@ void main() {
     int step = walk_step_once(t, interval, after_gap);
     if (step < 0) break;
     if (step == 0) continue;
-    uvec2 list = texel_list(t);
+    dvec2 range2 = squared_range(w, d, interval);
+    vec2 z = blocks[(t.x * blocks_per_row + t.z / GPU_BOUNDS_BLOCK) * blocks_per_row + t.y / GPU_BOUNDS_BLOCK];
+    bool unread = z.x > z.y || double(z.y) * double(z.y) < range2.x || double(z.x) * double(z.x) > range2.y;
+    uvec2 list = unread ? uvec2(0u) : texel_list(t);
     uint worst = (list.y - list.x) * (FRAGMENT_COST + (stop != STOP_NONE ? CROSSING_COST : 0u));
     if (walk_iterations * STEP_COST + spent + worst > loop_budget) {
       flags |= 8u;
       break;
     }
-    dvec2 range2 = squared_range(w, d, interval);
     for (uint k = list.x; k < list.y; ++k) {
       spent += FRAGMENT_COST;
       Fragment f = fragments[k];

@@ -77,7 +77,8 @@ struct GlCandidateScan::Buffers {
   GlProgram refine{std::vector<const char*>{"double_math.glsl", "cube_walk.glsl", "scan_common.glsl",
                                             "triangle_geometry.glsl", "mesh_refine.glsl", "cube_refine.comp"}};
   GlCubeWalks walks;
-  std::unique_ptr<GlBuffer> lists, fragments, planes, positions, neighbours;
+  std::unique_ptr<GlBuffer> lists, fragments, planes, positions, neighbours, blocks;
+  int blocks_per_row = 0;
   std::vector<uint32_t> objects;     // per triangle its object
   std::vector<uint32_t> opaque;      // bit t: triangle t lets no light through (blocker_transmittance 0)
   std::vector<uint32_t> face_first;  // each face's first fragment in `fragments`, then the total
@@ -85,7 +86,7 @@ struct GlCandidateScan::Buffers {
 
 GlCandidateScan::GlCandidateScan(const SearchContext& ctx) : ctx_(&ctx) {
   require_storage_bindings("GPU candidate scan", CUBE_SCAN_POSITIONS_BINDING);
-  require_compute_blocks("GPU candidate scan", 8);
+  require_compute_blocks("GPU candidate scan", 9);
   buffers_ = std::make_unique<Buffers>();
   Buffers& b = *buffers_;
   const CubeABuffer& cube = ctx.cube();
@@ -135,6 +136,18 @@ GlCandidateScan::GlCandidateScan(const SearchContext& ctx) : ctx_(&ctx) {
   }
   check_block("the triangles' neighbours", neighbours.size() * sizeof(uint32_t));
   b.neighbours = std::make_unique<GlBuffer>(neighbours.size() * sizeof(uint32_t), neighbours.data());
+  // BLOCK BOUNDS, as the search context holds them: face by face, row by row.
+  b.blocks_per_row = (cube.n + SearchContext::BOUNDS_BLOCK - 1) / SearchContext::BOUNDS_BLOCK;
+  std::vector<glm::vec2> blocks;
+  for (int f = 0; f < CUBE_FACES; ++f) {
+    for (int bj = 0; bj < b.blocks_per_row; ++bj) {
+      for (int bi = 0; bi < b.blocks_per_row; ++bi) {
+        blocks.push_back(ctx.node_bounds(f, 0, bi * SearchContext::BOUNDS_BLOCK, bj * SearchContext::BOUNDS_BLOCK));
+      }
+    }
+  }
+  check_block("the block bounds", blocks.size() * sizeof(glm::vec2));
+  b.blocks = std::make_unique<GlBuffer>(blocks.size() * sizeof(glm::vec2), blocks.data());
   b.objects = soup.object_id;
   b.opaque.assign((soup.triangle_count() + 31) / 32, 0u);
   for (uint32_t t = 0; t < static_cast<uint32_t>(soup.triangle_count()); ++t) {
@@ -153,9 +166,13 @@ uint64_t GlCandidateScan::upload_bytes(const SearchContext& ctx) {
   for (const ABuffer& face : cube.faces) fragments += face.fragments.size();
   const uint64_t texels = static_cast<uint64_t>(CUBE_FACES) * static_cast<uint64_t>(cube.n) * cube.n;
   const uint64_t triangles = ctx.scene().triangles->triangle_count();
-  // The offsets (uploaded from a host copy), the fragments; a triangle's plane (4 doubles, and
+  const uint64_t blocks_per_row =
+      (static_cast<uint64_t>(cube.n) + SearchContext::BOUNDS_BLOCK - 1) / SearchContext::BOUNDS_BLOCK;
+  const uint64_t block_bytes = 2 * CUBE_FACES * blocks_per_row * blocks_per_row * sizeof(glm::vec2);
+  // The offsets (uploaded from a host copy), the fragments, the block bounds (and their host
+  // copy); a triangle's plane (4 doubles, and
   // its host copy), vertices, neighbours (and their host copy), object (host) and opaque bit.
-  return 2 * (texels + 1) * sizeof(uint32_t) + fragments * sizeof(Fragment) +
+  return 2 * (texels + 1) * sizeof(uint32_t) + fragments * sizeof(Fragment) + block_bytes +
          triangles * (2 * 4 * sizeof(double) + 9 * sizeof(float) + 2 * 3 * sizeof(uint32_t) + sizeof(uint32_t) + 1);
 }
 
@@ -312,6 +329,8 @@ WalkingScan scan_walking(const GlCandidateScan::Buffers& b, const CubeABuffer& c
     set_walk_uniforms(p, cube.n, cap);
     b.positions->bind(CUBE_SCAN_POSITIONS_BINDING);
     outs.bind(CUBE_WALK_COUNTS_BINDING);
+    b.blocks->bind(CUBE_SCAN_BLOCKS_BINDING);
+    glUniform1i(p.uniform("blocks_per_row"), b.blocks_per_row);
     glUniform1ui(p.uniform("ray_count"), static_cast<GLuint>(count));
     glUniform1d(p.uniform("skip_radius"), cube.near_distance);
     glUniform1ui(p.uniform("opaque_at"), opaque_at);

@@ -83,8 +83,11 @@ constexpr unsigned CUBE_SCAN_POSITIONS_BINDING = 30;
 constexpr unsigned CUBE_REFINE_NEIGHBOURS_BINDING = CUBE_SCAN_LISTS_BINDING;
 constexpr unsigned GPU_REFINE_MAX_STEPS = static_cast<unsigned>(REFINE_MAX_STEPS);
 constexpr unsigned GPU_REFINE_MAX_TRIANGLES = static_cast<unsigned>(REFINE_MAX_TRIANGLES);
-// The scan that walks (cube_scan_walks.comp): its STOP HINT's window (search.hpp).
+// The scan that walks (cube_scan_walks.comp): its STOP HINT's window (search.hpp), and the
+// BLOCK BOUNDS it reads at the walks' offsets binding, which it does not use.
 constexpr unsigned GPU_CROSSING_WINDOW_TEXELS = static_cast<unsigned>(CROSSING_WINDOW_TEXELS);
+constexpr unsigned CUBE_SCAN_BLOCKS_BINDING = CUBE_WALK_OFFSETS_BINDING;
+constexpr int GPU_BOUNDS_BLOCK = SearchContext::BOUNDS_BLOCK;
 constexpr unsigned ABUFFER_SCAN_BLOCK = 512;
 constexpr int ABUFFER_TILE = 8;
 constexpr unsigned ABUFFER_GPU_LIST_MAX = 64;
