@@ -8,9 +8,12 @@
 // GPU and by CubeWalk on one CPU thread, with the share of walks identical; and the searches'
 // candidates in the cube A-buffer (gl_cube_scan.hpp scene_search_rays) on the GPU and by
 // scan_candidates on one CPU thread, with the share of rays whose candidates are identical.
+// Last, the camera's resolve with local Phong on every core: pack_under_mask alone, THE
+// RESOLVE PLAN made on the GPU (gl_resolve_plan.hpp), the resolve running its steps, and the
+// share of pixels whose colours are the same bits.
 //
 //   bench_gl_passes SCENE.json [--sizes 256,512,1024] [--runs 5] [--gl auto|egl|osmesa]
-//                   [--error-samples 20000] [--walk-triangles 4096]
+//                   [--error-samples 20000] [--walk-triangles 4096] [--resolve-size W,H]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -30,8 +33,11 @@
 #include "gl/gl_cube_scan.hpp"
 #include "gl/gl_cube_walks.hpp"
 #include "gl/gl_passes.hpp"
+#include "gl/gl_resolve_plan.hpp"
 #include "reference/raytrace.hpp"
 #include "scene/scene_load.hpp"
+#include "shading/fragment_texture.hpp"
+#include "shading/resolve.hpp"
 
 namespace abcube {
 namespace {
@@ -43,6 +49,7 @@ struct Options {
   std::string gl = "auto";
   int error_samples = 20000;
   int walk_triangles = 4096;
+  std::vector<int> resolve_size;  // the resolve's camera, width and height (empty: the scene's)
 };
 
 // The command line: every option with its default and unit in --help.
@@ -52,6 +59,7 @@ void add_options(BenchCommandLine& line, Options& o) {
   line.number("--runs", o.runs, "runs per N (median, min and max reported)", 1, 1000);
   line.choice("--gl", o.gl, "GL path", {"auto", "egl", "egl-device", "egl-surfaceless", "osmesa", "none"});
   line.number("--error-samples", o.error_samples, "texel-centre rays checked against the exact tracer", 0, 100000000);
+  line.numbers("--resolve-size", o.resolve_size, "the resolve's camera: WIDTH,HEIGHT (default the scene's)", 1, 16384);
   line.number("--walk-triangles", o.walk_triangles, "triangles whose search rays are walked and scanned (0 = neither)",
               0, 100000000);
 }
@@ -203,6 +211,46 @@ void print_candidates(const SceneData& scene, const Options& o) {
   }
 }
 
+// The camera's resolve, pack alone against the GPU's plan and its steps, at the scene's size.
+void print_resolve(SceneData scene, GlScene& gl, const Options& o) {
+  if (o.resolve_size.size() == 2) scene.camera.width = o.resolve_size[0], scene.camera.height = o.resolve_size[1];
+  if (!o.resolve_size.empty() && o.resolve_size.size() != 2) throw InputError("--resolve-size: WIDTH,HEIGHT");
+  const ABuffer camera = build_camera_abuffer(scene);
+  const PixelShader shade = local_phong_shader(scene, camera, false);
+  ResolveOptions ro;
+  std::vector<double> pack, plan, steps;
+  Image by_pack, by_steps;
+  ResolvePlanStats s;
+  for (int r = 0; r < o.runs; ++r) {
+    Clock::time_point t0 = Clock::now();
+    by_pack = resolve_image(camera, *scene.triangles, shade, scene.background, ro);
+    pack.push_back(ms_since(t0));
+    t0 = Clock::now();
+    const ResolvePlan p = gl.resolve_planner().plan(camera, scene, {}, &s);
+    plan.push_back(ms_since(t0));
+    ResolveOptions with = ro;
+    with.plan = &p;
+    t0 = Clock::now();
+    by_steps = resolve_image(camera, *scene.triangles, shade, scene.background, with);
+    steps.push_back(ms_since(t0));
+  }
+  size_t same = 0;
+  const size_t pixels = camera.view.pixel_count();
+  for (size_t q = 0; q < pixels; ++q) {
+    same += std::equal(by_pack.data.begin() + 3 * q, by_pack.data.begin() + 3 * q + 3, by_steps.data.begin() + 3 * q);
+  }
+  const Spread a = spread(pack), b = spread(plan), c = spread(steps);
+  std::printf(
+      "\n| camera | fragments | resolve, pack alone ms | GPU plan ms | resolve by its steps ms | steps | pixels "
+      "planned "
+      "| pixels the same bits |\n|---|---|---|---|---|---|---|---|\n"
+      "| %dx%d | %zu | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %.1f [%.1f, %.1f] | %llu | %llu of %zu | %zu of %zu |\n",
+      camera.width(), camera.height(), camera.fragments.size(), a.median, a.lo, a.hi, b.median, b.lo, b.hi, c.median,
+      c.lo, c.hi, static_cast<unsigned long long>(s.steps), static_cast<unsigned long long>(s.planned), pixels, same,
+      pixels);
+  std::fflush(stdout);
+}
+
 int run(const Options& o) {
   const SceneData scene = load_scene(o.scene);
   GlChoice choice = GlChoice::automatic;
@@ -268,6 +316,7 @@ int run(const Options& o) {
     print_walks(scene, o);
     print_candidates(scene, o);
   }
+  print_resolve(scene, gl, o);
   return 0;
 }
 

@@ -19,14 +19,6 @@ struct Setup {
   uint id;  // triangle | back-face bit
 };
 
-// A view (RasterView: a cube face, or the camera): pixel (x, y) looks along to_dir * (x, y, 1).
-struct View {
-  dvec4 to_dir[3];  // the columns of to_direction
-  dvec4 row_x, row_y, row_w;
-  double near_distance;
-  int width, first_pixel;  // pixels a row, and the view's first pixel in the build's pixel order
-};
-
 layout(std430, binding = ABUFFER_SETUPS_BINDING) readonly buffer Setups { Setup setups[]; };
 // The count and fill passes' work items: (setup, tile of its pixel bounds), an invocation each.
 layout(std430, binding = ABUFFER_ITEMS_BINDING) readonly buffer Items { uvec2 items[]; };
@@ -48,18 +40,6 @@ ivec4 setup_tile(Setup s, uint tile) {
   int across = (s.x1 - s.x0 + ABUFFER_TILE - 1) / ABUFFER_TILE;
   int x = s.x0 + int(tile) % across * ABUFFER_TILE, y = s.y0 + int(tile) / across * ABUFFER_TILE;
   return ivec4(x, y, min(ABUFFER_TILE, s.x1 - x), min(ABUFFER_TILE, s.y1 - y));
-}
-
-double sample_dx(int k) { return (double(k % MASK_COLUMNS) + 0.5lf) / double(MASK_COLUMNS); }
-double sample_dy(int k) { return (double(k / MASK_COLUMNS) + 0.5lf) / double(MASK_ROWS); }
-
-// Unnormalised direction through pixel point (x, y): glm's mat3 * vec3, row by row.
-dvec3 view_direction(View v, double x, double y) {
-  precise dvec3 d;
-  d.x = v.to_dir[0].x * x + v.to_dir[1].x * y + v.to_dir[2].x * 1.0lf;
-  d.y = v.to_dir[0].y * x + v.to_dir[1].y * y + v.to_dir[2].y * 1.0lf;
-  d.z = v.to_dir[0].z * x + v.to_dir[1].z * y + v.to_dir[2].z * 1.0lf;
-  return d;
 }
 
 // pixel_mask (raster.cpp): the samples of pixel (x, y) the triangle covers.

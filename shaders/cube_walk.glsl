@@ -39,18 +39,6 @@ double walk_l;
 uint walk_texels, walk_iterations;
 bool walk_aborted, walk_done;
 
-// std::max and std::min exactly (GLSL's leave the sign of a zero and NaN to the GL). The
-// comparison is precise: a compiler may otherwise fold the select back into its own max or
-// min, which returns either zero of +0 and -0.
-double std_max(double a, double b) {
-  precise bool less = a < b;
-  return less ? b : a;
-}
-double std_min(double a, double b) {
-  precise bool less = b < a;
-  return less ? b : a;
-}
-
 // The face envelope's line k at l: F_k . X(l) = c_k + l s_k.
 double envelope_c(int k) { return (k & 1) == 0 ? walk_w[k >> 1] : -walk_w[k >> 1]; }
 double envelope_s(int k) { return (k & 1) == 0 ? walk_d[k >> 1] : -walk_d[k >> 1]; }

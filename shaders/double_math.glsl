@@ -17,3 +17,15 @@ dvec3 cross3(dvec3 a, dvec3 b) {
 
 // +infinity (GLSL has no literal for it).
 double inf() { return packDouble2x32(uvec2(0u, 0x7ff00000u)); }
+
+// std::max and std::min exactly (GLSL's leave the sign of a zero and NaN to the GL). The
+// comparison is precise: a compiler may otherwise fold the select back into its own max or
+// min, which returns either zero of +0 and -0.
+double std_max(double a, double b) {
+  precise bool less = a < b;
+  return less ? b : a;
+}
+double std_min(double a, double b) {
+  precise bool less = b < a;
+  return less ? b : a;
+}

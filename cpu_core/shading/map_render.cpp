@@ -180,6 +180,7 @@ class MapRender {
     ro.threads = threads;
     ro.exact_priority = shader_.exact_priority();
     ro.only = only_;
+    ro.plan = shader_.resolve_plan();
     if (progress_ && *progress_) ro.progress = *progress_;  // the first pass: most of the shading
     // SHADOW EDGES and SECONDARY EDGES (header): what each pixel's points saw, and in the
     // second pass the pixels an edge runs between whose points and their neighbour's.

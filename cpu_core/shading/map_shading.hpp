@@ -19,6 +19,7 @@
 #include "raster/abuffer.hpp"
 #include "io/image.hpp"
 #include "search/lens.hpp"
+#include "shading/resolve.hpp"
 #include "io/metrics.hpp"
 #include "scene/scene_data.hpp"
 #include "reference/raytrace.hpp"
@@ -225,6 +226,10 @@ class MapShader {
   // none is left unanswered. It must outlive its use; its options must be this shader's.
   void defer_searches(DeferredSearches* d) { deferred_ = d; }
   DeferredSearches* deferred() const { return deferred_; }
+  // THE RESOLVE PLAN (resolve.hpp) of the camera A-buffer the renders that follow resolve
+  // (null: none, pack_under_mask alone): every resolve of render_with_map runs its steps.
+  void plan_resolve(const ResolvePlan* plan) { resolve_plan_ = plan; }
+  const ResolvePlan* resolve_plan() const { return resolve_plan_; }
   // SearchRefine::mesh (docs/design/search.md, MESH REFINEMENT): besides the crossing searches'
   // candidates, camera fragments' shading points are moved onto the surface the same way (any
   // mode).
@@ -283,6 +288,7 @@ class MapShader {
 
   std::shared_ptr<SearchContext> ctx_;
   DeferredSearches* deferred_ = nullptr;
+  const ResolvePlan* resolve_plan_ = nullptr;
   std::vector<LensFit> lenses_;
   std::vector<int> lens_of_object_;  // index into lenses_, -1 if none
   // envmap: the resolved colour of each texel looked up so far (envmap_at).

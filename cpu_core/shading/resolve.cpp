@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <limits>
+#include <stdexcept>
 
 #include "base/error.hpp"
 #include "base/parallel.hpp"
@@ -110,6 +111,53 @@ glm::dvec3 pack(FragmentList list, CoverageMask search, Shade&& shade, const Tri
   return colour;
 }
 
+// A pixel's colour by its planned steps (ResolvePlan): the shader called in pack's order,
+// whole shades kept as pack keeps them, and each sum pack's expression. A shade whose
+// opacity is not the one planned would make the plan wrong: a logic error, never trusted.
+template <class Shade>
+glm::dvec3 run_steps(FragmentList list, const ResolveStep* steps, size_t count, Shade&& shade,
+                     const TriangleSoup& triangles, const ResolvePlan& plan, const glm::dvec3& background,
+                     PackScratch* sc) {
+  sc->shaded.resize(list.size());
+  sc->done.assign(list.size(), 0);
+  const auto checked = [&](const Fragment& f) {
+    ShadedFragment s = shade(f);
+    s.opacity = std::clamp(s.opacity, 0.0, 1.0);
+    if (s.opacity != plan.opacity[triangles.material_id[f.triangle()]]) {
+      throw std::logic_error("resolve plan: a shader answered an opacity other than its material's");
+    }
+    return s;
+  };
+  const auto colour_of = [&](uint32_t at, CoverageMask mask) -> glm::dvec3 {
+    if (mask == 0) {
+      if (!sc->done[at]) sc->shaded[at] = checked(list[at]), sc->done[at] = 1;
+      return sc->shaded[at].colour;
+    }
+    Fragment part = list[at];
+    part.mask = mask;
+    return checked(part).colour;
+  };
+  glm::dvec3 colour(0.0);
+  for (size_t k = 0; k < count; ++k) {
+    const ResolveStep& s = steps[k];
+    if (s.at[0] != ResolveStep::NONE && s.at[0] >= list.size())
+      throw std::logic_error("resolve plan: a step past its list");
+    switch (s.kind) {
+      case ResolveStep::shade: colour_of(s.at[0], 0); break;
+      case ResolveStep::add: colour += s.weight[0] * colour_of(s.at[0], s.mask[0]); break;
+      case ResolveStep::add_two: {
+        const glm::dvec3 c0 = colour_of(s.at[0], s.mask[0]);
+        const glm::dvec3 c1 = s.at[1] == ResolveStep::NONE ? glm::dvec3(0.0) : colour_of(s.at[1], s.mask[1]);
+        colour += s.weight[0] * c0 + s.weight[1] * c1;
+        break;
+      }
+      case ResolveStep::background: colour += s.weight[0] * background; break;
+      default: throw std::logic_error("resolve plan: a step of no kind");
+    }
+  }
+  return colour;
+}
+
 }  // namespace
 
 double SampleDepth::t(const Fragment& f, int k) const {
@@ -161,6 +209,14 @@ void visible_triangles(const ABuffer& camera, const TriangleSoup& triangles, int
   }
 }
 
+void ResolvePlan::check(const ABuffer& camera, bool exact) const {
+  const size_t pixels = camera.view.pixel_count();
+  if (offsets.size() != pixels + 1 || planned.size() != pixels || fragments != camera.fragments.size() ||
+      offsets.back() != steps.size() || exact_priority != exact) {
+    throw InputError("resolve: the plan given is not of this camera A-buffer and rule");
+  }
+}
+
 int resolve_workers(const ABuffer& camera, const ResolveOptions& options) {
   if (options.threads < 0) throw InputError("resolve: threads must be >= 0, got " + std::to_string(options.threads));
   return thread_count(options.threads, static_cast<size_t>(camera.height()));
@@ -175,6 +231,8 @@ Image resolve_image(const ABuffer& camera, const TriangleSoup& triangles, const 
 Image resolve_image_per_worker(const ABuffer& camera, const TriangleSoup& triangles, const WorkerPixelShader& shade,
                                const glm::dvec3& background, const ResolveOptions& options) {
   const int threads = resolve_workers(camera, options);
+  const ResolvePlan* plan = options.plan;
+  if (plan) plan->check(camera, options.exact_priority);
   Image image(camera.width(), camera.height(), 3);
   std::vector<PackScratch> scratch(static_cast<size_t>(threads));
   std::atomic<int> rows_done{0};
@@ -191,6 +249,14 @@ Image resolve_image_per_worker(const ABuffer& camera, const TriangleSoup& triang
         continue;
       }
       const auto shade_here = [&](const Fragment& f) { return shade(f, x, y, worker); };
+      const size_t p = static_cast<size_t>(y) * static_cast<size_t>(camera.width()) + static_cast<size_t>(x);
+      if (plan && plan->planned[p]) {
+        const uint32_t first = plan->offsets[p];
+        const glm::dvec3 c = run_steps(camera.list(x, y), plan->steps.data() + first, plan->offsets[p + 1] - first,
+                                       shade_here, triangles, *plan, background, &scratch[static_cast<size_t>(worker)]);
+        image.set_rgb(x, y, glm::vec3(c));
+        continue;
+      }
       const SampleDepth depth{&camera.view, &triangles, x, y};
       const glm::dvec3 c = pack(camera.list(x, y), FULL_MASK, shade_here, triangles, background,
                                 &scratch[static_cast<size_t>(worker)], options.exact_priority ? &depth : nullptr);

@@ -61,6 +61,43 @@ glm::dvec3 pack_under_mask(FragmentList list, CoverageMask search, const Fragmen
                            const TriangleSoup& triangles, const glm::dvec3& background, PackScratch* scratch = nullptr,
                            const SampleDepth* depth = nullptr);
 
+// THE RESOLVE PLAN: pack_under_mask split in two. Its masks, weights and the order in which
+// it shades never depend on a fragment's colour, only on its material's opacity (every
+// shader here answers that opacity), so a planner that knows the opacities can write down a
+// pixel's resolve as steps, and the colours come after: shade these fragments, in this
+// order, and sum them with these weights. The GPU plans (host/gl/gl_resolve_plan.hpp); the
+// CPU runs the steps, calling the shader exactly as pack_under_mask would, and with the
+// same sums, so the colour is pack_under_mask's bit for bit.
+struct ResolveStep {
+  enum Kind : uint32_t {
+    shade = 0,       // shade at[0] over its whole mask (once a pixel: later steps reuse it)
+    add = 1,         // colour += weight[0] * C(0)
+    add_two = 2,     // colour += weight[0] * C(0) + weight[1] * C(1), C(1) zero if at[1] is NONE
+    background = 3,  // colour += weight[0] * background
+  };
+  static constexpr uint32_t NONE = 0xffffffffu;
+  uint32_t kind = shade;
+  uint32_t at[2] = {NONE, NONE};  // list positions of the colours summed (C(k)), in shading order
+  CoverageMask mask[2] = {0, 0};  // 0: the fragment's whole shade; else the samples it is shaded over
+  uint32_t pad = 0;
+  double weight[2] = {0.0, 0.0};
+};
+static_assert(sizeof(ResolveStep) == 40, "ResolveStep must match shaders/resolve_plan.comp");
+
+// A camera A-buffer's plan: pixel p's steps are steps[offsets[p], offsets[p + 1]). A pixel
+// whose `planned` is 0 is left to pack_under_mask (the planner's stack or loops ran out).
+struct ResolvePlan {
+  std::vector<uint32_t> offsets;
+  std::vector<ResolveStep> steps;
+  std::vector<uint8_t> planned;
+  std::vector<double> opacity;  // each material's, clamped to [0, 1]: what the plan assumed
+  size_t fragments = 0;         // the A-buffer's fragment count (a check that it is this one)
+  bool exact_priority = true;   // the rule it planned intersecting fragments by
+
+  // Throws InputError unless this plan is of `camera` with `exact_priority`'s rule.
+  void check(const ABuffer& camera, bool exact_priority) const;
+};
+
 // Shades fragment f of pixel (x, y) of the camera A-buffer.
 using PixelShader = std::function<ShadedFragment(const Fragment& f, int x, int y)>;
 
@@ -73,6 +110,9 @@ struct ResolveOptions {
   const std::vector<uint8_t>* only = nullptr;
   // Called now and then on the calling thread with the share of rows resolved, in [0, 1].
   std::function<void(double)> progress;
+  // When set: the pixels it planned are resolved by its steps (the same colours), the others
+  // by pack_under_mask. It must be this A-buffer's, with exact_priority's rule.
+  const ResolvePlan* plan = nullptr;
 };
 
 // The antialiased image (row 0 at the top): pack_under_mask(list, FULL_MASK) per pixel.

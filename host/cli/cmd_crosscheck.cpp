@@ -107,6 +107,16 @@ struct CrosscheckCommand {
                 r.tied_agree);
     print_lists("GPU cube A-buffer lists", r.lists, r.gpu_abuffer_ms);
     print_lists("GPU camera A-buffer lists", r.camera_lists, r.gpu_camera_abuffer_ms);
+    const CrosscheckResult::ResolvePlanCheck& plan = r.resolve_plan;
+    if (!plan.skipped.empty()) {
+      std::printf("GPU resolve plan: %s\n", plan.skipped.c_str());
+    } else {
+      std::printf(
+          "GPU resolve plan: %zu of %zu pixels the CPU's resolve, bit for bit; %zu planned, %llu steps "
+          "(%.1f ms)%s%s\n",
+          plan.identical, plan.pixels, plan.planned, static_cast<unsigned long long>(plan.steps), plan.ms,
+          plan.example.empty() ? "" : "; first not: ", plan.example.c_str());
+    }
     print_searches(r);
     std::printf("camera interior pixels: %zu of %zu, RMSE %.2e (<= %.0e), max abs %.2e (<= %.2e)\n", r.interior_pixels,
                 r.pixels, r.interior_rmse, tol.interior_rmse, r.interior_max_abs, tol.interior_max_abs);

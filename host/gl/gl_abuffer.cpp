@@ -14,6 +14,7 @@
 #include "base/parallel.hpp"
 #include "base/timer.hpp"
 #include "gl/gl_compute.hpp"
+#include "gl/gl_view.hpp"
 #include "gl/gl_program.hpp"
 #include "gl/glsl_shared.hpp"
 #include "raster/cube_map.hpp"
@@ -43,16 +44,6 @@ struct GpuSetup {
 static_assert(sizeof(GpuSetup) == 576 && offsetof(GpuSetup, plane_distance) == 512 && offsetof(GpuSetup, id) == 560,
               "GpuSetup must match Setup in shaders/abuffer_common.glsl");
 
-// shaders/abuffer_common.glsl's View in std430.
-struct GpuView {
-  double to_dir[3][4];
-  double row_x[4], row_y[4], row_w[4];
-  double near_distance;
-  int32_t width, first_pixel;
-  uint32_t pad[4];
-};
-static_assert(sizeof(GpuView) == 224 && offsetof(GpuView, width) == 200, "GpuView must match View");
-
 void put(double* out, const glm::dvec3& v, double w = 0.0) {
   out[0] = v.x;
   out[1] = v.y;
@@ -81,18 +72,6 @@ GpuSetup pack(const TriangleSetup& s, int view) {
   g.x1 = s.x1;
   g.y1 = s.y1;
   g.id = s.triangle | (s.back_face() ? Fragment::BACK_FACE_BIT : 0u);
-  return g;
-}
-
-GpuView pack(const RasterView& v, int first_pixel) {
-  GpuView g{};
-  for (int c = 0; c < 3; ++c) put(g.to_dir[c], v.to_direction[c]);
-  put(g.row_x, v.row_x);
-  put(g.row_y, v.row_y);
-  put(g.row_w, v.row_w);
-  g.near_distance = v.near_distance;
-  g.width = v.width;
-  g.first_pixel = first_pixel;
   return g;
 }
 
@@ -231,13 +210,13 @@ struct GpuRun {
 }  // namespace
 
 struct GlABufferBuilder::Programs {
-  GlProgram count{
-      std::vector<const char*>{"double_math.glsl", "fragment.glsl", "abuffer_common.glsl", "abuffer_count.comp"}};
+  GlProgram count{std::vector<const char*>{"double_math.glsl", "fragment.glsl", "view.glsl", "abuffer_common.glsl",
+                                           "abuffer_count.comp"}};
   GlProgram scan{std::vector<const char*>{"abuffer_scan.comp"}};
-  GlProgram fill{
-      std::vector<const char*>{"double_math.glsl", "fragment.glsl", "abuffer_common.glsl", "abuffer_fill.comp"}};
-  GlProgram finish{
-      std::vector<const char*>{"double_math.glsl", "fragment.glsl", "abuffer_common.glsl", "abuffer_finish.comp"}};
+  GlProgram fill{std::vector<const char*>{"double_math.glsl", "fragment.glsl", "view.glsl", "abuffer_common.glsl",
+                                          "abuffer_fill.comp"}};
+  GlProgram finish{std::vector<const char*>{"double_math.glsl", "fragment.glsl", "view.glsl", "abuffer_common.glsl",
+                                            "abuffer_finish.comp"}};
 };
 
 namespace {
@@ -249,7 +228,7 @@ GpuRun run_passes(const GlABufferBuilder::Programs& programs, const SceneData& s
   const uint64_t pixels = set.pixels;
   std::vector<GpuView> views;
   for (size_t v = 0; v < set.rasters.size(); ++v)
-    views.push_back(pack(set.rasters[v], static_cast<int>(set.first_pixel[v])));
+    views.push_back(gpu_view(set.rasters[v], static_cast<int>(set.first_pixel[v])));
   std::vector<uint32_t> object_material(2 * soup.triangle_count());
   for (size_t t = 0; t < soup.triangle_count(); ++t) {
     object_material[2 * t] = soup.object_id[t];

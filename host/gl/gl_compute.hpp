@@ -63,6 +63,22 @@ inline void require_storage_bindings(const char* what, unsigned highest) {
   }
 }
 
+// The most bytes one storage block may take (128 MiB at least on any GL 4.3).
+inline uint64_t max_block_bytes() {
+  GLint64 block = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
+  return static_cast<uint64_t>(block);
+}
+
+// Throws RuntimeFailure unless `bytes` of `what` fit one storage block; `advice` ends the line.
+inline void require_block_bytes(const std::string& what, uint64_t bytes, const std::string& advice) {
+  if (bytes > max_block_bytes()) {
+    throw RuntimeFailure(what + " take " + std::to_string(bytes) +
+                         " bytes, above the GL's GL_MAX_SHADER_STORAGE_BLOCK_SIZE " +
+                         std::to_string(max_block_bytes()) + "; " + advice);
+  }
+}
+
 // Throws RuntimeFailure naming `what` unless one compute shader may use `count` storage blocks.
 inline void require_compute_blocks(const char* what, int count) {
   GLint blocks = 0;

@@ -42,19 +42,9 @@ constexpr uint64_t CANDIDATES_AT = 16;  // bytes before the first candidate
 static_assert(sizeof(Fragment) == 20, "cube_scan.comp reads fragments as 20 bytes");
 constexpr uint32_t NO_ROW = 0xffffffffu;
 
-uint64_t max_block_bytes() {
-  GLint64 block = 0;
-  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
-  return static_cast<uint64_t>(block);
-}
-
 // Throws RuntimeFailure unless `bytes` of `what` fit one storage block.
 void check_block(const char* what, uint64_t bytes) {
-  if (bytes > max_block_bytes()) {
-    throw RuntimeFailure(std::string("GPU candidate scan: ") + what + " take " + std::to_string(bytes) +
-                         " bytes, above the GL's GL_MAX_SHADER_STORAGE_BLOCK_SIZE " +
-                         std::to_string(max_block_bytes()) + "; lower N or scan on the CPU");
-  }
+  require_block_bytes(std::string("GPU candidate scan: ") + what, bytes, "lower N or scan on the CPU");
 }
 
 // cube_scan_walks.comp's RayScanOut.

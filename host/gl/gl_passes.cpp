@@ -9,6 +9,7 @@
 #include "base/timer.hpp"
 #include "gl/gl_abuffer.hpp"
 #include "gl/gl_camera_exact.hpp"
+#include "gl/gl_resolve_plan.hpp"
 #include "gl/gl_scene_parts.hpp"
 #include "raster/cube_map.hpp"
 
@@ -61,6 +62,10 @@ const GpuTimings& GlScene::timings() const { return parts_->timings; }
 const GlABufferBuilder& GlScene::abuffer_builder() {
   if (!abuffer_) abuffer_ = std::make_unique<GlABufferBuilder>();
   return *abuffer_;
+}
+const GlResolvePlanner& GlScene::resolve_planner() {
+  if (!resolve_planner_) resolve_planner_ = std::make_unique<GlResolvePlanner>();
+  return *resolve_planner_;
 }
 bool GlScene::soup_pinned() const { return parts_->buffers.pinned(); }
 bool GlScene::triangle_ids() const { return parts_->buffers.triangle_ids(); }

@@ -21,6 +21,7 @@
 namespace abcube {
 
 class GlABufferBuilder;
+class GlResolvePlanner;
 class GlExactCamera;
 struct GlSceneParts;
 
@@ -104,6 +105,8 @@ class GlScene {
   // The A-buffers' compute passes (gl_abuffer.hpp), compiled on first use and kept with the
   // scene, so that the renders of one upload compile them once.
   const GlABufferBuilder& abuffer_builder();
+  // THE RESOLVE PLAN's compute pass (gl_resolve_plan.hpp), kept the same way.
+  const GlResolvePlanner& resolve_planner();
   // The techniques' shared parts, for the passes outside this class (gl_shadow_probe.hpp).
   GlSceneParts& parts() { return *parts_; }
 
@@ -111,6 +114,7 @@ class GlScene {
   std::unique_ptr<GlSceneParts> parts_;
   std::unique_ptr<GlExactCamera> exact_;
   std::unique_ptr<GlABufferBuilder> abuffer_;
+  std::unique_ptr<GlResolvePlanner> resolve_planner_;
   int camera_layers_ = 0;
   bool camera_layers_capped_ = false;
 };

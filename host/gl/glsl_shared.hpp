@@ -88,6 +88,21 @@ constexpr unsigned GPU_REFINE_MAX_TRIANGLES = static_cast<unsigned>(REFINE_MAX_T
 constexpr unsigned GPU_CROSSING_WINDOW_TEXELS = static_cast<unsigned>(CROSSING_WINDOW_TEXELS);
 constexpr unsigned CUBE_SCAN_BLOCKS_BINDING = CUBE_WALK_OFFSETS_BINDING;
 constexpr int GPU_BOUNDS_BLOCK = SearchContext::BOUNDS_BLOCK;
+// THE RESOLVE PLAN on the GPU (gl_resolve_plan.cpp, resolve_plan.comp): the camera's view,
+// its lists' offsets and fragments, each triangle's object and opacity, the vertices, each
+// pixel's count of steps and status, where each pixel's steps start, and the steps. A
+// separate program, so it takes the A-buffer passes' bindings. Each invocation keeps at most
+// RESOLVE_STACK items of Pack_Under_Mask's stack; a pixel that needs more is resolved by
+// the CPU.
+constexpr unsigned RESOLVE_VIEW_BINDING = ABUFFER_VIEWS_BINDING;
+constexpr unsigned RESOLVE_LISTS_BINDING = ABUFFER_OFFSETS_BINDING;
+constexpr unsigned RESOLVE_FRAGMENTS_BINDING = ABUFFER_FRAGMENTS_BINDING;
+constexpr unsigned RESOLVE_TRIANGLES_BINDING = ABUFFER_TRIANGLES_BINDING;
+constexpr unsigned RESOLVE_POSITIONS_BINDING = ABUFFER_SETUPS_BINDING;
+constexpr unsigned RESOLVE_COUNTS_BINDING = ABUFFER_SCAN_VALUES_BINDING;
+constexpr unsigned RESOLVE_STARTS_BINDING = ABUFFER_SCAN_SUMS_BINDING;
+constexpr unsigned RESOLVE_STEPS_BINDING = ABUFFER_CURSORS_BINDING;
+constexpr unsigned RESOLVE_STACK = 64;
 constexpr unsigned ABUFFER_SCAN_BLOCK = 512;
 constexpr int ABUFFER_TILE = 8;
 constexpr unsigned ABUFFER_GPU_LIST_MAX = 64;

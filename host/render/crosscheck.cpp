@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "base/error.hpp"
 #include "base/parallel.hpp"
@@ -22,6 +23,7 @@
 #include "gl/gl_abuffer.hpp"
 #include "gl/gl_cube_scan.hpp"
 #include "gl/gl_cube_walks.hpp"
+#include "gl/gl_resolve_plan.hpp"
 #include "gl/gl_shadow_probe.hpp"
 #include "material/shading.hpp"
 #include "base/timer.hpp"
@@ -147,6 +149,35 @@ void compare_camera_lists(const SceneData& scene, GlScene& gl, const ABuffer& cp
   r->camera_lists = compare_lists(cpu, gpu);
 }
 
+// THE RESOLVE PLAN made on the GPU, its steps run on the CPU, against `cpu`: pack's image.
+void compare_resolve_plan(const SceneData& scene, GlScene& gl, const ABuffer& camera, const ResolveOptions& ro,
+                          const Image& cpu, CrosscheckResult* r) {
+  CrosscheckResult::ResolvePlanCheck& c = r->resolve_plan;
+  ResolvePlanStats s;
+  ResolvePlan plan;
+  try {
+    plan = gl.resolve_planner().plan(camera, scene, {}, &s);
+  } catch (const RuntimeFailure& e) {
+    c.skipped = e.what();
+    return;
+  }
+  c.ms = s.ms, c.pixels = s.pixels, c.planned = s.planned, c.steps = s.steps;
+  ResolveOptions with = ro;
+  with.plan = &plan;
+  const Image by_steps =
+      resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera, false), scene.background, with);
+  for (int y = 0; y < camera.height(); ++y) {
+    for (int x = 0; x < camera.width(); ++x) {
+      const glm::vec3 a = cpu.rgb(x, y), b = by_steps.rgb(x, y);
+      if (std::memcmp(&a, &b, sizeof(a)) == 0) {
+        ++c.identical;
+      } else if (c.example.empty()) {
+        c.example = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")";
+      }
+    }
+  }
+}
+
 void compare_camera(const SceneData& scene, int threads, GlScene& gl, CrosscheckResult* r) {
   const Image gpu = gl.camera_color(scene.camera);
   ABufferOptions options;
@@ -160,6 +191,7 @@ void compare_camera(const SceneData& scene, int threads, GlScene& gl, Crosscheck
   const Image cpu =
       resolve_image(camera, *scene.triangles, local_phong_shader(scene, camera, false), scene.background, ro);
   r->cpu_image = cpu;
+  compare_resolve_plan(scene, gl, camera, ro, cpu, r);
   // Interior: one triangle over all 32 samples and the centre, none of them at an edge tie
   // (edge_ties.hpp).
   const std::vector<uint8_t> tie_pixels = edge_tie_pixels(scene);
@@ -382,6 +414,9 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   fail(r.volumes.interior_share() < tol.volumes_agreement_min, "shadow volumes against the tracer");
   fail(!r.lists.within_bounds(), "GPU A-buffer lists");
   fail(!r.camera_lists.within_bounds(), "GPU camera A-buffer lists");
+  // The plan's steps are pack's expressions; on a GL whose doubles round as IEEE 754 says,
+  // every colour is the same bits.
+  fail(r.resolve_plan.skipped.empty() && r.resolve_plan.identical < r.resolve_plan.pixels, "GPU resolve plan");
   fail(r.walks.differing > 0, "GPU cube walks");
   // A GL whose double division or square root does not round as IEEE 754 says moves a walk's
   // ends within rounding; a fragment at the end of a texel's range may then pass on one side
@@ -425,6 +460,14 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
               {"gpu_abuffer_ms", r.gpu_abuffer_ms},
               {"camera_abuffer_lists", lists_json(r.camera_lists)},
               {"gpu_camera_abuffer_ms", r.gpu_camera_abuffer_ms},
+              {"resolve_plan",
+               {{"pixels", r.resolve_plan.pixels},
+                {"planned", r.resolve_plan.planned},
+                {"identical", r.resolve_plan.identical},
+                {"steps", r.resolve_plan.steps},
+                {"first_not_identical", r.resolve_plan.example},
+                {"not_compared", r.resolve_plan.skipped},
+                {"gpu_ms", r.resolve_plan.ms}}},
               {"cube_walks",
                {{"rays", r.walks.rays},
                 {"identical", r.walks.identical},

@@ -96,6 +96,15 @@ struct CrosscheckResult {
   double gpu_abuffer_ms = 0;
   ListComparison camera_lists;  // the same for the camera's A-buffer
   double gpu_camera_abuffer_ms = 0;
+  // THE RESOLVE PLAN made on the GPU (gl_resolve_plan.hpp) and run by the CPU against
+  // cpu_image's resolve: the pixels whose colours are the same bits, of those planned.
+  struct ResolvePlanCheck {
+    size_t pixels = 0, planned = 0, identical = 0;
+    uint64_t steps = 0;
+    std::string example;  // the first pixel not identical
+    std::string skipped;  // why the plan was not compared (a GL or budget refusal)
+    double ms = 0;
+  } resolve_plan;
   // The cube walks of the searches' rays (shadow segments to the lights and reflection rays
   // from points on the triangles) on the GPU against CubeWalk's, texel for texel
   // (gl_cube_walks.hpp compare_walks): it fails on any walk differing beyond rounding. Not

@@ -6,6 +6,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,10 @@ struct RenderRequest {
   // where it is a hardware GPU and the options allow it, else the CPU.
   enum class SearchOn { cpu, gpu, automatic };
   SearchOn search_on = SearchOn::cpu;
+  // Where the camera's resolve is planned (--resolve-on, gpu_abuffer): THE RESOLVE PLAN on GL
+  // compute (gl_resolve_plan.hpp), or pack_under_mask alone on the CPU; unset for a method
+  // that does not read it.
+  std::optional<SearchOn> resolve_on;
   std::vector<std::string> aovs;
 };
 

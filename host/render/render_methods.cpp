@@ -37,10 +37,18 @@ void read_gpu_options(const RenderOptions& o, int max_depth, RenderRequest* r) {
   r->gpu.max_depth = max_depth;
 }
 
-void read_search_on(const RenderOptions& o, RenderRequest* r) {
+namespace {
+
+RenderRequest::SearchOn read_where(const std::string& name) {
   using SearchOn = RenderRequest::SearchOn;
-  r->search_on = o.search_on == "gpu" ? SearchOn::gpu : o.search_on == "cpu" ? SearchOn::cpu : SearchOn::automatic;
+  return name == "gpu" ? SearchOn::gpu : name == "cpu" ? SearchOn::cpu : SearchOn::automatic;
 }
+
+}  // namespace
+
+void read_search_on(const RenderOptions& o, RenderRequest* r) { r->search_on = read_where(o.search_on); }
+
+void read_resolve_on(const RenderOptions& o, RenderRequest* r) { r->resolve_on = read_where(o.resolve_on); }
 
 std::vector<std::string> gpu_camera_option_keys() {
   return {"gpu_mirrors", "gpu_shadows", "gpu_max_views", "gpu_shading"};

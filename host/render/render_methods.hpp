@@ -34,6 +34,8 @@ void read_map_options(const RenderOptions& options, MapVariant variant, RenderRe
 // --search-on into request->search_on (refuse_options_unused_by refuses gpu with the thesis
 // mode).
 void read_search_on(const RenderOptions& options, RenderRequest* request);
+// --resolve-on into request->resolve_on.
+void read_resolve_on(const RenderOptions& options, RenderRequest* request);
 // The GPU camera pass's options (--gpu-*) into request->gpu.
 void read_gpu_options(const RenderOptions& options, int max_depth, RenderRequest* request);
 // The table's keys of what read_map_options reads for every variant (the cube map's N and

@@ -8,8 +8,8 @@
 # difference is a wrong list, never a tolerance. Then the doors: `abcube render --method
 # gpu_abuffer` with its stats (the GL it built on, both A-buffers' figures), a scene file's
 # render.method, Python's render(method=...), and its options: abuffer's, others refused.
-# Then the same with the searches on the GPU (--search-on gpu), on the same scenes at 40 x 30,
-# through the command line, batch and Python (a scene file names the method alone, as for
+# Then the same with the searches on the GPU (--search-on gpu) and the resolve planned there
+# (--resolve-on gpu), on the same scenes at 40 x 30, through the command line, batch and Python (a scene file names the method alone, as for
 # every method's options), and under a memory budget its answers fill.
 # In the checked builds (ABCUBE_CHECKED_BUILD, tools/sanitize.sh) the same commands run on
 # cornell and three generated scenes, and Python is left out (those builds make no module).
@@ -110,7 +110,7 @@ for s in "${gpu_scenes[@]}"; do
   stem=searches/$(basename "$(dirname "$s")")_$(basename "$s" .json)
   for m in abuffer gpu; do
     method=$([ $m = gpu ] && echo gpu_abuffer || echo abuffer)
-    on=$([ $m = gpu ] && echo ', "search_on": "gpu"')
+    on=$([ $m = gpu ] && echo ', "search_on": "gpu", "resolve_on": "gpu"')
     echo "{\"scene\": \"$s\", \"out\": \"${stem}_$m.exr\", \"method\": \"$method\"$on, \"cube_res\": 32, \"camera\": {\"width\": 40, \"height\": 30}}" \
       >> "$WORK/searches.jsonl"
   done
@@ -124,28 +124,34 @@ for s in "${gpu_scenes[@]}"; do
 done
 check "every image with the searches on the GPU is abuffer's, byte for byte (${#gpu_scenes[@]} scenes, $differ differ)" \
   [ "$differ" -eq 0 ]
-check "render --search-on gpu" "$ABCUBE" render "$CORNELL" --method gpu_abuffer --search-on gpu --size 40x30 \
-  --cube-res 32 -o "$WORK/g.exr" --stats "$WORK/g.json"
+check "render --search-on gpu --resolve-on gpu" "$ABCUBE" render "$CORNELL" --method gpu_abuffer --search-on gpu \
+  --resolve-on gpu --size 40x30 --cube-res 32 -o "$WORK/g.exr" --stats "$WORK/g.json"
 check "the batch's image" cmp "$WORK/g.exr" "$WORK/searches/scenes_cornell_gpu.exr"
-check "its stats: searches on the GPU, in passes, every answer from a scan" $PY -c 'import json, sys
+check "its stats: searches on the GPU, in passes, every answer from a scan; every pixel's resolve planned there" \
+  $PY -c 'import json, sys
 s = json.load(open(sys.argv[1]))
 assert s["plan"]["searches_on"] == {"where": "gpu", "why": "asked: --search-on gpu"}, s["plan"]["searches_on"]
+assert s["plan"]["resolve_on"] == {"where": "gpu", "why": "asked: --resolve-on gpu"}, s["plan"]["resolve_on"]
+p = s["resolve_plan"]
+assert p["pixels"] == 1200 and p["planned"] == 1200 and p["steps"] >= 1200, p
 d = s["searches"]["deferred"]
 assert d["passes"] >= 2 and d["rays"] > 1000 and d["answers_used"] > 1000, d
 assert s["timings_ms"]["gpu_search_scan"] > 0, s["timings_ms"]' "$WORK/g.json"
 check "--search-on auto on llvmpipe: the CPU, and why" bash -c "'$ABCUBE' render '$CORNELL' --method gpu_abuffer \
-  --size 40x30 --cube-res 32 -o '$WORK/u.exr' --stats '$WORK/u.json' && grep -q 'GL is software' '$WORK/u.json' &&
+  --size 40x30 --cube-res 32 -o '$WORK/u.exr' --stats '$WORK/u.json' &&
+  [ \$(grep -c 'GL is software' '$WORK/u.json') -eq 2 ] &&
   cmp '$WORK/u.exr' '$WORK/g.exr'"
 [ "$CHECKED" = 1 ] || check "Python: render(search_on=\"gpu\") is the CLI's image" \
   env PYTHONPATH="$(dirname "$ABCUBE")/python" $PY -c 'import sys, abcube
 import numpy as np
-img = abcube.Renderer().render(abcube.load_scene(sys.argv[1]), method="gpu_abuffer", search_on="gpu", width=40,
+img = abcube.Renderer().render(abcube.load_scene(sys.argv[1]), method="gpu_abuffer", search_on="gpu",
+                               resolve_on="gpu", width=40,
                                height=30, cube_res=32)
 assert np.array_equal(img, abcube.read_image(sys.argv[2])), "differs"' "$CORNELL" "$WORK/g.exr"
 check "--max-memory 20 (MiB): the scan's batches smaller, the answers' store full, the rest walked on the CPU, \
 the same image" bash -c "
-  '$ABCUBE' render '$CORNELL' --method gpu_abuffer --search-on gpu --size 40x30 --cube-res 32 --max-memory 20 \
-    -o '$WORK/m.exr' --stats '$WORK/m.json' && cmp '$WORK/m.exr' '$WORK/g.exr' &&
+  '$ABCUBE' render '$CORNELL' --method gpu_abuffer --search-on gpu --resolve-on gpu --size 40x30 --cube-res 32 \
+    --max-memory 20 -o '$WORK/m.exr' --stats '$WORK/m.json' && cmp '$WORK/m.exr' '$WORK/g.exr' &&
   $PY -c 'import json, sys
 d = json.load(open(sys.argv[1]))[\"searches\"][\"deferred\"]
 assert d[\"walked_now\"] > 0 and d[\"bytes\"] + d[\"scan_bytes\"] <= 20 << 20, d' '$WORK/m.json'"
@@ -175,6 +181,9 @@ refused() {  # WHAT PATTERN ARGS...: exit 2, one line matching PATTERN, no image
 refused "--search-on gpu with the thesis mode" "--search-on: gpu takes the crossing mode only" --method gpu_abuffer --search-on gpu --search thesis
 refused "--search-on with abuffer" "--search-on: not used by method abuffer" --method abuffer --search-on gpu
 refused "--search-on elsewhere" "--search-on" --method gpu_abuffer --search-on gpus
+refused "--resolve-on with abuffer" "--resolve-on: not used by method abuffer" --method abuffer --resolve-on gpu
+refused "--resolve-on gpu in too little memory" "GPU resolve plan: its .* steps .* over the memory budget" \
+  --method gpu_abuffer --resolve-on gpu --search-on cpu --size 320x240 --cube-res 32 --max-memory 24
 refused "--search-on gpu in too little memory" "search scan needs .* above --max-memory 8 MiB" \
   --method gpu_abuffer --search-on gpu --size 40x30 --cube-res 32 --max-memory 8
 

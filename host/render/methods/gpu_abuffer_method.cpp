@@ -1,7 +1,9 @@
 // The gpu_abuffer method: the abuffer method with its camera's and cube's A-buffers built by
 // GL compute shaders (gl/gl_abuffer.hpp), the same lists as the CPU core's; the searches
 // walk on the GPU too where --search-on says (the DEFERRED SEARCHES over gl_cube_scan.hpp),
-// the shading and the resolve run on the CPU. Its options are abuffer's and --search-on.
+// and the resolve is planned there where --resolve-on says (THE RESOLVE PLAN,
+// gl_resolve_plan.hpp); the shading runs on the CPU. Its options are abuffer's, --search-on
+// and --resolve-on.
 #include <memory>
 
 #include "render/method.hpp"
@@ -24,12 +26,14 @@ class GpuABufferMethod : public RenderMethod {
   std::vector<std::string> reads() const override {
     std::vector<std::string> keys = abuffer_->reads();
     keys.push_back("search_on");
+    keys.push_back("resolve_on");
     return keys;
   }
   void read_options(const RenderOptions& options, const SceneData& view, RenderRequest* request) const override {
     abuffer_->read_options(options, view, request);
     request->abuffers_on_gl = true;
     read_search_on(options, request);
+    read_resolve_on(options, request);
   }
   bool needs_gl() const override { return true; }
   Image render(MethodContext& mc) const override {

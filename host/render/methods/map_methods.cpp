@@ -11,6 +11,8 @@
 #include "base/timer.hpp"
 #include "gl/gl_context.hpp"
 #include "gl/gl_cube_scan.hpp"
+#include "gl/gl_passes.hpp"
+#include "gl/gl_resolve_plan.hpp"
 #include "io/metrics.hpp"
 #include "reference/raytrace.hpp"
 #include "render/method.hpp"
@@ -29,6 +31,47 @@ using nlohmann::json;
 
 namespace {
 
+// --resolve-on: THE RESOLVE PLAN of `camera` made on GL compute, or none (pack_under_mask on
+// the CPU), with where and why in stats["plan"]["resolve_on"]. `held_bytes`: the A-buffers'
+// (the memory budget's share the plan may not take).
+std::unique_ptr<ResolvePlan> gl_resolve_plan(MethodContext& mc, const ABuffer& camera, uint64_t held_bytes) {
+  using SearchOn = RenderRequest::SearchOn;
+  const RenderRequest& r = mc.request;
+  std::unique_ptr<ResolvePlan> plan;
+  if (!mc.gl_scene || !r.resolve_on) return plan;
+  const SearchOn asked = *r.resolve_on;
+  bool on = asked == SearchOn::gpu;
+  std::string why = on ? "asked: --resolve-on gpu" : "asked: --resolve-on cpu";
+  if (asked == SearchOn::automatic) {
+    on = !software_renderer(mc.record.gl_renderer);
+    why = on ? "auto: GL is a hardware GPU"
+             : "auto: GL is software (" + mc.record.gl_renderer + "), where the CPU's resolve alone is faster";
+  }
+  if (on) {
+    const uint64_t budget = memory_budget_bytes(r.abuffer.max_memory_bytes);
+    const uint64_t held = r.abuffer.reserved_bytes + held_bytes;
+    ResolvePlanOptions o;
+    o.exact_priority = r.map.exact_priority;
+    o.max_bytes = budget > held ? budget - held : 1;
+    ResolvePlanStats s;
+    try {
+      plan = std::make_unique<ResolvePlan>(mc.gl_scene->resolve_planner().plan(camera, mc.scene, o, &s));
+      mc.record.timings_ms["gpu_resolve_plan"] = s.ms;
+      mc.stats["resolve_plan"] = {{"pixels", s.pixels}, {"planned", s.planned}, {"steps", s.steps}, {"bytes", s.bytes}};
+    } catch (const RenderTimeout&) {
+      throw;
+    } catch (const Interrupted&) {
+      throw;
+    } catch (const std::runtime_error& e) {  // the budget (InputError) or the GL (RuntimeFailure)
+      if (asked == SearchOn::gpu) throw;
+      why += std::string(", but the GPU's plan was refused: ") + e.what();
+      on = false;
+    }
+  }
+  mc.stats["plan"]["resolve_on"] = {{"where", on ? "gpu" : "cpu"}, {"why", why}};
+  return plan;
+}
+
 // The camera view through the CPU A-buffer with local Phong, for a scene with nothing to
 // search: the resolve's rule for intersecting fragments and the texture lookups as the
 // request's map options say. `only` (optional): the pixels to render (ResolveOptions::only).
@@ -44,6 +87,8 @@ Image render_abuffer_local(MethodContext& mc, const std::vector<uint8_t>* only) 
   ro.exact_priority = r.map.exact_priority;
   ro.only = only;
   t0 = Clock::now();
+  const std::unique_ptr<ResolvePlan> plan = gl_resolve_plan(mc, camera, s.bytes_total);
+  ro.plan = plan.get();
   const PixelShader shade = local_phong_shader(scene, camera, r.map.plan.texture_samples());
   Image image = resolve_image(camera, *scene.triangles, shade, scene.background, ro);
   mc.record.timings_ms["camera_abuffer"] = build_ms;
@@ -223,8 +268,13 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   stats["cube_abuffer"] = cube_abuffer_json(map.stats);
   mc.record.timings_ms["map_setup"] = map.setup_ms;
   mc.record.timings_ms["camera_abuffer"] = camera_ms;
+  const std::unique_ptr<ResolvePlan> resolve_plan = gl_resolve_plan(mc, camera, as.bytes_total + map.stats.bytes_total);
+  const uint64_t plan_bytes =
+      resolve_plan ? resolve_plan->steps.size() * sizeof(ResolveStep) + resolve_plan->offsets.size() * sizeof(uint32_t)
+                   : 0;
+  map.shader->plan_resolve(resolve_plan.get());
   const GlSearches on_gl =
-      mc.gl_scene ? gl_searches(mc, *map.shader, as.bytes_total + map.stats.bytes_total) : GlSearches{};
+      mc.gl_scene ? gl_searches(mc, *map.shader, as.bytes_total + map.stats.bytes_total + plan_bytes) : GlSearches{};
   const Clock::time_point t0 = Clock::now();
   MapShadingStats ms;
   std::function<void(double)> shading;

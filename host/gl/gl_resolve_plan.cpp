@@ -1,0 +1,175 @@
+#include "gl/gl_resolve_plan.hpp"
+
+#include <glad/gl.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "base/error.hpp"
+#include "base/timer.hpp"
+#include "gl/gl_compute.hpp"
+#include "gl/gl_program.hpp"
+#include "gl/gl_view.hpp"
+#include "gl/glsl_shared.hpp"
+#include "scene/tie_rule.hpp"
+
+namespace abcube {
+
+namespace {
+
+// resolve_plan.comp's TriangleInfo in std430.
+struct GpuTriangleInfo {
+  uint32_t object, pad;
+  double opacity;
+};
+static_assert(sizeof(GpuTriangleInfo) == 16, "must match shaders/resolve_plan.comp");
+
+// The steps a fill pass writes at most: a band of pixels whose steps fit one storage block,
+// and no more than 64 MiB on the GPU at a time.
+uint64_t band_steps() {
+  return std::max<uint64_t>(1, std::min<uint64_t>(max_block_bytes(), uint64_t{64} << 20) / sizeof(ResolveStep));
+}
+
+const char* const WHAT = "GPU resolve plan";
+
+// The statuses both passes gave (two words a pixel: steps, status) must show every invocation
+// ran to its end (bit 4), with the same steps in both.
+void check_passes(const std::vector<uint32_t>& counted, const std::vector<uint32_t>& filled, size_t first,
+                  size_t end) {
+  for (size_t p = first; p < end; ++p) {
+    const uint32_t status = counted[2 * p + 1];
+    if (!(status & 4u) || filled[2 * (p - first)] != counted[2 * p] || filled[2 * (p - first) + 1] != status) {
+      throw RuntimeFailure(std::string(WHAT) + ": the GL ended pixel " + std::to_string(p) +
+                           "'s plan early or differently between its passes; resolve on the CPU");
+    }
+  }
+}
+
+}  // namespace
+
+GlResolvePlanner::GlResolvePlanner() {
+  require_storage_bindings(WHAT, RESOLVE_COUNTS_BINDING);
+  require_compute_blocks(WHAT, 8);
+  program_ = std::make_unique<GlProgram>(
+      std::vector<const char*>{"double_math.glsl", "fragment.glsl", "view.glsl", "resolve_plan.comp"});
+}
+
+GlResolvePlanner::~GlResolvePlanner() = default;
+
+uint64_t GlResolvePlanner::upload_bytes(const ABuffer& camera, const SceneData& scene) {
+  const uint64_t pixels = camera.view.pixel_count();
+  const uint64_t triangles = scene.triangles->triangle_count();
+  return sizeof(GpuView) + (pixels + 1) * sizeof(uint32_t) + camera.fragments.size() * sizeof(Fragment) +
+         triangles * (sizeof(GpuTriangleInfo) + 9 * sizeof(float)) + 2 * pixels * 2 * sizeof(uint32_t) +
+         (pixels + 1) * sizeof(uint32_t);
+}
+
+ResolvePlan GlResolvePlanner::plan(const ABuffer& camera, const SceneData& scene, const ResolvePlanOptions& options,
+                                   ResolvePlanStats* stats) const {
+  const Clock::time_point t0 = Clock::now();
+  const TriangleSoup& soup = *scene.triangles;
+  const size_t pixels = camera.view.pixel_count();
+  const uint64_t upload = upload_bytes(camera, scene);
+  const auto over_budget = [&](uint64_t bytes, const std::string& what) {
+    if (options.max_bytes && bytes > options.max_bytes) {
+      throw InputError(std::string(WHAT) + ": " + what + " take " + std::to_string(bytes >> 20) +
+                       " MiB, over the memory budget's " + std::to_string(options.max_bytes >> 20) +
+                       " MiB left; raise --max-memory or resolve on the CPU");
+    }
+  };
+  over_budget(upload, "its lists and triangles");
+  require_block_bytes(std::string(WHAT) + ": the camera's fragments", camera.fragments.size() * sizeof(Fragment),
+                      "resolve on the CPU");
+
+  ResolvePlan out;
+  out.exact_priority = options.exact_priority;
+  out.fragments = camera.fragments.size();
+  out.opacity.reserve(scene.materials.size());
+  for (const Material& m : scene.materials) out.opacity.push_back(std::clamp(m.opacity, 0.0, 1.0));
+  std::vector<GpuTriangleInfo> info(soup.triangle_count());
+  for (size_t t = 0; t < info.size(); ++t) {
+    info[t] = {soup.object_id[t], 0u, out.opacity[soup.material_id[t]]};
+  }
+  const GpuView view = gpu_view(camera.view, 0);
+  const GlBuffer view_buffer(sizeof(view), &view);
+  const GlBuffer lists(camera.offsets.size() * sizeof(uint32_t), camera.offsets.data());
+  const GlBuffer fragments(camera.fragments.size() * sizeof(Fragment), camera.fragments.data());
+  const GlBuffer triangles(info.size() * sizeof(GpuTriangleInfo), info.data());
+  const GlBuffer positions(soup.positions.size() * sizeof(glm::vec3), soup.positions.data());
+  const GlBuffer counts(2 * pixels * sizeof(uint32_t), nullptr);
+
+  const GlProgram& p = *program_;
+  p.use();
+  view_buffer.bind(RESOLVE_VIEW_BINDING);
+  lists.bind(RESOLVE_LISTS_BINDING);
+  fragments.bind(RESOLVE_FRAGMENTS_BINDING);
+  triangles.bind(RESOLVE_TRIANGLES_BINDING);
+  positions.bind(RESOLVE_POSITIONS_BINDING);
+  counts.bind(RESOLVE_COUNTS_BINDING);
+  glUniform1i(p.uniform("exact_priority"), options.exact_priority ? 1 : 0);
+  glUniform3d(p.uniform("centre"), camera.view.centre.x, camera.view.centre.y, camera.view.centre.z);
+  glUniform1d(p.uniform("tie_relative"), TIE_RELATIVE);
+  glUniform1ui(p.uniform("loop_budget"), options.loop_budget);
+  glUniform1ui(p.uniform("one"), 1u);
+  const auto run = [&](size_t first, size_t count, bool writing) {
+    glUniform1ui(p.uniform("first_pixel"), static_cast<GLuint>(first));
+    glUniform1ui(p.uniform("pixel_count"), static_cast<GLuint>(count));
+    glUniform1i(p.uniform("writing"), writing ? 1 : 0);
+    dispatch(p, (count + 63) / 64);
+  };
+  {
+    const GlBuffer no_starts(4, nullptr);
+    no_starts.bind(RESOLVE_STARTS_BINDING);
+    const GlBuffer no_steps(sizeof(ResolveStep), nullptr);
+    no_steps.bind(RESOLVE_STEPS_BINDING);
+    run(0, pixels, false);
+  }
+  const std::vector<uint32_t> counted = counts.read<uint32_t>(2 * pixels);
+
+  // Each pixel's steps from the count: none where it is left to the CPU.
+  out.offsets.assign(pixels + 1, 0);
+  out.planned.assign(pixels, 0);
+  for (size_t q = 0; q < pixels; ++q) {
+    const bool planned = (counted[2 * q + 1] & 3u) == 1u;
+    out.planned[q] = planned ? 1 : 0;
+    out.offsets[q + 1] = out.offsets[q] + (planned ? counted[2 * q] : 0u);
+  }
+  const uint64_t total = out.offsets.back();
+  const uint64_t band = band_steps();
+  const uint64_t held = upload + total * sizeof(ResolveStep) + std::min(total, band) * sizeof(ResolveStep);
+  over_budget(held, "its " + std::to_string(total) + " steps and upload");
+  out.steps.resize(total);
+
+  // The fill pass in bands of whole pixels, each band's steps in one buffer.
+  for (size_t first = 0; first < pixels;) {
+    size_t end = first + 1;
+    while (end < pixels && out.offsets[end + 1] - out.offsets[first] <= band) ++end;
+    const uint32_t base = out.offsets[first];
+    std::vector<uint32_t> starts(end - first + 1);
+    for (size_t q = first; q <= end; ++q) starts[q - first] = out.offsets[q] - base;
+    const uint64_t count = starts.back();
+    const GlBuffer start_buffer(starts.size() * sizeof(uint32_t), starts.data());
+    const GlBuffer step_buffer(std::max<uint64_t>(count, 1) * sizeof(ResolveStep), nullptr);
+    const GlBuffer band_counts(2 * (end - first) * sizeof(uint32_t), nullptr);
+    start_buffer.bind(RESOLVE_STARTS_BINDING);
+    step_buffer.bind(RESOLVE_STEPS_BINDING);
+    band_counts.bind(RESOLVE_COUNTS_BINDING);
+    run(first, end - first, true);
+    check_passes(counted, band_counts.read<uint32_t>(2 * (end - first)), first, end);
+    const std::vector<ResolveStep> got = step_buffer.read<ResolveStep>(count);
+    std::copy(got.begin(), got.end(), out.steps.begin() + base);
+    first = end;
+  }
+  check_gl(WHAT);
+  if (stats) {
+    stats->pixels = pixels;
+    stats->planned = static_cast<uint64_t>(std::count(out.planned.begin(), out.planned.end(), 1));
+    stats->steps = total;
+    stats->bytes = held;
+    stats->ms = ms_since(t0);
+  }
+  return out;
+}
+
+}  // namespace abcube

@@ -1,0 +1,60 @@
+// THE RESOLVE PLAN (cpu_core/shading/resolve.hpp) made by a GL compute shader
+// (shaders/resolve_plan.comp), an invocation a pixel of the camera's A-buffer: Pack_Under_Mask
+// run over each list with the materials' opacities, writing down what it shades, in its
+// order, and the weights it sums them with. Its expressions (the masks' weights, the EXACT
+// PRIORITY MASKS' planes and THE TIE RULE) are the CPU's in double precision, operation for
+// operation, so that on a GL whose doubles round as IEEE 754 says the CPU's run of the steps
+// gives resolve_image's colours bit for bit. docs/design/gpu-abuffer.md has the layout.
+#pragma once
+#include <cstdint>
+#include <memory>
+
+#include "raster/abuffer.hpp"
+#include "scene/scene_data.hpp"
+#include "shading/resolve.hpp"
+
+namespace abcube {
+
+class GlProgram;
+
+// A pixel's plan passes over its list and stack at most this many times (counted as the
+// shader's loops may cost) before it is left to the CPU: under llvmpipe's silent 65535.
+constexpr uint32_t GPU_RESOLVE_LOOP_BUDGET = 30000;
+
+struct ResolvePlanOptions {
+  bool exact_priority = true;  // EXACT PRIORITY MASKS (true) or the thesis' Vis_front estimate
+  uint32_t loop_budget = GPU_RESOLVE_LOOP_BUDGET;
+  // The memory the plan may take, its upload and its steps on the GPU and the host: 0, none.
+  uint64_t max_bytes = 0;
+};
+
+// What a plan took.
+struct ResolvePlanStats {
+  uint64_t pixels = 0, planned = 0, steps = 0;
+  uint64_t bytes = 0;  // the most it held, on the GPU and the host together
+  double ms = 0;
+};
+
+// The compiled program, on the GL context current when it was made (GL 4.5 core with 8
+// storage blocks to a compute shader), which must stay current for its life.
+class GlResolvePlanner {
+ public:
+  GlResolvePlanner();
+  ~GlResolvePlanner();
+  GlResolvePlanner(const GlResolvePlanner&) = delete;
+  GlResolvePlanner& operator=(const GlResolvePlanner&) = delete;
+
+  // The plan of `camera`, an A-buffer of `scene`'s triangles. Throws InputError when it
+  // would pass options.max_bytes (the figures named), RuntimeFailure when the GL cannot run
+  // it or ended an invocation's loops early.
+  ResolvePlan plan(const ABuffer& camera, const SceneData& scene, const ResolvePlanOptions& options = {},
+                   ResolvePlanStats* stats = nullptr) const;
+
+  // The bytes a plan of `camera` holds before its steps are counted: its upload.
+  static uint64_t upload_bytes(const ABuffer& camera, const SceneData& scene);
+
+ private:
+  std::unique_ptr<GlProgram> program_;
+};
+
+}  // namespace abcube

@@ -1,0 +1,140 @@
+// THE RESOLVE PLAN made on the GPU (host/gl/gl_resolve_plan.hpp) against pack_under_mask
+// (cpu_core/shading/resolve.hpp): on the repository's scenes and the hard cases kept as
+// regressions, under both rules for intersecting fragments, with their materials as they are
+// and made half transparent, the resolve that runs the plan calls the shader with the same
+// fragments and masks in the same order, and gives the same image bit for bit. A plan whose
+// loops run out leaves its pixels to pack, with the same image again.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "base/error.hpp"
+#include "gl/gl_resolve_plan.hpp"
+#include "gl_test_support.hpp"
+#include "raster/abuffer.hpp"
+#include "scene/scene_load.hpp"
+#include "shading/resolve.hpp"
+
+namespace abcube {
+namespace {
+
+// A shade that depends on everything the resolve hands it (the fragment, its mask, the pixel),
+// so that a step shaded over another mask or at another fragment shows in the image.
+ShadedFragment hashed_shade(const SceneData& scene, const Fragment& f, int x, int y) {
+  uint64_t h = f.triangle_and_facing * 0x9E3779B97F4A7C15ull ^ (uint64_t{f.mask} << 7) ^ f.normal;
+  h ^= (static_cast<uint64_t>(x) << 40) ^ (static_cast<uint64_t>(y) << 20);
+  h *= 0xBF58476D1CE4E5B9ull;
+  const auto part = [&](int k) { return static_cast<double>((h >> (16 * k)) & 0xffff) / 65535.0; };
+  return {glm::dvec3(part(0), part(1), part(2)), scene.materials[scene.triangles->material_id[f.triangle()]].opacity};
+}
+
+// Each call the resolve makes, in order (one thread).
+struct Call {
+  int x, y;
+  uint32_t id;
+  CoverageMask mask;
+  bool operator==(const Call& o) const { return x == o.x && y == o.y && id == o.id && mask == o.mask; }
+};
+
+Image resolve_recorded(const ABuffer& camera, const SceneData& scene, const ResolvePlan* plan, bool exact,
+                       std::vector<Call>* calls) {
+  ResolveOptions ro;
+  ro.threads = 1;
+  ro.exact_priority = exact;
+  ro.plan = plan;
+  const PixelShader shade = [&](const Fragment& f, int x, int y) {
+    calls->push_back({x, y, f.triangle_and_facing, f.mask});
+    return hashed_shade(scene, f, x, y);
+  };
+  return resolve_image(camera, *scene.triangles, shade, scene.background, ro);
+}
+
+// The plan's figures, after holding its resolve to pack's.
+ResolvePlanStats expect_plan_resolves_as_pack(const GlResolvePlanner& planner, const SceneData& scene, bool exact,
+                                              uint32_t loop_budget, const std::string& what) {
+  const ABuffer camera = build_camera_abuffer(scene);
+  ResolvePlanOptions o;
+  o.exact_priority = exact;
+  o.loop_budget = loop_budget;
+  ResolvePlanStats stats;
+  const ResolvePlan plan = planner.plan(camera, scene, o, &stats);
+  std::vector<Call> by_pack, by_plan;
+  const Image a = resolve_recorded(camera, scene, nullptr, exact, &by_pack);
+  const Image b = resolve_recorded(camera, scene, &plan, exact, &by_plan);
+  EXPECT_EQ(a.data.size(), b.data.size()) << what;
+  size_t differ = 0;
+  for (size_t k = 0; k < a.data.size(); ++k) differ += std::memcmp(&a.data[k], &b.data[k], sizeof(float)) != 0;
+  EXPECT_EQ(differ, 0u) << what << ": image values differing";
+  EXPECT_EQ(by_pack.size(), by_plan.size()) << what << ": shader calls";
+  for (size_t k = 0; k < std::min(by_pack.size(), by_plan.size()); ++k) {
+    if (!(by_pack[k] == by_plan[k])) {
+      ADD_FAILURE() << what << ": call " << k << " at pixel (" << by_pack[k].x << ", " << by_pack[k].y << ") differs";
+      break;
+    }
+  }
+  EXPECT_EQ(stats.pixels, camera.view.pixel_count()) << what;
+  if (loop_budget >= GPU_RESOLVE_LOOP_BUDGET) EXPECT_EQ(stats.planned, stats.pixels) << what;
+  return stats;
+}
+
+// The first kept scene at width x height.
+SceneData first_scene(int width, int height) {
+  SceneData scene = load_scene(test::scene_files().front());
+  scene.camera.width = width;
+  scene.camera.height = height;
+  return scene;
+}
+
+TEST(ResolvePlanGl, StepsAreTheCpuResolvesOnEveryKeptScene) {
+  test::test_context();
+  const GlResolvePlanner planner;
+  const std::vector<std::string> files = test::scene_files();
+  ASSERT_GE(files.size(), test::checked_build() ? 5u : 15u);
+  for (const std::string& file : files) {
+    SceneData scene = load_scene(file);
+    scene.camera.width = 48;
+    scene.camera.height = 36;
+    for (const bool exact : {true, false}) {
+      const std::string what = file + (exact ? " (exact priority)" : " (Vis estimate)");
+      expect_plan_resolves_as_pack(planner, scene, exact, GPU_RESOLVE_LOOP_BUDGET, what);
+      SceneData half = scene;
+      for (size_t m = 0; m < half.materials.size(); ++m) half.materials[m].opacity = m % 2 ? 1.0 : 0.5;
+      expect_plan_resolves_as_pack(planner, half, exact, GPU_RESOLVE_LOOP_BUDGET, what + ", half transparent");
+    }
+  }
+}
+
+// A budget that runs out at the first pixel of any depth leaves those pixels to pack.
+TEST(ResolvePlanGl, PixelsPastTheLoopBudgetAreLeftToPack) {
+  test::test_context();
+  const GlResolvePlanner planner;
+  SceneData scene = first_scene(32, 24);
+  for (Material& m : scene.materials) m.opacity = 0.5;
+  const ResolvePlanStats stats = expect_plan_resolves_as_pack(planner, scene, true, 6, "budget 6");
+  EXPECT_LT(stats.planned, stats.pixels);
+  EXPECT_GT(stats.planned, 0u);
+}
+
+TEST(ResolvePlanGl, RefusesAPlanOverItsBudgetAndAPlanOfAnotherBuffer) {
+  test::test_context();
+  const GlResolvePlanner planner;
+  const SceneData scene = first_scene(32, 24);
+  const ABuffer camera = build_camera_abuffer(scene);
+  ResolvePlanOptions o;
+  o.max_bytes = 1024;
+  EXPECT_THROW(planner.plan(camera, scene, o), InputError);
+  const ResolvePlan plan = planner.plan(camera, scene);
+  ResolveOptions ro;
+  ro.plan = &plan;
+  ro.exact_priority = false;  // planned with exact priority
+  const PixelShader shade = [&](const Fragment& f, int x, int y) { return hashed_shade(scene, f, x, y); };
+  EXPECT_THROW(resolve_image(camera, *scene.triangles, shade, scene.background, ro), InputError);
+}
+
+}  // namespace
+}  // namespace abcube
