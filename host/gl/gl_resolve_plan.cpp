@@ -35,8 +35,7 @@ const char* const WHAT = "GPU resolve plan";
 
 // The statuses both passes gave (two words a pixel: steps, status) must show every invocation
 // ran to its end (bit 4), with the same steps in both.
-void check_passes(const std::vector<uint32_t>& counted, const std::vector<uint32_t>& filled, size_t first,
-                  size_t end) {
+void check_passes(const std::vector<uint32_t>& counted, const std::vector<uint32_t>& filled, size_t first, size_t end) {
   for (size_t p = first; p < end; ++p) {
     const uint32_t status = counted[2 * p + 1];
     if (!(status & 4u) || filled[2 * (p - first)] != counted[2 * p] || filled[2 * (p - first) + 1] != status) {
@@ -65,6 +64,79 @@ uint64_t GlResolvePlanner::upload_bytes(const ABuffer& camera, const SceneData& 
          (pixels + 1) * sizeof(uint32_t);
 }
 
+namespace {
+
+// The plan's inputs on the GPU, bound, with the program's uniforms set.
+struct PlanUpload {
+  GlBuffer view, lists, fragments, triangles, positions;
+
+  PlanUpload(const GlProgram& p, const ABuffer& camera, const TriangleSoup& soup, const ResolvePlanOptions& options,
+             const GpuView& v, const std::vector<GpuTriangleInfo>& info)
+      : view(sizeof(v), &v),
+        lists(camera.offsets.size() * sizeof(uint32_t), camera.offsets.data()),
+        fragments(camera.fragments.size() * sizeof(Fragment), camera.fragments.data()),
+        triangles(info.size() * sizeof(GpuTriangleInfo), info.data()),
+        positions(soup.positions.size() * sizeof(glm::vec3), soup.positions.data()) {
+    p.use();
+    view.bind(RESOLVE_VIEW_BINDING);
+    lists.bind(RESOLVE_LISTS_BINDING);
+    fragments.bind(RESOLVE_FRAGMENTS_BINDING);
+    triangles.bind(RESOLVE_TRIANGLES_BINDING);
+    positions.bind(RESOLVE_POSITIONS_BINDING);
+    glUniform1i(p.uniform("exact_priority"), options.exact_priority ? 1 : 0);
+    glUniform3d(p.uniform("centre"), camera.view.centre.x, camera.view.centre.y, camera.view.centre.z);
+    glUniform1d(p.uniform("tie_relative"), TIE_RELATIVE);
+    glUniform1ui(p.uniform("loop_budget"), options.loop_budget);
+    glUniform1ui(p.uniform("one"), 1u);
+  }
+};
+
+// One dispatch over pixels [first, first + count), counting (writing false) or writing steps
+// at the bound starts, each pixel's count and status written at the bound counts.
+void run_pass(const GlProgram& p, size_t first, size_t count, bool writing) {
+  glUniform1ui(p.uniform("first_pixel"), static_cast<GLuint>(first));
+  glUniform1ui(p.uniform("pixel_count"), static_cast<GLuint>(count));
+  glUniform1i(p.uniform("writing"), writing ? 1 : 0);
+  dispatch(p, (count + 63) / 64);
+}
+
+// The count pass: two words a pixel, its steps and its status.
+std::vector<uint32_t> count_steps(const GlProgram& p, size_t pixels) {
+  const GlBuffer counts(2 * pixels * sizeof(uint32_t), nullptr);
+  const GlBuffer no_starts(4, nullptr), no_steps(sizeof(ResolveStep), nullptr);
+  counts.bind(RESOLVE_COUNTS_BINDING);
+  no_starts.bind(RESOLVE_STARTS_BINDING);
+  no_steps.bind(RESOLVE_STEPS_BINDING);
+  run_pass(p, 0, pixels, false);
+  return counts.read<uint32_t>(2 * pixels);
+}
+
+// The fill pass in bands of whole pixels whose steps fit `band`, into out->steps.
+void fill_steps(const GlProgram& p, const std::vector<uint32_t>& counted, uint64_t band, ResolvePlan* out) {
+  const size_t pixels = out->planned.size();
+  for (size_t first = 0; first < pixels;) {
+    size_t end = first + 1;
+    while (end < pixels && out->offsets[end + 1] - out->offsets[first] <= band) ++end;
+    const uint32_t base = out->offsets[first];
+    std::vector<uint32_t> starts(end - first + 1);
+    for (size_t q = first; q <= end; ++q) starts[q - first] = out->offsets[q] - base;
+    const uint64_t count = starts.back();
+    const GlBuffer start_buffer(starts.size() * sizeof(uint32_t), starts.data());
+    const GlBuffer step_buffer(std::max<uint64_t>(count, 1) * sizeof(ResolveStep), nullptr);
+    const GlBuffer band_counts(2 * (end - first) * sizeof(uint32_t), nullptr);
+    start_buffer.bind(RESOLVE_STARTS_BINDING);
+    step_buffer.bind(RESOLVE_STEPS_BINDING);
+    band_counts.bind(RESOLVE_COUNTS_BINDING);
+    run_pass(p, first, end - first, true);
+    check_passes(counted, band_counts.read<uint32_t>(2 * (end - first)), first, end);
+    const std::vector<ResolveStep> got = step_buffer.read<ResolveStep>(count);
+    std::copy(got.begin(), got.end(), out->steps.begin() + base);
+    first = end;
+  }
+}
+
+}  // namespace
+
 ResolvePlan GlResolvePlanner::plan(const ABuffer& camera, const SceneData& scene, const ResolvePlanOptions& options,
                                    ResolvePlanStats* stats) const {
   const Clock::time_point t0 = Clock::now();
@@ -85,47 +157,11 @@ ResolvePlan GlResolvePlanner::plan(const ABuffer& camera, const SceneData& scene
   ResolvePlan out;
   out.exact_priority = options.exact_priority;
   out.fragments = camera.fragments.size();
-  out.opacity.reserve(scene.materials.size());
   for (const Material& m : scene.materials) out.opacity.push_back(std::clamp(m.opacity, 0.0, 1.0));
   std::vector<GpuTriangleInfo> info(soup.triangle_count());
-  for (size_t t = 0; t < info.size(); ++t) {
-    info[t] = {soup.object_id[t], 0u, out.opacity[soup.material_id[t]]};
-  }
-  const GpuView view = gpu_view(camera.view, 0);
-  const GlBuffer view_buffer(sizeof(view), &view);
-  const GlBuffer lists(camera.offsets.size() * sizeof(uint32_t), camera.offsets.data());
-  const GlBuffer fragments(camera.fragments.size() * sizeof(Fragment), camera.fragments.data());
-  const GlBuffer triangles(info.size() * sizeof(GpuTriangleInfo), info.data());
-  const GlBuffer positions(soup.positions.size() * sizeof(glm::vec3), soup.positions.data());
-  const GlBuffer counts(2 * pixels * sizeof(uint32_t), nullptr);
-
-  const GlProgram& p = *program_;
-  p.use();
-  view_buffer.bind(RESOLVE_VIEW_BINDING);
-  lists.bind(RESOLVE_LISTS_BINDING);
-  fragments.bind(RESOLVE_FRAGMENTS_BINDING);
-  triangles.bind(RESOLVE_TRIANGLES_BINDING);
-  positions.bind(RESOLVE_POSITIONS_BINDING);
-  counts.bind(RESOLVE_COUNTS_BINDING);
-  glUniform1i(p.uniform("exact_priority"), options.exact_priority ? 1 : 0);
-  glUniform3d(p.uniform("centre"), camera.view.centre.x, camera.view.centre.y, camera.view.centre.z);
-  glUniform1d(p.uniform("tie_relative"), TIE_RELATIVE);
-  glUniform1ui(p.uniform("loop_budget"), options.loop_budget);
-  glUniform1ui(p.uniform("one"), 1u);
-  const auto run = [&](size_t first, size_t count, bool writing) {
-    glUniform1ui(p.uniform("first_pixel"), static_cast<GLuint>(first));
-    glUniform1ui(p.uniform("pixel_count"), static_cast<GLuint>(count));
-    glUniform1i(p.uniform("writing"), writing ? 1 : 0);
-    dispatch(p, (count + 63) / 64);
-  };
-  {
-    const GlBuffer no_starts(4, nullptr);
-    no_starts.bind(RESOLVE_STARTS_BINDING);
-    const GlBuffer no_steps(sizeof(ResolveStep), nullptr);
-    no_steps.bind(RESOLVE_STEPS_BINDING);
-    run(0, pixels, false);
-  }
-  const std::vector<uint32_t> counted = counts.read<uint32_t>(2 * pixels);
+  for (size_t t = 0; t < info.size(); ++t) info[t] = {soup.object_id[t], 0u, out.opacity[soup.material_id[t]]};
+  const PlanUpload bound(*program_, camera, soup, options, gpu_view(camera.view, 0), info);
+  const std::vector<uint32_t> counted = count_steps(*program_, pixels);
 
   // Each pixel's steps from the count: none where it is left to the CPU.
   out.offsets.assign(pixels + 1, 0);
@@ -140,27 +176,7 @@ ResolvePlan GlResolvePlanner::plan(const ABuffer& camera, const SceneData& scene
   const uint64_t held = upload + total * sizeof(ResolveStep) + std::min(total, band) * sizeof(ResolveStep);
   over_budget(held, "its " + std::to_string(total) + " steps and upload");
   out.steps.resize(total);
-
-  // The fill pass in bands of whole pixels, each band's steps in one buffer.
-  for (size_t first = 0; first < pixels;) {
-    size_t end = first + 1;
-    while (end < pixels && out.offsets[end + 1] - out.offsets[first] <= band) ++end;
-    const uint32_t base = out.offsets[first];
-    std::vector<uint32_t> starts(end - first + 1);
-    for (size_t q = first; q <= end; ++q) starts[q - first] = out.offsets[q] - base;
-    const uint64_t count = starts.back();
-    const GlBuffer start_buffer(starts.size() * sizeof(uint32_t), starts.data());
-    const GlBuffer step_buffer(std::max<uint64_t>(count, 1) * sizeof(ResolveStep), nullptr);
-    const GlBuffer band_counts(2 * (end - first) * sizeof(uint32_t), nullptr);
-    start_buffer.bind(RESOLVE_STARTS_BINDING);
-    step_buffer.bind(RESOLVE_STEPS_BINDING);
-    band_counts.bind(RESOLVE_COUNTS_BINDING);
-    run(first, end - first, true);
-    check_passes(counted, band_counts.read<uint32_t>(2 * (end - first)), first, end);
-    const std::vector<ResolveStep> got = step_buffer.read<ResolveStep>(count);
-    std::copy(got.begin(), got.end(), out.steps.begin() + base);
-    first = end;
-  }
+  fill_steps(*program_, counted, band, &out);
   check_gl(WHAT);
   if (stats) {
     stats->pixels = pixels;

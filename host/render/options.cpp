@@ -378,7 +378,7 @@ void add_gpu_camera(Table& t) {
       reset(&RenderOptions::search_on));
   add(t, {"resolve_on", "--resolve-on", OptionKind::choice, OptionScope::job, {"auto", "gpu", "cpu"}, 0, 0,
        d.resolve_on, "", true,
-       "gpu_abuffer's resolve: auto (the GPU where it is hardware) | gpu (GL compute plans it) | cpu", {}},
+       "gpu_abuffer and hybrid's resolve: auto (the GPU where it is hardware) | gpu (GL compute plans it) | cpu", {}},
       [](RenderSetup& s, const json& v) { s.render.resolve_on = v.get<std::string>(); },
       [d](const RenderSetup& s) { return unless(s.render.resolve_on, d.resolve_on); },
       reset(&RenderOptions::resolve_on));

@@ -52,7 +52,7 @@ struct RenderOptions {
   int gpu_max_views = 256;              // gpu: mirror views drawn per camera tile, at most
   std::string gpu_shading = "pixels";   // gpu: shade once a pixel and surface | once a sample
   std::string search_on = "auto";       // gpu_abuffer, hybrid: map searches on auto (hardware GL) | gpu | cpu
-  std::string resolve_on = "auto";      // gpu_abuffer: the resolve planned on auto (hardware GL) | gpu | cpu
+  std::string resolve_on = "auto";      // gpu_abuffer, hybrid: the resolve planned on auto (hardware GL) | gpu | cpu
   uint32_t max_layers = 0;              // A-buffer layers kept per list (0 = all)
   uint64_t max_memory_mib = 0;          // the whole render's memory budget, MiB (0 = the memory available)
   uint64_t max_pixels = 0;              // refuse a camera image larger than this (0 = no cap)

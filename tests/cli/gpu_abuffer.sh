@@ -155,10 +155,12 @@ the same image" bash -c "
   $PY -c 'import json, sys
 d = json.load(open(sys.argv[1]))[\"searches\"][\"deferred\"]
 assert d[\"walked_now\"] > 0 and d[\"bytes\"] + d[\"scan_bytes\"] <= 20 << 20, d' '$WORK/m.json'"
-check "hybrid --search-on gpu: hybrid's image with the searches on the CPU" bash -c "'$ABCUBE' render '$CORNELL' \
-  --method hybrid --search-on gpu --size 40x30 --cube-res 32 -o '$WORK/h_gpu.exr' --stats '$WORK/h.json' &&
-  '$ABCUBE' render '$CORNELL' --method hybrid --search-on cpu --size 40x30 --cube-res 32 -o '$WORK/h_cpu.exr' &&
-  cmp '$WORK/h_gpu.exr' '$WORK/h_cpu.exr' && grep -q '\"where\": *\"gpu\"' '$WORK/h.json'"
+check "hybrid --search-on gpu --resolve-on gpu: hybrid's image with both on the CPU" bash -c "'$ABCUBE' render \
+  '$CORNELL' --method hybrid --search-on gpu --resolve-on gpu --size 40x30 --cube-res 32 -o '$WORK/h_gpu.exr' \
+  --stats '$WORK/h.json' &&
+  '$ABCUBE' render '$CORNELL' --method hybrid --search-on cpu --resolve-on cpu --size 40x30 --cube-res 32 \
+    -o '$WORK/h_cpu.exr' &&
+  cmp '$WORK/h_gpu.exr' '$WORK/h_cpu.exr' && [ \$(grep -c '\"where\": *\"gpu\"' '$WORK/h.json') -ge 2 ]"
 check "abcube report: gpu_abuffer with its searches on the GPU, a method beside abuffer, the same error" bash -c "
   '$ABCUBE' report '$CORNELL' -o '$WORK/report' --methods abuffer,gpu_abuffer --search-on gpu --size 32x24 \
     --cube-res 24 --no-crosscheck > /dev/null &&

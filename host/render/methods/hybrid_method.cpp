@@ -70,7 +70,7 @@ json render_cpu_pixels(MethodContext& mc, const std::vector<uint8_t>* only, Imag
     *image = part;
   }
   for (const auto& [k, v] : cpu_record.timings_ms) mc.record.timings_ms["cpu." + k] = v;
-  for (const char* key : {"plan", "cube_abuffer", "abuffer", "searches"}) {
+  for (const char* key : {"plan", "cube_abuffer", "abuffer", "searches", "resolve_plan"}) {
     if (cpu_stats.contains(key)) out[key] = cpu_stats[key];
   }
   out["abuffers_built_on"] = request.abuffers_on_gl ? "gpu" : "cpu";
@@ -160,11 +160,13 @@ class HybridMethod : public RenderMethod {
     keys.push_back("refraction");
     for (const std::string& k : gpu_camera_option_keys()) keys.push_back(k);
     keys.push_back("search_on");
+    keys.push_back("resolve_on");
     return keys;
   }
   void read_options(const RenderOptions& options, const SceneData& view, RenderRequest* request) const override {
     read_map_options(options, MapVariant::abuffer, request);  // abuffer's searches
     read_search_on(options, request);
+    read_resolve_on(options, request);
     read_gpu_options(options, view.render.max_depth, request);
   }
   bool needs_gl() const override { return true; }
