@@ -18,9 +18,7 @@ static_assert(sizeof(GpuView) == 224 && offsetof(GpuView, width) == 200, "GpuVie
 
 // View `v`, its first pixel at `first_pixel` in the build's pixel order.
 inline GpuView gpu_view(const RasterView& v, int first_pixel) {
-  const auto put = [](double* out, const glm::dvec3& a) {
-    out[0] = a.x, out[1] = a.y, out[2] = a.z, out[3] = 0.0;
-  };
+  const auto put = [](double* out, const glm::dvec3& a) { out[0] = a.x, out[1] = a.y, out[2] = a.z, out[3] = 0.0; };
   GpuView g{};
   for (int c = 0; c < 3; ++c) put(g.to_dir[c], v.to_direction[c]);
   put(g.row_x, v.row_x);
