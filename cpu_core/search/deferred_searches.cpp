@@ -211,10 +211,12 @@ DeferredTally DeferredSearches::tally_here() { return tally_on_thread; }
 
 void DeferredSearches::begin_pass() { ++store_->stats.passes; }
 
-void DeferredSearches::note_image(uint64_t answers_used, uint64_t walked_now, uint64_t rows_shaded) {
+void DeferredSearches::note_image(uint64_t answers_used, uint64_t walked_now, uint64_t rows_shaded,
+                                  uint64_t edge_rows_shaded) {
   store_->stats.answers_used = answers_used;
   store_->stats.walked_now = walked_now;
   store_->stats.rows_shaded = rows_shaded;
+  store_->stats.edge_rows_shaded = edge_rows_shaded;
 }
 
 size_t DeferredSearches::queued() const {

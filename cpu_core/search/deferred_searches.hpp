@@ -63,9 +63,11 @@ struct DeferredSearchStats {
   // and those walked on the CPU at once, the store full.
   uint64_t answers_used = 0;
   uint64_t walked_now = 0;
-  // The rows the passes shaded: each pass shades again only the rows that took a stand-in
-  // in the last (the edge and sparse passes' pixels aside).
+  // The rows the passes' first stages shaded: each pass shades again only the rows that took
+  // a stand-in in the last. And the rows with pixels the edge and sparse passes shaded: a row
+  // whose pixels and force bits are the last pass's, and which took no stand-in, is kept.
   uint64_t rows_shaded = 0;
+  uint64_t edge_rows_shaded = 0;
   uint64_t bytes = 0;  // the most the answers and the queue held
   double scan_ms = 0, answer_ms = 0;
 };
@@ -95,9 +97,9 @@ class DeferredSearches {
   // it before and after some shading knows which searches that shading took, and whether it
   // took only true answers (and would be the same in the next pass).
   static DeferredTally tally_here();
-  // Sets the stats' answers_used and walked_now (the image's searches') and rows_shaded
-  // (render_with_map).
-  void note_image(uint64_t answers_used, uint64_t walked_now, uint64_t rows_shaded);
+  // Sets the stats' answers_used and walked_now (the image's searches'), rows_shaded and
+  // edge_rows_shaded (render_with_map).
+  void note_image(uint64_t answers_used, uint64_t walked_now, uint64_t rows_shaded, uint64_t edge_rows_shaded);
 
   // Starts a pass: counts it and forgets which answers were asked.
   void begin_pass();

@@ -16,6 +16,7 @@
 #include "scene/texture.hpp"
 #include "shading/fragment_texture.hpp"
 #include "shading/map_shading.hpp"
+#include "shading/pass_rows.hpp"
 #include "shading/resolve.hpp"
 #include "shading/secondary_edges.hpp"
 #include "shading/shadow_edges.hpp"
@@ -74,25 +75,6 @@ struct Quarters {
   int count = 0;
 };
 
-// DEFERRED SEARCHES (search/deferred_searches.hpp): what a pass's first stage (every
-// fragment at its points, before the edge and sparse passes) left, kept for the next pass,
-// which shades again only the rows marked `redo`. A row's first stage depends on nothing
-// outside it but the searches' answers (its KNOWN BLOCKERS start afresh), so a row that took
-// no stand-in is shaded the same in the next pass, bit for bit: its pixels, what they noted
-// for the edge passes, their fallback counts and its statistics are kept instead.
-struct FirstStageRows {
-  bool kept = false;          // false: no pass yet, every row to shade
-  std::vector<uint8_t> redo;  // per row: a stand-in was taken in it
-  Image image;
-  PixelShadows seen;
-  PixelTrails trails;
-  std::vector<std::pair<uint64_t, uint64_t>> pixel_searches;
-  std::vector<MapShadingStats> row_stats;
-  std::vector<DeferredTally> row_took;  // the searches each row took (used, walked_now)
-  DeferredTally image_took;             // the whole image's, after its pass
-  uint64_t rows_shaded = 0;             // by every pass's first stage
-};
-
 // a += (after - before), for the searches taken (not the stand-ins).
 void add_taken(DeferredTally* a, const DeferredTally& before, const DeferredTally& after) {
   a->used += after.used - before.used;
@@ -136,28 +118,27 @@ class MapRender {
     const int width = camera_.width(), height = camera_.height();
     FirstStageRows& k = *rows_;
     if (!k.kept) {
-      k.redo.assign(static_cast<size_t>(height), 1);
-      k.row_stats.assign(static_cast<size_t>(height), MapShadingStats{});
-      k.row_took.assign(static_cast<size_t>(height), DeferredTally{});
+      k.rows.size(static_cast<size_t>(height));
     } else {
-      if (edges_) seen_ = k.seen, seen_.forget_rows(k.redo, width);
-      if (trails_on_) trails_ = k.trails, trails_.forget_rows(k.redo, width);
+      if (edges_) seen_ = k.seen, seen_.forget_rows(k.rows.redo, width);
+      if (trails_on_) trails_ = k.trails, trails_.forget_rows(k.rows.redo, width);
       if (fallback_) pixel_searches_ = k.pixel_searches;
     }
     std::vector<uint8_t> mask(pixels_, 0);
     for (size_t p = 0; p < pixels_; ++p) {
       const size_t y = p / static_cast<size_t>(width);
-      if (!k.redo[y]) continue;
+      if (!k.rows.redo[y]) continue;
       mask[p] = ro.only ? (*ro.only)[p] : 1;
       if (fallback_) pixel_searches_[p] = {0, 0};
     }
-    const std::vector<uint8_t> redo = k.redo;
+    const std::vector<uint8_t> redo = k.rows.redo;
     for (size_t y = 0; y < redo.size(); ++y) {
       if (!redo[y]) continue;
-      k.row_stats[y] = MapShadingStats{}, k.row_took[y] = DeferredTally{}, k.redo[y] = 0;
-      ++k.rows_shaded;
+      k.rows.start_row(y);
+      ++k.rows.rows_shaded;
     }
     ro.only = &mask;
+    stage_ = &k.rows;
     Image image = resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, ro);
     if (k.kept) {
       const size_t row = static_cast<size_t>(width) * static_cast<size_t>(image.channels);
@@ -193,7 +174,6 @@ class MapRender {
     const size_t workers = static_cast<size_t>(resolve_workers(camera_, ro));
     per_worker_.assign(workers, MapShadingStats{});
     known_.assign(workers, Known{});
-    worker_took_.assign(workers, DeferredTally{});
     worker_direct_.resize(workers);
     if (trails_on_) trails_ = PixelTrails(pixels_, workers);
     const WorkerPixelShader shade = [this](const Fragment& f, int x, int y, int worker) {
@@ -201,19 +181,20 @@ class MapRender {
     };
     Image image = rows_ ? first_stage_kept(shade, ro)
                         : resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, ro);
-    first_stage_ = false;
     if (edges_ || trails_on_) second_pass(shade, ro, &image);
     if (sparse_) sparse_pass(shade, ro, &image);
+    stage_ = nullptr;
     if (rows_) {
       DeferredTally& took = rows_->image_took;
       took = DeferredTally{};
-      for (const DeferredTally& t : rows_->row_took) add_taken(&took, DeferredTally{}, t);
-      for (const DeferredTally& t : worker_took_) add_taken(&took, DeferredTally{}, t);
+      for (const RowRecords* r : {&rows_->rows, &rows_->edges.rows, &rows_->sparse.rows}) {
+        for (const DeferredTally& t : r->took) add_taken(&took, DeferredTally{}, t);
+        if (stats) {
+          for (const MapShadingStats& s : r->stats) stats->merge(s);
+        }
+      }
     }
     if (stats) {
-      if (rows_) {
-        for (const MapShadingStats& s : rows_->row_stats) stats->merge(s);
-      }
       for (const MapShadingStats& s : per_worker_) stats->merge(s);
     }
     if (fallback_) {
@@ -229,11 +210,12 @@ class MapRender {
  private:
   // The fragment shaded at its covered quarters, adaptively (header, QUARTER_SPLIT_SRGB).
   ShadedFragment shade_fragment(const Fragment& f, int x, int y, int worker) {
-    // DEFERRED SEARCHES: the first stage's statistics by row, and whether the row took a
-    // stand-in (FirstStageRows).
-    const bool by_row = rows_ && first_stage_;
-    MapShadingStats* s = by_row ? &rows_->row_stats[static_cast<size_t>(y)] : &per_worker_[static_cast<size_t>(worker)];
-    const DeferredTally tally = rows_ ? DeferredSearches::tally_here() : DeferredTally{};
+    // DEFERRED SEARCHES: the stage's statistics by row, and whether the row took a stand-in
+    // (pass_rows.hpp).
+    RowRecords* const by_row = stage_;
+    const size_t row = static_cast<size_t>(y);
+    MapShadingStats* s = by_row ? &by_row->stats[row] : &per_worker_[static_cast<size_t>(worker)];
+    const DeferredTally tally = by_row ? DeferredSearches::tally_here() : DeferredTally{};
     Known& known = known_[static_cast<size_t>(worker)];
     if (known.row != y) {  // KNOWN BLOCKERS (map_shading.hpp): none carried from another row
       known.row = y;
@@ -255,11 +237,10 @@ class MapRender {
       p.first += after.first - before.first;
       p.second += after.second - before.second;
     }
-    if (rows_) {
+    if (by_row) {
       const DeferredTally now = DeferredSearches::tally_here();
-      add_taken(by_row ? &rows_->row_took[static_cast<size_t>(y)] : &worker_took_[static_cast<size_t>(worker)], tally,
-                now);
-      if (by_row && now.stand_ins != tally.stand_ins) rows_->redo[static_cast<size_t>(y)] = 1;
+      add_taken(&by_row->took[row], tally, now);
+      if (now.stand_ins != tally.stand_ins) by_row->redo[row] = 1;
     }
     return ShadedFragment{c, scene_.materials[scene_.triangles->material_id[f.triangle()]].opacity};
   }
@@ -430,7 +411,7 @@ class MapRender {
       flagged += light ? 1 : 0;
       flagged_secondary += secondary ? 1 : 0;
     }
-    shade_again(shade, ro, again, flagged + flagged_secondary, image);
+    shade_again(shade, ro, again, flagged + flagged_secondary, image, rows_ ? &rows_->edges : nullptr);
     per_worker_[0].shadow_edge_pixels += flagged;
     per_worker_[0].secondary_edge_pixels += flagged_secondary;
   }
@@ -461,35 +442,64 @@ class MapRender {
       }
     }
     sparse_again_ = true;  // shade_fragment: the quarters
-    shade_again(shade, ro, again, flagged, image);
+    shade_again(shade, ro, again, flagged, image, rows_ ? &rows_->sparse : nullptr);
     sparse_again_ = false;
     per_worker_[0].sparse_pixels += flagged;
   }
 
   // The pixels `again` (`count` of them) resolved once more, their searches counted afresh;
   // the neighbours a pass shaded beside `only` (widened_) black again, as `only` says.
+  // DEFERRED SEARCHES: `kept` (null: none) the stage as the last pass left it; its rows whose
+  // pixels need no shading again (StageRows::rows_to_shade) take their kept colours.
   void shade_again(const WorkerPixelShader& shade, const ResolveOptions& ro, const std::vector<uint8_t>& again,
-                   uint64_t count, Image* image) {
-    const size_t channels = static_cast<size_t>(image->channels);
+                   uint64_t count, Image* image, StageRows* kept) {
+    const size_t channels = static_cast<size_t>(image->channels), width = static_cast<size_t>(camera_.width());
     for (size_t p = 0; p < pixels_; ++p) {
       const bool outside = !widened_.empty() && !(*only_)[p];
       if (outside) std::fill_n(image->data.begin() + static_cast<std::ptrdiff_t>(p * channels), image->channels, 0.f);
       if (fallback_ && (outside || again[p])) pixel_searches_[p] = {0, 0};
     }
-    if (count == 0) return;
-    for (Known& k : known_) k.row = -1;  // each row starts afresh in this pass too
-    ResolveOptions second = ro;
-    second.only = &again;
-    const Image redone = resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, second);
-    for (size_t p = 0; p < pixels_; ++p) {
-      if (!again[p]) continue;
-      for (size_t ch = 0; ch < channels; ++ch) image->data[p * channels + ch] = redone.data[p * channels + ch];
+    std::vector<uint8_t> shaded = again, rows;
+    if (kept) {
+      rows = kept->rows_to_shade(camera_.width(), camera_.height(), again, forced_, forced_secondary_);
+      if (!kept->kept) kept->rows.size(rows.size());
+      count = 0;
+      for (size_t y = 0; y < rows.size(); ++y) {
+        if (!rows[y]) continue;
+        kept->rows.start_row(y);
+        const auto first = shaded.begin() + static_cast<std::ptrdiff_t>(y * width);
+        const uint64_t in_row = static_cast<uint64_t>(std::count(first, first + static_cast<std::ptrdiff_t>(width), 1));
+        kept->rows.rows_shaded += in_row > 0 ? 1 : 0;
+        count += in_row;
+      }
+      for (size_t p = 0; p < pixels_; ++p) shaded[p] = rows[p / width] ? shaded[p] : 0;
+      stage_ = &kept->rows;
     }
+    if (count > 0) {
+      for (Known& k : known_) k.row = -1;  // each row starts afresh in this pass too
+      ResolveOptions second = ro;
+      second.only = &shaded;
+      const Image redone = resolve_image_per_worker(camera_, *scene_.triangles, shade, scene_.background, second);
+      for (size_t p = 0; p < pixels_; ++p) {
+        if (!shaded[p]) continue;
+        for (size_t ch = 0; ch < channels; ++ch) image->data[p * channels + ch] = redone.data[p * channels + ch];
+      }
+    }
+    if (!kept) return;
+    for (size_t p = 0; p < pixels_ && kept->kept; ++p) {
+      if (!again[p] || rows[p / width]) continue;
+      std::copy_n(kept->image.data.begin() + static_cast<std::ptrdiff_t>(p * channels), channels,
+                  image->data.begin() + static_cast<std::ptrdiff_t>(p * channels));
+      if (fallback_) pixel_searches_[p] = kept->pixel_searches[p];
+    }
+    kept->kept = true;
+    kept->again = again, kept->forced = forced_, kept->forced_secondary = forced_secondary_;
+    kept->image = *image;
+    if (fallback_) kept->pixel_searches = pixel_searches_;
   }
 
-  FirstStageRows* const rows_;  // DEFERRED SEARCHES: the first stage kept between passes
-  bool first_stage_ = true;
-  std::vector<DeferredTally> worker_took_;       // the searches the later stages took, by worker
+  FirstStageRows* const rows_;                   // DEFERRED SEARCHES: the stages kept between passes
+  RowRecords* stage_ = nullptr;                  // the current stage's records by row, when kept
   const std::function<void(double)>* progress_;  // the first pass's rows, when given
   const SceneData& scene_;
   const ABuffer& camera_;
@@ -535,7 +545,8 @@ Image render_with_map(const SceneData& scene, const ABuffer& camera, const MapSh
     Image image = MapRender(scene, camera, shader, fallback, only, progress, &rows).render(threads, neighbours, &pass);
     if (deferred->queued() == 0) {
       if (stats) stats->merge(pass);
-      deferred->note_image(rows.image_took.used, rows.image_took.walked_now, rows.rows_shaded);
+      deferred->note_image(rows.image_took.used, rows.image_took.walked_now, rows.rows.rows_shaded,
+                           rows.edges.rows.rows_shaded + rows.sparse.rows.rows_shaded);
       return image;
     }
     deferred->answer_queued();

@@ -140,8 +140,9 @@ glm::dvec3 run_steps(FragmentList list, const ResolveStep* steps, size_t count, 
   glm::dvec3 colour(0.0);
   for (size_t k = 0; k < count; ++k) {
     const ResolveStep& s = steps[k];
-    if (s.at[0] != ResolveStep::NONE && s.at[0] >= list.size())
-      throw std::logic_error("resolve plan: a step past its list");
+    for (const uint32_t at : s.at) {
+      if (at != ResolveStep::NONE && at >= list.size()) throw std::logic_error("resolve plan: a step past its list");
+    }
     switch (s.kind) {
       case ResolveStep::shade: colour_of(s.at[0], 0); break;
       case ResolveStep::add: colour += s.weight[0] * colour_of(s.at[0], s.mask[0]); break;

@@ -58,7 +58,7 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
     scenes.resize(2);
     plans.resize(2);
   }
-  uint64_t most_passes = 0, rays = 0, rescanned = 0, stopped = 0, shaded_rows = 0, pass_rows = 0;
+  uint64_t most_passes = 0, rays = 0, rescanned = 0, stopped = 0, shaded_rows = 0, pass_rows = 0, edge_rows = 0;
   for (const std::string& file : scenes) {
     const SceneData s = deferred_scene(file, checked ? 20 : 48, 40);
     const CubeABuffer cube = build_cube_abuffer(s, s.camera.position, s.render.cube_resolution);
@@ -68,7 +68,8 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
       o.plan = plan;
       const MapShader walked(s, cube, o);
       MapShadingStats walked_stats, deferred_stats;
-      const Image a = render_with_map(s, camera, walked, 2, &walked_stats);
+      Image walked_fallback, deferred_fallback;  // the "fallback" AOV, kept rows and all
+      const Image a = render_with_map(s, camera, walked, 2, &walked_stats, &walked_fallback);
       MapShader shader(s, cube, o);
       DeferredSearchOptions small;
       small.threads = 2;
@@ -78,10 +79,19 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
       DeferredSearches deferred(shader.context(), shader.options().search, cpu_candidate_scanner(shader.context(), 2),
                                 small);
       shader.defer_searches(&deferred);
-      const Image b = render_with_map(s, camera, shader, 2, &deferred_stats);
+      const Image b = render_with_map(s, camera, shader, 2, &deferred_stats, &deferred_fallback);
       const DeferredSearchStats d = deferred.stats();
       const std::string what = file + " plan " + std::to_string(&plan - plans.data());
       EXPECT_EQ(a.data, b.data) << what;
+      EXPECT_EQ(walked_fallback.data, deferred_fallback.data) << what;
+      // The edge and sparse passes' figures, kept rows and all.
+      EXPECT_EQ(walked_stats.multi_point_fragments, deferred_stats.multi_point_fragments) << what;
+      EXPECT_EQ(walked_stats.shadow_edge_fragments, deferred_stats.shadow_edge_fragments) << what;
+      EXPECT_EQ(walked_stats.shadow_edge_samples, deferred_stats.shadow_edge_samples) << what;
+      EXPECT_EQ(walked_stats.shadow_edge_pixels, deferred_stats.shadow_edge_pixels) << what;
+      EXPECT_EQ(walked_stats.secondary_edge_samples, deferred_stats.secondary_edge_samples) << what;
+      EXPECT_EQ(walked_stats.secondary_edge_pixels, deferred_stats.secondary_edge_pixels) << what;
+      EXPECT_EQ(walked_stats.sparse_pixels, deferred_stats.sparse_pixels) << what;
       const SearchStats &x = walked_stats.searches, &y = deferred_stats.searches;
       EXPECT_EQ(x.reflection.rays, y.reflection.rays) << what;
       EXPECT_EQ(x.reflection.hits, y.reflection.hits) << what;
@@ -104,6 +114,7 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
       if (d.passes > 2) EXPECT_LT(d.rows_shaded, d.passes * rows) << what;
       shaded_rows += d.rows_shaded;
       pass_rows += d.passes * rows;
+      edge_rows += d.edge_rows_shaded;
       most_passes = std::max(most_passes, d.passes);
       rescanned += d.rescanned;
       stopped += d.stopped;
@@ -121,6 +132,10 @@ TEST(DeferredSearches, RenderIsTheWalkedSearchesImageBitForBit) {
   std::printf("[ deferred ] %llu rows shaded of the %llu the passes hold\n",
               static_cast<unsigned long long>(shaded_rows), static_cast<unsigned long long>(pass_rows));
   EXPECT_LT(shaded_rows, pass_rows * 3 / 4);
+  // The edge and sparse passes keep the rows whose pixels, force bits and answers held.
+  std::printf("[ deferred ] %llu rows with pixels shaded by the edge and sparse passes\n",
+              static_cast<unsigned long long>(edge_rows));
+  EXPECT_GT(edge_rows, 0u);
 }
 
 // A store with room for a few hundred rays: the searches past it are walked at once by the

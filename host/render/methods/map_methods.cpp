@@ -192,6 +192,7 @@ void record_gl_searches(const GlSearches& g, MethodContext& mc) {
                                       {"answers_used", d.answers_used},
                                       {"walked_now", d.walked_now},
                                       {"rows_shaded", d.rows_shaded},
+                                      {"edge_rows_shaded", d.edge_rows_shaded},
                                       {"texels", d.texels},
                                       {"stopped", d.stopped},
                                       {"rescanned", d.rescanned},
