@@ -206,15 +206,25 @@ check "info prints GL_RENDERER" grep -q "GL_RENDERER" "$WORK/info"
 # --- outputs are byte-reproducible: the same render written twice, by two processes more
 # than a second apart, gives the same bytes (no time stamp, no temporary name, no stray
 # header bytes). The only sleep of the suite: a DateTime attribute has one-second steps.
+# DPX and SGI go through the image module (OpenImageIO, loaded when first needed). In the
+# checked builds (ABCUBE_CHECKED_BUILD, tools/sanitize.sh) their renders run without
+# LeakSanitizer: its tracer crashes at exit on the dynamic TLS that loading brings (gcc 12's
+# libasan; docs/robustness.md), in every dpx and sgi render of one fresh clone's CI run. The
+# built-in codecs' renders (exr, tif, png) keep it.
+repro_env() {  # FORMAT: the environment's changes for its renders, if any
+  if [ "${ABCUBE_CHECKED_BUILD:-0}" = 1 ] && { [ "$1" = dpx ] || [ "$1" = sgi ]; }; then
+    echo "ASAN_OPTIONS=${ASAN_OPTIONS:-}:detect_leaks=0"
+  fi
+}
 mkdir -p "$WORK/repro"
 for e in exr tif dpx sgi png; do
-  "$ABCUBE" render "$WORK/small.json" -o "$WORK/repro/r.$e" --method raytrace 2> "$WORK/err" &&
+  env $(repro_env $e) "$ABCUBE" render "$WORK/small.json" -o "$WORK/repro/r.$e" --method raytrace 2> "$WORK/err" &&
     mv "$WORK/repro/r.$e" "$WORK/repro/first.$e"
   check "reproducible $e: first render ($(head -c 200 "$WORK/err"))" [ -s "$WORK/repro/first.$e" ]
 done
 sleep 1.1
 for e in exr tif dpx sgi png; do
-  "$ABCUBE" render "$WORK/small.json" -o "$WORK/repro/r.$e" --method raytrace 2> /dev/null
+  env $(repro_env $e) "$ABCUBE" render "$WORK/small.json" -o "$WORK/repro/r.$e" --method raytrace 2> /dev/null
   check "reproducible $e: same bytes a second later" cmp -s "$WORK/repro/r.$e" "$WORK/repro/first.$e"
 done
 
