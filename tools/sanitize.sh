@@ -33,33 +33,7 @@ configure() {  # FOLDER SANITIZERS
 # run, and up to 4 processes in one test) runs again, alone and by its name, up to three
 # times, when the run printed no report of ASan, UBSan or a leak. Any other failure stands.
 # (By name, not --rerun-failed: a rerun by ctest's numbers once ran other tests.)
-sanitizer_report='ERROR: AddressSanitizer|runtime error:|ERROR: LeakSanitizer: detected memory leaks'
-tracer_crash='LeakSanitizer has encountered a fatal error'
-
-failed_tests() {  # LOG: the names ctest lists under "The following tests FAILED:"
-  sed -n '/^The following tests FAILED:/,$p' "$1" | sed -nE 's/^[[:space:]]*[0-9]+ - (.*) \([^()]*\)$/\1/p'
-}
-
-test_output() {  # LOG NAME: what --output-on-failure printed under NAME's result line, up to
-  # the next test's line (ctest prints a finished test's output whole, even with -j)
-  awk -v name="$2" '
-    /^[[:space:]]*[0-9]+\/[0-9]+ +Test +#[0-9]+: / {
-      here = $0; sub(/^[^:]*: /, "", here); sub(/ .*/, "", here); inside = (here == name); next
-    }
-    /^[[:space:]]*Start +[0-9]+: / || /^[0-9]+% tests passed/ { inside = 0 }
-    inside' "$1"
-}
-
-only_tracer_crashes() {  # LOG: no sanitizer's report, and every failed test's output holds the
-  # tracer's crash (one test may run many processes, and more than one may crash)
-  local name failed=0
-  ! grep -qE "$sanitizer_report" "$1" || return 1
-  while IFS= read -r name; do
-    failed=$((failed + 1))
-    test_output "$1" "$name" | grep -q "$tracer_crash" || return 1
-  done < <(failed_tests "$1")
-  [[ $failed -gt 0 ]]
-}
+source "$supp/ctest_log.sh"
 
 asan_ctest() {
   local log one status name round retry
