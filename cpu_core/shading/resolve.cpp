@@ -140,9 +140,11 @@ glm::dvec3 run_steps(FragmentList list, const ResolveStep* steps, size_t count, 
   glm::dvec3 colour(0.0);
   for (size_t k = 0; k < count; ++k) {
     const ResolveStep& s = steps[k];
-    for (const uint32_t at : s.at) {
-      if (at != ResolveStep::NONE && at >= list.size()) throw std::logic_error("resolve plan: a step past its list");
-    }
+    // Every step but the background's names a fragment of this list first; only add_two may
+    // name a second, or NONE. A step from the GPU that breaks this is refused, not read.
+    const bool first_ok = s.kind == ResolveStep::background ? s.at[0] == ResolveStep::NONE : s.at[0] < list.size();
+    const bool second_ok = s.at[1] == ResolveStep::NONE || (s.kind == ResolveStep::add_two && s.at[1] < list.size());
+    if (!first_ok || !second_ok) throw std::logic_error("resolve plan: a step past its list");
     switch (s.kind) {
       case ResolveStep::shade: colour_of(s.at[0], 0); break;
       case ResolveStep::add: colour += s.weight[0] * colour_of(s.at[0], s.mask[0]); break;

@@ -28,6 +28,7 @@ class GlBuffer {
   GLuint id() const { return id_; }
   void bind(unsigned binding) const { glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, id_); }
   void zero() const { glClearNamedBufferData(id_, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr); }
+  void fill(uint32_t word) const { glClearNamedBufferData(id_, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &word); }
   template <class T>
   std::vector<T> read(size_t count) const {
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);

@@ -3,6 +3,8 @@
 #include <glad/gl.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -27,8 +29,10 @@ static_assert(sizeof(GpuTriangleInfo) == 16, "must match shaders/resolve_plan.co
 
 // The steps a fill pass writes at most: a band of pixels whose steps fit one storage block,
 // and no more than 64 MiB on the GPU at a time.
-uint64_t band_steps() {
-  return std::max<uint64_t>(1, std::min<uint64_t>(max_block_bytes(), uint64_t{64} << 20) / sizeof(ResolveStep));
+uint64_t band_steps(const ResolvePlanOptions& options) {
+  const uint64_t most =
+      std::max<uint64_t>(1, std::min<uint64_t>(max_block_bytes(), uint64_t{64} << 20) / sizeof(ResolveStep));
+  return options.band_steps ? std::min(options.band_steps, most) : most;
 }
 
 const char* const WHAT = "GPU resolve plan";
@@ -48,7 +52,9 @@ void check_passes(const std::vector<uint32_t>& counted, const std::vector<uint32
 }  // namespace
 
 GlResolvePlanner::GlResolvePlanner() {
-  require_storage_bindings(WHAT, RESOLVE_COUNTS_BINDING);
+  require_storage_bindings(WHAT, std::max({RESOLVE_VIEW_BINDING, RESOLVE_LISTS_BINDING, RESOLVE_FRAGMENTS_BINDING,
+                                           RESOLVE_TRIANGLES_BINDING, RESOLVE_POSITIONS_BINDING, RESOLVE_COUNTS_BINDING,
+                                           RESOLVE_STARTS_BINDING, RESOLVE_STEPS_BINDING}));
   require_compute_blocks(WHAT, 8);
   program_ = std::make_unique<GlProgram>(
       std::vector<const char*>{"double_math.glsl", "fragment.glsl", "view.glsl", "resolve_plan.comp"});
@@ -122,7 +128,10 @@ void fill_steps(const GlProgram& p, const std::vector<uint32_t>& counted, uint64
     for (size_t q = first; q <= end; ++q) starts[q - first] = out->offsets[q] - base;
     const uint64_t count = starts.back();
     const GlBuffer start_buffer(starts.size() * sizeof(uint32_t), starts.data());
+    // Every word all ones first: a step the GPU did not write reads as no kind at no fragment,
+    // which run_steps refuses, never as a shade of the list's first fragment.
     const GlBuffer step_buffer(std::max<uint64_t>(count, 1) * sizeof(ResolveStep), nullptr);
+    step_buffer.fill(0xffffffffu);
     const GlBuffer band_counts(2 * (end - first) * sizeof(uint32_t), nullptr);
     start_buffer.bind(RESOLVE_STARTS_BINDING);
     step_buffer.bind(RESOLVE_STEPS_BINDING);
@@ -130,6 +139,7 @@ void fill_steps(const GlProgram& p, const std::vector<uint32_t>& counted, uint64
     run_pass(p, first, end - first, true);
     check_passes(counted, band_counts.read<uint32_t>(2 * (end - first)), first, end);
     const std::vector<ResolveStep> got = step_buffer.read<ResolveStep>(count);
+    if (base + count > out->steps.size()) throw std::logic_error("GPU resolve plan: a band past its steps");
     std::copy(got.begin(), got.end(), out->steps.begin() + base);
     first = end;
   }
@@ -153,6 +163,10 @@ ResolvePlan GlResolvePlanner::plan(const ABuffer& camera, const SceneData& scene
   over_budget(upload, "its lists and triangles");
   require_block_bytes(std::string(WHAT) + ": the camera's fragments", camera.fragments.size() * sizeof(Fragment),
                       "resolve on the CPU");
+  require_block_bytes(std::string(WHAT) + ": the pixels' counts", 2 * uint64_t{pixels} * sizeof(uint32_t),
+                      "resolve on the CPU");
+  if (options.only && options.only->size() != pixels)
+    throw std::logic_error("GPU resolve plan: `only` of another size");
 
   ResolvePlan out;
   out.exact_priority = options.exact_priority;
@@ -164,16 +178,23 @@ ResolvePlan GlResolvePlanner::plan(const ABuffer& camera, const SceneData& scene
   const std::vector<uint32_t> counted = count_steps(*program_, pixels);
 
   // Each pixel's steps from the count: none where it is left to the CPU.
+  // The offsets are 32-bit: a plan of more steps is refused before they could wrap.
   out.offsets.assign(pixels + 1, 0);
   out.planned.assign(pixels, 0);
+  uint64_t total = 0;
   for (size_t q = 0; q < pixels; ++q) {
-    const bool planned = (counted[2 * q + 1] & 3u) == 1u;
+    const bool planned = (counted[2 * q + 1] & 3u) == 1u && (!options.only || (*options.only)[q]);
     out.planned[q] = planned ? 1 : 0;
-    out.offsets[q + 1] = out.offsets[q] + (planned ? counted[2 * q] : 0u);
+    total += planned ? counted[2 * q] : 0u;
+    if (total > UINT32_MAX) {
+      throw InputError(std::string(WHAT) + ": more than " + std::to_string(UINT32_MAX) +
+                       " steps, past a plan's offsets; resolve on the CPU");
+    }
+    out.offsets[q + 1] = static_cast<uint32_t>(total);
   }
-  const uint64_t total = out.offsets.back();
-  const uint64_t band = band_steps();
-  const uint64_t held = upload + total * sizeof(ResolveStep) + std::min(total, band) * sizeof(ResolveStep);
+  const uint64_t band = band_steps(options);
+  // At the peak: the upload, the plan on the host, and one band on the GPU and in its copy back.
+  const uint64_t held = upload + pixels + (total + 2 * std::min(total, band)) * sizeof(ResolveStep);
   over_budget(held, "its " + std::to_string(total) + " steps and upload");
   out.steps.resize(total);
   fill_steps(*program_, counted, band, &out);

@@ -26,6 +26,13 @@ struct ResolvePlanOptions {
   uint32_t loop_budget = GPU_RESOLVE_LOOP_BUDGET;
   // The memory the plan may take, its upload and its steps on the GPU and the host: 0, none.
   uint64_t max_bytes = 0;
+  // The most steps one fill dispatch writes: 0, as many as one storage block holds (at most
+  // 64 MiB of them). A pixel's steps are never split; a smaller band only adds dispatches.
+  uint64_t band_steps = 0;
+  // When set (a byte a pixel, as ResolveOptions::only): only the pixels whose entry is not 0
+  // are planned; the others are left to pack, as pixels past the loop budget are (hybrid's
+  // CPU part resolves only its pixels, and their neighbours for its edge passes).
+  const std::vector<uint8_t>* only = nullptr;
 };
 
 // What a plan took.

@@ -415,8 +415,11 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   fail(!r.lists.within_bounds(), "GPU A-buffer lists");
   fail(!r.camera_lists.within_bounds(), "GPU camera A-buffer lists");
   // The plan's steps are pack's expressions; on a GL whose doubles round as IEEE 754 says,
-  // every colour is the same bits.
-  fail(r.resolve_plan.skipped.empty() && r.resolve_plan.identical < r.resolve_plan.pixels, "GPU resolve plan");
+  // every colour is the same bits. A plan that planned no pixel would pass that by pack's
+  // colours alone: it fails.
+  fail(r.resolve_plan.skipped.empty() && (r.resolve_plan.identical < r.resolve_plan.pixels ||
+                                          (r.resolve_plan.pixels > 0 && r.resolve_plan.planned == 0)),
+       "GPU resolve plan");
   fail(r.walks.differing > 0, "GPU cube walks");
   // A GL whose double division or square root does not round as IEEE 754 says moves a walk's
   // ends within rounding; a fragment at the end of a texel's range may then pass on one side

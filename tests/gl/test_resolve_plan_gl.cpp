@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -55,12 +57,10 @@ Image resolve_recorded(const ABuffer& camera, const SceneData& scene, const Reso
 }
 
 // The plan's figures, after holding its resolve to pack's.
-ResolvePlanStats expect_plan_resolves_as_pack(const GlResolvePlanner& planner, const SceneData& scene, bool exact,
-                                              uint32_t loop_budget, const std::string& what) {
+ResolvePlanStats expect_plan_resolves_as_pack(const GlResolvePlanner& planner, const SceneData& scene,
+                                              const ResolvePlanOptions& o, const std::string& what) {
   const ABuffer camera = build_camera_abuffer(scene);
-  ResolvePlanOptions o;
-  o.exact_priority = exact;
-  o.loop_budget = loop_budget;
+  const bool exact = o.exact_priority;
   ResolvePlanStats stats;
   const ResolvePlan plan = planner.plan(camera, scene, o, &stats);
   std::vector<Call> by_pack, by_plan;
@@ -78,8 +78,15 @@ ResolvePlanStats expect_plan_resolves_as_pack(const GlResolvePlanner& planner, c
     }
   }
   EXPECT_EQ(stats.pixels, camera.view.pixel_count()) << what;
-  if (loop_budget >= GPU_RESOLVE_LOOP_BUDGET) EXPECT_EQ(stats.planned, stats.pixels) << what;
+  if (o.loop_budget >= GPU_RESOLVE_LOOP_BUDGET && !o.only) EXPECT_EQ(stats.planned, stats.pixels) << what;
   return stats;
+}
+
+ResolvePlanOptions rule(bool exact, uint32_t loop_budget = GPU_RESOLVE_LOOP_BUDGET) {
+  ResolvePlanOptions o;
+  o.exact_priority = exact;
+  o.loop_budget = loop_budget;
+  return o;
 }
 
 // The first kept scene at width x height.
@@ -101,10 +108,10 @@ TEST(ResolvePlanGl, StepsAreTheCpuResolvesOnEveryKeptScene) {
     scene.camera.height = 36;
     for (const bool exact : {true, false}) {
       const std::string what = file + (exact ? " (exact priority)" : " (Vis estimate)");
-      expect_plan_resolves_as_pack(planner, scene, exact, GPU_RESOLVE_LOOP_BUDGET, what);
+      expect_plan_resolves_as_pack(planner, scene, rule(exact), what);
       SceneData half = scene;
       for (size_t m = 0; m < half.materials.size(); ++m) half.materials[m].opacity = m % 2 ? 1.0 : 0.5;
-      expect_plan_resolves_as_pack(planner, half, exact, GPU_RESOLVE_LOOP_BUDGET, what + ", half transparent");
+      expect_plan_resolves_as_pack(planner, half, rule(exact), what + ", half transparent");
     }
   }
 }
@@ -115,9 +122,80 @@ TEST(ResolvePlanGl, PixelsPastTheLoopBudgetAreLeftToPack) {
   const GlResolvePlanner planner;
   SceneData scene = first_scene(32, 24);
   for (Material& m : scene.materials) m.opacity = 0.5;
-  const ResolvePlanStats stats = expect_plan_resolves_as_pack(planner, scene, true, 6, "budget 6");
+  const ResolvePlanStats stats = expect_plan_resolves_as_pack(planner, scene, rule(true, 6), "budget 6");
   EXPECT_LT(stats.planned, stats.pixels);
   EXPECT_GT(stats.planned, 0u);
+}
+
+// Fill dispatches of a few steps each (a pixel's steps never split): the same plan in many
+// bands as in one, each band's steps at their place.
+TEST(ResolvePlanGl, StepsFilledInManyBandsAreThoseOfOne) {
+  test::test_context();
+  const GlResolvePlanner planner;
+  SceneData scene = first_scene(32, 24);
+  for (size_t m = 0; m < scene.materials.size(); ++m) scene.materials[m].opacity = m % 2 ? 1.0 : 0.5;
+  for (const uint64_t band : {1u, 7u}) {
+    ResolvePlanOptions o = rule(true);
+    o.band_steps = band;
+    expect_plan_resolves_as_pack(planner, scene, o, "bands of " + std::to_string(band) + " steps");
+  }
+}
+
+// A plan of the pixels `only` marks (hybrid's CPU part) plans those alone; a resolve of every
+// pixel by it gives pack's image, the others resolved by pack.
+TEST(ResolvePlanGl, OnlyTheMarkedPixelsArePlanned) {
+  test::test_context();
+  const GlResolvePlanner planner;
+  SceneData scene = first_scene(32, 24);
+  for (size_t m = 0; m < scene.materials.size(); ++m) scene.materials[m].opacity = m % 2 ? 1.0 : 0.5;
+  std::vector<uint8_t> only(32 * 24, 0);
+  for (size_t p = 0; p < only.size(); ++p) only[p] = (p % 32 + p / 32) % 3 == 0;
+  ResolvePlanOptions o = rule(true);
+  o.only = &only;
+  const ResolvePlanStats stats = expect_plan_resolves_as_pack(planner, scene, o, "a third of the pixels");
+  EXPECT_EQ(stats.planned, static_cast<uint64_t>(std::count(only.begin(), only.end(), 1)));
+  const ABuffer camera = build_camera_abuffer(scene);
+  const ResolvePlan plan = planner.plan(camera, scene, o);
+  for (size_t p = 0; p < only.size(); ++p) {
+    ASSERT_EQ(plan.planned[p] != 0, only[p] != 0) << "pixel " << p;
+    if (!only[p]) ASSERT_EQ(plan.offsets[p + 1], plan.offsets[p]) << "pixel " << p;
+  }
+}
+
+// A plan whose steps break their rules (a step of no fragment, a second fragment where only
+// add_two takes one, a fragment past the list, a kind of none) is refused, never read.
+TEST(ResolvePlanGl, StepsThatBreakTheirRulesAreRefused) {
+  test::test_context();
+  const GlResolvePlanner planner;
+  const SceneData scene = first_scene(16, 12);
+  const ABuffer camera = build_camera_abuffer(scene);
+  const ResolvePlan good = planner.plan(camera, scene);
+  ASSERT_FALSE(good.steps.empty());
+  const PixelShader shade = [&](const Fragment& f, int x, int y) { return hashed_shade(scene, f, x, y); };
+  ResolveOptions ro;
+  ro.plan = &good;
+  EXPECT_NO_THROW(resolve_image(camera, *scene.triangles, shade, scene.background, ro));
+  const auto first_of = [&](uint32_t kind) {
+    return std::find_if(good.steps.begin(), good.steps.end(), [&](const ResolveStep& s) { return s.kind == kind; }) -
+           good.steps.begin();
+  };
+  const std::vector<std::function<void(ResolveStep&)>> breaks = {
+      [](ResolveStep& s) { s.at[0] = ResolveStep::NONE; },
+      [](ResolveStep& s) { s.at[1] = s.at[0]; },
+      [](ResolveStep& s) { s.at[0] = 1u << 30; },
+      [](ResolveStep& s) { s.kind = 7; },
+  };
+  for (const uint32_t kind : {ResolveStep::shade, ResolveStep::add}) {
+    const size_t at = static_cast<size_t>(first_of(kind));
+    ASSERT_LT(at, good.steps.size()) << "no step of kind " << kind;
+    for (size_t b = 0; b < breaks.size(); ++b) {
+      ResolvePlan bad = good;
+      breaks[b](bad.steps[at]);
+      ro.plan = &bad;
+      EXPECT_THROW(resolve_image(camera, *scene.triangles, shade, scene.background, ro), std::logic_error)
+          << "kind " << kind << ", break " << b;
+    }
+  }
 }
 
 TEST(ResolvePlanGl, RefusesAPlanOverItsBudgetAndAPlanOfAnotherBuffer) {

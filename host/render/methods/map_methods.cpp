@@ -33,8 +33,10 @@ namespace {
 
 // --resolve-on: THE RESOLVE PLAN of `camera` made on GL compute, or none (pack_under_mask on
 // the CPU), with where and why in stats["plan"]["resolve_on"]. `held_bytes`: the A-buffers'
-// (the memory budget's share the plan may not take).
-std::unique_ptr<ResolvePlan> gl_resolve_plan(MethodContext& mc, const ABuffer& camera, uint64_t held_bytes) {
+// (the memory budget's share the plan may not take). `only` (optional): the pixels to plan,
+// those the render resolves (the others, if resolved, go through pack).
+std::unique_ptr<ResolvePlan> gl_resolve_plan(MethodContext& mc, const ABuffer& camera, uint64_t held_bytes,
+                                             const std::vector<uint8_t>* only) {
   using SearchOn = RenderRequest::SearchOn;
   const RenderRequest& r = mc.request;
   std::unique_ptr<ResolvePlan> plan;
@@ -53,6 +55,7 @@ std::unique_ptr<ResolvePlan> gl_resolve_plan(MethodContext& mc, const ABuffer& c
     ResolvePlanOptions o;
     o.exact_priority = r.map.exact_priority;
     o.max_bytes = budget > held ? budget - held : 1;
+    o.only = only;
     ResolvePlanStats s;
     try {
       plan = std::make_unique<ResolvePlan>(mc.gl_scene->resolve_planner().plan(camera, mc.scene, o, &s));
@@ -86,7 +89,7 @@ Image render_abuffer_local(MethodContext& mc, const std::vector<uint8_t>* only) 
   ro.threads = r.abuffer.threads;
   ro.exact_priority = r.map.exact_priority;
   ro.only = only;
-  const std::unique_ptr<ResolvePlan> plan = gl_resolve_plan(mc, camera, s.bytes_total);  // timed on its own
+  const std::unique_ptr<ResolvePlan> plan = gl_resolve_plan(mc, camera, s.bytes_total, only);  // timed on its own
   ro.plan = plan.get();
   t0 = Clock::now();
   const PixelShader shade = local_phong_shader(scene, camera, r.map.plan.texture_samples());
@@ -269,7 +272,8 @@ Image render_map_method(MethodContext& mc, const std::vector<uint8_t>* only) {
   stats["cube_abuffer"] = cube_abuffer_json(map.stats);
   mc.record.timings_ms["map_setup"] = map.setup_ms;
   mc.record.timings_ms["camera_abuffer"] = camera_ms;
-  const std::unique_ptr<ResolvePlan> resolve_plan = gl_resolve_plan(mc, camera, as.bytes_total + map.stats.bytes_total);
+  const std::unique_ptr<ResolvePlan> resolve_plan =
+      gl_resolve_plan(mc, camera, as.bytes_total + map.stats.bytes_total, only);
   const uint64_t plan_bytes =
       resolve_plan ? resolve_plan->steps.size() * sizeof(ResolveStep) + resolve_plan->offsets.size() * sizeof(uint32_t)
                    : 0;
