@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -218,6 +219,30 @@ void ResolvePlan::check(const ABuffer& camera, bool exact) const {
       offsets.back() != steps.size() || exact_priority != exact) {
     throw InputError("resolve: the plan given is not of this camera A-buffer and rule");
   }
+}
+
+ShadedFragment probe_shade(const SceneData& scene, const Fragment& f, int x, int y) {
+  uint64_t h = f.triangle_and_facing * 0x9E3779B97F4A7C15ull ^ (uint64_t{f.mask} << 7) ^ f.normal;
+  h = (h ^ (static_cast<uint64_t>(x) << 40) ^ (static_cast<uint64_t>(y) << 20)) * 0xBF58476D1CE4E5B9ull;
+  const auto part = [&](int k) { return static_cast<double>((h >> (16 * k)) & 0xffff) / 65535.0; };
+  return {glm::dvec3(part(0), part(1), part(2)), scene.materials[scene.triangles->material_id[f.triangle()]].opacity};
+}
+
+std::string plan_differs_from_pack(const ABuffer& camera, const SceneData& scene, const ResolvePlan& plan) {
+  const TriangleSoup& soup = *scene.triangles;
+  const PixelShader shade = [&](const Fragment& f, int x, int y) { return probe_shade(scene, f, x, y); };
+  ResolveOptions ro;
+  ro.exact_priority = plan.exact_priority;
+  const Image by_pack = resolve_image(camera, soup, shade, scene.background, ro);
+  ro.plan = &plan;
+  const Image by_plan = resolve_image(camera, soup, shade, scene.background, ro);
+  for (int y = 0; y < camera.height(); ++y) {
+    for (int x = 0; x < camera.width(); ++x) {
+      const glm::vec3 a = by_pack.rgb(x, y), b = by_plan.rgb(x, y);
+      if (std::memcmp(&a, &b, sizeof(a)) != 0) return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")";
+    }
+  }
+  return "";
 }
 
 int resolve_workers(const ABuffer& camera, const ResolveOptions& options) {

@@ -9,6 +9,7 @@
 // docs/design/resolve.md has the pseudo-code and the whole argument.
 #pragma once
 #include <functional>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -128,6 +129,16 @@ using WorkerPixelShader = std::function<ShadedFragment(const Fragment& f, int x,
 int resolve_workers(const ABuffer& camera, const ResolveOptions& options);
 Image resolve_image_per_worker(const ABuffer& camera, const TriangleSoup& triangles, const WorkerPixelShader& shade,
                                const glm::dvec3& background, const ResolveOptions& options = {});
+
+// A shade for checking resolves: the fragment, its mask and the pixel hashed into a colour,
+// with its material's opacity. A step at another fragment or over another mask, or a weight
+// off by more than the image's float rounding, shows in the colours it sums.
+ShadedFragment probe_shade(const SceneData& scene, const Fragment& f, int x, int y);
+
+// Where resolving `camera` by `plan` (made under its exact_priority rule) with probe_shade
+// differs from pack_under_mask: "pixel (x, y)", the first such, or empty when every colour
+// is the same bits.
+std::string plan_differs_from_pack(const ABuffer& camera, const SceneData& scene, const ResolvePlan& plan);
 
 // What each of the 32 samples of pixel (x, y) sees: the triangle of the nearest surface
 // covering it (NO_SAMPLE_TRIANGLE where none), by the list's coverage masks and, where

@@ -113,9 +113,10 @@ struct CrosscheckCommand {
     } else {
       std::printf(
           "GPU resolve plan: %zu of %zu pixels the CPU's resolve, bit for bit; %zu planned, %llu steps "
-          "(%.1f ms)%s%s\n",
+          "(%.1f ms)%s%s; the probe: %s\n",
           plan.identical, plan.pixels, plan.planned, static_cast<unsigned long long>(plan.steps), plan.ms,
-          plan.example.empty() ? "" : "; first not: ", plan.example.c_str());
+          plan.example.empty() ? "" : "; first not: ", plan.example.c_str(),
+          plan.probe.empty() ? "agrees" : plan.probe.c_str());
     }
     print_searches(r);
     std::printf("camera interior pixels: %zu of %zu, RMSE %.2e (<= %.0e), max abs %.2e (<= %.2e)\n", r.interior_pixels,

@@ -14,6 +14,7 @@
 #include "gl/gl_program.hpp"
 #include "gl/gl_view.hpp"
 #include "gl/glsl_shared.hpp"
+#include "scene/scene_load.hpp"
 #include "scene/tie_rule.hpp"
 
 namespace abcube {
@@ -207,6 +208,50 @@ ResolvePlan GlResolvePlanner::plan(const ABuffer& camera, const SceneData& scene
     stats->ms = ms_since(t0);
   }
   return out;
+}
+
+namespace {
+
+// The probe's scene: in most pixels two or more half-transparent layers, where the quads
+// cross two objects' fragments at nearly the same depth (the EXACT PRIORITY MASKS, THE TIE
+// RULE), and partly covered pixels along every edge.
+const char* const PROBE_SCENE = R"({"version": 1,
+  "camera": {"position": [0.13, 0.21, 3.1], "look_at": [0, 0, 0], "fov_y": 40, "width": 24, "height": 18},
+  "background": [0.2, 0.3, 0.4],
+  "materials": {"veil": {"color": [0.8, 0.2, 0.2], "opacity": 0.5}, "glass": {"color": [0.2, 0.8, 0.2], "opacity": 0.7},
+                "mist": {"color": [0.3, 0.3, 0.9], "opacity": 0.3}},
+  "objects": [
+    {"type": "quad", "vertices": [[-1, -1, -0.5], [1, -1, 0.5], [1, 1, 0.5], [-1, 1, -0.5]], "material": "veil"},
+    {"type": "quad", "vertices": [[-1, -1, 0.5], [1, -1, -0.5], [1, 1, -0.5], [-1, 1, 0.5]], "material": "glass"},
+    {"type": "sphere", "center": [0.3, 0.2, 0.9], "radius": 0.45, "segments": 10, "material": "mist"},
+    {"type": "box", "min": [-1.6, -1.6, -1.6], "max": [1.6, 1.6, -1.3]}]})";
+
+}  // namespace
+
+const std::string& GlResolvePlanner::probe(double* ms) const {
+  const Clock::time_point t0 = Clock::now();
+  if (!probe_) {
+    std::string why;
+    const SceneData scene = load_scene_text(PROBE_SCENE, "the resolve plan's probe", ".");
+    const ABuffer camera = build_camera_abuffer(scene);
+    for (const bool exact : {true, false}) {
+      ResolvePlanOptions o;
+      o.exact_priority = exact;
+      ResolvePlanStats s;
+      const ResolvePlan plan = this->plan(camera, scene, o, &s);
+      const std::string rule = exact ? " (exact priority masks)" : " (the Vis estimate)";
+      if (s.planned < s.pixels) {
+        why = "the GL left " + std::to_string(s.pixels - s.planned) + " of a probe's pixels unplanned" + rule;
+      } else if (const std::string at = plan_differs_from_pack(camera, scene, plan); !at.empty()) {
+        why = "the GL's plan of a probe scene gives another colour than the CPU's resolve at " + at + rule +
+              ": its doubles do not round as the CPU's";
+      }
+      if (!why.empty()) break;
+    }
+    probe_ = why;
+  }
+  if (ms) *ms = ms_since(t0);
+  return *probe_;
 }
 
 }  // namespace abcube

@@ -8,6 +8,9 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "raster/abuffer.hpp"
 #include "scene/scene_data.hpp"
@@ -60,8 +63,16 @@ class GlResolvePlanner {
   // The bytes a plan of `camera` holds before its steps are counted: its upload.
   static uint64_t upload_bytes(const ABuffer& camera, const SceneData& scene);
 
+  // THE PROBE: this GL's plans of a small built-in scene (two half-transparent quads that
+  // cross, a faceted veil in front, an opaque wall behind), under both rules, held to
+  // pack_under_mask bit for bit (plan_differs_from_pack). Empty when every colour agrees,
+  // else why not: a GL whose doubles do not round as IEEE 754 says would change images. Run
+  // at the first call only; its time is in `ms`.
+  const std::string& probe(double* ms = nullptr) const;
+
  private:
   std::unique_ptr<GlProgram> program_;
+  mutable std::optional<std::string> probe_;
 };
 
 }  // namespace abcube

@@ -156,6 +156,7 @@ void compare_resolve_plan(const SceneData& scene, GlScene& gl, const ABuffer& ca
   ResolvePlanStats s;
   ResolvePlan plan;
   try {
+    c.probe = gl.resolve_planner().probe();
     plan = gl.resolve_planner().plan(camera, scene, {}, &s);
   } catch (const RuntimeFailure& e) {
     c.skipped = e.what();
@@ -416,9 +417,10 @@ CrosscheckResult crosscheck(const SceneData& scene, int n, int threads, const Cr
   fail(!r.camera_lists.within_bounds(), "GPU camera A-buffer lists");
   // The plan's steps are pack's expressions; on a GL whose doubles round as IEEE 754 says,
   // every colour is the same bits. A plan that planned no pixel would pass that by pack's
-  // colours alone: it fails.
-  fail(r.resolve_plan.skipped.empty() && (r.resolve_plan.identical < r.resolve_plan.pixels ||
-                                          (r.resolve_plan.pixels > 0 && r.resolve_plan.planned == 0)),
+  // colours alone: it fails, as does a GL that failed THE PROBE (gl_resolve_plan.hpp).
+  const CrosscheckResult::ResolvePlanCheck& plan = r.resolve_plan;
+  fail(plan.skipped.empty() &&
+           (plan.identical < plan.pixels || (plan.pixels > 0 && plan.planned == 0) || !plan.probe.empty()),
        "GPU resolve plan");
   fail(r.walks.differing > 0, "GPU cube walks");
   // A GL whose double division or square root does not round as IEEE 754 says moves a walk's
@@ -467,6 +469,7 @@ nlohmann::json crosscheck_json(const CrosscheckResult& r, const CrosscheckTolera
                {{"pixels", r.resolve_plan.pixels},
                 {"planned", r.resolve_plan.planned},
                 {"identical", r.resolve_plan.identical},
+                {"probe", r.resolve_plan.probe.empty() ? "agrees" : r.resolve_plan.probe},
                 {"steps", r.resolve_plan.steps},
                 {"first_not_identical", r.resolve_plan.example},
                 {"not_compared", r.resolve_plan.skipped},

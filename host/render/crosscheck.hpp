@@ -103,6 +103,7 @@ struct CrosscheckResult {
     uint64_t steps = 0;
     std::string example;  // the first pixel not identical
     std::string skipped;  // why the plan was not compared (a GL or budget refusal)
+    std::string probe;    // THE PROBE's verdict (gl_resolve_plan.hpp): empty, it agrees
     double ms = 0;
   } resolve_plan;
   // The cube walks of the searches' rays (shadow segments to the lights and reflection rays

@@ -29,9 +29,11 @@ failed=0
 # their own size (the camera samples are checked at 512 x 384 below).
 for scene in $SCENES; do
   for gl in $APIS; do
-    # The image shaded with the GPU's search candidates is the CPU searches', byte for byte.
+    # The image shaded with the GPU's search candidates is the CPU searches', byte for byte;
+    # the resolve's plan gives the CPU's colours, and the GL passed THE PROBE.
     if "$ABCUBE" crosscheck "$REPO/scenes/$scene.json" --cube-res 96 --size 256x192 --gl "$gl" --stats "$WORK/$scene.json" \
-        > "$WORK/out" 2>&1 && grep -q '^GPU search image: 64x48, 0 pixels over 1/255 .* the same bytes' "$WORK/out"; then
+        > "$WORK/out" 2>&1 && grep -q '^GPU search image: 64x48, 0 pixels over 1/255 .* the same bytes' "$WORK/out" &&
+      grep -q "^GPU resolve plan: \([0-9]*\) of \1 pixels .*; the probe: agrees$" "$WORK/out"; then
       passed=$((passed + 1))
       echo "ok   $scene ($gl): $(grep -E '^distance' "$WORK/out" | head -1); $(grep '^GPU search image' "$WORK/out")"
     else

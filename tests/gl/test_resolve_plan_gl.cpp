@@ -25,16 +25,6 @@
 namespace abcube {
 namespace {
 
-// A shade that depends on everything the resolve hands it (the fragment, its mask, the pixel),
-// so that a step shaded over another mask or at another fragment shows in the image.
-ShadedFragment hashed_shade(const SceneData& scene, const Fragment& f, int x, int y) {
-  uint64_t h = f.triangle_and_facing * 0x9E3779B97F4A7C15ull ^ (uint64_t{f.mask} << 7) ^ f.normal;
-  h ^= (static_cast<uint64_t>(x) << 40) ^ (static_cast<uint64_t>(y) << 20);
-  h *= 0xBF58476D1CE4E5B9ull;
-  const auto part = [&](int k) { return static_cast<double>((h >> (16 * k)) & 0xffff) / 65535.0; };
-  return {glm::dvec3(part(0), part(1), part(2)), scene.materials[scene.triangles->material_id[f.triangle()]].opacity};
-}
-
 // Each call the resolve makes, in order (one thread).
 struct Call {
   int x, y;
@@ -51,7 +41,7 @@ Image resolve_recorded(const ABuffer& camera, const SceneData& scene, const Reso
   ro.plan = plan;
   const PixelShader shade = [&](const Fragment& f, int x, int y) {
     calls->push_back({x, y, f.triangle_and_facing, f.mask});
-    return hashed_shade(scene, f, x, y);
+    return probe_shade(scene, f, x, y);
   };
   return resolve_image(camera, *scene.triangles, shade, scene.background, ro);
 }
@@ -162,6 +152,37 @@ TEST(ResolvePlanGl, OnlyTheMarkedPixelsArePlanned) {
   }
 }
 
+// THE PROBE agrees on this GL; the comparison it makes sees a step over another mask, and a
+// weight moved by a ten-thousandth.
+TEST(ResolvePlanGl, TheProbeAgreesHereAndSeesAPlanOff) {
+  test::test_context();
+  const GlResolvePlanner planner;
+  double ms = -1;
+  EXPECT_EQ(planner.probe(&ms), "");
+  EXPECT_GE(ms, 0.0);
+  SceneData scene = first_scene(24, 18);
+  for (size_t m = 0; m < scene.materials.size(); ++m) scene.materials[m].opacity = m % 2 ? 1.0 : 0.5;
+  const ABuffer camera = build_camera_abuffer(scene);
+  const ResolvePlan plan = planner.plan(camera, scene);
+  EXPECT_EQ(plan_differs_from_pack(camera, scene, plan), "");
+  size_t weighted = 0, masked = 0, tried = 0;
+  for (size_t k = 0; k < plan.steps.size(); ++k) {
+    const ResolveStep& s = plan.steps[k];
+    if (s.kind == ResolveStep::add && s.weight[0] > 0.1 && tried < 8) {
+      ++tried;
+      ResolvePlan off = plan;
+      off.steps[k].weight[0] *= 1.0 + 1e-4;
+      weighted += !plan_differs_from_pack(camera, scene, off).empty();
+      off = plan;
+      off.steps[k].mask[0] = s.mask[0] == 0 ? 1u : s.mask[0] & (s.mask[0] - 1);  // the shade over fewer samples
+      masked += !plan_differs_from_pack(camera, scene, off).empty();
+    }
+  }
+  ASSERT_EQ(tried, 8u);
+  EXPECT_EQ(weighted, tried);
+  EXPECT_EQ(masked, tried);
+}
+
 // A plan whose steps break their rules (a step of no fragment, a second fragment where only
 // add_two takes one, a fragment past the list, a kind of none) is refused, never read.
 TEST(ResolvePlanGl, StepsThatBreakTheirRulesAreRefused) {
@@ -171,7 +192,7 @@ TEST(ResolvePlanGl, StepsThatBreakTheirRulesAreRefused) {
   const ABuffer camera = build_camera_abuffer(scene);
   const ResolvePlan good = planner.plan(camera, scene);
   ASSERT_FALSE(good.steps.empty());
-  const PixelShader shade = [&](const Fragment& f, int x, int y) { return hashed_shade(scene, f, x, y); };
+  const PixelShader shade = [&](const Fragment& f, int x, int y) { return probe_shade(scene, f, x, y); };
   ResolveOptions ro;
   ro.plan = &good;
   EXPECT_NO_THROW(resolve_image(camera, *scene.triangles, shade, scene.background, ro));
@@ -210,7 +231,7 @@ TEST(ResolvePlanGl, RefusesAPlanOverItsBudgetAndAPlanOfAnotherBuffer) {
   ResolveOptions ro;
   ro.plan = &plan;
   ro.exact_priority = false;  // planned with exact priority
-  const PixelShader shade = [&](const Fragment& f, int x, int y) { return hashed_shade(scene, f, x, y); };
+  const PixelShader shade = [&](const Fragment& f, int x, int y) { return probe_shade(scene, f, x, y); };
   EXPECT_THROW(resolve_image(camera, *scene.triangles, shade, scene.background, ro), InputError);
 }
 

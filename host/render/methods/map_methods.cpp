@@ -58,8 +58,14 @@ std::unique_ptr<ResolvePlan> gl_resolve_plan(MethodContext& mc, const ABuffer& c
     o.only = only;
     ResolvePlanStats s;
     try {
-      plan = std::make_unique<ResolvePlan>(mc.gl_scene->resolve_planner().plan(camera, mc.scene, o, &s));
-      mc.record.timings_ms["gpu_resolve_plan"] = s.ms;
+      // THE PROBE first (once a GL scene): a GL whose plans would change the image is refused.
+      double probe_ms = 0;
+      const GlResolvePlanner& planner = mc.gl_scene->resolve_planner();
+      if (const std::string& off = planner.probe(&probe_ms); !off.empty()) {
+        throw RuntimeFailure("GPU resolve plan: " + off + "; resolve on the CPU");
+      }
+      plan = std::make_unique<ResolvePlan>(planner.plan(camera, mc.scene, o, &s));
+      mc.record.timings_ms["gpu_resolve_plan"] = probe_ms + s.ms;
       mc.stats["resolve_plan"] = {{"pixels", s.pixels}, {"planned", s.planned}, {"steps", s.steps}, {"bytes", s.bytes}};
     } catch (const RenderTimeout&) {
       throw;
